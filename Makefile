@@ -1,0 +1,22 @@
+# The two commands of the README: `make demo` and `make test`. Each bootstraps a fresh machine first.
+VENV ?= .venv
+export OMPI_ALLOW_RUN_AS_ROOT = 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM = 1
+export OPENBLAS_NUM_THREADS = 1
+
+.PHONY: bootstrap demo test bench clean
+
+bootstrap:
+	@bash scripts/bootstrap.sh
+
+demo: bootstrap
+	$(VENV)/bin/housingfe run box-free --out results/box-free
+
+test: bootstrap
+	$(VENV)/bin/python -m pytest -q tests
+
+bench: bootstrap
+	$(VENV)/bin/housingfe bench modal --out results/bench-modal
+
+clean:
+	rm -rf results .pytest_cache

@@ -1,0 +1,3 @@
+from housingfe.cli import main
+
+raise SystemExit(main())

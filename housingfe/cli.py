@@ -1,0 +1,111 @@
+"""Command line: `housingfe run|scenes|validate|bench|...`.
+
+Heavy modules (dolfinx, PETSc, gmsh) are imported inside the command handlers, so `housingfe --help`,
+`housingfe scenes` and the analytic commands start fast.  Modules of other concerns add their own
+sub-commands through a `register_cli(subparsers)` function listed in `_EXTENSIONS`.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from housingfe.errors import InputError, SolverError
+
+# Modules that contribute sub-commands (each defines register_cli(subparsers)).
+_EXTENSIONS = (
+    "housingfe.bearings",
+    "housingfe.radiation",
+    "housingfe.source.cli",
+)
+
+
+def _cmd_scenes(args: argparse.Namespace) -> int:
+    from housingfe import scene
+
+    for name, description in scene.builtin_scenes().items():
+        print(f"{name:24s} {description}")
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from housingfe import run
+
+    run.run_scene(args.scene, out_dir=args.out, overrides=args.set or [])
+    return 0
+
+
+def _cmd_validate(args: argparse.Namespace) -> int:
+    from housingfe import validate
+
+    validate.main(out_dir=args.out, json_path=args.json, scenes=args.scenes)
+    return 0
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from housingfe import bench
+
+    bench.main(args.which, out_dir=args.out, quick=args.quick)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="housingfe", description="Gearbox noise: gear source, bearings, FE housing, radiation."
+    )
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    p = sub.add_parser("run", help="run the analyses a scene lists (built-in name or TOML path)")
+    p.add_argument("scene", help="built-in scene name (see `housingfe scenes`) or path to a TOML file")
+    p.add_argument("--out", default=None, help="result folder (default results/<scene>)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE",
+                   help="override a scene value, e.g. --set mesh.size=0.015 (repeatable)")
+    p.set_defaults(func=_cmd_run)
+
+    p = sub.add_parser("scenes", help="list the built-in scenes")
+    p.set_defaults(func=_cmd_scenes)
+
+    p = sub.add_parser("validate", help="our results next to the published ones")
+    p.add_argument("scenes", nargs="*", help="restrict to these scenes")
+    p.add_argument("--out", default="results/validate", help="folder for validate.csv / validate.md")
+    p.add_argument("--json", default=None, metavar="FILE", help="also write the rows as JSON")
+    p.set_defaults(func=_cmd_validate)
+
+    p = sub.add_parser("bench", help="speed-against-error benchmarks (tables, CSV, PNG)")
+    p.add_argument("which", choices=["modal", "frf", "scenes"], help="which benchmark")
+    p.add_argument("--out", default=None, help="result folder (default results/bench-<which>)")
+    p.add_argument("--quick", action="store_true", help="small subset, for a smoke run")
+    p.set_defaults(func=_cmd_bench)
+
+    for name in _EXTENSIONS:
+        try:
+            module = importlib.import_module(name)
+        except ModuleNotFoundError as exc:
+            if exc.name and name.startswith(exc.name):
+                continue  # that concern is not built yet
+            raise
+        register = getattr(module, "register_cli", None)
+        if register is not None:
+            register(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the `housingfe` console script; returns the process exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except InputError as exc:
+        print(f"housingfe: error: {exc}", file=sys.stderr)
+        return 2
+    except SolverError as exc:
+        print(f"housingfe: solver error: {exc}", file=sys.stderr)
+        return 3
+    except KeyboardInterrupt:
+        print("housingfe: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,10 @@
+"""Errors a user can act on. The CLI prints their message on one line and exits with code 2."""
+
+
+class InputError(Exception):
+    """Bad input: a malformed scene, an unknown key, a non-physical value, an unreadable file,
+    a load a bearing cannot carry.  The message names the file and/or key."""
+
+
+class SolverError(Exception):
+    """A numerical failure the user must know about (incomplete eigen-solution, singular system)."""
