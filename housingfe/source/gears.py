@@ -1,0 +1,387 @@
+"""Involute gear pair geometry (van Roosmalen 1994, Appendix B and F; DIN 3960 / ISO 21771 formulas).
+
+All quantities are SI: lengths in m, angles in rad, forces in N, torques in N m, speeds in rad/s
+unless a name says otherwise (`_rpm`, `_deg`, `_mm`).  Index 0 is the pinion (driving gear, gear 1),
+index 1 the wheel (gear 2).  External gears only.
+
+Main API
+--------
+`GearPair` (frozen dataclass) built from the basic rack and blank data; its properties give the
+derived geometry (pitch/base/tip/root diameters, transverse and operating pressure angles, base
+helix angle, addendum reduction k*m, transverse/overlap/total contact ratios, path of contact) and
+`tooth_loads(torque)` the loads of Appendix F.  `GearPair.from_table(d)` builds one from a scene /
+reference table with millimetre and degree keys.  `tooth_profile(pair, gear)` gives the transverse
+tooth outline (involute + trochoid fillet) as points.
+
+Definitions used (Appendix F's printed values follow from exactly these):
+  d = m z / cos(beta), alpha_t = atan(tan(alpha_n)/cos(beta)), d_b = d cos(alpha_t),
+  cos(alpha_wt) = a0 cos(alpha_t) / a with a0 = (d1 + d2)/2,
+  k m = (a - a0) - (x1 + x2) m   (addendum reduction, negative = tips shortened),
+  d_a = d + 2 m (h_a + x) + 2 k m,  d_f = d - 2 m (h_f - x),
+  eps_alpha = (sqrt(r_a1^2 - r_b1^2) + sqrt(r_a2^2 - r_b2^2) - a sin(alpha_wt)) / p_bt,
+  eps_beta = b sin(beta) / (pi m) with b the smaller (per helix) face width.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from housingfe.errors import InputError
+
+KINDS = ("spur", "single_helical", "double_helical")
+
+
+def involute(angle):
+    """Involute function inv(a) = tan(a) - a (angle in rad)."""
+    return np.tan(angle) - angle
+
+
+@dataclass(frozen=True)
+class GearPair:
+    """An external involute gear pair.
+
+    Attributes (SI):
+      module: normal module m_n [m]
+      teeth: (z1, z2)
+      pressure_angle: normal pressure angle alpha_n [rad]
+      helix_angle: helix angle beta at the pitch circle [rad] (0 for spur)
+      profile_shift: addendum modification factors (x1, x2) [-]
+      face_width: (b1, b2) [m]; for double helical gears the width of ONE helix
+      centre_distance: operating centre distance a [m]
+      addendum_coefficient: h_a [-] (Appendix F: 1.0)
+      dedendum_coefficient: h_f [-] (Appendix F: 1.4)
+      rack_tip_radius_factor: rho_f / m of the cutter tip [-] (Appendix F: 0.4)
+      kind: "spur", "single_helical" or "double_helical"
+      helix_gap: gap between the two helices of a double helical gear [m]
+      youngs_modulus, poisson_ratio, density: material (steel default) [Pa, -, kg/m^3]
+    """
+
+    module: float
+    teeth: tuple[int, int]
+    pressure_angle: float
+    helix_angle: float
+    profile_shift: tuple[float, float]
+    face_width: tuple[float, float]
+    centre_distance: float
+    addendum_coefficient: float = 1.0
+    dedendum_coefficient: float = 1.25
+    rack_tip_radius_factor: float = 0.38
+    kind: str = "single_helical"
+    helix_gap: float = 0.0
+    youngs_modulus: float = 2.06e11
+    poisson_ratio: float = 0.3
+    density: float = 7850.0
+    name: str = field(default="", compare=False)
+
+    def __post_init__(self):
+        where = self.name or "gear pair"
+        if self.kind not in KINDS:
+            raise InputError(f"{where}: kind: {self.kind!r} is not one of {', '.join(KINDS)}")
+        if not self.module > 0:
+            raise InputError(f"{where}: module: must be > 0, got {self.module}")
+        if len(self.teeth) != 2 or min(self.teeth) < 5:
+            raise InputError(f"{where}: teeth: need two tooth numbers >= 5, got {self.teeth}")
+        if not 0 < self.pressure_angle < math.radians(45):
+            raise InputError(f"{where}: pressure_angle: must lie in (0, 45) deg")
+        if not 0 <= abs(self.helix_angle) < math.radians(60):
+            raise InputError(f"{where}: helix_angle: must lie in [0, 60) deg")
+        if self.kind == "spur" and self.helix_angle != 0:
+            raise InputError(f"{where}: helix_angle: a spur gear has helix angle 0")
+        if self.kind != "spur" and self.helix_angle == 0:
+            raise InputError(f"{where}: helix_angle: a {self.kind} gear needs a helix angle > 0")
+        if min(self.face_width) <= 0:
+            raise InputError(f"{where}: face_width: must be > 0")
+        a_min = 0.5 * self.module * sum(self.teeth) / math.cos(self.helix_angle) * 0.8
+        if not self.centre_distance > a_min:
+            raise InputError(f"{where}: centre_distance: {self.centre_distance} m is far too small")
+        if self.contact_length_tip_limited() <= 0:
+            raise InputError(f"{where}: geometry gives no path of contact (check profile shifts)")
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_table(cls, t: dict, where: str = "gears") -> "GearPair":
+        """Build from a table with Appendix F style keys in mm / degrees:
+        module_mm, teeth, pressure_angle_deg, helix_angle_deg, addendum_modification, face_width_mm
+        (a pair, or for double helical pairs of [b, b]), centre_distance_mm, addendum_coefficient,
+        dedendum_coefficient, rack_tip_radius_factor, kind (optional), helix_gap_mm (optional)."""
+        try:
+            widths = t["face_width_mm"]
+            double = isinstance(widths[0], (list, tuple))
+            kind = t.get("kind", "double_helical" if double else
+                         ("spur" if float(t.get("helix_angle_deg", 0.0)) == 0 else "single_helical"))
+            if double:
+                widths = [w[0] for w in widths]
+            return cls(
+                module=float(t["module_mm"]) * 1e-3,
+                teeth=(int(t["teeth"][0]), int(t["teeth"][1])),
+                pressure_angle=math.radians(float(t["pressure_angle_deg"])),
+                helix_angle=math.radians(float(t.get("helix_angle_deg", 0.0))),
+                profile_shift=(float(t["addendum_modification"][0]), float(t["addendum_modification"][1])),
+                face_width=(float(widths[0]) * 1e-3, float(widths[1]) * 1e-3),
+                centre_distance=float(t["centre_distance_mm"]) * 1e-3,
+                addendum_coefficient=float(t.get("addendum_coefficient", 1.0)),
+                dedendum_coefficient=float(t.get("dedendum_coefficient", 1.25)),
+                rack_tip_radius_factor=float(t.get("rack_tip_radius_factor", 0.38)),
+                kind=kind,
+                helix_gap=float(t.get("helix_gap_mm", 0.0)) * 1e-3,
+                name=where,
+            )
+        except KeyError as exc:
+            raise InputError(f"{where}: missing key {exc.args[0]}") from None
+        except (TypeError, ValueError, IndexError) as exc:
+            raise InputError(f"{where}: malformed value ({exc})") from None
+
+    # ------------------------------------------------------------------ basic geometry
+    @property
+    def ratio(self) -> float:
+        """Gear ratio u = z2 / z1 [-]."""
+        return self.teeth[1] / self.teeth[0]
+
+    @property
+    def transverse_module(self) -> float:
+        """m_t = m / cos(beta) [m]."""
+        return self.module / math.cos(self.helix_angle)
+
+    @property
+    def transverse_pressure_angle(self) -> float:
+        """alpha_t [rad]."""
+        return math.atan(math.tan(self.pressure_angle) / math.cos(self.helix_angle))
+
+    @property
+    def base_helix_angle(self) -> float:
+        """beta_b [rad]: tan(beta_b) = tan(beta) cos(alpha_t)."""
+        return math.atan(math.tan(self.helix_angle) * math.cos(self.transverse_pressure_angle))
+
+    @property
+    def pitch_diameter(self) -> np.ndarray:
+        """(d1, d2) = m_t z [m]."""
+        return self.transverse_module * np.array(self.teeth, dtype=float)
+
+    @property
+    def base_diameter(self) -> np.ndarray:
+        """(d_b1, d_b2) = d cos(alpha_t) [m]."""
+        return self.pitch_diameter * math.cos(self.transverse_pressure_angle)
+
+    @property
+    def reference_centre_distance(self) -> float:
+        """a0 = (d1 + d2) / 2 [m]."""
+        return 0.5 * float(self.pitch_diameter.sum())
+
+    @property
+    def operating_pressure_angle(self) -> float:
+        """Operating transverse pressure angle alpha_wt [rad] at the given centre distance."""
+        return math.acos(self.reference_centre_distance * math.cos(self.transverse_pressure_angle)
+                         / self.centre_distance)
+
+    @property
+    def zero_backlash_centre_distance(self) -> float:
+        """Centre distance [m] at which the profile shifts mesh without backlash (DIN 3960)."""
+        from scipy.optimize import brentq
+
+        at = self.transverse_pressure_angle
+        target = involute(at) + 2 * math.tan(self.pressure_angle) * sum(self.profile_shift) / sum(self.teeth)
+        awt = brentq(lambda t: involute(t) - target, 1e-3, 1.4)
+        return self.reference_centre_distance * math.cos(at) / math.cos(awt)
+
+    @property
+    def addendum_reduction(self) -> float:
+        """k m = (a - a0) - (x1 + x2) m [m]; negative: the tips are shortened to keep tip clearance."""
+        return (self.centre_distance - self.reference_centre_distance) - sum(self.profile_shift) * self.module
+
+    @property
+    def tip_diameter(self) -> np.ndarray:
+        """(d_a1, d_a2) = d + 2 m (h_a + x) + 2 k m [m]."""
+        x = np.array(self.profile_shift)
+        return self.pitch_diameter + 2 * self.module * (self.addendum_coefficient + x) + 2 * self.addendum_reduction
+
+    @property
+    def root_diameter(self) -> np.ndarray:
+        """(d_f1, d_f2) = d - 2 m (h_f - x) [m]."""
+        x = np.array(self.profile_shift)
+        return self.pitch_diameter - 2 * self.module * (self.dedendum_coefficient - x)
+
+    @property
+    def transverse_base_pitch(self) -> float:
+        """p_bt = pi m_t cos(alpha_t) [m]: the distance between successive contacts on the line of action."""
+        return math.pi * self.transverse_module * math.cos(self.transverse_pressure_angle)
+
+    @property
+    def contact_width(self) -> float:
+        """Face width in contact per helix b = min(b1, b2) [m]."""
+        return min(self.face_width)
+
+    @property
+    def total_contact_width(self) -> float:
+        """Face width in contact over all helices [m] (2 b for double helical gears)."""
+        return self.contact_width * (2 if self.kind == "double_helical" else 1)
+
+    # ------------------------------------------------------------------ path of contact
+    def contact_length_tip_limited(self) -> float:
+        """Length g_alpha of the path of contact in the transverse plane [m] (tips limit it)."""
+        ra, rb = self.tip_diameter / 2, self.base_diameter / 2
+        return float(np.sqrt(ra[0]**2 - rb[0]**2) + np.sqrt(ra[1]**2 - rb[1]**2)
+                     - self.centre_distance * math.sin(self.operating_pressure_angle))
+
+    @property
+    def line_of_action_length(self) -> float:
+        """T1T2 = a sin(alpha_wt) [m]: the common tangent between the base circles."""
+        return self.centre_distance * math.sin(self.operating_pressure_angle)
+
+    @property
+    def path_of_contact(self) -> tuple[float, float]:
+        """(start, end) of contact measured along the line of action from the pinion's tangent point
+        T1 [m]: start A = T1T2 - sqrt(r_a2^2 - r_b2^2) (wheel tip engages the pinion root),
+        end E = sqrt(r_a1^2 - r_b1^2) (pinion tip)."""
+        ra, rb = self.tip_diameter / 2, self.base_diameter / 2
+        start = self.line_of_action_length - math.sqrt(ra[1]**2 - rb[1]**2)
+        end = math.sqrt(ra[0]**2 - rb[0]**2)
+        return start, end
+
+    @property
+    def transverse_contact_ratio(self) -> float:
+        """eps_alpha = g_alpha / p_bt [-]."""
+        return self.contact_length_tip_limited() / self.transverse_base_pitch
+
+    @property
+    def overlap_ratio(self) -> float:
+        """eps_beta = b sin(beta) / (pi m) [-], per helix, b = the smaller face width."""
+        return self.contact_width * math.sin(self.helix_angle) / (math.pi * self.module)
+
+    @property
+    def total_contact_ratio(self) -> float:
+        """eps_gamma = eps_alpha + eps_beta [-] (per helix for double helical gears, as Appendix F)."""
+        return self.transverse_contact_ratio + self.overlap_ratio
+
+    # ------------------------------------------------------------------ loads and kinematics
+    def pitch_line_velocity(self, pinion_speed_rpm: float) -> float:
+        """v = pi d1 n1 / 60 [m/s]."""
+        return math.pi * float(self.pitch_diameter[0]) * pinion_speed_rpm / 60.0
+
+    def tooth_frequency(self, pinion_speed_rpm: float) -> float:
+        """Tooth (mesh) frequency z1 n1 / 60 [Hz]."""
+        return self.teeth[0] * pinion_speed_rpm / 60.0
+
+    def tooth_loads(self, pinion_torque: float) -> dict[str, float]:
+        """Loads for a pinion torque T1 [N m]: circumferential F_t = 2 T1 / d1, axial F_ax = F_t tan(beta)
+        (per gear; 0 net for double helical), radial F_r = F_t tan(alpha_wt), normal on the base
+        plane F_bn = F_t / (cos(alpha_wt) cos(beta_b)) computed with the operating transverse pressure
+        angle [N]; wheel torque T2 = T1 u [N m]."""
+        ft = 2.0 * pinion_torque / float(self.pitch_diameter[0])
+        fax = 0.0 if self.kind == "double_helical" else ft * math.tan(self.helix_angle)
+        ft_w = 2.0 * pinion_torque / float(self.base_diameter[0]) * math.cos(self.operating_pressure_angle)
+        return {
+            "circumferential_N": ft,
+            "axial_N": fax,
+            "radial_N": ft_w * math.tan(self.operating_pressure_angle),
+            "normal_N": 2.0 * pinion_torque / float(self.base_diameter[0]) / math.cos(self.base_helix_angle),
+            "wheel_torque_Nm": pinion_torque * self.ratio,
+        }
+
+    def appendix_f_table(self, power_W: float | None = None, pinion_speed_rpm: float | None = None) -> dict:
+        """The derived quantities of Appendix F with its names, lengths in mm and angles in degrees."""
+        out = {
+            "pitch_diameter_mm": (self.pitch_diameter * 1e3).tolist(),
+            "tip_diameter_mm": (self.tip_diameter * 1e3).tolist(),
+            "root_diameter_mm": (self.root_diameter * 1e3).tolist(),
+            "base_diameter_mm": (self.base_diameter * 1e3).tolist(),
+            "addendum_reduction_mm": self.addendum_reduction * 1e3,
+            "transverse_contact_ratio": self.transverse_contact_ratio,
+            ("overlap_ratio_per_helix" if self.kind == "double_helical" else "overlap_ratio"): self.overlap_ratio,
+            "total_contact_ratio": self.total_contact_ratio,
+            "transverse_pressure_angle_deg": math.degrees(self.transverse_pressure_angle),
+            "operating_transverse_pressure_angle_deg": math.degrees(self.operating_pressure_angle),
+            "base_helix_angle_deg": math.degrees(self.base_helix_angle),
+            "gear_ratio": self.ratio,
+            "transverse_base_pitch_mm": self.transverse_base_pitch * 1e3,
+            "zero_backlash_centre_distance_mm": self.zero_backlash_centre_distance * 1e3,
+        }
+        if power_W is not None and pinion_speed_rpm is not None:
+            torque = power_W / (pinion_speed_rpm * math.pi / 30.0)
+            loads = self.tooth_loads(torque)
+            out.update({
+                "pitch_line_velocity_m_per_s": self.pitch_line_velocity(pinion_speed_rpm),
+                "circumferential_tooth_load_N": loads["circumferential_N"],
+                "axial_tooth_load_N": loads["axial_N"],
+                "torque_Nm": [torque, loads["wheel_torque_Nm"]],
+            })
+        return out
+
+
+# ---------------------------------------------------------------------- tooth profile (Appendix B)
+def _rack_boundary(pair: GearPair, x: float, n: int = 200) -> np.ndarray:
+    """Transverse outline of the cutting rack tooth to the right of the gap that forms a gear tooth
+    centred on u = 0: flank, tip rounding (radius rho m), tip line.  Coordinates (u, v) in m, u along
+    the pitch line, v radial from the gear's pitch circle (v < 0 towards the gear centre)."""
+    m, mt, at = pair.module, pair.transverse_module, pair.transverse_pressure_angle
+    rho = pair.rack_tip_radius_factor * m
+    v_tip = (x - pair.dedendum_coefficient) * m
+    v_top = (x + pair.addendum_coefficient + 0.5) * m
+
+    def flank_u(v):
+        return math.pi * mt / 4 - (v - x * m) * math.tan(at)   # gap widens towards the gear centre
+
+    vc = v_tip + rho
+    uc = flank_u(vc) + rho / math.cos(at)
+    v_touch = vc - rho * math.sin(at)
+    flank_v = np.linspace(v_top, v_touch, n)
+    flank = np.column_stack([flank_u(flank_v), flank_v])
+    angles = np.linspace(math.pi + at, 1.5 * math.pi, n)
+    arc = np.column_stack([uc + rho * np.cos(angles), vc + rho * np.sin(angles)])
+    # the tip line only up to the rack tooth's centre: beyond it the other flank's rounding takes over
+    tip = np.column_stack([np.linspace(uc, max(uc, math.pi * mt / 2), n // 4), np.full(n // 4, v_tip)])
+    return np.vstack([flank, arc, tip])
+
+
+def tooth_profile(pair: GearPair, gear: int, n_radii: int = 120) -> dict[str, np.ndarray]:
+    """Transverse outline of one tooth of gear 0 (pinion) or 1 (wheel) as generated by the basic rack
+    (Appendix B, Fig. B.2): involute flank, trochoid fillet cut by the rack's tip rounding (radius
+    rho m), root circle, tip circle.  The envelope is computed numerically: the rack outline is rolled
+    over the pitch circle and, at every radius, the tooth boundary is the smallest polar angle the rack
+    reaches.  (The small elliptical distortion of the tip rounding in the transverse section of a
+    helical gear is neglected, as in eq. B-5.)
+
+    Returns arrays in m, frame centred on the gear axis, tooth symmetry line along +y:
+      'right_flank' (n, 2) from root to tip, 'radius' (n,) and 'half_angle' (n,) [rad] of that flank,
+      'form_radius' [m] where fillet and involute meet, 'outline' (closed, both flanks and tip arc)."""
+    if gear not in (0, 1):
+        raise InputError(f"tooth_profile: gear must be 0 (pinion) or 1 (wheel), got {gear}")
+    x = pair.profile_shift[gear]
+    r = float(pair.pitch_diameter[gear]) / 2
+    ra = float(pair.tip_diameter[gear]) / 2
+    rf = float(pair.root_diameter[gear]) / 2
+    rack = _rack_boundary(pair, x, n=400)
+    phi_max = 2.5 * (pair.dedendum_coefficient + pair.addendum_coefficient + 1) * pair.module / r + 0.3
+    phis = np.linspace(-phi_max, phi_max, 3000)
+    # Rack translated by r*phi, gear frame rotated back by phi (pure rolling on the pitch circle).
+    X = rack[None, :, 0] + r * phis[:, None]
+    Y = r + rack[None, :, 1]
+    c, s = np.cos(phis)[:, None], np.sin(phis)[:, None]
+    gx, gy = X * c - Y * s, X * s + Y * c
+    R = np.hypot(gx, gy).ravel()
+    theta = np.arctan2(gx, gy).ravel()
+    order = np.argsort(R)
+    R, theta = R[order], theta[order]
+    radii = np.linspace(rf, ra, n_radii)
+    # Narrow radius windows keep the bias small: the flank angle changes ~tan(alpha) * window / r.
+    window = 2e-4 * pair.module
+    lo = np.searchsorted(R, radii - window)
+    hi = np.searchsorted(R, radii + window)
+    half = np.array([theta[a:b].min() if b > a else np.nan for a, b in zip(lo, hi)])
+    half[0] = half[1] if np.isnan(half[0]) else half[0]
+    rb = float(pair.base_diameter[gear]) / 2
+    psi_b = (math.pi / 2 + 2 * x * math.tan(pair.pressure_angle)) / pair.teeth[gear] \
+        + float(involute(pair.transverse_pressure_angle))
+    involute_half = np.where(radii >= rb, psi_b - involute(np.arccos(np.minimum(rb / radii, 1.0))), np.nan)
+    on_involute = np.abs(half - involute_half) * radii < 1e-3 * pair.module   # within 1 per mille of m
+    # form radius: from here up to the tip the flank is the involute
+    off = np.flatnonzero(~on_involute[:-1])
+    form_radius = float(radii[off[-1] + 1]) if off.size else float(radii[0])
+    right = np.column_stack([radii * np.sin(half), radii * np.cos(half)])
+    tip_angles = np.linspace(half[-1], -half[-1], 20)
+    tip = np.column_stack([ra * np.sin(tip_angles), ra * np.cos(tip_angles)])
+    left = right[::-1] * np.array([-1.0, 1.0])
+    outline = np.vstack([right, tip[1:-1], left])
+    return {"right_flank": right, "radius": radii, "half_angle": half, "form_radius": form_radius,
+            "outline": outline}
