@@ -1,0 +1,147 @@
+"""From a validated scene geometry to a distributed dolfinx mesh with named cell and facet tags."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from housingfe.errors import InputError
+from housingfe.geometry.blocks import BlockModel, build_gmsh_model
+
+
+@dataclass
+class HousingMesh:
+    """A dolfinx mesh with its tags and the exact geometric facts of the model it came from.
+
+    cell_groups / facet_groups map feature names to tag values in cell_tags / facet_tags.
+    volume (m^3) and centroid (m) are exact (from the block model), for checks of the FE model.
+    """
+
+    mesh: object
+    cell_tags: object
+    facet_tags: object
+    cell_groups: dict[str, int]
+    facet_groups: dict[str, int]
+    volume: float
+    centroid: np.ndarray
+    element_size: float
+    element: str
+    points: dict = field(default_factory=dict)
+    mesh_time_s: float = 0.0
+    quality: dict = field(default_factory=dict)
+
+    def facets(self, name: str) -> np.ndarray:
+        """Local indices of the facets in the named surface group (raises InputError if unknown)."""
+        if name not in self.facet_groups:
+            raise InputError(f"unknown surface group {name!r}; known: {', '.join(sorted(self.facet_groups))}")
+        return self.facet_tags.find(self.facet_groups[name])
+
+
+def bending_wavelength(frequency: float, thickness: float, youngs_modulus: float, poisson_ratio: float,
+                       density: float) -> float:
+    """Bending wavelength (m) of a thin plate of `thickness` (m) at `frequency` (Hz)."""
+    D = youngs_modulus * thickness**3 / (12 * (1 - poisson_ratio**2))
+    omega = 2 * math.pi * frequency
+    k = (omega**2 * density * thickness / D) ** 0.25
+    return 2 * math.pi / k
+
+
+def block_model_for(geometry) -> BlockModel:
+    """The block model of a validated scene geometry section (see housingfe.scene)."""
+    from housingfe.geometry.box import box_model
+    from housingfe.geometry.plate import plate_model
+
+    if geometry.kind == "box":
+        return box_model(geometry.length, geometry.width, geometry.height, geometry.wall_thickness,
+                         geometry.flange_thickness, geometry.flange_width, geometry.bolt_patch_size)
+    if geometry.kind == "plate":
+        return plate_model(geometry.a, geometry.b, geometry.h)
+    raise InputError(f"geometry.kind: no builder for {geometry.kind!r}")
+
+
+def build_mesh(geometry, element: str, size: float, layers: int, comm) -> HousingMesh:
+    """Build the gmsh model on rank 0, mesh it and distribute it as a dolfinx mesh.
+
+    element: "hex" (structured quadratic-ready hexahedra) or "tet"; size: element size (m);
+    layers: elements through a wall thickness (hex meshes).
+    """
+    import gmsh
+    from dolfinx.io import gmshio
+
+    t0 = time.perf_counter()
+    model = block_model_for(geometry)
+    groups = None
+    if comm.rank == 0:
+        gmsh.initialize()
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.model.add("housing")
+            groups = build_gmsh_model(model, element, size, layers)
+        except Exception:
+            gmsh.finalize()
+            raise
+    groups = comm.bcast(groups, root=0)
+    try:
+        mesh, cell_tags, facet_tags = gmshio.model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0, gdim=3)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()
+    mesh.topology.create_connectivity(2, 3)
+    return HousingMesh(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=groups["cells"],
+                       facet_groups=groups["facets"], volume=model.volume(), centroid=model.centroid(),
+                       element_size=size, element=element, points=model.points,
+                       mesh_time_s=time.perf_counter() - t0, quality=element_quality(mesh))
+
+
+def element_quality(mesh) -> dict:
+    """Min/max element quality over the mesh (all ranks): for tetrahedra 6*sqrt(2)*V / l_rms^3 (1 for the
+    regular tetrahedron), for hexahedra the minimum scaled Jacobian over the eight corners (1 for a cube,
+    <= 0 for an inverted element)."""
+    x = mesh.geometry.x
+    dofs = mesh.geometry.dofmap.array.reshape(mesh.topology.index_map(3).size_local
+                                              + mesh.topology.index_map(3).num_ghosts, -1)
+    n_local = mesh.topology.index_map(3).size_local
+    xc = x[dofs[:n_local]]
+    if xc.shape[1] == 4 or (xc.shape[1] == 10):
+        q = _tet_quality(xc[:, :4])
+        measure = "tet 6*sqrt(2)*V/l_rms^3"
+    else:
+        q = _hex_scaled_jacobian(xc[:, :8])
+        measure = "hex min scaled Jacobian"
+    comm = mesh.comm
+    qmin = comm.allreduce(float(q.min()) if len(q) else np.inf, op=_mpi_min())
+    qmax = comm.allreduce(float(q.max()) if len(q) else -np.inf, op=_mpi_max())
+    return {"min": qmin, "max": qmax, "measure": measure}
+
+
+def _mpi_min():
+    from mpi4py import MPI
+    return MPI.MIN
+
+
+def _mpi_max():
+    from mpi4py import MPI
+    return MPI.MAX
+
+
+def _tet_quality(v: np.ndarray) -> np.ndarray:
+    e = [v[:, j] - v[:, i] for i, j in ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))]
+    vol = np.abs(np.einsum("ij,ij->i", e[0], np.cross(e[1], e[2]))) / 6
+    l_rms = np.sqrt(sum((ek**2).sum(axis=1) for ek in e) / 6)
+    return 6 * np.sqrt(2) * vol / l_rms**3
+
+
+def _hex_scaled_jacobian(v: np.ndarray) -> np.ndarray:
+    # dolfinx hexahedron vertices are in tensor-product order: vertex index = i + 2 j + 4 k
+    q = np.full(len(v), np.inf)
+    for corner in range(8):
+        edges = []
+        for bit in range(3):
+            e = v[:, corner ^ (1 << bit)] - v[:, corner]
+            if corner & (1 << bit):
+                e = -e
+            edges.append(e / np.linalg.norm(e, axis=1)[:, None])
+        q = np.minimum(q, np.einsum("ij,ij->i", edges[0], np.cross(edges[1], edges[2])))
+    return q

@@ -1,0 +1,26 @@
+"""Rectangular plate a x b x h as a single block, for verification (NAFEMS FV12 and plate theory).
+
+Coordinates: the plate occupies [0, a] x [0, b] x [0, h].  Edge faces are tagged edge_x0 (x = 0),
+edge_x1 (x = a), edge_y0, edge_y1; the faces top (z = h) and bottom (z = 0).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from housingfe.geometry.blocks import BlockModel, cells_where
+
+
+def plate_model(a: float, b: float, h: float) -> BlockModel:
+    """Block model of a plate (lengths in m)."""
+    grid = (np.array([0.0, a]), np.array([0.0, b]), np.array([0.0, h]))
+
+    def classify(centre: np.ndarray, normal: np.ndarray) -> list[str]:
+        x, y, z = centre
+        if abs(normal[2]) > 0.5:
+            return ["top", "outer"] if normal[2] > 0 else ["bottom", "outer"]
+        if abs(normal[0]) > 0.5:
+            return ["edge_x0"] if x < a / 2 else ["edge_x1"]
+        return ["edge_y0"] if y < b / 2 else ["edge_y1"]
+
+    return BlockModel(grid=grid, cells=cells_where(grid, lambda x, y, z: "plate"), classify_face=classify,
+                      thin_dimensions=(h,))
