@@ -1,0 +1,64 @@
+"""Published numbers (van Roosmalen 1994, NAFEMS) and the rows that put ours next to them."""
+from __future__ import annotations
+
+import functools
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+THESIS = "van Roosmalen 1994"
+_DATA = Path(__file__).parent / "data" / "roosmalen1994.toml"
+
+
+@functools.lru_cache(maxsize=1)
+def thesis() -> dict:
+    """The thesis' published numbers (housingfe/data/roosmalen1994.toml) as a dict."""
+    with open(_DATA, "rb") as fh:
+        return tomllib.load(fh)
+
+
+def row(scene: str, quantity: str, ours, published, unit: str, source: str) -> dict:
+    """One comparison row; `difference` is ours - published (and relative where meaningful)."""
+    out = {"scene": scene, "quantity": quantity, "ours": ours, "published": published, "unit": unit,
+           "source": source}
+    if isinstance(ours, (int, float)) and isinstance(published, (int, float)) and not math.isnan(published):
+        out["difference"] = ours - published
+        if published:
+            out["relative_difference"] = (ours - published) / published
+    return out
+
+
+def modal_comparison(scene, summary: dict) -> list[dict]:
+    """Rows comparing a modal result with the published data the scene names."""
+    ref = scene.reference
+    if ref is None:
+        return []
+    name = scene.scene.name
+    freqs = np.asarray(summary["frequencies_hz"])
+    rows = []
+    if ref.frequencies_hz:
+        for i, f_ref in enumerate(ref.frequencies_hz):
+            ours = float(freqs[i]) if i < len(freqs) else float("nan")
+            rows.append(row(name, f"elastic mode {i + 1}", ours, f_ref, "Hz", ref.source))
+    if ref.section:
+        data = thesis()[ref.section]
+        src = f"{THESIS} [{ref.section}]"
+        if "mass_kg" in data:
+            rows.append(row(name, "mass", summary["mass_kg"], data["mass_kg"], "kg", src))
+        if "fem_first_elastic_Hz" in data:
+            rows.append(row(name, "first elastic mode (thesis FEM)", float(freqs[0]),
+                            data["fem_first_elastic_Hz"], "Hz", src))
+        for key, value in data.items():
+            if key.startswith("fem_modes_below_"):
+                f_lim = float(key.removeprefix("fem_modes_below_").removesuffix("Hz"))
+                if f_lim <= summary["f_max_hz"] * (1 + 1e-9):
+                    rows.append(row(name, f"elastic modes below {f_lim:g} Hz (thesis FEM)",
+                                    int(np.sum(freqs < f_lim)), value, "-", src))
+            if key.startswith("ema_modes_below_"):
+                f_lim = float(key.removeprefix("ema_modes_below_").removesuffix("Hz"))
+                if f_lim <= summary["f_max_hz"] * (1 + 1e-9):
+                    rows.append(row(name, f"elastic modes below {f_lim:g} Hz (thesis EMA found)",
+                                    int(np.sum(freqs < f_lim)), value, "-", src))
+    return rows

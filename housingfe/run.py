@@ -1,0 +1,87 @@
+"""`housingfe run <scene>`: scene -> geometry -> model -> solver -> report, written atomically."""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from housingfe import published, report
+from housingfe.errors import SolverError
+from housingfe.scene import load_housing_scene
+
+
+def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
+    """Run every analysis the scene lists and write the result folder; returns its path."""
+    from mpi4py import MPI
+
+    t_start = time.perf_counter()
+    scene, path = load_housing_scene(name_or_path, overrides)
+    comm = MPI.COMM_WORLD
+    out = Path(out_dir or f"results/{scene.scene.name}")
+
+    from housingfe.model import build_model
+    from housingfe.solvers import modal
+
+    model = build_model(scene, comm)
+    result = modal.solve_modes(model.K, model.M, scene.analysis.modal.f_max, tol=scene.analysis.modal.tolerance)
+    checks = modal_checks(model, result)
+    wall = time.perf_counter() - t_start
+    summary = modal_summary(model, result, checks, wall)
+    with report.atomic_output_dir(out, is_writer=comm.rank == 0) as tmp:
+        report.write_modal_outputs(tmp, model, result, summary, comm)
+    if comm.rank == 0:
+        print(report.modal_summary_text(summary))
+        print(f"results: {out}/")
+    return out
+
+
+def modal_checks(model, result) -> dict:
+    """Rigid-body count and the mass / centre of gravity that the rigid modes carry (free structures)."""
+    from housingfe.solvers import elasticity, modal
+
+    freqs = result.frequencies_hz
+    n_rigid = model.rigid_modes_expected
+    checks: dict = {"rigid_modes_expected": n_rigid}
+    if n_rigid:
+        if len(freqs) <= n_rigid or freqs[n_rigid - 1] > 1e-3 * freqs[n_rigid]:
+            raise SolverError(f"expected {n_rigid} rigid-body modes well below the first elastic mode, got "
+                              f"frequencies {np.round(freqs[:n_rigid + 1], 4).tolist()} Hz")
+        props = modal.rigid_body_mass_properties(model.M, result.vectors[:n_rigid],
+                                                 elasticity.rigid_body_vectors(model.V))
+        checks.update(props)
+    checks["geometry_mass_kg"] = model.material.density * model.housing.volume
+    checks["geometry_centre_of_gravity_m"] = model.housing.centroid
+    return checks
+
+
+def modal_summary(model, result, checks: dict, wall_time_s: float) -> dict:
+    """The content of modes.json."""
+    n_rigid = model.rigid_modes_expected
+    freqs = result.frequencies_hz
+    scene = model.scene
+    summary = {
+        "scene": scene.scene.name,
+        "description": scene.scene.description,
+        "frequencies_hz": freqs[n_rigid:],
+        "rigid_body_frequencies_hz": freqs[:n_rigid],
+        "mass_kg": checks["geometry_mass_kg"],
+        "mass_from_rigid_modes_kg": checks.get("mass_kg"),
+        "centre_of_gravity_m": checks["geometry_centre_of_gravity_m"],
+        "centre_of_gravity_from_rigid_modes_m": checks.get("centre_of_gravity_m"),
+        "dofs": model.dofs,
+        "f_max_hz": result.f_max,
+        "complete": result.complete,
+        "eigenvalues_below_f_max_by_inertia": result.expected_count,
+        "residuals": result.residuals[n_rigid:],
+        "rigid_body_residuals": result.residuals[:n_rigid],
+        "element": f"{model.housing.element}{'27' if model.housing.element == 'hex' else '10'}"
+                   if model.scene.mesh.degree == 2 else f"{model.housing.element} P{model.scene.mesh.degree}",
+        "element_size_m": model.housing.element_size,
+        "mesh_quality": model.housing.quality,
+        "mpi_ranks": model.V.mesh.comm.size,
+        "timings_s": {**model.timings, **result.timings},
+        "wall_time_s": wall_time_s,
+    }
+    summary["published"] = published.modal_comparison(scene, summary)
+    return summary

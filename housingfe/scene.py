@@ -1,0 +1,250 @@
+"""Scenes: TOML files describing what to build and what to compute, validated with pydantic.
+
+A scene is addressed by the name of a built-in scene (housingfe/scenes/<name>.toml) or by a path.
+All values are SI (m, Pa, kg/m^3, Hz).  Every table forbids unknown keys, so a typo is an error that
+names the file and the key, never a silently ignored setting.
+"""
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Annotated, Literal, Optional, Union
+
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, ValidationError, model_validator
+
+from housingfe.errors import InputError
+from housingfe.materials import LIBRARY, Material
+
+SCENE_DIR = Path(__file__).parent / "scenes"
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class SceneInfo(_Strict):
+    name: str
+    kind: Literal["housing", "source"]
+    description: str = ""
+
+
+class BoxGeometry(_Strict):
+    """The open welded box of Sec. 4.2 (lengths in m; H from the flange underside to the top)."""
+
+    kind: Literal["box"]
+    length: PositiveFloat
+    width: PositiveFloat
+    height: PositiveFloat
+    wall_thickness: PositiveFloat
+    flange_thickness: PositiveFloat
+    flange_width: PositiveFloat
+    bolt_patch_size: PositiveFloat = 0.024
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if 2 * self.wall_thickness >= min(self.length, self.width):
+            raise ValueError("wall_thickness: walls thicker than half the length/width leave no box")
+        if self.flange_thickness + self.wall_thickness >= self.height:
+            raise ValueError("height: must exceed flange_thickness + wall_thickness")
+        if self.bolt_patch_size >= self.flange_width:
+            raise ValueError("bolt_patch_size: must be smaller than flange_width")
+        return self
+
+    @property
+    def min_thickness(self) -> float:
+        return min(self.wall_thickness, self.flange_thickness)
+
+
+EdgeCondition = Literal["free", "clamped", "simply_supported"]
+
+
+class PlateEdges(_Strict):
+    x0: EdgeCondition = "free"
+    x1: EdgeCondition = "free"
+    y0: EdgeCondition = "free"
+    y1: EdgeCondition = "free"
+
+
+class PlateGeometry(_Strict):
+    """Rectangular plate a x b x h (m) with per-edge conditions; simply supported = zero transverse
+    displacement on the edge face."""
+
+    kind: Literal["plate"]
+    a: PositiveFloat
+    b: PositiveFloat
+    h: PositiveFloat
+    edges: PlateEdges = PlateEdges()
+
+    @property
+    def min_thickness(self) -> float:
+        return self.h
+
+
+Geometry = Annotated[Union[BoxGeometry, PlateGeometry], Field(discriminator="kind")]
+
+
+class MaterialSpec(_Strict):
+    """A library material by name, with optional overrides of its values."""
+
+    name: str = "steel"
+    youngs_modulus: Optional[PositiveFloat] = None
+    poisson_ratio: Optional[float] = None
+    density: Optional[PositiveFloat] = None
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.name not in LIBRARY and None in (self.youngs_modulus, self.poisson_ratio, self.density):
+            raise ValueError(f"name: {self.name!r} is not in the library ({', '.join(LIBRARY)}); "
+                             "give youngs_modulus, poisson_ratio and density")
+        if self.poisson_ratio is not None and not -1.0 < self.poisson_ratio < 0.5:
+            raise ValueError(f"poisson_ratio: {self.poisson_ratio} is outside (-1, 0.5)")
+        return self
+
+    def resolve(self) -> Material:
+        base = LIBRARY.get(self.name, Material(self.name, 1.0, 0.0, 1.0))
+        return Material(self.name,
+                        self.youngs_modulus if self.youngs_modulus is not None else base.youngs_modulus,
+                        self.poisson_ratio if self.poisson_ratio is not None else base.poisson_ratio,
+                        self.density if self.density is not None else base.density)
+
+
+class MeshSpec(_Strict):
+    """Discretisation.  The element size follows from the highest frequency of interest unless `size` is
+    given: size = bending wavelength of the thinnest wall at f_max / elements_per_wavelength."""
+
+    element: Literal["hex", "tet"] = "hex"
+    degree: Literal[1, 2, 3] = 2
+    elements_per_wavelength: PositiveFloat = 6.0
+    layers: PositiveInt = 1
+    size: Optional[PositiveFloat] = None
+
+
+class ModalSpec(_Strict):
+    """Eigenmodes: all modes below f_max (Hz), proven complete by an inertia count."""
+
+    f_max: PositiveFloat
+    tolerance: PositiveFloat = 1e-10
+
+
+class Analyses(_Strict):
+    modal: Optional[ModalSpec] = None
+
+    @property
+    def f_max(self) -> float:
+        return self.modal.f_max if self.modal else 0.0
+
+
+class OutputSpec(_Strict):
+    mode_pictures: int = Field(6, ge=0, le=12)
+    paraview: bool = True
+    pictures: bool = True
+
+
+class ReferenceSpec(_Strict):
+    """Published data to compare with: a section of housingfe/data/roosmalen1994.toml and/or a list of
+    reference eigenfrequencies (Hz) with their source."""
+
+    section: Optional[str] = None
+    frequencies_hz: Optional[list[PositiveFloat]] = None
+    source: str = ""
+
+
+class HousingScene(_Strict):
+    scene: SceneInfo
+    geometry: Geometry
+    material: MaterialSpec = MaterialSpec()
+    mesh: MeshSpec = MeshSpec()
+    analysis: Analyses
+    output: OutputSpec = OutputSpec()
+    reference: Optional[ReferenceSpec] = None
+
+    @model_validator(mode="after")
+    def _needs_analysis(self):
+        if self.analysis.modal is None:
+            raise ValueError("analysis: the scene requests no analysis (add [analysis.modal])")
+        return self
+
+
+def builtin_scenes() -> dict[str, str]:
+    """Names and one-line descriptions of the built-in scenes."""
+    out = {}
+    for path in sorted(SCENE_DIR.glob("*.toml")):
+        with open(path, "rb") as fh:
+            info = tomllib.load(fh).get("scene", {})
+        out[path.stem] = info.get("description", "")
+    return out
+
+
+def resolve_scene_path(name_or_path: str) -> Path:
+    """Path of a built-in scene name or of a TOML file; InputError if neither exists."""
+    path = Path(name_or_path)
+    if path.suffix == ".toml" or path.exists():
+        if not path.is_file():
+            raise InputError(f"{name_or_path}: scene file not found")
+        return path
+    builtin = SCENE_DIR / f"{name_or_path}.toml"
+    if builtin.is_file():
+        return builtin
+    raise InputError(f"{name_or_path}: no such scene (built-in: {', '.join(builtin_scenes())})")
+
+
+def read_scene_dict(name_or_path: str) -> tuple[dict, Path]:
+    """Parse a scene TOML into a dict; InputError naming the file on unreadable or malformed TOML."""
+    path = resolve_scene_path(name_or_path)
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh), path
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML: {exc}") from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
+
+
+def apply_overrides(data: dict, overrides: list[str], source: str = "--set") -> dict:
+    """Apply KEY=VALUE overrides (dotted keys, TOML values; bare words are strings)."""
+    for item in overrides:
+        if "=" not in item:
+            raise InputError(f"{source}: {item!r} is not KEY=VALUE")
+        key, raw = item.split("=", 1)
+        try:
+            value = tomllib.loads(f"v = {raw}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = raw
+        node = data
+        parts = key.strip().split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise InputError(f"{source}: {key}: {part} is not a table")
+        node[parts[-1]] = value
+    return data
+
+
+def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) -> tuple[HousingScene, Path]:
+    """Read and validate a housing scene; InputError with file and key on any problem."""
+    data, path = read_scene_dict(name_or_path)
+    apply_overrides(data, overrides or [])
+    kind = data.get("scene", {}).get("kind") if isinstance(data.get("scene"), dict) else None
+    if kind == "source":
+        raise InputError(f"{path}: scene.kind: this is a source scene; run it with `housingfe source`")
+    try:
+        return HousingScene.model_validate(data), path
+    except ValidationError as exc:
+        raise InputError(f"{path}: {_first_error(exc)}") from None
+
+
+def _first_error(exc: ValidationError) -> str:
+    err = exc.errors()[0]
+    loc = ".".join(str(p) for p in err["loc"] if not (isinstance(p, str) and p in ("box", "plate")))
+    msg = err["msg"]
+    if err["type"] == "extra_forbidden":
+        msg = "unknown key"
+    elif msg.startswith("Value error, "):
+        msg = msg[len("Value error, "):]
+        # our validators name the key first ("key: problem"): attach it to the location
+        if ": " in msg:
+            key, rest = msg.split(": ", 1)
+            if key.replace("_", "").isalnum():
+                return f"{loc + '.' if loc else ''}{key}: {rest}"
+    extra = "" if len(exc.errors()) == 1 else f" (and {len(exc.errors()) - 1} more)"
+    return f"{loc}: {msg}{extra}" if loc else f"{msg}{extra}"
