@@ -7,6 +7,8 @@ import numpy as np
 import pytest
 import scipy.sparse as sp
 
+from pathlib import Path
+
 from housingfe.errors import InputError
 from housingfe.source import trueman as tr
 from housingfe.source import trueman_data as data
@@ -198,3 +200,57 @@ def test_bad_configuration_raises_input_error():
         tr.DriveConfig(machine_type="Z")
     with pytest.raises(InputError, match="coupling_flexibility_factor"):
         tr.DriveConfig(coupling_flexibility_factor=-1.0)
+
+
+# ------------------------------------------------------------------ geometry, scenes
+def test_table_2_1_pitch_diameters_from_shared_gear_geometry():
+    from housingfe.source.gears import GearPair
+
+    for teeth, published_in in ((29, 3.4177), (25, 2.9463), (20, 2.3570)):
+        helix = math.radians(45.0)
+        pair = GearPair(module=INCH / 12, teeth=(teeth, 20), pressure_angle=math.radians(20), helix_angle=helix,
+                        profile_shift=(0.0, 0.0), face_width=(0.02, 0.02),
+                        centre_distance=(teeth + 20) / 2 * INCH / 12 / math.cos(helix))
+        assert pair.pitch_diameter[0] / INCH == pytest.approx(published_in, abs=6e-5)
+
+
+def _load_scene(name):
+    import tomllib
+    from pathlib import Path
+
+    path = Path(tr.__file__).parents[1] / "scenes" / f"{name}.toml"
+    return tomllib.loads(path.read_text()), str(path)
+
+
+def test_run_scene_type_b_writes_critical_speeds_and_envelopes(tmp_path):
+    import csv
+    import json
+
+    scene, path = _load_scene("trueman-type-b")
+    scene["forced"]["speeds"] = 7            # keep the test fast
+    scene["forced"]["machines"] = 10
+    tr.run_scene(scene, path, tmp_path)
+    crit = json.loads((tmp_path / "critical_speeds.json").read_text())
+    assert _rel(crit["type B"], data.TABLE_6_1_RPM["type B"]).max() < 0.01
+    rows = list(csv.DictReader(open(tmp_path / "mesh_load_envelopes.csv")))
+    assert len(rows) == 7 * 60
+    for r in rows:
+        assert float(r["min_Nm"]) <= float(r["mean_Nm"]) <= float(r["max_Nm"])
+    # every separation flag really has a dynamic torque above the mean transmitted torque
+    for r in csv.DictReader(open(tmp_path / "separation_flags.csv")):
+        assert float(r["max_dynamic_Nm"]) > float(r["mean_transmitted_Nm"])
+        assert int(r["machines_exceeding"]) >= 1
+    assert (tmp_path / "mesh_load_envelopes.png").stat().st_size > 1000
+
+
+@pytest.mark.parametrize("mutate, key", [
+    (lambda s: s["machine"].update(typo=1), "machine.typo"),
+    (lambda s: s["configurations"][0].update(drawroll_inertia_factor=-0.5), "drawroll_inertia_factor"),
+    (lambda s: s["forced"].update(configuration="nope"), "configuration"),
+])
+def test_bad_scene_raises_input_error_naming_file_and_key(mutate, key):
+    scene, path = _load_scene("trueman-type-b")
+    mutate(scene)
+    with pytest.raises(InputError, match=key) as info:
+        tr.run_scene(scene, path, Path("/nonexistent"))
+    assert str(info.value).startswith(path)
