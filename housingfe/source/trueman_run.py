@@ -128,7 +128,8 @@ def parse_scene(scene: dict, scene_path: str) -> TruemanScene:
     except ValidationError as exc:
         err = exc.errors()[0]
         key = ".".join(str(p) for p in err["loc"]) or "scene"
-        raise InputError(f"{scene_path}: {key}: {err['msg']}") from None
+        msg = err["msg"].removeprefix("Value error, ")
+        raise InputError(f"{scene_path}: {key}: {msg}") from None
 
 
 def drive_config(sc: TruemanScene, conf) -> "DriveConfig":
@@ -281,8 +282,8 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
     {configuration: [drawroll r.p.m., ...]}), and, when a [forced] table is present, the Monte-Carlo
     dynamic mesh loads over speed with min/mean/max envelopes, the tooth-separation flags and the
     fundamental gear-mesh force spectrum.  Writes into the existing folder `out_dir`."""
-    out_dir = Path(out_dir)
     sc = parse_scene(scene, scene_path)
+    out_dir = Path(out_dir)
     rows = _critical_outputs(sc, out_dir)
     summary = {"scene": sc.scene.name, "critical_speeds_rpm": "critical_speeds.json"}
     text = [f"{sc.scene.name}: {sc.scene.description}", "",
