@@ -1,0 +1,43 @@
+"""Bearing stiffness (and fluid-film damping) matrices — standalone, no FE needed.
+
+Public API (axis convention: z = shaft axis, DOF order x, y, z, theta_x, theta_y, theta_z; SI units):
+
+    bearing_stiffness(bearing, load, model=None, preload_axial=0.0) -> BearingResult
+        bearing: catalogue designation ("SKF 6312") or a RollingBearing; load (Fx, Fy, Fz, Mx, My) [N, N m]
+        applied by the shaft to the inner ring.  result.K is the symmetric 6x6 [K]_bm of van Roosmalen (1994)
+        Sec. 3.2/3.3 [N/m, N/rad, N m/rad], result.displacement the mean inner-ring displacement [m, rad],
+        result.element_loads the rolling-element loads [N].
+    fluid_film.journal_bearing_coefficients(...) -> FluidFilmResult with non-symmetric K and C.
+
+`housingfe bearing DESIGNATION --load FX FY FZ MX MY [--json]` prints the same (see bearings.cli).
+"""
+from __future__ import annotations
+
+from housingfe.bearings.catalogue import designations, lookup
+from housingfe.bearings.rolling import (DOF_NAMES, BearingResult, RollingBearing, finite_difference_stiffness,
+                                        make_model, rolling_bearing_stiffness, stiffness_at)
+
+__all__ = ["DOF_NAMES", "BearingResult", "RollingBearing", "bearing_stiffness", "designations", "lookup",
+           "make_model", "stiffness_at", "finite_difference_stiffness", "register_cli"]
+
+
+def bearing_stiffness(bearing: str | RollingBearing, load, *, model: str | None = None,
+                      preload_axial: float = 0.0, fixed_tilt: tuple[float, float] | None = None) -> BearingResult:
+    """6x6 mean stiffness of a rolling bearing under a mean load.
+
+    bearing: catalogue designation (str) or RollingBearing; load: (Fx, Fy, Fz, Mx, My) [N, N m] on the inner
+    ring (a sixth value Mz must be 0); model: "lim-ball", "lim-roller", "sliced-roller", "self-aligning" or
+    None (the thesis' choice for the kind); preload_axial [N] is added to Fz; fixed_tilt=(bx, by) [rad]
+    prescribes the tilt instead of the moments (result.load then holds the moments it takes).
+    Returns BearingResult (K [N/m, N/rad, N m/rad], displacement [m, rad], element_loads [N]).
+    Raises InputError for an unknown designation or a load the bearing cannot carry."""
+    geometry = lookup(bearing) if isinstance(bearing, str) else bearing
+    return rolling_bearing_stiffness(geometry, load, model=model, preload_axial=preload_axial,
+                                     fixed_tilt=fixed_tilt)
+
+
+def register_cli(subparsers) -> None:
+    """Add `housingfe bearing ...` to the top-level CLI."""
+    from housingfe.bearings.cli import register
+
+    register(subparsers)

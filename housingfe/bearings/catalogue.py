@@ -1,0 +1,112 @@
+"""The bearings van Roosmalen (1994) uses, from their boundary dimensions.
+
+Public catalogue data: bore d, outside diameter D, width B (SKF), the contact angle of the 7xxx B series (40 deg)
+and, for SKF 6312 / 6215, the number and diameter of the balls printed in thesis Sec. 4.6.  Everything else is
+internal geometry that SKF does not publish; it is estimated by the rules below and listed in each entry's
+`estimated` dict (field -> rule), so every result can say which inputs are guesses.
+
+Estimation rules (stated before any result was computed, not tuned to any published stiffness):
+  pitch diameter      d_m = (d + D) / 2.
+  ball diameter       D_w = 0.3175 (D - d), rounded to the nearest 1/32 inch (ratio of the two bearings whose
+                      balls the thesis prints: 22.22/70 = 0.3174, 17.46/55 = 0.3175).
+  number of balls     Z = round(0.596 pi d_m / D_w) for deep groove bearings (fill factor of the two printed
+                      bearings: 0.596 both); 0.70 for angular contact bearings (filled from one side, more balls).
+  groove curvature    f_i = 0.52, f_o = 0.53 (Harris' typical values for deep groove and angular contact).
+  radial clearance    deep groove: half the mid-range ISO 5753-1 Group N (CN) diametral clearance;
+                      angular contact (adjusted in pairs): 0; roller bearings: half the mid-range CN value.
+  cylindrical rollers D_w = 0.26 (D - d), effective length 0.6 B, Z = round(0.80 pi d_m / D_w).
+  spherical rollers   two rows, D_w = 0.22 (D - d), length per row 0.4 B, Z per row = round(0.80 pi d_m / D_w),
+                      contact angle 9 deg (from a typical SKF calculation factor e = 1.5 tan(alpha) ~ 0.24).
+  material            bearing steel E = 208 GPa, nu = 0.3.
+"""
+from __future__ import annotations
+
+import math
+
+from housingfe.bearings.rolling import RollingBearing
+from housingfe.errors import InputError
+
+_INCH = 25.4e-3
+_MM = 1e-3
+_UM = 1e-6
+
+# designation: kind, d, D, B [mm], contact angle [deg], published (Z, D_w [mm]) or None, CN diametral
+# clearance range [um] (ISO 5753-1 Group N, estimated)
+_BOUNDARY = {
+    "6312": ("ball", 60, 130, 31, 0.0, (8, 22.22), (11, 28)),
+    "6215": ("ball", 75, 130, 25, 0.0, (11, 17.46), (12, 36)),
+    "6316": ("ball", 80, 170, 39, 0.0, None, (12, 36)),
+    "6219": ("ball", 95, 170, 32, 0.0, None, (18, 43)),
+    "7316B": ("ball", 80, 170, 39, 40.0, None, None),
+    "7219B": ("ball", 95, 170, 32, 40.0, None, None),
+    "21316CC": ("spherical_roller", 80, 170, 39, None, None, (55, 75)),
+    "22219CC": ("spherical_roller", 95, 170, 43, None, None, (65, 90)),
+    "NJ316": ("cylindrical_roller", 80, 170, 39, 0.0, None, (40, 70)),
+    "NU2219": ("cylindrical_roller", 95, 170, 43, 0.0, None, (45, 75)),
+}
+
+_SPHERICAL_CONTACT_ANGLE_DEG = 9.0
+
+
+def normalise(designation: str) -> str:
+    """'SKF 7316 B' -> '7316B' (upper case, no spaces, no 'SKF' prefix)."""
+    key = designation.upper().replace(" ", "").replace("-", "")
+    return key[3:] if key.startswith("SKF") else key
+
+
+def designations() -> list[str]:
+    """The catalogue's designations (SKF spelling without spaces)."""
+    return list(_BOUNDARY)
+
+
+def _ball_diameter(d: float, outer: float) -> float:
+    return round(0.3175 * (outer - d) / (_INCH / 32.0)) * _INCH / 32.0
+
+
+def lookup(designation: str) -> RollingBearing:
+    """RollingBearing for a catalogue designation (e.g. 'SKF 6312'); unknown -> InputError."""
+    key = normalise(designation)
+    if key not in _BOUNDARY:
+        raise InputError(f"bearing designation {designation!r}: not in the catalogue "
+                         f"(known: {', '.join(_BOUNDARY)})")
+    kind, d, outer, width, alpha_deg, published, clearance = _BOUNDARY[key]
+    d, outer, width = d * _MM, outer * _MM, width * _MM
+    pitch = (d + outer) / 2.0
+    est = {"pitch_diameter": "(d + D) / 2", "E": "bearing steel 208 GPa", "nu": "0.3"}
+    name = f"SKF {key}"
+    radial_clearance = 0.0 if clearance is None else 0.25 * (clearance[0] + clearance[1]) * _UM
+    if clearance is not None:
+        est["radial_clearance"] = f"half of the mid-range ISO 5753-1 Group N diametral clearance {clearance} um"
+    else:
+        est["radial_clearance"] = "0 (angular contact, adjusted against its partner)"
+    if kind == "ball":
+        if published:
+            z, dw = published[0], published[1] * _MM
+        else:
+            dw = _ball_diameter(d, outer)
+            fill = 0.596 if alpha_deg == 0 else 0.70
+            z = round(fill * math.pi * pitch / dw)
+            est["element_diameter"] = "0.3175 (D - d), nearest 1/32 inch"
+            est["n_elements"] = f"round({fill} pi d_m / D_w)"
+        est["groove_inner"] = "0.52 (Harris typical)"
+        est["groove_outer"] = "0.53 (Harris typical)"
+        return RollingBearing(designation=name, kind=kind, bore=d, outer_diameter=outer, width=width,
+                              n_elements=z, element_diameter=dw, pitch_diameter=pitch,
+                              contact_angle=math.radians(alpha_deg), radial_clearance=radial_clearance,
+                              groove_inner=0.52, groove_outer=0.53, estimated=est)
+    if kind == "cylindrical_roller":
+        dw = 0.26 * (outer - d)
+        z = round(0.80 * math.pi * pitch / dw)
+        est.update(element_diameter="0.26 (D - d)", roller_length="0.6 B", n_elements="round(0.80 pi d_m / D_w)")
+        return RollingBearing(designation=name, kind=kind, bore=d, outer_diameter=outer, width=width,
+                              n_elements=z, element_diameter=dw, pitch_diameter=pitch, contact_angle=0.0,
+                              radial_clearance=radial_clearance, roller_length=0.6 * width, estimated=est)
+    dw = 0.22 * (outer - d)
+    z = round(0.80 * math.pi * pitch / dw)
+    est.update(element_diameter="0.22 (D - d)", roller_length="0.4 B per row",
+               n_elements="round(0.80 pi d_m / D_w) per row",
+               contact_angle=f"{_SPHERICAL_CONTACT_ANGLE_DEG} deg (e = 1.5 tan(alpha) ~ 0.24)")
+    return RollingBearing(designation=name, kind=kind, bore=d, outer_diameter=outer, width=width, n_elements=z,
+                          element_diameter=dw, pitch_diameter=pitch,
+                          contact_angle=math.radians(_SPHERICAL_CONTACT_ANGLE_DEG),
+                          radial_clearance=radial_clearance, roller_length=0.4 * width, rows=2, estimated=est)

@@ -1,0 +1,454 @@
+"""Rolling-element bearing stiffness matrices after Lim (van Roosmalen 1994, Sec. 3.2, 3.3, Appendix D).
+
+Axis convention (the same for every model and for the 6x6 results):
+  z is the shaft (bearing) axis, x and y are radial; DOF order (dx, dy, dz, bx, by, bz).
+  `load` = (Fx, Fy, Fz, Mx, My) is the mean force [N] and moment [N m] the shaft applies to the inner ring;
+  `displacement` is the rigid-body motion of the inner ring relative to the outer ring [m, rad];
+  K = d(load)/d(displacement) [N/m, N/rad (= N m/m), N m/rad], symmetric, torsional row/column bz zero.
+  Rolling element j sits at psi_j = 2 pi j / Z from the x-axis (thesis Fig. 3.1).
+
+Models:
+  "lim-ball"      Eqs. (3.1)-(3.12), Appendix D (C-1): ball on raceway groove curvature centres, n = 3/2,
+                  K_n from Hertz point contact (hertz.ball_effective_stiffness).
+  "lim-roller"    Eqs. (3.13)-(3.14), (C-2): fixed contact angle, n = 10/9, K_n from Palmgren's line contact.
+                  Tilt stiffness is zero for alpha0 = 0 (the defect Sec. 3.3.2 points out).
+  "sliced-roller" Sec. 3.3.2: every roller cut into slices along its length, each slice with the
+                  Weber–Banaschek law Eq. (3.17); the approach of slice a is delta_j - a * gamma_j (rigid rings).
+  "self-aligning" Double-row spherical roller bearing: two rows of Lim rollers at +-alpha0 whose contact
+                  normals pass through the centre of the spherical outer raceway, so a tilt loads no element
+                  and the moment rows/columns of K are zero by construction (as the thesis did, Sec. 5.8).
+
+The mean displacement is solved by Newton–Raphson (Eqs. (3.11)-(3.12)) with the analytic Jacobian.  The
+bearing is conservative and its elastic energy is convex in the displacement, so Newton's step is
+safeguarded by a line search on the potential energy U(q) - f.q; a load the bearing cannot carry
+makes that energy unbounded below and is reported as InputError.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import minimize
+
+from housingfe.bearings import hertz
+from housingfe.errors import InputError
+
+DOF_NAMES = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
+
+
+@dataclass(frozen=True)
+class RollingBearing:
+    """Geometry of a rolling-element bearing (SI units: m, rad, Pa).
+
+    kind: "ball", "cylindrical_roller", "tapered_roller" or "spherical_roller" (double-row self-aligning).
+    contact_angle: unloaded contact angle alpha0 (ball: 0 for deep groove; the clearance is radial_clearance).
+    radial_clearance: Lim's r_L, the radial play of the unloaded, centred rings (half the diametral one).
+    groove_inner/groove_outer: groove radius / ball diameter (balls only).
+    roller_length: effective contact length of one roller (rollers only).
+    estimated: {field name: estimation rule} for every value that is not public catalogue data.
+    """
+    designation: str
+    kind: str
+    bore: float
+    outer_diameter: float
+    width: float
+    n_elements: int
+    element_diameter: float
+    pitch_diameter: float
+    contact_angle: float = 0.0
+    radial_clearance: float = 0.0
+    groove_inner: float = 0.52
+    groove_outer: float = 0.53
+    roller_length: float = 0.0
+    rows: int = 1
+    E: float = 208e9
+    nu: float = 0.3
+    estimated: dict = field(default_factory=dict, compare=False, hash=False)
+
+    def __post_init__(self):
+        name = self.designation or "bearing"
+        if self.kind not in ("ball", "cylindrical_roller", "tapered_roller", "spherical_roller"):
+            raise InputError(f"{name}: kind={self.kind!r}: must be ball, cylindrical_roller, "
+                             "tapered_roller or spherical_roller")
+        positive = {"bore": self.bore, "outer_diameter": self.outer_diameter, "width": self.width,
+                    "element_diameter": self.element_diameter, "pitch_diameter": self.pitch_diameter}
+        for key, value in positive.items():
+            if not (value > 0 and math.isfinite(value)):
+                raise InputError(f"{name}: {key}={value}: must be a positive length in m")
+        if self.n_elements < 3:
+            raise InputError(f"{name}: n_elements={self.n_elements}: need at least 3 rolling elements")
+        if not (self.bore < self.pitch_diameter < self.outer_diameter):
+            raise InputError(f"{name}: pitch_diameter={self.pitch_diameter} m: must lie between bore and "
+                             "outside diameter")
+        if self.element_diameter >= (self.outer_diameter - self.bore) / 2:
+            raise InputError(f"{name}: element_diameter={self.element_diameter} m: larger than the ring section")
+        if not (0.0 <= self.contact_angle < math.pi / 2):
+            raise InputError(f"{name}: contact_angle={self.contact_angle} rad: must be in [0, pi/2)")
+        if self.radial_clearance < -0.01 * self.element_diameter:
+            raise InputError(f"{name}: radial_clearance={self.radial_clearance} m: non-physical interference")
+        if self.kind != "ball" and self.roller_length <= 0:
+            raise InputError(f"{name}: roller_length={self.roller_length} m: rollers need a positive length")
+        if self.kind == "ball" and (self.groove_inner <= 0.5 or self.groove_outer <= 0.5):
+            raise InputError(f"{name}: groove curvature factors must be > 0.5 "
+                             f"(got {self.groove_inner}, {self.groove_outer})")
+        if self.rows not in (1, 2):
+            raise InputError(f"{name}: rows={self.rows}: must be 1 or 2")
+
+
+@dataclass
+class BearingResult:
+    """Mean operating point and 6x6 stiffness of one bearing (axis convention: module docstring).
+
+    K [N/m, N/rad, N m/rad]; displacement (dx, dy, dz, bx, by, bz) [m, rad]; element_loads [N] per rolling
+    element (row-major for two rows), element_angles psi_j [rad]; contact_angles [rad] (loaded, balls).
+    """
+    designation: str
+    model: str
+    load: np.ndarray
+    K: np.ndarray
+    displacement: np.ndarray
+    element_loads: np.ndarray
+    element_angles: np.ndarray
+    contact_angles: np.ndarray
+    iterations: int
+    residual: float
+
+    def as_dict(self) -> dict:
+        """JSON-ready dict: K, displacement, element_loads (SI units) and the operating point."""
+        return {"designation": self.designation, "model": self.model, "load": self.load.tolist(),
+                "K": self.K.tolist(), "displacement": self.displacement.tolist(),
+                "element_loads": self.element_loads.tolist(),
+                "element_angles_deg": np.degrees(self.element_angles).tolist(),
+                "contact_angles_deg": np.degrees(self.contact_angles).tolist(),
+                "iterations": self.iterations}
+
+
+# ----------------------------------------------------------------------------------------------- models
+class _Model:
+    """One bearing model: energy, load vector and analytic Jacobian as functions of the 5 mean DOFs."""
+    name = ""
+    exponent = 1.5
+    carries_moments = True
+
+    def __init__(self, bearing: RollingBearing):
+        self.bearing = bearing
+        z = bearing.n_elements
+        self.psi = 2.0 * np.pi * np.arange(z) / z
+        self.cos, self.sin = np.cos(self.psi), np.sin(self.psi)
+
+    def radial_direction(self) -> np.ndarray:
+        """d(delta_r,j)/dq, one row per element (Eq. (3.5))."""
+        u = np.zeros((len(self.psi), 5))
+        u[:, 0], u[:, 1] = self.cos, self.sin
+        return u
+
+    def axial_direction(self, radius: float) -> np.ndarray:
+        """d(delta_z,j)/dq = (0, 0, 1, r sin psi, -r cos psi) (Eq. (3.5))."""
+        u = np.zeros((len(self.psi), 5))
+        u[:, 2] = 1.0
+        u[:, 3], u[:, 4] = radius * self.sin, -radius * self.cos
+        return u
+
+    def reference_deflection(self, load: np.ndarray) -> float:
+        """Typical element deflection [m] for this load: scales the Newton iteration."""
+        force = max(np.linalg.norm(load[:3]), np.linalg.norm(load[3:]) / self.moment_arm(), 1.0)
+        return (force / (len(self.psi) * self.bearing.rows * self.k_n)) ** (1.0 / self.exponent)
+
+    def moment_arm(self) -> float:
+        return self.bearing.pitch_diameter / 2.0
+
+    def evaluate(self, q: np.ndarray):
+        """(energy [J], load vector F(q) (5,), Jacobian dF/dq (5, 5), element loads, contact angles)."""
+        raise NotImplementedError
+
+
+class LimBall(_Model):
+    """Lim's ball bearing, Eqs. (3.1)-(3.9); Jacobian = Appendix D (C-1a..p) in vector form."""
+    name = "lim-ball"
+    exponent = 1.5
+
+    def __init__(self, bearing: RollingBearing):
+        super().__init__(bearing)
+        b = bearing
+        self.k_n = hertz.ball_effective_stiffness(b.element_diameter, b.pitch_diameter, b.contact_angle,
+                                                  b.groove_inner, b.groove_outer, b.E, b.nu)
+        self.a0 = (b.groove_inner + b.groove_outer - 1.0) * b.element_diameter       # Eq. (3.2), A_0
+        # r_j: radius of the inner raceway groove curvature centre (Eq. (3.5))
+        self.r_j = b.pitch_diameter / 2.0 + (b.groove_inner - 0.5) * b.element_diameter * math.cos(b.contact_angle)
+        self.u_r = self.radial_direction()
+        self.u_z = self.axial_direction(self.r_j)
+
+    def evaluate(self, q):
+        b, n = self.bearing, self.exponent
+        s_r = self.a0 * math.cos(b.contact_angle) + self.u_r @ q - b.radial_clearance   # (delta*)_rj, (3.4)
+        s_z = self.a0 * math.sin(b.contact_angle) + self.u_z @ q                         # (delta*)_zj, (3.3)
+        a = np.hypot(s_r, s_z)                                                            # A_j, (3.2)
+        d = np.maximum(a - self.a0, 0.0)                                                  # delta_j, (3.1)
+        q_j = self.k_n * d**n                                                             # (3.6)
+        v = (s_r[:, None] * self.u_r + s_z[:, None] * self.u_z) / a[:, None]              # unit "normal"
+        force = q_j @ v                                                                    # (3.8)
+        on = d > 0
+        w_geo = np.where(on, q_j / a, 0.0)
+        w_dir = np.where(on, n * self.k_n * d ** (n - 1.0), 0.0) - w_geo
+        jac = (self.u_r.T * w_geo) @ self.u_r + (self.u_z.T * w_geo) @ self.u_z + (v.T * w_dir) @ v
+        energy = self.k_n / (n + 1.0) * np.sum(d ** (n + 1.0))
+        return energy, force, jac, q_j, np.arctan2(s_z, s_r)
+
+    def moment_arm(self):
+        return self.r_j
+
+
+class LimRoller(_Model):
+    """Lim's roller bearing, Eqs. (3.13)-(3.14), (C-2): fixed contact angle, n = 10/9, uniform load per roller."""
+    name = "lim-roller"
+    exponent = 10.0 / 9.0
+
+    def __init__(self, bearing: RollingBearing):
+        super().__init__(bearing)
+        b = bearing
+        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.E, b.nu)
+        self.r_j = b.pitch_diameter / 2.0
+        a = b.contact_angle
+        self.g = math.cos(a) * self.radial_direction() + math.sin(a) * self.axial_direction(self.r_j)
+        self.gap = b.radial_clearance * math.cos(a)
+
+    def evaluate(self, q):
+        n = self.exponent
+        d = np.maximum(self.g @ q - self.gap, 0.0)                  # Eq. (3.13)
+        q_j = self.k_n * d**n
+        force = q_j @ self.g                                        # Eq. (3.14)
+        jac = (self.g.T * (n * self.k_n * d ** (n - 1.0))) @ self.g  # (C-2)
+        energy = self.k_n / (n + 1.0) * np.sum(d ** (n + 1.0))
+        return energy, force, jac, q_j, np.full(len(d), self.bearing.contact_angle)
+
+
+class SelfAligningRoller(LimRoller):
+    """Double-row spherical roller bearing: rows at +-alpha0, contact normals through the sphere centre, so a
+    tilt of the inner ring compresses no roller and the moment stiffness is zero by construction."""
+    name = "self-aligning"
+    carries_moments = False
+
+    def __init__(self, bearing: RollingBearing):
+        _Model.__init__(self, bearing)
+        b = bearing
+        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.E, b.nu)
+        self.r_j = b.pitch_diameter / 2.0
+        a = b.contact_angle
+        rad = self.radial_direction()
+        ax = np.zeros_like(rad)
+        ax[:, 2] = 1.0                       # no r*beta term: the outer raceway is a sphere about the centre
+        self.g = np.vstack([math.cos(a) * rad + math.sin(a) * ax, math.cos(a) * rad - math.sin(a) * ax])
+        self.psi = np.concatenate([self.psi, self.psi])
+        self.gap = b.radial_clearance * math.cos(a)
+
+
+class SlicedRoller(_Model):
+    """Thesis Sec. 3.3.2: rollers sliced along their length, non-uniform load, Weber–Banaschek per slice.
+
+    Slice k of roller j at a_k (from the roller centre along its axis, -l/2..l/2) is compressed by
+    delta_j - a_k gamma_j with delta_j of Eq. (3.13) and gamma_j = bx sin psi - by cos psi (Eq. (3.15)); this is
+    the exact small-rotation approach of two rigid rings.  The slice forces act along the contact normal,
+    so F = sum F_jk g_jk and K = sum dF_jk/d(delta) g_jk g_jk^T with g_jk = d(approach)/dq (virtual work).
+    """
+    name = "sliced-roller"
+    exponent = 10.0 / 9.0
+
+    def __init__(self, bearing: RollingBearing, slices: int = 20):
+        super().__init__(bearing)
+        b = bearing
+        self.slices = slices
+        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.E, b.nu)   # only for scaling
+        self.r_j = b.pitch_diameter / 2.0
+        dl = b.roller_length / slices
+        self.a = (np.arange(slices) + 0.5) * dl - b.roller_length / 2.0
+        alpha = b.contact_angle
+        g_centre = math.cos(alpha) * self.radial_direction() + math.sin(alpha) * self.axial_direction(self.r_j)
+        tilt = np.zeros_like(g_centre)
+        tilt[:, 3], tilt[:, 4] = self.sin, -self.cos                                # d(gamma_j)/dq
+        # (Z, slices, 5) -> (Z*slices, 5)
+        self.g = (g_centre[:, None, :] - self.a[None, :, None] * tilt[:, None, :]).reshape(-1, 5)
+        self.gap = b.radial_clearance * math.cos(alpha)
+        inner_race = b.pitch_diameter / 2.0 - b.element_diameter / 2.0
+        outer_race = b.pitch_diameter / 2.0 + b.element_diameter / 2.0
+        self.law = hertz.LineContactSlices(b.element_diameter, inner_race, outer_race, dl, b.E, b.nu)
+
+    def evaluate(self, q):
+        approach = self.g @ q - self.gap
+        f, k = self.law.force_and_stiffness(approach)
+        force = f @ self.g
+        jac = (self.g.T * k) @ self.g
+        energy = float(np.sum(self.law.energy(approach)))
+        per_roller = f.reshape(len(self.psi), self.slices).sum(axis=1)
+        return energy, force, jac, per_roller, np.full(len(self.psi), self.bearing.contact_angle)
+
+
+_MODELS = {"lim-ball": LimBall, "lim-roller": LimRoller, "sliced-roller": SlicedRoller,
+           "self-aligning": SelfAligningRoller}
+
+
+def default_model(bearing: RollingBearing) -> str:
+    """The thesis' model for each kind: Lim for balls, the Sec. 3.3.2 improvement for rollers."""
+    return {"ball": "lim-ball", "cylindrical_roller": "sliced-roller", "tapered_roller": "sliced-roller",
+            "spherical_roller": "self-aligning"}[bearing.kind]
+
+
+def make_model(bearing: RollingBearing, model: str | None = None) -> _Model:
+    """Instantiate a model by name (None: default_model); checks that model and kind match."""
+    name = model or default_model(bearing)
+    if name not in _MODELS:
+        raise InputError(f"{bearing.designation}: model={name!r}: must be one of {sorted(_MODELS)}")
+    if (name == "lim-ball") != (bearing.kind == "ball"):
+        raise InputError(f"{bearing.designation}: model {name!r} does not fit a {bearing.kind} bearing")
+    if (name == "self-aligning") != (bearing.kind == "spherical_roller"):
+        raise InputError(f"{bearing.designation}: model {name!r} does not fit a {bearing.kind} bearing "
+                         "(spherical roller bearings use 'self-aligning')")
+    return _MODELS[name](bearing)
+
+
+# ----------------------------------------------------------------------------------------------- solver
+def _load_vector(load, preload_axial: float, name: str) -> np.ndarray:
+    f = np.asarray(load, dtype=float).ravel()
+    if f.size not in (5, 6):
+        raise InputError(f"{name}: load: need 5 values (Fx Fy Fz Mx My) [N, N m], got {f.size}")
+    if not np.all(np.isfinite(f)):
+        raise InputError(f"{name}: load: non-finite value in {f.tolist()}")
+    if f.size == 6 and f[5] != 0.0:
+        raise InputError(f"{name}: load: Mz={f[5]} N m: a bearing transmits no torque about its axis")
+    f = f[:5].copy()
+    f[2] += preload_axial
+    return f
+
+
+class _Unbounded(Exception):
+    """The iterate left the physical range: the energy has no minimum (load cannot be carried)."""
+
+
+def solve_mean_displacement(model: _Model, f: np.ndarray, tol: float = 1e-10, max_iter: int = 200,
+                            fixed_tilt: tuple[float, float] | None = None):
+    """Mean displacement q with F(q) = f (Eqs. (3.11)-(3.12)).
+
+    The Newton–Raphson iteration of the thesis (analytic Jacobian = [K]) is globalised as a trust-region
+    Newton method (scipy 'trust-exact') on the potential energy U(q) - f.q, which is convex for every model
+    here: this converges from q = 0 even while no element is loaded (singular K).
+    fixed_tilt: prescribe (bx, by) [rad] instead of solving for them (the moments Mx, My in f are then
+    ignored and follow from the solution).  Returns (q (5,), iterations, scaled residual).
+    Raises InputError when no equilibrium exists (energy unbounded below) or Newton fails."""
+    b = model.bearing
+    r = model.moment_arm()
+    d_ref = model.reference_deflection(f)
+    k_ref = model.k_n * d_ref ** (model.exponent - 1.0) * len(model.psi)
+    scale_q = np.array([d_ref, d_ref, d_ref, d_ref / r, d_ref / r])     # DOF scaling: rotations as r*beta
+    f_ref = k_ref * d_ref
+    scale_f = scale_q * k_ref
+    q0 = np.zeros(5)
+    free = np.ones(5, bool)
+    if fixed_tilt is not None:
+        free[3:] = False
+        q0[3:] = fixed_tilt
+    elif not model.carries_moments:
+        if np.any(np.abs(f[3:]) > 1e-9 * f_ref * r):
+            raise InputError(f"{b.designation}: load: Mx={f[3]}, My={f[4]} N m: a self-aligning bearing "
+                             "carries no moment")
+        free[3:] = False        # tilts are free and load nothing: keep them at zero
+    sq = scale_q[free]
+    limit = 0.25 * b.element_diameter / d_ref                             # beyond this: no equilibrium
+    cache = {}
+
+    def state(x):
+        key = x.tobytes()
+        if key not in cache:
+            if np.max(np.abs(x)) > limit:
+                raise _Unbounded
+            q = q0.copy()
+            q[free] = x * sq
+            cache.clear()
+            cache[key] = model.evaluate(q)
+        return cache[key]
+
+    def potential(x):
+        return (state(x)[0] - f[free] @ (x * sq)) / (f_ref * d_ref)
+
+    def gradient(x):
+        return (state(x)[1][free] - f[free]) * sq / (f_ref * d_ref)
+
+    def hessian(x):
+        return state(x)[2][np.ix_(free, free)] * sq[:, None] * sq[None, :] / (f_ref * d_ref) \
+            + 1e-12 * np.eye(len(sq))
+
+    try:
+        sol = minimize(potential, np.zeros(len(sq)), jac=gradient, hess=hessian, method="trust-exact",
+                       options={"gtol": tol, "maxiter": max_iter, "initial_trust_radius": 1.0})
+    except _Unbounded:
+        raise InputError(f"{b.designation}: load {f.tolist()} N, N m: the bearing cannot carry it "
+                         "(displacement grows without bound)") from None
+    q = q0.copy()
+    q[free] = sol.x * sq
+    residual = float(np.max(np.abs((f - model.evaluate(q)[1])[free] / scale_f[free])))
+    iterations = int(sol.nit)
+    # the trust region may stop a little early where the Jacobian is not Lipschitz (n = 10/9 contacts);
+    # finish with plain Newton–Raphson steps, Eq. (3.12), while they reduce the residual
+    for _ in range(10):
+        if residual < tol:
+            break
+        _, force, jac, *_ = model.evaluate(q)
+        trial = q.copy()
+        trial[free] += np.linalg.lstsq(jac[np.ix_(free, free)], (f - force)[free], rcond=1e-14)[0]
+        new_residual = float(np.max(np.abs((f - model.evaluate(trial)[1])[free] / scale_f[free])))
+        if new_residual >= residual:
+            break
+        q, residual, iterations = trial, new_residual, iterations + 1
+    if residual > 1e3 * tol:
+        raise InputError(f"{b.designation}: load {f.tolist()} N, N m: Newton did not converge in {iterations} "
+                         f"iterations (residual {residual:.2e}); the bearing cannot carry this load")
+    return q, iterations, residual
+
+
+def embed_6x6(jac5: np.ndarray) -> np.ndarray:
+    """5x5 (dx, dy, dz, bx, by) -> 6x6 with a zero torsional row/column (Eq. (C-1p))."""
+    k = np.zeros((6, 6))
+    k[:5, :5] = 0.5 * (jac5 + jac5.T)    # symmetric analytically; remove round-off asymmetry
+    return k
+
+
+def stiffness_at(model: _Model, q: np.ndarray) -> np.ndarray:
+    """Analytic 6x6 stiffness [N/m, N/rad, N m/rad] at mean displacement q (5 or 6 values)."""
+    return embed_6x6(model.evaluate(np.asarray(q, float)[:5])[2])
+
+
+def finite_difference_stiffness(model: _Model, q: np.ndarray, rel_step: float = 1e-6) -> np.ndarray:
+    """Central-difference 6x6 stiffness of the load vector around q (for checking the analytic one)."""
+    q = np.asarray(q, float)[:5]
+    r = model.moment_arm()
+    size = max(np.max(np.abs(q[:3])), np.max(np.abs(q[3:])) * r, 1e-9)
+    k = np.zeros((6, 6))
+    for i in range(5):
+        h = rel_step * size / (r if i >= 3 else 1.0)
+        dq = np.zeros(5)
+        dq[i] = h
+        k[:5, i] = (model.evaluate(q + dq)[1] - model.evaluate(q - dq)[1]) / (2 * h)
+    return k
+
+
+def rolling_bearing_stiffness(bearing: RollingBearing, load, *, model: str | None = None,
+                              preload_axial: float = 0.0,
+                              fixed_tilt: tuple[float, float] | None = None) -> BearingResult:
+    """Mean displacement and 6x6 stiffness of a rolling bearing under the mean load (Fx, Fy, Fz, Mx, My).
+
+    load [N, N m] acts on the inner ring; preload_axial [N] is added to Fz.  fixed_tilt=(bx, by) [rad]
+    prescribes the tilt (e.g. (0, 0) for a bearing on a stiff shaft held by a second bearing) instead of the
+    moments; the returned load then holds the moments that tilt needs.  Raises InputError if the bearing
+    cannot carry the load (no equilibrium, or every element unloaded at equilibrium)."""
+    m = make_model(bearing, model)
+    f = _load_vector(load, preload_axial, bearing.designation)
+    q, iterations, residual = solve_mean_displacement(m, f, fixed_tilt=fixed_tilt)
+    _, force, jac, loads, angles = m.evaluate(q)
+    if fixed_tilt is not None:
+        f[3:] = force[3:]
+    if not np.any(loads > 0):
+        raise InputError(f"{bearing.designation}: load {f.tolist()} N, N m: every rolling element is unloaded "
+                         "(zero stiffness); apply a load or preload")
+    return BearingResult(designation=bearing.designation, model=m.name, load=np.append(f, 0.0),
+                         K=embed_6x6(jac), displacement=np.append(q, 0.0), element_loads=loads,
+                         element_angles=m.psi.copy(), contact_angles=angles, iterations=iterations,
+                         residual=residual)
