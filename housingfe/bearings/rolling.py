@@ -159,7 +159,11 @@ class _Model:
         return self.bearing.pitch_diameter / 2.0
 
     def evaluate(self, q: np.ndarray):
-        """(energy [J], load vector F(q) (5,), Jacobian dF/dq (5, 5), element loads, contact angles)."""
+        """(energy [J], load vector F(q) (5,), Jacobian dF/dq (5, 5), element loads [N], contact angles [rad])
+        at the mean displacement q = (dx, dy, dz, bx, by[, bz]) [m, rad]."""
+        return self._evaluate(np.asarray(q, float)[:5])
+
+    def _evaluate(self, q: np.ndarray):
         raise NotImplementedError
 
 
@@ -179,12 +183,16 @@ class LimBall(_Model):
         self.u_r = self.radial_direction()
         self.u_z = self.axial_direction(self.r_j)
 
-    def evaluate(self, q):
+    def _evaluate(self, q):
         b, n = self.bearing, self.exponent
         s_r = self.a0 * math.cos(b.contact_angle) + self.u_r @ q - b.radial_clearance   # (delta*)_rj, (3.4)
         s_z = self.a0 * math.sin(b.contact_angle) + self.u_z @ q                         # (delta*)_zj, (3.3)
         a = np.hypot(s_r, s_z)                                                            # A_j, (3.2)
         d = np.maximum(a - self.a0, 0.0)                                                  # delta_j, (3.1)
+        if b.contact_angle > 0:
+            # an angular contact ring has a shoulder on one side only: a ball pushed past the groove
+            # bottom (loaded contact angle < 0) leaves its raceway instead of contacting the other side
+            d = np.where(s_z > 0, d, 0.0)
         q_j = self.k_n * d**n                                                             # (3.6)
         v = (s_r[:, None] * self.u_r + s_z[:, None] * self.u_z) / a[:, None]              # unit "normal"
         force = q_j @ v                                                                    # (3.8)
@@ -213,7 +221,7 @@ class LimRoller(_Model):
         self.g = math.cos(a) * self.radial_direction() + math.sin(a) * self.axial_direction(self.r_j)
         self.gap = b.radial_clearance * math.cos(a)
 
-    def evaluate(self, q):
+    def _evaluate(self, q):
         n = self.exponent
         d = np.maximum(self.g @ q - self.gap, 0.0)                  # Eq. (3.13)
         q_j = self.k_n * d**n
@@ -273,7 +281,7 @@ class SlicedRoller(_Model):
         outer_race = b.pitch_diameter / 2.0 + b.element_diameter / 2.0
         self.law = hertz.LineContactSlices(b.element_diameter, inner_race, outer_race, dl, b.E, b.nu)
 
-    def evaluate(self, q):
+    def _evaluate(self, q):
         approach = self.g @ q - self.gap
         f, k = self.law.force_and_stiffness(approach)
         force = f @ self.g
@@ -352,7 +360,8 @@ def solve_mean_displacement(model: _Model, f: np.ndarray, tol: float = 1e-10, ma
                              "carries no moment")
         free[3:] = False        # tilts are free and load nothing: keep them at zero
     sq = scale_q[free]
-    limit = 0.25 * b.element_diameter / d_ref                             # beyond this: no equilibrium
+    # 100x any real contact deflection plus room for the axial play: beyond this there is no equilibrium
+    limit = (0.02 * b.element_diameter + 20.0 * abs(b.radial_clearance)) / d_ref
     cache = {}
 
     def state(x):

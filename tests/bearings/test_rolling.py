@@ -1,0 +1,161 @@
+"""Lim's 6x6 bearing stiffness (thesis Sec. 3.2, 3.3, Appendix D) against analytic properties and solutions."""
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from housingfe.bearings import (bearing_stiffness, finite_difference_stiffness, lookup, make_model,
+                                RollingBearing)
+from housingfe.errors import InputError
+
+LOADS = {
+    "radial": [0.0, -10000.0, 0.0, 0.0, 0.0],
+    "radial+axial": [0.0, -10000.0, 4000.0, 0.0, 0.0],
+    "combined+moment": [3000.0, -8000.0, 4000.0, 40.0, -25.0],
+}
+CASES = [("6312", None, "radial+axial"), ("6215", None, "combined+moment"), ("6312", None, "radial"),
+         ("7316B", None, "radial+axial"), ("NJ316", "lim-roller", "radial"), ("NJ316", "sliced-roller", "radial"),
+         ("NU2219", "sliced-roller", "radial"), ("21316CC", None, "radial+axial")]
+
+
+def zero_clearance_ball(z=8, alpha_deg=0.0):
+    b = lookup("6312")
+    return dataclasses.replace(b, n_elements=z, radial_clearance=0.0, contact_angle=math.radians(alpha_deg))
+
+
+@pytest.mark.parametrize("name,model,load", CASES)
+def test_matrix_properties_and_analytic_jacobian(name, model, load):
+    res = bearing_stiffness(name, LOADS[load], model=model)
+    k = res.K
+    assert k.shape == (6, 6)
+    assert np.array_equal(k, k.T)
+    assert np.all(k[5] == 0) and np.all(k[:, 5] == 0)            # free rotation about the shaft axis
+    assert np.min(np.linalg.eigvalsh(k)) >= -1e-9 * np.max(np.abs(k))
+    # the solution really carries the load
+    m = make_model(lookup(name), model)
+    assert m.evaluate(res.displacement)[1] == pytest.approx(np.array(LOADS[load]), abs=1e-6 * 1e4)
+    fd = finite_difference_stiffness(m, res.displacement)
+    assert np.max(np.abs(fd - k)) < 1e-5 * np.max(np.abs(k))
+
+
+def test_jacobian_equals_appendix_d_formulas():
+    # explicit (C-1a), (C-1c), (C-1e), (C-1j), (C-1m) of the thesis, evaluated independently of the code's
+    # vector form
+    b = lookup("6215")
+    res = bearing_stiffness(b, LOADS["combined+moment"])
+    m = make_model(b)
+    dx, dy, dz, bx, by, _ = res.displacement
+    psi = 2 * np.pi * np.arange(b.n_elements) / b.n_elements
+    a0 = (b.groove_inner + b.groove_outer - 1) * b.element_diameter
+    rj = m.r_j
+    sz = a0 * math.sin(b.contact_angle) + dz + rj * (bx * np.sin(psi) - by * np.cos(psi))
+    sr = a0 * math.cos(b.contact_angle) + dx * np.cos(psi) + dy * np.sin(psi) - b.radial_clearance
+    a = np.hypot(sr, sz)
+    on = a > a0
+    n, kn = 1.5, m.k_n
+    w = np.where(on, (np.maximum(a - a0, 0)) ** n / a**3, 0.0)
+    na = np.where(on, n * a / np.maximum(a - a0, 1e-300), 0.0)
+    kxx = kn * np.sum(w * (na * sr**2 + sz**2) * np.cos(psi) ** 2)
+    kxz = kn * np.sum(w * (na - 1) * sr * sz * np.cos(psi))
+    kxby = kn * np.sum(w * (1 - na) * rj * sr * sz * np.cos(psi) ** 2)
+    kzz = kn * np.sum(w * (na * sz**2 + sr**2))
+    kbxbx = kn * np.sum(w * (na * sz**2 + sr**2) * rj**2 * np.sin(psi) ** 2)
+    k = res.K
+    assert [k[0, 0], k[0, 2], k[0, 4], k[2, 2], k[3, 3]] == pytest.approx([kxx, kxz, kxby, kzz, kbxbx], rel=1e-10)
+
+
+def test_radial_stiffness_grows_as_cube_root_of_load():
+    # alpha0 = 0, zero clearance, pure radial: F = K_n delta^1.5 sum cos^2.5 -> k = 1.5 F / delta ~ F^(1/3)
+    b = zero_clearance_ball()
+    r1 = bearing_stiffness(b, [5000.0, 0, 0, 0, 0])
+    r2 = bearing_stiffness(b, [10000.0, 0, 0, 0, 0])
+    assert r2.K[0, 0] / r1.K[0, 0] == pytest.approx(2 ** (1 / 3), rel=1e-9)
+    assert r1.K[0, 0] == pytest.approx(1.5 * 5000.0 / r1.displacement[0], rel=1e-9)
+
+
+@pytest.mark.parametrize("z", [8, 16, 40])
+def test_stribeck_maximum_ball_load(z):
+    # exact: Q_max = F_r / sum_{|psi|<90} cos^2.5(psi); Stribeck's integral limit Q_max = 4.37 F_r / Z
+    b = zero_clearance_ball(z)
+    fr = 10000.0
+    res = bearing_stiffness(b, [fr, 0, 0, 0, 0])
+    psi = 2 * np.pi * np.arange(z) / z
+    c = np.cos(psi)
+    assert res.element_loads.max() == pytest.approx(fr / np.sum(c[c > 0] ** 2.5), rel=1e-9)
+    stribeck = res.element_loads.max() * z / fr
+    assert stribeck == pytest.approx(4.37, rel=0.01 if z >= 16 else 0.05)
+
+
+def test_stiffness_grows_with_axial_preload():
+    diag = [np.diag(bearing_stiffness("6312", [0, -5000.0, 0, 0, 0], preload_axial=p).K)[:5]
+            for p in (500.0, 1000.0, 2000.0, 4000.0)]
+    assert np.all(np.diff(np.array(diag), axis=0) > 0)
+
+
+def test_angular_contact_pure_axial_is_rotationally_symmetric():
+    # alpha0 = 40 deg, pure axial: every ball carries Fz / (Z sin(alpha)) (contact angle grows a little)
+    res = bearing_stiffness("7316B", [0, 0, 8000.0, 0, 0])
+    assert np.ptp(res.element_loads) < 1e-9 * res.element_loads.max()
+    assert res.element_loads * np.sin(res.contact_angles) == pytest.approx(8000.0 / len(res.element_loads))
+    assert res.K[0, 0] == pytest.approx(res.K[1, 1], rel=1e-9)
+    assert res.K[3, 3] == pytest.approx(res.K[4, 4], rel=1e-9)
+
+
+def test_lim_roller_has_no_tilt_stiffness_but_sliced_roller_has():
+    lim = bearing_stiffness("NJ316", LOADS["radial"], model="lim-roller").K
+    assert np.count_nonzero(np.abs(lim) > 0) == 4       # only k_xx, k_xy = k_yx, k_yy (thesis Sec. 3.3.2)
+    sliced = bearing_stiffness("NJ316", LOADS["radial"], model="sliced-roller").K
+    assert sliced[3, 3] > 0 and sliced[4, 4] > 0
+
+
+@pytest.mark.parametrize("slices", [10, 40])
+def test_sliced_roller_tilt_stiffness_is_radial_times_l2_over_12(slices):
+    # at zero tilt every slice of a roller is compressed alike, so k_slice = k_roller / N and
+    # k_bxbx = sum k_slice a^2 sin^2 = k_yy * mean(a^2) = k_yy l^2/12 (1 - 1/N^2) for alpha0 = 0
+    b = lookup("NJ316")
+    m = make_model(b, "sliced-roller")
+    m.__init__(b, slices=slices)
+    q = np.array([0.0, -3e-5, 0.0, 0.0, 0.0])
+    k = m.evaluate(q)[2]
+    factor = b.roller_length**2 / 12 * (1 - 1 / slices**2)
+    assert k[3, 3] == pytest.approx(k[1, 1] * factor, rel=1e-9)
+    assert k[4, 4] == pytest.approx(k[0, 0] * factor, rel=1e-9)
+
+
+def test_self_aligning_has_zero_moment_stiffness_and_rejects_moments():
+    res = bearing_stiffness("22219CC", LOADS["radial+axial"])
+    assert np.all(res.K[3:] == 0) and np.all(res.K[:, 3:] == 0)
+    assert res.K[2, 2] > 0 and res.K[1, 1] > 0
+    with pytest.raises(InputError, match="no moment"):
+        bearing_stiffness("22219CC", [0, -10000.0, 0, 50.0, 0])
+
+
+def test_fixed_tilt_returns_the_moments_it_needs():
+    free = bearing_stiffness("6312", LOADS["radial+axial"])
+    fixed = bearing_stiffness("6312", LOADS["radial+axial"], fixed_tilt=(0.0, 0.0))
+    assert fixed.displacement[3:5] == pytest.approx([0.0, 0.0], abs=0)
+    # prescribing the tilt the free solution found needs zero moment
+    again = bearing_stiffness("6312", LOADS["radial+axial"], fixed_tilt=tuple(free.displacement[3:5]))
+    assert again.load[3:5] == pytest.approx([0.0, 0.0], abs=1e-6)
+    assert fixed.load[3] != pytest.approx(0.0, abs=1.0)
+
+
+@pytest.mark.parametrize("designation,load,match", [
+    ("SKF 9999", LOADS["radial"], "not in the catalogue"),
+    ("7316B", [0, -1000.0, -4000.0, 0, 0], "cannot carry"),     # angular contact loaded the wrong way
+    ("NJ316", [0, -1000.0, 2000.0, 0, 0], "cannot carry"),      # cylindrical roller: no axial load
+    ("6312", [0, 0, 0, 0, 0], "unloaded"),
+    ("6312", [0, 0, 0, 0, 0, 10.0], "torque"),
+    ("6312", [0, 1e9, 0, 0, 0], "cannot carry"),
+])
+def test_bad_input_raises_input_error(designation, load, match):
+    with pytest.raises(InputError, match=match):
+        bearing_stiffness(designation, load)
+
+
+def test_nonphysical_geometry_raises_input_error():
+    with pytest.raises(InputError, match="pitch_diameter"):
+        RollingBearing("x", "ball", 0.06, 0.13, 0.03, 8, 0.022, 0.2)
+    with pytest.raises(InputError, match="groove"):
+        dataclasses.replace(lookup("6312"), groove_inner=0.49)
