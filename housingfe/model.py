@@ -20,7 +20,8 @@ MIN_ELEMENT_QUALITY = 0.05
 @dataclass
 class HousingModel:
     """Everything the solvers need.  K, M are PETSc matrices with Dirichlet rows eliminated
-    (1 on K's diagonal, 0 on M's); rigid_modes_expected is 6 for a free structure, else 0."""
+    (1 on K's diagonal, 0 on M's); rigid_modes_expected is 6 for a free structure, else 0 (partial
+    supports may still leave mechanisms, which the modal result counts)."""
 
     scene: HousingScene
     housing: HousingMesh

@@ -163,7 +163,7 @@ def plot_mode_shapes(path: Path, model, result, count: int) -> None:
     from dolfinx import fem, plot
 
     pyvista.OFF_SCREEN = True
-    n_rigid = model.rigid_modes_expected
+    n_rigid = result.rigid_count
     modes = list(range(n_rigid, min(n_rigid + count, len(result.vectors))))
     if not modes:
         return

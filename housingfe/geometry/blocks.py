@@ -99,7 +99,8 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) 
     groups (volumes per feature, surfaces per classifier name) and mesh.
 
     element: "hex" (transfinite, recombined hexahedra) or "tet".  size: target element size (m).
-    Returns {"cells": {name: tag}, "facets": {name: tag}} of the physical groups.
+    Returns {"cells": {name: tag}, "facets": {name: [tags]}} of the physical groups (a surface name may
+    cover several facet tag values).
     Runs on the calling rank only; the caller owns gmsh initialise/finalise.
     """
     import gmsh
@@ -110,7 +111,10 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) 
     tags = []
     for i, j, k in keys:
         tags.append(occ.addBox(gx[i], gy[j], gz[k], gx[i + 1] - gx[i], gy[j + 1] - gy[j], gz[k + 1] - gz[k]))
-    _, out_map = occ.fragment([(3, t) for t in tags[:1]], [(3, t) for t in tags[1:]])
+    if len(tags) > 1:
+        _, out_map = occ.fragment([(3, t) for t in tags[:1]], [(3, t) for t in tags[1:]])
+    else:
+        out_map = [[(3, tags[0])]]
     occ.synchronize()
     # out_map[n] lists the volumes that input n became; blocks never overlap, so each maps to one volume.
     feature_volumes: dict[str, list[int]] = {}
@@ -137,21 +141,24 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) 
     return {"cells": cell_groups, "facets": facet_groups}
 
 
-def _classify_boundary(model: BlockModel) -> dict[str, int]:
+def _classify_boundary(model: BlockModel) -> dict[str, list[int]]:
+    """Physical surface groups.  A dolfinx facet tag holds one value per facet, so each face gets one
+    atomic group named by all its names ("outer/outer_top"); every name maps to the union of the
+    atomic groups that carry it."""
     import gmsh
 
     boundary = gmsh.model.getBoundary(gmsh.model.getEntities(3), combined=True, oriented=False)
-    groups: dict[str, list[int]] = {}
+    atomic: dict[tuple[str, ...], list[int]] = {}
     for dim, tag in boundary:
         centre = np.array(gmsh.model.occ.getCenterOfMass(2, abs(tag)))
-        normal = _outward_normal(abs(tag), centre, model)
-        for name in model.classify_face(centre, normal):
-            groups.setdefault(name, []).append(abs(tag))
-    facet_groups = {}
-    for n, name in enumerate(sorted(groups), start=1):
-        gmsh.model.addPhysicalGroup(2, sorted(set(groups[name])), n)
-        gmsh.model.setPhysicalName(2, n, name)
-        facet_groups[name] = n
+        names = tuple(model.classify_face(centre, _outward_normal(abs(tag), centre, model)))
+        atomic.setdefault(names, []).append(abs(tag))
+    facet_groups: dict[str, list[int]] = {}
+    for n, names in enumerate(sorted(atomic), start=1):
+        gmsh.model.addPhysicalGroup(2, sorted(set(atomic[names])), n)
+        gmsh.model.setPhysicalName(2, n, "/".join(names))
+        for name in names:
+            facet_groups.setdefault(name, []).append(n)
     return facet_groups
 
 

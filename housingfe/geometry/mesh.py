@@ -15,7 +15,8 @@ from housingfe.geometry.blocks import BlockModel, build_gmsh_model
 class HousingMesh:
     """A dolfinx mesh with its tags and the exact geometric facts of the model it came from.
 
-    cell_groups / facet_groups map feature names to tag values in cell_tags / facet_tags.
+    cell_groups maps feature names to tag values in cell_tags; facet_groups maps surface names to the
+    tuple of tag values in facet_tags that make up the surface (use `facet_tag_values` with ufl's ds).
     volume (m^3) and centroid (m) are exact (from the block model), for checks of the FE model.
     """
 
@@ -23,7 +24,7 @@ class HousingMesh:
     cell_tags: object
     facet_tags: object
     cell_groups: dict[str, int]
-    facet_groups: dict[str, int]
+    facet_groups: dict[str, list[int]]
     volume: float
     centroid: np.ndarray
     element_size: float
@@ -32,11 +33,16 @@ class HousingMesh:
     mesh_time_s: float = 0.0
     quality: dict = field(default_factory=dict)
 
-    def facets(self, name: str) -> np.ndarray:
-        """Local indices of the facets in the named surface group (raises InputError if unknown)."""
+    def facet_tag_values(self, name: str) -> tuple[int, ...]:
+        """Tag values making up the named surface, for ufl: ds(housing.facet_tag_values("outer"))."""
         if name not in self.facet_groups:
             raise InputError(f"unknown surface group {name!r}; known: {', '.join(sorted(self.facet_groups))}")
-        return self.facet_tags.find(self.facet_groups[name])
+        return tuple(self.facet_groups[name])
+
+    def facets(self, name: str) -> np.ndarray:
+        """Local indices of the facets of the named surface (raises InputError if unknown)."""
+        values = self.facet_tag_values(name)
+        return np.unique(np.concatenate([self.facet_tags.find(v) for v in values]))
 
 
 def bending_wavelength(frequency: float, thickness: float, youngs_modulus: float, poisson_ratio: float,

@@ -19,6 +19,11 @@ from slepc4py import SLEPc
 from housingfe.errors import SolverError
 
 
+# Rigid-body modes come out at ~1e-7 f_max in double precision; elastic modes of any sensible scene lie
+# far above 1e-4 f_max.
+RIGID_FREQUENCY_RATIO = 1e-4
+
+
 @dataclass
 class ModalResult:
     """Eigenpairs below f_max.
@@ -40,6 +45,11 @@ class ModalResult:
     def frequencies_hz(self) -> np.ndarray:
         """Eigenfrequencies (Hz); tiny negative round-off of rigid modes is shown as 0."""
         return np.sqrt(np.clip(self.eigenvalues, 0.0, None)) / (2 * math.pi)
+
+    @property
+    def rigid_count(self) -> int:
+        """Number of rigid-body (mechanism) modes: frequencies below RIGID_FREQUENCY_RATIO * f_max."""
+        return int(np.sum(self.frequencies_hz < RIGID_FREQUENCY_RATIO * self.f_max))
 
     @property
     def complete(self) -> bool:

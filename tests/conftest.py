@@ -1,0 +1,29 @@
+"""Shared fixtures: small FE models built once per session."""
+import os
+
+import pytest
+
+os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+
+@pytest.fixture(scope="session")
+def comm():
+    from mpi4py import MPI
+
+    return MPI.COMM_WORLD
+
+
+def load_scene(name, *overrides):
+    from housingfe.scene import load_housing_scene
+
+    return load_housing_scene(name, list(overrides))[0]
+
+
+@pytest.fixture(scope="session")
+def coarse_box_model(comm):
+    """The box-free scene on a coarse hex mesh (fast, still 6 rigid + a dozen elastic modes to 2.5 kHz)."""
+    from housingfe.model import build_model
+
+    return build_model(load_scene("box-free", "mesh.size=0.04", "analysis.modal.f_max=2500.0"), comm)
