@@ -376,8 +376,10 @@ def tooth_profile(pair: GearPair, gear: int, n_radii: int = 120) -> dict[str, np
     involute_half = np.where(radii >= rb, psi_b - involute(np.arccos(np.minimum(rb / radii, 1.0))), np.nan)
     on_involute = np.abs(half - involute_half) * radii < 1e-3 * pair.module   # within 1 per mille of m
     # form radius: from here up to the tip the flank is the involute
-    off = np.flatnonzero(~on_involute[:-1])
-    form_radius = float(radii[off[-1] + 1]) if off.size else float(radii[0])
+    # first radius from which 10 consecutive samples lie on the involute (isolated sampling outliers of
+    # a few um higher up do not move it)
+    runs = np.convolve(on_involute.astype(int), np.ones(10, dtype=int), mode="valid") == 10
+    form_radius = float(radii[np.argmax(runs)]) if runs.any() else float(radii[0])
     right = np.column_stack([radii * np.sin(half), radii * np.cos(half)])
     tip_angles = np.linspace(half[-1], -half[-1], 20)
     tip = np.column_stack([ra * np.sin(tip_angles), ra * np.cos(tip_angles)])

@@ -1,0 +1,492 @@
+"""Analytic tooth stiffness and load distribution (van Roosmalen 1994, Sec. 2.2-2.4, Appendix A).
+
+The contact lines of all tooth pairs in mesh are discretised into points (one per face-width slice).
+The compliance between two points i, j (normal deflection at i per unit normal force at j) is
+
+    c_ij = [tooth plate, same tooth pair only]  sum_g G_g(w_i, w_j) g_g(i) g_g(j)       (eq. 2.31-2.32)
+         + [Hertz, i = j]                        delta_Hertz(F_i) / F_i                 (eq. 2.40, secant)
+         + [shaft bending, both gears]           cos^2(beta_b) a_g(z_i, z_j)            (Euler beams)
+         + [wheel body torsion, both gears]      cos^2(beta_b) r_b^2 L_k / (G I_p)       (eq. 2.49-2.52)
+
+G_g is the Green's function of Schmidt's cantilever-plate edge equation
+S1 f'''' - S2 f'' + S3 f = P delta(x - xi) with free ends (eq. 2.7-2.29), solved exactly with the
+four exponential roots (both root cases of Appendix A are covered by complex arithmetic; the 8x8
+system is assembled here rather than copied from the OCR'd Appendix A, whose entries did not survive
+legibly).  g = sqrt(f_tot(y)/f_etot) uses the Weber-Banaschek deflection of the tooth (eq. 2.36) and
+root (eq. 2.39) of the virtual spur gear in the normal section.  The load distribution follows Sec. 2.3:
+equal approach delta at all loaded points, points that would carry tension are released, iteration on
+the non-linear Hertz term.  The mesh stiffness per unit width is s = (dF/B) / d(delta) (eq. 2.55).
+
+Conventions: forces and deflections are NORMAL to the flank (the plane of action), in N and m; the
+mesh stiffness S_t(t) is the normal stiffness used in Appendix C's matrix.  Position on the path of
+contact s is measured along the transverse line of action from the pinion's tangent point T1.
+Assumptions where the thesis' figures are missing are listed in docs/source.md.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from housingfe.errors import InputError, SolverError
+from housingfe.source.gears import GearPair, involute, tooth_profile
+
+# Schmidt's plate factor alpha = 12 / (1 + 2 nu)^2 (eq. 2.11 as printed).
+def _plate_alpha(nu: float) -> float:
+    return 12.0 / (1.0 + 2.0 * nu) ** 2
+
+
+# ----------------------------------------------------------------------------- inputs
+@dataclass(frozen=True)
+class ShaftBending:
+    """Euler-beam model of one gear shaft (Fig. 2.6): bearings as simple supports (infinitely stiff
+    radially, no moment stiffness), shaft diameter `shaft_diameter` [m] over `left_span` and
+    `right_span` [m] between the bearings and the gear faces; the gear body is a solid cylinder of the
+    root diameter over the face width."""
+
+    left_span: float
+    right_span: float
+    shaft_diameter: float
+
+
+@dataclass(frozen=True)
+class Corrections:
+    """Flank corrections as the gap they open along the flank normal (m).
+
+    tip_relief: (pinion, wheel) amount at the tip [m]; tip_relief_length: (pinion, wheel) length along
+    the transverse line of action [m], linear ramp.  width_relief on the pinion: amount [m] over
+    `width_relief_length` [m] from the face w = 0, linear.  triangular=True turns the tip reliefs into
+    the 3-D triangular correction D of Fig. F.1: relief = amount * max(0, 1 - l/L - w'/W) with l the
+    distance from the tip along the line of action and w' the distance from the corner Q (pinion:
+    face w = 0, wheel: face w = b), W = triangle_width (pinion, wheel) [m]."""
+
+    tip_relief: tuple[float, float] = (0.0, 0.0)
+    tip_relief_length: tuple[float, float] = (0.0, 0.0)
+    width_relief: float = 0.0
+    width_relief_length: float = 0.0
+    triangular: bool = False
+    triangle_width: tuple[float, float] = (0.0, 0.0)
+
+    @classmethod
+    def from_table(cls, t: dict, where: str = "corrections") -> "Corrections":
+        """From Appendix F style keys in um / mm: pinion_um, pinion_mm, wheel_um, wheel_mm,
+        pinion_width_relief_um, pinion_width_relief_mm, kind = "3-D triangular", pinion_width_mm,
+        wheel_width_mm."""
+        known = {"pinion_um", "pinion_mm", "wheel_um", "wheel_mm", "pinion_width_relief_um",
+                 "pinion_width_relief_mm", "kind", "pinion_width_mm", "wheel_width_mm"}
+        unknown = set(t) - known
+        if unknown:
+            raise InputError(f"{where}: unknown key {sorted(unknown)[0]!r}")
+        vals = {k: v for k, v in t.items() if k != "kind"}
+        if any((not isinstance(v, (int, float))) or v < 0 for v in vals.values()):
+            raise InputError(f"{where}: amounts and lengths must be numbers >= 0")
+        kind = t.get("kind", "tip relief")
+        if kind not in ("tip relief", "3-D triangular"):
+            raise InputError(f"{where}: kind: {kind!r} is not 'tip relief' or '3-D triangular'")
+        triangular = kind == "3-D triangular"
+        c = cls(
+            tip_relief=(t.get("pinion_um", 0) * 1e-6, t.get("wheel_um", 0) * 1e-6),
+            tip_relief_length=(t.get("pinion_mm", 0) * 1e-3, t.get("wheel_mm", 0) * 1e-3),
+            width_relief=t.get("pinion_width_relief_um", 0) * 1e-6,
+            width_relief_length=t.get("pinion_width_relief_mm", 0) * 1e-3,
+            triangular=triangular,
+            triangle_width=(t.get("pinion_width_mm", 0) * 1e-3, t.get("wheel_width_mm", 0) * 1e-3),
+        )
+        for g in (0, 1):
+            if (c.tip_relief[g] > 0) != (c.tip_relief_length[g] > 0):
+                raise InputError(f"{where}: a tip relief needs both an amount and a length > 0")
+            if triangular and c.tip_relief[g] > 0 and c.triangle_width[g] <= 0:
+                raise InputError(f"{where}: a 3-D triangular correction needs pinion_width_mm/wheel_width_mm")
+        return c
+
+
+# ----------------------------------------------------------------------------- Weber-Banaschek
+@dataclass
+class _ToothFlex:
+    """Weber-Banaschek flexibility of one gear's tooth (virtual spur gear in the normal section) as
+    functions of the transverse roll distance rho_t = sqrt(r^2 - r_b^2) of the contact point."""
+
+    rho_t: np.ndarray            # m, grid along the flank
+    c_tooth: np.ndarray          # m^2/N: delta_t * B / F (rigid root), eq. 2.36
+    c_root: np.ndarray           # m^2/N: delta_r * B / F, eq. 2.39
+    t_hertz: np.ndarray          # m: distance contact point -> tooth centre line along the load line
+    rho_n: np.ndarray            # m: normal radius of curvature of the flank
+    tip_height: float            # m: plate height h_p (root to tip along the centre line)
+
+
+def _virtual_spur(pair: GearPair) -> GearPair:
+    """The virtual spur gear pair of the normal section: z_n = z / (cos^2(beta_b) cos(beta)), same
+    normal module, pressure angle, profile shifts, addendum reduction and rack."""
+    bb, b = pair.base_helix_angle, pair.helix_angle
+    zn = tuple(z / (math.cos(bb) ** 2 * math.cos(b)) for z in pair.teeth)
+    a0 = 0.5 * pair.module * (zn[0] + zn[1])
+    return GearPair(module=pair.module, teeth=zn, pressure_angle=pair.pressure_angle, helix_angle=0.0,
+                    profile_shift=pair.profile_shift, face_width=pair.face_width,
+                    centre_distance=a0 + sum(pair.profile_shift) * pair.module + pair.addendum_reduction,
+                    addendum_coefficient=pair.addendum_coefficient,
+                    dedendum_coefficient=pair.dedendum_coefficient,
+                    rack_tip_radius_factor=pair.rack_tip_radius_factor, kind="spur",
+                    youngs_modulus=pair.youngs_modulus, poisson_ratio=pair.poisson_ratio)
+
+
+def weber_banaschek(pair: GearPair, gear: int, n: int = 80) -> _ToothFlex:
+    """Tooth and root flexibility of gear 0/1 after Weber & Banaschek (eq. 2.34-2.39), Hertz distance
+    t and normal curvature radius, tabulated over the active flank.  Units: see `_ToothFlex`."""
+    E, nu = pair.youngs_modulus, pair.poisson_ratio
+    vp = _virtual_spur(pair)
+    prof = tooth_profile(vp, gear, n_radii=160)
+    R, psi = prof["radius"], prof["half_angle"]
+    y_prof, x_prof = R * np.cos(psi), R * np.sin(psi)
+    y0 = y_prof[0]                                   # root: where the fillet meets the root circle
+    root_thickness = 2 * x_prof[0]
+    rbv = float(vp.base_diameter[gear]) / 2
+    rav = float(vp.tip_diameter[gear]) / 2
+    r_lo = max(prof["form_radius"], rbv * 1.0001)
+    rv = np.linspace(r_lo, rav, n)
+    psi_v = np.interp(rv, R, psi)
+    alpha_load = np.arccos(rbv / rv) - psi_v          # angle of the load with the normal to the centre line
+    # load height above the root (clipped: a load line meeting the centre line below the root adds no arm)
+    yp = np.maximum(rv * np.cos(psi_v) - rv * np.sin(psi_v) * np.tan(alpha_load) - y0, 1e-6 * pair.module)
+    t_h = rv * np.sin(psi_v) / np.cos(alpha_load)
+    rho_n = np.sqrt(rv**2 - rbv**2)
+    c_t = np.empty(n)
+    for i in range(n):
+        ys = np.linspace(0.0, yp[i], 200)
+        half = np.interp(ys + y0, y_prof, x_prof)     # half thickness along the centre line
+        bending = 12 * (1 - nu**2) * np.trapz((yp[i] - ys) ** 2 / (2 * half) ** 3, ys)
+        shear = (2.4 * (1 + nu) + (1 - nu**2) * np.tan(alpha_load[i]) ** 2) * np.trapz(1 / (2 * half), ys)
+        c_t[i] = np.cos(alpha_load[i]) ** 2 / E * (bending + shear)
+    ratio = yp / root_thickness
+    c_r = np.cos(alpha_load) ** 2 / E * (
+        18 * (1 - nu**2) / math.pi * ratio**2 + 2 * (1 + nu) * (1 - 2 * nu) * ratio
+        + 4.8 / math.pi * (1 - nu**2) * (1 + (1 - nu) / 2.4 * np.tan(alpha_load) ** 2))
+    # transverse roll distance of the real gear belonging to each virtual radius
+    rho_t = rho_n * math.cos(pair.base_helix_angle)
+    return _ToothFlex(rho_t=rho_t, c_tooth=c_t, c_root=c_r, t_hertz=t_h, rho_n=rho_n,
+                      tip_height=float(rav * math.cos(psi_v[-1]) - y0))
+
+
+# ----------------------------------------------------------------------------- Schmidt plate
+def plate_green(length: float, S1: float, S2: float, S3: float, xi: float, x: np.ndarray) -> np.ndarray:
+    """Edge deflection f(x) [m] of Schmidt's cantilever plate of width `length` [m] for a unit point
+    force [N] at xi: S1 f'''' - S2 f'' + S3 f = delta(x - xi), free ends f'' = 0 and
+    f''' - (S2/S1) f' = 0 (eq. 2.7, 2.22-2.29).  S1 [N m^2], S2 [N], S3 [N/m^2]."""
+    a, b = S2 / S1, S3 / S1
+    disc = np.sqrt(complex(a * a / 4 - b))
+    lam = np.array([np.sqrt(a / 2 + disc), -np.sqrt(a / 2 + disc), np.sqrt(a / 2 - disc), -np.sqrt(a / 2 - disc)])
+    # basis exp(lam (x - ref)) with ref chosen so that no basis function exceeds 1 in its region
+    ref_left = np.where(lam.real > 0, xi, 0.0)
+    ref_right = np.where(lam.real > 0, length, xi)
+
+    def rows(pt, ref, order):
+        return lam**order * np.exp(lam * (pt - ref))
+
+    A = np.zeros((8, 8), dtype=complex)
+    rhs = np.zeros(8, dtype=complex)
+    A[0, :4] = rows(0.0, ref_left, 2)
+    A[1, :4] = rows(0.0, ref_left, 3) - a * rows(0.0, ref_left, 1)
+    A[2, 4:] = rows(length, ref_right, 2)
+    A[3, 4:] = rows(length, ref_right, 3) - a * rows(length, ref_right, 1)
+    for k, order in enumerate((0, 1, 2)):            # continuity of f, f', f'' at xi
+        A[4 + k, :4] = rows(xi, ref_left, order)
+        A[4 + k, 4:] = -rows(xi, ref_right, order)
+    A[7, :4] = -rows(xi, ref_left, 3)                # jump of f''' = P / S1
+    A[7, 4:] = rows(xi, ref_right, 3)
+    rhs[7] = 1.0 / S1
+    coef = np.linalg.solve(A, rhs)
+    x = np.asarray(x, dtype=float)
+    left = (np.exp(np.outer(x, lam) - lam * ref_left) @ coef[:4])
+    right = (np.exp(np.outer(x, lam) - lam * ref_right) @ coef[4:])
+    return np.where(x <= xi, left, right).real
+
+
+def plate_coefficients(flex: _ToothFlex, nu: float) -> tuple[float, float, float]:
+    """(S1, S2, S3) of eq. 2.8-2.10 for one tooth.  The equivalent plate has the tooth height h_p and
+    a flexural rigidity N chosen so that its cantilever compliance h_p^3/(3N) equals the
+    Weber-Banaschek rigid-root compliance at the tip; then S3 = gamma 3N/h_p^3 = 1/f_etot (per unit
+    width), so a uniformly loaded long tooth deflects exactly as Weber-Banaschek predicts."""
+    f_e = flex.c_tooth[-1]
+    f_etot = flex.c_tooth[-1] + flex.c_root[-1]
+    hp = flex.tip_height
+    N = hp**3 / (3 * f_e)
+    gamma = f_e / f_etot
+    alpha = _plate_alpha(nu)
+    return hp * N / alpha, 2 * (1 - nu) * N / hp, gamma * 3 * N / hp**3
+
+
+# ----------------------------------------------------------------------------- shafts and torsion
+def beam_influence(z: np.ndarray, shaft: ShaftBending, gear_diameter: float, face_width: float,
+                   gear_offset: float, E: float, n_grid: int = 1500) -> np.ndarray:
+    """Deflection at axial positions z_i [m] (measured from the gear's first face) per unit transverse
+    force at z_j, of a simply supported stepped Euler beam (unit-load method) [m/N]."""
+    L = shaft.left_span + face_width + shaft.right_span
+    zz = np.linspace(0.0, L, n_grid)
+    in_gear = (zz >= shaft.left_span) & (zz <= shaft.left_span + face_width)
+    d = np.where(in_gear, gear_diameter, shaft.shaft_diameter)
+    EI = E * math.pi * d**4 / 64
+    zp = shaft.left_span + gear_offset + np.asarray(z)
+    m = np.where(zz[None, :] <= zp[:, None], zz[None, :] * (L - zp[:, None]) / L,
+                 zp[:, None] * (L - zz[None, :]) / L)
+    w = np.gradient(zz) / EI
+    return (m * w) @ m.T
+
+
+# ----------------------------------------------------------------------------- mesh model
+@dataclass
+class MeshModel:
+    """Everything that does not change with mesh position: flexibilities, plate Green's functions,
+    shaft and torsion influence matrices over the face-width slices.
+
+    torque_configuration 1 or 2 (Fig. 2.7): 1 = both torques enter at face w = 0, 2 = the wheel torque
+    leaves at the opposite face.  n_slices: points per contact line per helix."""
+
+    pair: GearPair
+    shafts: tuple[ShaftBending, ShaftBending] | None = None
+    corrections: Corrections = field(default_factory=Corrections)
+    n_slices: int = 24
+    torque_configuration: int = 2
+    include_plate_coupling: bool = True
+
+    def __post_init__(self):
+        if self.torque_configuration not in (1, 2):
+            raise InputError(f"stiffness: torque_configuration: must be 1 or 2, got {self.torque_configuration}")
+        if self.n_slices < 2:
+            raise InputError("stiffness: n_slices: need at least 2 slices")
+        p = self.pair
+        nu, E = p.poisson_ratio, p.youngs_modulus
+        self.G_shear = E / (2 * (1 + nu))
+        self.flex = [weber_banaschek(p, 0), weber_banaschek(p, 1)]
+        b = p.contact_width
+        self.dw = b / self.n_slices
+        w_local = (np.arange(self.n_slices) + 0.5) * self.dw
+        helices = 2 if p.kind == "double_helical" else 1
+        # axial position of every slice over all helices, and the helix it belongs to
+        self.w = np.concatenate([w_local + h * (b + p.helix_gap) for h in range(helices)])
+        self.helix = np.repeat(np.arange(helices), self.n_slices)
+        self.w_local = np.tile(w_local, helices)
+        # plate Green's functions (per gear, per helix identical)
+        self.green = []
+        for g in (0, 1):
+            S1, S2, S3 = plate_coefficients(self.flex[g], nu)
+            if self.include_plate_coupling:
+                Gm = np.array([plate_green(b, S1, S2, S3, xi, w_local) for xi in w_local]).T
+            else:                                         # independent slices (no plate coupling)
+                Gm = np.eye(self.n_slices) / (S3 * self.dw)
+            self.green.append(Gm)
+        self.f_etot = [f.c_tooth[-1] + f.c_root[-1] for f in self.flex]
+        cb2 = math.cos(p.base_helix_angle) ** 2
+        total_width = float(self.w[-1] + 0.5 * self.dw)
+        body = np.zeros((len(self.w), len(self.w)))
+        rb = p.base_diameter / 2
+        for g in (0, 1):
+            Ip = math.pi * (float(p.pitch_diameter[g]) / 2) ** 4 / 2
+            wi, wj = np.meshgrid(self.w, self.w, indexing="ij")
+            if g == 1 and self.torque_configuration == 2:
+                twist_length = total_width - np.maximum(wi, wj)
+            else:
+                twist_length = np.minimum(wi, wj)
+            body += cb2 * rb[g] ** 2 * twist_length / (self.G_shear * Ip)
+            if self.shafts is not None:
+                body += cb2 * beam_influence(self.w, self.shafts[g], float(p.root_diameter[g]),
+                                             total_width, 0.0, E)
+        self.body = body
+
+    # -------------------------------------------------------------- contact points
+    def contact_points(self, u: float) -> dict[str, np.ndarray]:
+        """Contact points at mesh position u [m] (0 <= u < p_bt, along the transverse line of action):
+        for every slice and tooth pair whose contact line crosses the slice inside the path of contact
+        A <= s <= E.  Returns slice index, tooth-pair index and position s [m]."""
+        p = self.pair
+        A, E_ = p.path_of_contact
+        pbt = p.transverse_base_pitch
+        tb = math.tan(p.base_helix_angle)
+        b = p.contact_width
+        # helix 0: contact line s = u + k pbt + w tan(beta_b); helix 1 mirrored
+        offset = np.where(self.helix == 0, self.w_local, b - self.w_local) * tb
+        k_lo = math.floor((A - u - b * tb) / pbt) - 1
+        k_hi = math.ceil((E_ - u) / pbt) + 1
+        slices, pairs, pos = [], [], []
+        for k in range(k_lo, k_hi + 1):
+            s = u + k * pbt + offset
+            ok = (s >= A) & (s <= E_)
+            idx = np.flatnonzero(ok)
+            slices.append(idx)
+            pairs.append(np.full(idx.size, k))
+            pos.append(s[idx])
+        return {"slice": np.concatenate(slices), "pair": np.concatenate(pairs), "s": np.concatenate(pos)}
+
+    def _flex_at(self, s: np.ndarray) -> dict[str, np.ndarray]:
+        p = self.pair
+        rho_t = [s, p.line_of_action_length - s]
+        out = {}
+        for g in (0, 1):
+            f = self.flex[g]
+            r = np.clip(rho_t[g], f.rho_t[0], f.rho_t[-1])
+            out[f"c{g}"] = np.interp(r, f.rho_t, f.c_tooth + f.c_root)
+            out[f"t{g}"] = np.interp(r, f.rho_t, f.t_hertz)
+            out[f"rho{g}"] = np.interp(r, f.rho_t, f.rho_n)
+        return out
+
+    def gaps(self, pts: dict[str, np.ndarray]) -> np.ndarray:
+        """Initial gap [m] along the normal at each contact point from the flank corrections."""
+        p, c = self.pair, self.corrections
+        A, E_ = p.path_of_contact
+        s, w = pts["s"], self.w_local[pts["slice"]]
+        hx = self.helix[pts["slice"]]
+        b = p.contact_width
+        # the corner Q where a helix' contact starts/ends depends on the helix hand
+        w_from_pinion_corner = np.where(hx == 0, w, b - w)
+        gap = np.zeros_like(s)
+        for g, dist in ((0, E_ - s), (1, s - A)):
+            amt, length = c.tip_relief[g], c.tip_relief_length[g]
+            if amt <= 0:
+                continue
+            if c.triangular:
+                wq = w_from_pinion_corner if g == 0 else b - w_from_pinion_corner
+                gap += amt * np.maximum(0.0, 1 - dist / length - wq / c.triangle_width[g])
+            else:
+                gap += amt * np.maximum(0.0, 1 - dist / length)
+        if c.width_relief > 0:
+            gap += c.width_relief * np.maximum(0.0, 1 - self.w[pts["slice"]] / c.width_relief_length)
+        return gap
+
+    def compliance(self, pts: dict[str, np.ndarray]) -> np.ndarray:
+        """Linear part of the compliance matrix [m/N] between the contact points (no Hertz)."""
+        sl, pr = pts["slice"], pts["pair"]
+        fl = self._flex_at(pts["s"])
+        same_pair = (pr[:, None] == pr[None, :]) & (self.helix[sl][:, None] == self.helix[sl][None, :])
+        loc = sl % self.n_slices
+        C = self.body[np.ix_(sl, sl)].copy()
+        for g in (0, 1):
+            gg = np.sqrt(fl[f"c{g}"] / self.f_etot[g])
+            C += same_pair * self.green[g][np.ix_(loc, loc)] * np.outer(gg, gg)
+        return C
+
+    def hertz(self, pts, forces: np.ndarray) -> np.ndarray:
+        """Hertzian approach [m] of each contact point under its normal force [N] (eq. 2.40), with the
+        contact-line length of one slice dw / cos(beta_b)."""
+        p = self.pair
+        fl = self._flex_at(pts["s"])
+        E, nu = p.youngs_modulus, p.poisson_ratio
+        L = self.dw / math.cos(p.base_helix_angle)
+        rho_v = fl["rho0"] * fl["rho1"] / (fl["rho0"] + fl["rho1"])
+        F = np.maximum(forces, 1e-9)
+        arg = fl["t0"] * fl["t1"] * math.pi * E * L / (2 * rho_v * (1 - nu**2) * F)
+        return 2 * F * (1 - nu**2) / (math.pi * E * L) * (np.log(np.maximum(arg, 1.0 + 1e-12)) - nu / (1 - nu))
+
+    # -------------------------------------------------------------- load distribution
+    def load_distribution(self, u: float, total_force: float, tol: float = 1e-10, max_iter: int = 60):
+        """Force distribution [N] and mean approach [m] at mesh position u for a total normal force
+        [N] (Sec. 2.3).  Returns (points, forces, delta)."""
+        pts = self.contact_points(u)
+        n = pts["s"].size
+        if n == 0:
+            raise SolverError(f"stiffness: no contact at mesh position {u}")
+        C = self.compliance(pts)
+        e = self.gaps(pts)
+        active = np.ones(n, dtype=bool)
+        F = np.full(n, total_force / n)
+        for _ in range(max_iter):
+            h = self.hertz(pts, F) / np.maximum(F, 1e-9)          # secant Hertz compliance
+            idx = np.flatnonzero(active)
+            m = idx.size
+            K = np.zeros((m + 1, m + 1))
+            K[:m, :m] = C[np.ix_(idx, idx)] + np.diag(h[idx])
+            K[:m, m] = -1.0
+            K[m, :m] = 1.0
+            rhs = np.concatenate([-e[idx], [total_force]])
+            sol = np.linalg.solve(K, rhs)
+            F_new = np.zeros(n)
+            F_new[idx] = sol[:m]
+            delta = sol[m]
+            neg = F_new < 0
+            if neg.any():                                          # release points that pull
+                active &= ~neg
+                F = np.where(active, np.maximum(F_new, total_force * 1e-6), 0.0)
+                continue
+            # re-admit points that the approach would push into the mating flank
+            approach = C @ F_new + e
+            penetrating = (~active) & (approach < delta - 1e-12)
+            change = np.max(np.abs(F_new - F)) / total_force
+            F = F_new
+            if penetrating.any():
+                active |= penetrating
+                continue
+            if change < tol:
+                return pts, F, delta
+        raise SolverError(f"stiffness: load distribution did not converge at u = {u:.3e} m")
+
+    def stiffness_at(self, u: float, total_force: float, rel_step: float = 1e-3) -> dict[str, float]:
+        """Mean approach delta [m] and mesh stiffness [N/m] (dF / d delta, eq. 2.55) at position u."""
+        _, F, d0 = self.load_distribution(u, total_force)
+        _, _, d1 = self.load_distribution(u, total_force * (1 + rel_step))
+        k = total_force * rel_step / (d1 - d0)
+        return {"delta": d0, "stiffness": k, "n_points": int(np.count_nonzero(F > 0))}
+
+
+@dataclass
+class StiffnessCurve:
+    """Mesh stiffness over one mesh period.  position: u / p_bt in [0, 1); stiffness: normal mesh
+    stiffness [N/m]; per_width: s = stiffness / total face width [N/m^2] (1 N/(mm um) = 1e9 N/m^2);
+    deflection: mean normal approach [m] at the given load."""
+
+    position: np.ndarray
+    stiffness: np.ndarray
+    per_width: np.ndarray
+    deflection: np.ndarray
+    total_force: float
+
+    @property
+    def mean(self) -> float:
+        """Mean normal mesh stiffness [N/m]."""
+        return float(self.stiffness.mean())
+
+    @property
+    def amplitude(self) -> float:
+        """Peak-to-peak stiffness / 2 [N/m]."""
+        return float(0.5 * (self.stiffness.max() - self.stiffness.min()))
+
+    def fourier(self) -> np.ndarray:
+        """Complex Fourier coefficients X_k (eq. 2.58) of the stiffness, k = 0..N-1 [N/m]."""
+        return np.fft.fft(self.stiffness) / self.stiffness.size
+
+
+def stiffness_curve(model: MeshModel, total_force: float, n_positions: int = 32) -> StiffnessCurve:
+    """Mesh stiffness over one mesh period at a total normal tooth force [N] (Sec. 2.4)."""
+    if not total_force > 0:
+        raise InputError(f"stiffness: total force must be > 0 N, got {total_force}")
+    pbt = model.pair.transverse_base_pitch
+    pos = np.arange(n_positions) / n_positions
+    out = [model.stiffness_at(x * pbt, total_force) for x in pos]
+    k = np.array([o["stiffness"] for o in out])
+    return StiffnessCurve(position=pos, stiffness=k, per_width=k / model.pair.total_contact_width,
+                          deflection=np.array([o["delta"] for o in out]), total_force=total_force)
+
+
+def normal_force_from_torque(pair: GearPair, pinion_torque: float) -> float:
+    """Total normal tooth force F_bn = T1 / (r_b1 cos(beta_b)) [N] for a pinion torque [N m]."""
+    return pinion_torque / (float(pair.base_diameter[0]) / 2 * math.cos(pair.base_helix_angle))
+
+
+# ----------------------------------------------------------------------------- ISO 6336-1
+def iso6336_stiffness(pair: GearPair, load_per_width: float | None = None) -> dict[str, float]:
+    """Single stiffness c' and mesh stiffness c_gamma_alpha after ISO 6336-1:2006 method B
+    (eq. for q', C_M = 0.8, C_R = 1 for solid blanks, C_B from the basic rack, cos(beta)).
+    load_per_width: F_t K_A / b [N/m]; below 100 N/mm c' is reduced proportionally.
+    Returns values in N/(m m) (divide by 1e9 for N/(mm um))."""
+    bb, b = pair.base_helix_angle, pair.helix_angle
+    zn1, zn2 = (z / (math.cos(bb) ** 2 * math.cos(b)) for z in pair.teeth)
+    x1, x2 = pair.profile_shift
+    q = (0.04723 + 0.15551 / zn1 + 0.25791 / zn2 - 0.00635 * x1 - 0.11654 * x1 / zn1
+         - 0.00193 * x2 - 0.24188 * x2 / zn2 + 0.00529 * x1**2 + 0.00182 * x2**2)   # mm um / N
+    c_th = 1.0 / q                                                                   # N/(mm um)
+    c_m, c_r = 0.8, 1.0
+    c_b = (1 + 0.5 * (1.2 - pair.dedendum_coefficient)) * (1 - 0.02 * (20 - math.degrees(pair.pressure_angle)))
+    c_prime = c_th * c_m * c_r * c_b * math.cos(b)
+    if load_per_width is not None and load_per_width < 100e3:
+        c_prime *= (load_per_width / 1e3) ** 0.25 / 100 ** 0.25
+    eps_a = pair.transverse_contact_ratio
+    c_gamma_alpha = c_prime * (0.75 * eps_a + 0.25)
+    return {"c_th": c_th * 1e9, "c_prime": c_prime * 1e9, "c_gamma_alpha": c_gamma_alpha * 1e9,
+            "c_gamma_beta": 0.85 * c_gamma_alpha * 1e9, "q_prime_mm_um_per_N": q}
