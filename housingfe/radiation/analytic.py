@@ -1,0 +1,111 @@
+"""Analytic radiators and quick estimates (van Roosmalen 1994, Sec. 4.7).
+
+Conventions used throughout `housingfe.radiation`:
+- SI units; frequencies in Hz; velocities in m/s.
+- Radiation efficiency sigma = P / (rho c S <v~^2>) (eq. 4.8), with <v~^2> the surface-averaged
+  *mean-square* (rms^2) normal velocity.  A harmonic velocity of peak amplitude v_hat has
+  v~^2 = |v_hat|^2 / 2.
+- Radiation index L_sigma = 10 lg sigma (dB).
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.special import j1
+
+from housingfe.errors import InputError
+
+SPEED_OF_SOUND = 344.0  # m/s, the value behind the printed numbers of Appendix E (1.13*U*fc/c)
+AIR_DENSITY = 1.21      # kg/m^3, air at about 20 degC and 1 atm
+
+
+def _positive(name: str, value) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(arr)) or np.any(arr <= 0.0):
+        raise InputError(f"{name}: must be positive and finite, got {value!r}")
+    return arr
+
+
+def _non_negative(name: str, value) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0.0):
+        raise InputError(f"{name}: must be non-negative and finite, got {value!r}")
+    return arr
+
+
+def wavenumber(frequency_hz, c: float = SPEED_OF_SOUND) -> np.ndarray:
+    """Acoustic wavenumber k = 2 pi f / c in rad/m."""
+    return 2.0 * np.pi * _non_negative("frequency_hz", frequency_hz) / _positive("c", c)
+
+
+def sphere_transition_frequency(radius_m: float, c: float = SPEED_OF_SOUND) -> float:
+    """Transitional frequency f_s = c / (2 pi R) of a pulsating sphere in Hz (eq. 4.7)."""
+    return float(_positive("c", c) / (2.0 * np.pi * _positive("radius_m", radius_m)))
+
+
+def sphere_sigma(ka) -> np.ndarray:
+    """Radiation efficiency of a uniformly pulsating sphere, sigma = (kR)^2 / (1 + (kR)^2) (eq. 4.9;
+    f/f_s = kR).  `ka` is the dimensionless Helmholtz number k*R."""
+    x2 = _non_negative("ka", ka) ** 2
+    return x2 / (1.0 + x2)
+
+
+def sphere_power(radius_m: float, velocity_amplitude_m_s, frequency_hz,
+                 rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND) -> np.ndarray:
+    """Time-averaged sound power of a pulsating sphere in W (eq. 4.6):
+    P = 2 pi rho c R^2 v_R^2 (f/f_s)^2 / (1 + (f/f_s)^2), with v_R the radial velocity *amplitude*
+    (peak, m/s) and R in m."""
+    R = _positive("radius_m", radius_m)
+    vR = _non_negative("velocity_amplitude_m_s", velocity_amplitude_m_s)
+    ka = wavenumber(frequency_hz, c) * R
+    return 2.0 * np.pi * _positive("rho", rho) * c * R**2 * vR**2 * sphere_sigma(ka)
+
+
+def piston_sigma(ka) -> np.ndarray:
+    """Radiation efficiency of a rigid circular piston of radius a in an infinite rigid baffle,
+    sigma = 1 - J1(2ka)/(ka) (radiating into one half-space).  Tends to (ka)^2/2 for ka -> 0."""
+    x = _non_negative("ka", ka)
+    small = x < 1e-4
+    safe = np.where(small, 1.0, x)
+    return np.where(small, 0.5 * x**2, 1.0 - j1(2.0 * safe) / safe)
+
+
+def piston_transition_frequency(area_m2: float, c: float = SPEED_OF_SOUND) -> float:
+    """Transitional frequency of a baffled piston f_p = c sqrt(2) / (2 pi a) = c / sqrt(2 pi S) in Hz
+    (eq. 4.10), S = pi a^2 in m^2."""
+    return float(_positive("c", c) / np.sqrt(2.0 * np.pi * _positive("area_m2", area_m2)))
+
+
+def plate_critical_frequency(thickness_m, youngs_modulus_pa: float, density_kg_m3: float,
+                             poisson_ratio: float, c: float = SPEED_OF_SOUND) -> np.ndarray:
+    """Critical (coincidence) frequency of a homogeneous plate in Hz,
+    f_c = c^2 / (2 pi) * sqrt(m'' / B) = c^2 / (2 pi h) * sqrt(12 rho (1 - nu^2) / E),
+    with m'' = rho h the mass per area and B = E h^3 / (12 (1 - nu^2)) the bending stiffness.
+    For steel and aluminium this is the rule f_c ~= 12/h of Sec. 4.7 (h in m)."""
+    h = _positive("thickness_m", thickness_m)
+    E = _positive("youngs_modulus_pa", youngs_modulus_pa)
+    rho = _positive("density_kg_m3", density_kg_m3)
+    nu = float(poisson_ratio)
+    if not -1.0 < nu < 0.5:
+        raise InputError(f"poisson_ratio: must lie in (-1, 0.5), got {poisson_ratio!r}")
+    return _positive("c", c) ** 2 / (2.0 * np.pi * h) * np.sqrt(12.0 * rho * (1.0 - nu**2) / E)
+
+
+def steel_rule_critical_frequency(thickness_m) -> np.ndarray:
+    """The rule of thumb f_c ~= 12 / h (Hz, h in m) for steel and aluminium plates (Sec. 4.7)."""
+    return 12.0 / _positive("thickness_m", thickness_m)
+
+
+def equivalent_radiated_power(mean_square_velocity_m2_s2, area_m2,
+                              rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND) -> np.ndarray:
+    """Equivalent radiated power (ERP) in W: the sound power with sigma = 1,
+    P = rho c S <v~^2>, from the surface-averaged mean-square (rms^2) normal velocity in m^2/s^2 and
+    the radiating area S in m^2.  The industry-standard upper-bound estimate above f_c."""
+    v2 = _non_negative("mean_square_velocity_m2_s2", mean_square_velocity_m2_s2)
+    return _positive("rho", rho) * _positive("c", c) * _positive("area_m2", area_m2) * v2
+
+
+def radiation_index_db(sigma) -> np.ndarray:
+    """Radiation index L_sigma = 10 lg sigma in dB."""
+    s = _non_negative("sigma", sigma)
+    with np.errstate(divide="ignore"):
+        return 10.0 * np.log10(s)
