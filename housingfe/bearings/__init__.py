@@ -7,18 +7,23 @@ Public API (axis convention: z = shaft axis, DOF order x, y, z, theta_x, theta_y
         applied by the shaft to the inner ring.  result.K is the symmetric 6x6 [K]_bm of van Roosmalen (1994)
         Sec. 3.2/3.3 [N/m, N/rad, N m/rad], result.displacement the mean inner-ring displacement [m, rad],
         result.element_loads the rolling-element loads [N].
-    fluid_film.journal_bearing_coefficients(...) -> FluidFilmResult with non-symmetric K and C.
+    journal_bearing_coefficients(JournalBearing(D, L, C, eta), omega, (Wx, Wy)) -> FluidFilmResult with the
+        eccentricity and the non-symmetric 6x6 K and C of a plain journal bearing (finite-length Reynolds
+        equation, force and tilt coefficients); short_bearing_coefficients: the Ocvirk short bearing.
 
 `housingfe bearing DESIGNATION --load FX FY FZ MX MY [--json]` prints the same (see bearings.cli).
 """
 from __future__ import annotations
 
 from housingfe.bearings.catalogue import designations, lookup
+from housingfe.bearings.fluid_film import (FluidFilmResult, JournalBearing, journal_bearing_coefficients,
+                                           short_bearing_coefficients)
 from housingfe.bearings.rolling import (DOF_NAMES, BearingResult, RollingBearing, finite_difference_stiffness,
                                         make_model, rolling_bearing_stiffness, stiffness_at)
 
 __all__ = ["DOF_NAMES", "BearingResult", "RollingBearing", "bearing_stiffness", "designations", "lookup",
-           "make_model", "stiffness_at", "finite_difference_stiffness", "register_cli"]
+           "make_model", "stiffness_at", "finite_difference_stiffness", "register_cli", "FluidFilmResult",
+           "JournalBearing", "journal_bearing_coefficients", "short_bearing_coefficients"]
 
 
 def bearing_stiffness(bearing: str | RollingBearing, load, *, model: str | None = None,
