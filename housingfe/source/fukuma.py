@@ -25,7 +25,7 @@ stiffness K (2.0e8 N/m, 20 N/(mm um) over b = 10 mm), the accelerometer radius (
 positions of Fig. 5 (figure missing; only A1 = mid-span, zl = 110 mm, is stated).
 
 Public API: `ShaftBearing`, `GearBody`, `FukumaPair`, `influence_coefficients`, `equivalent_inertia`,
-`harmonic_response`, `conversion_ratios`, `bearing_load_spectra`, `BearingLoadSpectra`, `run_scene`,
+`harmonic_response`, `conversion_ratios`, `bearing_load_spectra`, `run_scene`,
 `bench_rows`.
 """
 from __future__ import annotations
@@ -135,24 +135,6 @@ class FukumaPair:
             raise InputError("gear: pressure_angle: must lie in (0, 45) deg")
         if self.zeta < 0:
             raise InputError("gear: zeta: must be >= 0")
-
-
-@dataclass
-class BearingLoadSpectra:
-    """Dynamic loads the shafts exert on their bearings (= on the housing bores), per frequency.
-
-    frequencies_hz: (n_freq,) [Hz]
-    forces_N: complex (n_bearing, n_dof, n_freq) amplitudes (peak, e^{j omega t}); forces in N, moments in N m
-    bearing_names: n_bearing labels
-    dof_names: n_dof labels, here ("Fx", "Fy", "Fz", "Mx", "My", "Mz") in the frame x = horizontal H,
-        y = vertical V, z = shaft axis from bearing 1 to bearing 2 (right-handed); the driven gear's radial
-        displacement y_V (y_H) away from the mesh is +y (+x).  Spur gears: Fz = Mz = 0.
-    """
-
-    frequencies_hz: np.ndarray
-    forces_N: np.ndarray
-    bearing_names: list[str]
-    dof_names: tuple[str, ...] = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
 
 
 # ------------------------------------------------------------------------------- static influence functions
@@ -355,15 +337,25 @@ def _bearing_reactions(pair: FukumaPair, kp: float, z: float, load: np.ndarray):
     return out_f, out_m
 
 
-def bearing_load_spectra(pair: FukumaPair, z: float, rpm: float, te_harmonics_m) -> BearingLoadSpectra:
-    """Bearing force and moment spectra of the driven shaft (and, mirrored, the driving shaft) for a static
-    transmission error with harmonic amplitudes `te_harmonics_m` [m] at 1, 2, ... times the mesh frequency
-    (disturbing force F = K e, eq. 12) at shaft speed `rpm` and gear position z [-].
+def bearing_load_spectra(pair: FukumaPair, z: float, rpm: float, te_harmonics_m, torque_Nm: float = 0.0):
+    """Bearing force and moment spectra of the driving and driven shafts for a static transmission error
+    with harmonic amplitudes `te_harmonics_m` [m] at 1, 2, ... times the mesh frequency (disturbing force
+    F = K e, eq. 12) at shaft speed `rpm` and gear position z [-].
 
-    The gear loads on the shaft are P = (gamma y - beta phi)/Lambda, M = (alpha phi - beta y)/Lambda (eq. 2);
-    bearing forces K_p y_bearing follow from the blended influence functions, bearing moments are lambda
-    times the clamped-end moments.  Both gears move apart symmetrically, so the driving shaft's loads are
-    the driven shaft's with opposite sign in the common frame (x = H, y = V, z = shaft axis)."""
+    Returns the housing chain's structure `housingfe.source.dynamics.BearingSpectra` (issue 7):
+    frequency [Hz], names, z [m] (bearing positions along the shaft from the gear centre plane: -z l and
+    (1 - z) l), loads (4, 6, n_freq) complex one-sided amplitudes of [F_x, F_y, F_z, M_x, M_y, M_z] that
+    each SHAFT exerts on the housing at the bearing, load(t) = Re(A exp(i 2 pi f t)); x = horizontal H,
+    y = vertical V (the line of action for alpha_b = 0), z along the shaft (right-handed).  The driven
+    gear's radial displacement away from the mesh is +y / +x; the driving shaft's loads are the same with
+    opposite sign (both gears are pushed apart symmetrically).  Spur gears: F_z = M_z = 0.  `torque_Nm` is
+    only recorded (the model is linear; the mean load does not enter).
+
+    The gear loads on the shaft are P = (gamma y - beta phi)/Lambda, M = (alpha phi - beta y)/Lambda
+    (eq. 2); bearing forces K_p y_bearing follow from the blended influence functions, bearing moments are
+    lambda times the clamped-end moments."""
+    from housingfe.source.dynamics import BearingSpectra
+
     te = np.atleast_1d(np.asarray(te_harmonics_m, dtype=complex))
     omega0 = mesh_frequency(pair, rpm)
     freqs = np.arange(1, len(te) + 1) * omega0 / (2 * math.pi)
@@ -383,9 +375,10 @@ def bearing_load_spectra(pair: FukumaPair, z: float, rpm: float, te_harmonics_m)
                 loads[2 + j, fdof, h] = forces[j]
                 loads[2 + j, mdof, h] = msign * moments[j]
     loads[0:2] = -loads[2:4]
-    names = ["driving shaft bearing 1", "driving shaft bearing 2", "driven shaft bearing 1",
-             "driven shaft bearing 2"]
-    return BearingLoadSpectra(frequencies_hz=freqs, forces_N=loads, bearing_names=names)
+    length = pair.shaft.length
+    return BearingSpectra(speed_rpm=rpm, torque_Nm=torque_Nm, frequency=freqs,
+                          names=["driving_left", "driving_right", "driven_left", "driven_right"],
+                          z=np.array([-z * length, (1 - z) * length] * 2), loads=loads)
 
 
 # re-exported so the CLI finds them here

@@ -21,7 +21,7 @@ Scene layout (TOML, SI units):
     blank_outer_radius_m                     # default: pitch radius (assumed solid disc)
     sensor_radius_m                          # default: base radius
     [sweep]  z_min = 0.05, z_max = 0.95, points = 37, speeds_rpm = [700.0]
-    [loads]  gear_positions_m = [0.110], speed_rpm = 1000.0, te_harmonics_m = [1e-6]
+    [loads]  gear_positions_m = [0.110], speed_rpm = 1000.0, te_harmonics_m = [1e-6], torque_Nm = 39.2
 
 Outputs: conversion_ratios.csv / .png, bearing_loads.csv, summary.json, summary.txt.
 """
@@ -102,6 +102,7 @@ class _Loads(_Strict):
     gear_positions_m: list[float] = Field(min_length=1)
     speed_rpm: float = Field(1000.0, gt=0)
     te_harmonics_m: list[float] = Field([1e-6], min_length=1)
+    torque_Nm: float = Field(0.0, ge=0)
 
 
 class FukumaScene(_Strict):
@@ -223,18 +224,20 @@ def _bearing_outputs(sc: FukumaScene, pair, out_dir: Path) -> list:
 
     rows, out = [], []
     for pos in sc.loads.gear_positions_m:
-        spec = fk.bearing_load_spectra(pair, pos / sc.shaft.length_m, sc.loads.speed_rpm, sc.loads.te_harmonics_m)
-        for b, name in enumerate(spec.bearing_names):
-            for d, dof in enumerate(spec.dof_names):
-                for h, f in enumerate(spec.frequencies_hz):
-                    v = spec.forces_N[b, d, h]
-                    rows.append([f"{pos:.4f}", name, dof, f"{f:.4f}", f"{abs(v):.6g}",
+        spec = fk.bearing_load_spectra(pair, pos / sc.shaft.length_m, sc.loads.speed_rpm, sc.loads.te_harmonics_m,
+                                       torque_Nm=sc.loads.torque_Nm)
+        dofs = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
+        for b, name in enumerate(spec.names):
+            for d, dof in enumerate(dofs):
+                for h, f in enumerate(spec.frequency):
+                    v = spec.loads[b, d, h]
+                    rows.append([f"{pos:.4f}", name, f"{spec.z[b]:.4f}", dof, f"{f:.4f}", f"{abs(v):.6g}",
                                  f"{math.degrees(np.angle(v)):.3f}"])
         out.append({"gear_position_m": pos,
-                    "max_bearing_force_N": float(np.abs(spec.forces_N[:, :3]).max()),
-                    "max_bearing_moment_Nm": float(np.abs(spec.forces_N[:, 3:]).max())})
+                    "max_bearing_force_N": float(np.abs(spec.loads[:, :3]).max()),
+                    "max_bearing_moment_Nm": float(np.abs(spec.loads[:, 3:]).max())})
     write_csv(out_dir / "bearing_loads.csv",
-              ["gear_position_m", "bearing", "dof", "frequency_Hz", "amplitude", "phase_deg"], rows)
+              ["gear_position_m", "bearing", "bearing_z_m", "dof", "frequency_Hz", "amplitude", "phase_deg"], rows)
     return out
 
 

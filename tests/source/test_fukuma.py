@@ -105,9 +105,10 @@ def test_bearing_loads_balance_the_gear_load():
     z, rpm, te = 0.3, 1000.0, 1e-6
     spec = fk.bearing_load_spectra(pair, z, rpm, [te])
     q = fk.harmonic_response(pair, z, fk.mesh_frequency(pair, rpm), force=pair.mesh_stiffness * te)
-    assert spec.frequencies_hz[0] == pytest.approx(rpm / 60 * 36)
-    f = spec.forces_N[2:4, :, 0]                                           # driven shaft
-    assert np.allclose(spec.forces_N[0:2], -spec.forces_N[2:4])
+    assert spec.frequency[0] == pytest.approx(rpm / 60 * 36)
+    assert spec.z[2] == pytest.approx(-z * L) and spec.z[3] == pytest.approx((1 - z) * L)
+    f = spec.loads[2:4, :, 0]                                           # driven shaft
+    assert np.allclose(spec.loads[0:2], -spec.loads[2:4])
     a, b = z * L, (1 - z) * L
     for kp, iy, ip, fdof, mdof, msign in ((pair.shaft.bearing_stiffness_v, 1, 3, 1, 3, -1.0),
                                           (pair.shaft.bearing_stiffness_h, 2, 4, 0, 4, 1.0)):
