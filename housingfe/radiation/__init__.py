@@ -1,2 +1,40 @@
-"""Sound radiation (van Roosmalen 1994, Sec. 4.7, Appendix E): analytic radiators, Föller's box model,
-numerical radiation efficiency from a surface velocity field, sound power levels (eq. 4.16)."""
+"""Sound radiation (van Roosmalen 1994, Sec. 4.7, Appendix E).
+
+Public API (SI units; velocities are complex peak phasors, mean squares are rms^2; see analytic.py):
+- analytic radiators: `sphere_sigma`, `sphere_power`, `piston_sigma`, `plate_critical_frequency`,
+  `equivalent_radiated_power` (ERP, sigma = 1);
+- Föller's box model: `Plate`, `foller_radiation_index` -> `FollerResult`, `load_plate_table`;
+- numerical radiation efficiency from surface data: `rayleigh_radiated_power` (plane baffled radiator),
+  `baffled_plates_radiated_power` (housing, plate by plate), `helmholtz_fem_radiation` (closed bodies,
+  exterior Helmholtz FE in a complex-PETSc subprocess);
+- sound power (eq. 4.16): `sound_power_level`, `radiation_index_from_levels`, `sound_power_spectrum`.
+Sub-command: `housingfe radiation foller <table.toml|builtin:scale-model|builtin:test-gearbox>`.
+"""
+from housingfe.radiation.analytic import (AIR_DENSITY, SPEED_OF_SOUND, equivalent_radiated_power,
+                                          piston_sigma, plate_critical_frequency, radiation_index_db,
+                                          sphere_power, sphere_sigma, steel_rule_critical_frequency)
+from housingfe.radiation.fem import (FemGeometry, FemSweep, baffled_piston_geometry,
+                                     helmholtz_fem_radiation, sphere_geometry)
+from housingfe.radiation.foller import FollerResult, Plate, foller_radiation_index, load_plate_table
+from housingfe.radiation.numerical import (RadiationResult, baffled_plates_radiated_power,
+                                           rayleigh_radiated_power)
+from housingfe.radiation.power import (SoundPowerSpectrum, area_level_db, power_level_db,
+                                       radiation_index_from_levels, sound_power_level,
+                                       sound_power_spectrum)
+
+__all__ = [
+    "AIR_DENSITY", "SPEED_OF_SOUND", "equivalent_radiated_power", "piston_sigma", "plate_critical_frequency",
+    "radiation_index_db", "sphere_power", "sphere_sigma", "steel_rule_critical_frequency",
+    "FemGeometry", "FemSweep", "baffled_piston_geometry", "helmholtz_fem_radiation", "sphere_geometry",
+    "FollerResult", "Plate", "foller_radiation_index", "load_plate_table",
+    "RadiationResult", "baffled_plates_radiated_power", "rayleigh_radiated_power",
+    "SoundPowerSpectrum", "area_level_db", "power_level_db", "radiation_index_from_levels",
+    "sound_power_level", "sound_power_spectrum", "register_cli",
+]
+
+
+def register_cli(subparsers) -> None:
+    """Add `housingfe radiation ...` to the top-level CLI."""
+    from housingfe.radiation.cli import register
+
+    register(subparsers)

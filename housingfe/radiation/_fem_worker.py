@@ -85,7 +85,7 @@ def _classify(gmsh, radius, R, d, half, disc):
     gmsh.model.addPhysicalGroup(2, vib, VIBRATING)
 
 
-def build_mesh(geometry: dict):
+def build_mesh(geometry: dict, save_msh: str | None = None):
     """Mesh (second-order tets) of a built-in geometry in memory; returns (mesh, cell_tags, facet_tags)."""
     import gmsh
     from mpi4py import MPI
@@ -101,8 +101,13 @@ def build_mesh(geometry: dict):
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 1)
         gmsh.option.setNumber("Mesh.MeshSizeMax", geometry["h"])
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.1 * geometry["h"])
+        if geometry["kind"] == "msh":
+            # A user mesh: physical volume AIR (1) [and PML (2)], physical surface VIBRATING (10), the
+            # outer boundary the sphere r = outer_radius (+ pml_thickness) about the origin.
+            gmsh.open(geometry["path"])
+            return gmshio.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=3)
         gmsh.model.add("radiator")
-        args = (geometry["radius"], geometry["pml_inner_radius"], geometry["pml_thickness"])
+        args = (geometry["radius"], geometry["outer_radius"], geometry["pml_thickness"])
         if geometry["kind"] == "sphere":
             _sphere_model(gmsh, *args)
         elif geometry["kind"] == "baffled_piston":
@@ -125,6 +130,8 @@ def build_mesh(geometry: dict):
         field.setNumber(f_thr, "DistMax", 4 * geometry["h"])
         field.setAsBackgroundMesh(f_thr)
         gmsh.model.mesh.generate(3)
+        if save_msh:
+            gmsh.write(save_msh)
         return gmshio.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=3)
     finally:
         gmsh.finalize()
@@ -174,12 +181,12 @@ def solve(job: dict) -> dict:
     truncation = job.get("truncation", "bgt2")
     geometry = dict(job["geometry"])
     if truncation != "pml":
-        geometry["pml_thickness"] = 0.0  # the air ends at r = pml_inner_radius
-    mesh, cell_tags, facet_tags = build_mesh(geometry)
+        geometry["pml_thickness"] = 0.0  # the air ends at r = outer_radius
+    mesh, cell_tags, facet_tags = build_mesh(geometry, job.get("save_msh"))
     t_mesh = time.perf_counter() - t0
 
     rho, c = job["rho"], job["c"]
-    R, d = geometry["pml_inner_radius"], geometry["pml_thickness"]
+    R, d = geometry["outer_radius"], geometry["pml_thickness"]
     V = fem.FunctionSpace(mesh, ("Lagrange", job.get("degree", 2)))
     p, q = ufl.TrialFunction(V), ufl.TestFunction(V)
     k = fem.Constant(mesh, PETSc.ScalarType(1.0))

@@ -58,17 +58,11 @@ def radiation_index_from_levels(power_level_db, velocity_level_db, area_m2: floa
             - area_level_db(area_m2))
 
 
-def band_power_levels(frequencies_hz, power_level_db, bands: levels.Bands) -> np.ndarray:
+def band_power_levels(frequencies_hz, line_levels_db, bands: levels.Bands) -> np.ndarray:
     """Energy sum of narrow-band L_W lines (dB re 1 pW) into `bands` (IEC 61260, from
     `housingfe.levels`); an empty band gives -inf."""
-    power = power_from_level(_finite("power_level_db", power_level_db))
-    return power_level_db_of(levels.band_sum(frequencies_hz, power, bands))
-
-
-def power_level_db_of(power_w) -> np.ndarray:
-    """Alias of `power_level_db` without the sign check, for sums of non-negative powers."""
-    with np.errstate(divide="ignore"):
-        return 10.0 * np.log10(np.asarray(power_w, dtype=float) / levels.P0)
+    power = power_from_level(_finite("line_levels_db", line_levels_db))
+    return power_level_db(levels.band_sum(frequencies_hz, power, bands))
 
 
 def a_weighted(frequencies_hz, level_db) -> np.ndarray:
@@ -109,7 +103,9 @@ def sound_power_spectrum(frequencies_hz, velocity_level_db, area_m2: float, radi
     if f.ndim != 1 or f.size == 0 or np.any(f <= 0):
         raise InputError("frequencies_hz: need a 1-D array of positive frequencies")
     L_W = np.broadcast_to(sound_power_level(velocity_level_db, area_m2, radiation_index_db), f.shape)
-    bands = levels.third_octave_bands(f_min or f.min(), f_max or f.max())
+    # Default: every band that receives a line (a line lies within a factor 2^(1/6) of its band centre).
+    half_band = 2.0 ** (1.0 / 6.0)
+    bands = levels.third_octave_bands(f_min or f.min() / half_band, f_max or f.max() * half_band)
     band_L = band_power_levels(f, L_W, bands)
     band_LA = band_power_levels(f, a_weighted(f, L_W), bands)
     return SoundPowerSpectrum(f, np.array(L_W), bands, band_L, band_LA,

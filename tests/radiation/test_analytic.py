@@ -1,0 +1,74 @@
+"""Analytic radiators against textbook values (van Roosmalen 1994, eq. 4.6-4.10)."""
+import numpy as np
+import pytest
+from scipy.special import spherical_jn, spherical_yn
+
+from housingfe.errors import InputError
+from housingfe.radiation import analytic
+
+
+def test_sphere_sigma_half_at_ka_one():
+    # eq. 4.9 at f = f_s (kR = 1)
+    assert analytic.sphere_sigma(1.0) == pytest.approx(0.5, abs=1e-12)
+
+
+def test_sphere_sigma_is_monopole_impedance():
+    # sigma of a pulsating sphere = Re(z_0)/(rho c), z_0 = i rho c h0(ka)/h0'(ka) (spherical Hankel)
+    ka = np.array([0.1, 0.3, 1.0, 2.0, 5.0])
+    h = spherical_jn(0, ka) + 1j * spherical_yn(0, ka)
+    dh = spherical_jn(0, ka, True) + 1j * spherical_yn(0, ka, True)
+    assert analytic.sphere_sigma(ka) == pytest.approx((1j * h / dh).real, rel=1e-12)
+
+
+def test_sphere_power_eq_4_6_one_db_below_max_at_twice_fs():
+    # Sec. 4.7 property 2: at f = 2 f_s the power is 1.0 dB below 2 pi rho c R^2 v_R^2
+    R, v = 0.2, 1e-3
+    fs = analytic.sphere_transition_frequency(R)
+    p = analytic.sphere_power(R, v, 2 * fs)
+    p_max = 2 * np.pi * analytic.AIR_DENSITY * analytic.SPEED_OF_SOUND * R**2 * v**2
+    assert 10 * np.log10(p / p_max) == pytest.approx(-0.97, abs=0.01)
+
+
+def test_piston_sigma_published_values():
+    assert analytic.piston_sigma(2.0) == pytest.approx(1.033, abs=5e-4)
+    # low-frequency limit (ka)^2/2 and high-frequency limit 1
+    assert analytic.piston_sigma(0.01) == pytest.approx(0.5e-4, rel=1e-3)
+    assert analytic.piston_sigma(0.0) == 0.0
+    assert analytic.piston_sigma(200.0) == pytest.approx(1.0, abs=2e-3)
+
+
+def test_piston_transition_frequency_equals_sphere_for_a_equal_R_sqrt2():
+    # eq. 4.10: f_p = f_s when a = R sqrt(2)
+    R = 0.1
+    a = R * np.sqrt(2)
+    assert analytic.piston_transition_frequency(np.pi * a**2) == pytest.approx(
+        analytic.sphere_transition_frequency(R), rel=1e-12)
+
+
+@pytest.mark.parametrize("E, rho, nu", [(210e9, 7850.0, 0.3), (70e9, 2700.0, 0.33)])
+def test_plate_critical_frequency_matches_12_over_h_for_steel_and_aluminium(E, rho, nu):
+    h = 0.008
+    fc = analytic.plate_critical_frequency(h, E, rho, nu)
+    assert fc == pytest.approx(12.0 / h, rel=0.02)
+
+
+def test_plate_critical_frequency_other_material_differs_from_rule():
+    # cast iron (E = 110 GPa, rho = 7200, nu = 0.26): f_c h = 16.1 m/s by hand, 34 % above the steel rule
+    fc = analytic.plate_critical_frequency(0.01, 110e9, 7200.0, 0.26)
+    assert fc * 0.01 == pytest.approx(16.1, abs=0.05)
+
+
+def test_erp_is_rho_c_S_v2():
+    assert analytic.equivalent_radiated_power(1e-6, 2.0, rho=1.2, c=340.0) == pytest.approx(8.16e-4)
+
+
+@pytest.mark.parametrize("call", [
+    lambda: analytic.sphere_power(-1.0, 1.0, 100.0),
+    lambda: analytic.plate_critical_frequency(0.0, 210e9, 7850, 0.3),
+    lambda: analytic.plate_critical_frequency(0.01, 210e9, 7850, 0.6),
+    lambda: analytic.piston_sigma(-1.0),
+    lambda: analytic.equivalent_radiated_power(1.0, -2.0),
+])
+def test_non_physical_input_raises_input_error(call):
+    with pytest.raises(InputError):
+        call()
