@@ -35,7 +35,7 @@ from housingfe.source.trueman_model import DriveConfig, DriveModel, build_drive,
 __all__ = [
     "DriveConfig", "DriveModel", "build_drive", "vs_drive_ratios", "critical_speeds", "mesh_transfer",
     "mesh_torques", "random_te", "mesh_load_envelopes", "mesh_torque_from_receptances",
-    "shaft_end_stiffness", "rpm_to_omega", "run_scene", "bench_rows",
+    "shaft_end_stiffness", "rpm_to_omega", "thesis_propagation_factor", "run_scene", "bench_rows",
 ]
 
 
@@ -178,6 +178,34 @@ def shaft_end_stiffness(k_far, omega, length, diameter, shear_modulus, density):
     z = omega * polar * math.sqrt(shear_modulus * density)
     t = np.tan(omega * length / math.sqrt(shear_modulus / density))
     return (k_far - z * t) / (1.0 + k_far / z * t)
+
+
+def thesis_propagation_factor(cfg: DriveConfig, rpm: float) -> np.ndarray:
+    """|K_B / K_4| per mesh [-]: the factor by which the thesis's program (Appendix C) scales every INDUCED
+    mesh torque relative to a physically consistent solution.
+
+    The program injects theta = T_D / K_4 at the bronze gear (K_4: mesh in series with the steel-gear side,
+    eq. 5.1) where the true bronze displacement is T_D / K_B (K_B: the bronze gear's own side - crossed mesh,
+    layshaft, bronze gear and its drawshaft - without the mesh).  Both stiffnesses are evaluated here on the
+    global model with the mesh removed, at drawroll speed `rpm`."""
+    model = build_drive(cfg, rpm)
+    omega = float(rpm_to_omega(rpm))
+    z_full = model.dynamic_stiffness(omega)
+    out = np.empty(len(model.mesh_dofs))
+    for j, (a, b) in enumerate(model.mesh_dofs):
+        kbar = model.mesh_stiffness[j] + 1j * omega * model.mesh_damping[j]
+        z = z_full.tolil()
+        z[a, a] -= kbar
+        z[b, b] -= kbar
+        z[a, b] += kbar
+        z[b, a] += kbar
+        rhs = np.zeros((model.n_dof, 2), dtype=complex)
+        rhs[a, 0] = rhs[b, 1] = 1.0
+        x = sla.splu(z.tocsc()).solve(rhs)
+        k_b = 1.0 / x[a, 0]
+        k_4 = 1.0 / (1.0 / kbar + x[b, 1])
+        out[j] = abs(k_b / k_4)
+    return out
 
 
 # re-exported here so scenes and the benchmark only need this module
