@@ -132,10 +132,12 @@ def helmholtz_fem_radiation(geometry: FemGeometry, frequencies_hz, velocity=1.0,
         raise InputError("rho, c: must be positive")
     with tempfile.TemporaryDirectory(prefix="housingfe-fem-") as tmp:
         tmp = Path(tmp)
-        if np.isscalar(velocity) or np.ndim(velocity) == 0:
+        if not isinstance(velocity, (tuple, list)):
             v = complex(velocity)
             velocity_spec = {"uniform": [v.real, v.imag]}
         else:
+            if len(velocity) != 2:
+                raise InputError("velocity: need (points (n,3), values (n,))")
             points, values = velocity
             points = np.asarray(points, dtype=float)
             values = np.asarray(values, dtype=complex)
