@@ -49,6 +49,8 @@ class DriveConfig:
         Table 6.1 is insensitive to it above ~300 lbf in s^2)
     elements_per_section: finite elements per uniform drawshaft section
     damping_scale: multiplies every damper (1 = Appendix B)
+    mesh_damping_factor: multiplies the two mesh dampers FFD(10), FFD(11) (Sec. 6.5 sensitivity)
+    drawroll_damping_factor: multiplies the drawroll dampers AJD(11) (Sec. 6.5 sensitivity)
     """
 
     name: str = "standard A, solid gears"
@@ -64,6 +66,8 @@ class DriveConfig:
     headstock_inertia: float = 1.0e4 * data.LBF_IN
     elements_per_section: int = 3
     damping_scale: float = 1.0
+    mesh_damping_factor: float = 1.0
+    drawroll_damping_factor: float = 1.0
 
     def __post_init__(self):
         where = f"configuration {self.name!r}"
@@ -79,7 +83,7 @@ class DriveConfig:
                     "headstock_inertia"):
             if not getattr(self, key) > 0:
                 raise InputError(f"{where}: {key}: must be > 0")
-        for key in ("bush_damping_factor", "damping_scale"):
+        for key in ("bush_damping_factor", "damping_scale", "mesh_damping_factor", "drawroll_damping_factor"):
             if getattr(self, key) < 0:
                 raise InputError(f"{where}: {key}: must be >= 0")
         if self.drawshaft_mid_diameter is not None and not self.drawshaft_mid_diameter > 0:
@@ -214,6 +218,9 @@ def build_drive(cfg: DriveConfig, rpm: float | None = None) -> DriveModel:
     d = data.to_si(cfg.machine_type)
     s2 = d["speed_ratio"] ** 2
     damp = {k: v * cfg.damping_scale for k, v in d["damping"].items()}
+    damp["crossed_mesh"] *= cfg.mesh_damping_factor
+    damp["parallel_mesh"] *= cfg.mesh_damping_factor
+    damp["drawroll"] *= cfg.drawroll_damping_factor
     k_coupling = d["coupling_stiffness"] / s2 / cfg.coupling_flexibility_factor
     sections = list(d["drawshaft_sections"])
     if cfg.drawshaft_mid_diameter is not None:

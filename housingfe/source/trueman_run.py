@@ -14,7 +14,8 @@ Scene layout (TOML, SI units; every key optional unless marked):
     name = "standard A, solid gears"          (required)
     published_rpm = [473, 1413, 2332, 3215, 4052]
     bushed, bush_damping_factor, drawshaft_mid_diameter_m, drawroll_inertia_factor,
-    coupling_flexibility_factor, mesh_flexibility_factor, damping_scale, type, boxes, drive
+    coupling_flexibility_factor, mesh_flexibility_factor, damping_scale, mesh_damping_factor,
+    drawroll_damping_factor, type, boxes, drive
     [critical_speeds] count = 5, max_rpm = 6000
     [forced]
     configuration = "standard A, solid gears" (required: which configuration is swept)
@@ -76,6 +77,8 @@ class _Configuration(_Strict):
     coupling_flexibility_factor: float = Field(1.0, gt=0)
     mesh_flexibility_factor: float = Field(1.0, gt=0)
     damping_scale: float = Field(1.0, ge=0)
+    mesh_damping_factor: float = Field(1.0, ge=0)
+    drawroll_damping_factor: float = Field(1.0, ge=0)
 
 
 class _Critical(_Strict):
@@ -151,6 +154,8 @@ def drive_config(sc: TruemanScene, conf) -> "DriveConfig":
         coupling_flexibility_factor=conf.coupling_flexibility_factor,
         mesh_flexibility_factor=conf.mesh_flexibility_factor,
         damping_scale=conf.damping_scale,
+        mesh_damping_factor=conf.mesh_damping_factor,
+        drawroll_damping_factor=conf.drawroll_damping_factor,
     )
 
 
