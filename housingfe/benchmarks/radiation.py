@@ -1,0 +1,164 @@
+"""`housingfe bench radiation`: numerical radiation efficiency, time per frequency against error.
+
+Cases with analytic references (ka = 0.1 ... 5, radius a = 0.1 m):
+- pulsating sphere, sigma = (ka)^2 / (1 + (ka)^2)   - exterior Helmholtz FE (BGT2 on r = 1.5 a)
+- oscillating sphere (v_n = cos theta, sampled), sigma = (ka)^4 / (4 + (ka)^4) - FE
+- baffled piston, sigma = 1 - J1(2ka)/(ka)          - FE (BGT2 or PML) and the Rayleigh integral
+Writes radiation_bench.csv (one row per case/setting/ka), radiation_bench_summary.csv, radiation_bench.png.
+
+The comparison of Föller's box estimate with the numerical sigma of the real housing needs the housing's
+forced response: `compare_box_estimate_with_numerical` takes its surface data when it exists.
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+
+from housingfe.radiation import analytic, fem, foller, numerical
+from housingfe.report import format_table, write_csv
+
+A = 0.1  # m
+KA = np.array([0.1, 0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0])
+
+
+def _fibonacci_sphere(n: int, radius: float) -> np.ndarray:
+    i = np.arange(n) + 0.5
+    z = 1 - 2 * i / n
+    phi = np.pi * (1 + 5**0.5) * i
+    r = np.sqrt(1 - z**2)
+    return radius * np.column_stack([r * np.cos(phi), r * np.sin(phi), z])
+
+
+def _fem_cases(quick: bool):
+    """(case, method, setting label, geometry, velocity, truncation, reference sigma(ka))."""
+    sphere_h = [(0.4, 0.25)] if quick else [(0.4, 0.25), (0.25, 0.15), (0.15, 0.1)]
+    piston_h = [(0.35, 0.15)] if quick else [(0.35, 0.15), (0.25, 0.1), (0.15, 0.06)]
+    pts = _fibonacci_sphere(6000, A)
+    dipole = (pts, (1.0 + 0j) * pts[:, 2] / A)
+    cases = []
+    for h, hs in sphere_h:
+        cases.append(("pulsating sphere", "FE bgt2 R=1.5a", f"h={h}a hs={hs}a",
+                      fem.sphere_geometry(A, h * A, h_surface_m=hs * A), 1.0, "bgt2", analytic.sphere_sigma))
+        cases.append(("oscillating sphere", "FE bgt2 R=1.5a", f"h={h}a hs={hs}a",
+                      fem.sphere_geometry(A, h * A, h_surface_m=hs * A), dipole, "bgt2",
+                      lambda ka: ka**4 / (4 + ka**4)))
+    for h, hs in piston_h:
+        cases.append(("baffled piston", "FE bgt2 R=2a", f"h={h}a hs={hs}a",
+                      fem.baffled_piston_geometry(A, h * A, h_surface_m=hs * A), 1.0, "bgt2", analytic.piston_sigma))
+    h, hs = piston_h[0]
+    for R in ([] if quick else [1.5, 3.0]):
+        cases.append(("baffled piston", f"FE bgt2 R={R}a", f"h={h}a hs={hs}a",
+                      fem.baffled_piston_geometry(A, h * A, outer_radius_m=R * A, h_surface_m=hs * A), 1.0,
+                      "bgt2", analytic.piston_sigma))
+    if not quick:
+        cases.append(("baffled piston", "FE pml R=2a d=a", f"h={h}a hs={hs}a",
+                      fem.baffled_piston_geometry(A, h * A, h_surface_m=hs * A, pml_thickness_m=A), 1.0,
+                      "pml", analytic.piston_sigma))
+        cases.append(("pulsating sphere", "FE bgt1 R=1.5a", f"h={sphere_h[0][0]}a hs={sphere_h[0][1]}a",
+                      fem.sphere_geometry(A, sphere_h[0][0] * A, h_surface_m=sphere_h[0][1] * A), 1.0,
+                      "bgt1", analytic.sphere_sigma))
+    return cases
+
+
+def _run_fem(quick: bool):
+    rows, summary = [], []
+    f = KA * analytic.SPEED_OF_SOUND / (2 * np.pi * A)
+    for case, method, setting, geometry, velocity, truncation, reference in _fem_cases(quick):
+        sweep = fem.helmholtz_fem_radiation(geometry, f, velocity=velocity, truncation=truncation)
+        err = [10 * np.log10(r.sigma / reference(ka)) if r.sigma > 0 else np.nan
+               for r, ka in zip(sweep.results, KA)]
+        for r, ka, e in zip(sweep.results, KA, err):
+            rows.append((case, method, setting, sweep.ndofs, ka, r.sigma, float(reference(ka)), e, r.seconds))
+        per_f = float(np.mean([r.seconds for r in sweep.results]))
+        summary.append((case, method, setting, sweep.ndofs, float(np.nanmax(np.abs(err))), per_f,
+                        sweep.mesh_seconds + sweep.setup_seconds))
+    return rows, summary
+
+
+def _run_rayleigh(quick: bool):
+    rows, summary = [], []
+    settings = [(4, 12), (8, 24)] if quick else [(4, 12), (8, 24), (16, 48)]
+    for n_r, n_t in settings:
+        pts, nrm, w = numerical.disc_quadrature(A, n_r, n_t)
+        errs, times = [], []
+        for ka in KA:
+            f = ka * analytic.SPEED_OF_SOUND / (2 * np.pi * A)
+            t0 = time.perf_counter()
+            r = numerical.rayleigh_radiated_power(pts, nrm, w, np.ones(len(w)), f)
+            dt = time.perf_counter() - t0
+            e = 10 * np.log10(r.sigma / analytic.piston_sigma(ka))
+            errs.append(e)
+            times.append(dt)
+            rows.append(("baffled piston", "Rayleigh", f"{n_r}x{n_t} points", len(w), ka, r.sigma,
+                         float(analytic.piston_sigma(ka)), e, dt))
+        summary.append(("baffled piston", "Rayleigh", f"{n_r}x{n_t} points", len(w),
+                        float(np.max(np.abs(errs))), float(np.mean(times)), 0.0))
+    return rows, summary
+
+
+def _plot(path: Path, rows, summary) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.5))
+    for case, method, setting, n, err, per_f, _ in summary:
+        ax1.loglog(per_f, max(err, 1e-5), "o" if method.startswith("FE") else "s")
+        ax1.annotate(f"{case[:4]} {method} {setting}", (per_f, max(err, 1e-5)), fontsize=6)
+    ax1.axhline(0.5, color="r", lw=0.8, ls="--", label="0.5 dB acceptance")
+    ax1.set_xlabel("time per frequency [s]")
+    ax1.set_ylabel("max |error| over ka = 0.1 ... 5 [dB]")
+    ax1.grid(True, which="both", alpha=0.3)
+    ax1.legend(fontsize=8)
+    ka = np.geomspace(0.05, 10, 200)
+    ax2.semilogx(ka, 10 * np.log10(analytic.sphere_sigma(ka)), "k-", label="pulsating sphere (4.9)")
+    ax2.semilogx(ka, 10 * np.log10(analytic.piston_sigma(ka)), "k--", label="baffled piston")
+    ax2.semilogx(ka, 10 * np.log10(ka**4 / (4 + ka**4)), "k:", label="oscillating sphere")
+    shown = set()
+    for case, method, setting, n, k, sigma, ref, e, dt in rows:
+        key = (case, method)
+        if key in shown and setting != rows[0][2]:
+            continue
+        ax2.semilogx(k, 10 * np.log10(sigma), "o" if method.startswith("FE") else "x", ms=4, color="C0"
+                     if case == "pulsating sphere" else "C1" if case == "baffled piston" else "C2")
+        shown.add(key)
+    ax2.set_ylim(-45, 3)
+    ax2.set_xlabel("ka")
+    ax2.set_ylabel("radiation index [dB]")
+    ax2.grid(True, which="both", alpha=0.3)
+    ax2.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def compare_box_estimate_with_numerical(plates, points, normals, weights, velocity, plate_ids, frequency_hz,
+                                        c: float = analytic.SPEED_OF_SOUND):
+    """For the housing (later, with the lead's forced response): Föller's estimate (dB) next to the
+    plate-by-plate Rayleigh estimate (dB) at one frequency (Hz), from surface quadrature data
+    (points (n,3) m, unit normals (n,3), weights (n,) m^2, complex peak normal velocity (n,) m/s,
+    plate ids (n,)).  Returns (L_sigma_foller_db, L_sigma_rayleigh_db)."""
+    box = foller.foller_radiation_index(plates, [frequency_hz], c=c)
+    ray = numerical.baffled_plates_radiated_power(points, normals, weights, velocity, plate_ids, frequency_hz,
+                                                  c=c)
+    return float(box.L_sigma_db[0]), ray.radiation_index_db
+
+
+def main(out_dir: Path, quick: bool = False) -> None:
+    """Run the radiation benchmark; print a table and write CSV + PNG into out_dir."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    rows_r, summary_r = _run_rayleigh(quick)
+    rows_f, summary_f = _run_fem(quick)
+    rows, summary = rows_f + rows_r, summary_f + summary_r
+    header = ["case", "method", "setting", "dofs/points", "max |err| dB", "s per frequency", "mesh+setup s"]
+    print(format_table(header, summary, floatfmt="{:.3g}"))
+    write_csv(out_dir / "radiation_bench_summary.csv", header, summary)
+    write_csv(out_dir / "radiation_bench.csv",
+              ["case", "method", "setting", "dofs_or_points", "ka", "sigma", "sigma_analytic", "error_db",
+               "seconds"], rows)
+    _plot(out_dir / "radiation_bench.png", rows, summary)
+    print(f"wrote {out_dir}/radiation_bench.csv, radiation_bench_summary.csv, radiation_bench.png")
