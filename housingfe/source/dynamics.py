@@ -1,0 +1,421 @@
+"""Lumped dynamics of the gearbox interior (van Roosmalen 1994, Sec. 2.5-2.7, Appendix C).
+
+15 degrees of freedom (Fig. 2.10, numbering of Appendix C, 1-based there, 0-based here):
+  0-5   pinion with its shaft: x, y, z, theta_x, theta_y, theta_z
+  6-11  wheel with its shaft:  x, y, z, theta_x, theta_y, theta_z
+  12    coupling between shaft 2 (pinion - coupling) and shaft 1 (coupling - far end)
+  13    coupling between shaft 3 (wheel - coupling) and shaft 4 (coupling - ground)
+  14    far end of shaft 1: angle held constant so that shaft 1 carries the torque (preload)
+Translations in m, rotations in rad; x, y in the transverse plane (y along the line of action for
+alpha'_t = 0), z axial.  DOF 14 is eliminated: the dynamic model has 14 DOFs and the preload enters as
+the constant force k1 * theta_15 on DOF 12.
+
+The mesh couples the gears through S(t) h h^T with the normal mesh stiffness S(t) (Appendix C, with
+the operating transverse pressure angle alpha'_t and the base helix angle beta_b) and the engagement
+shock force F_e(t) (eq. 2.62) acts along h.  Damping: modal viscous damping with zeta = eta / 2 for
+every mode of the mean system (loss factor eta = 0.1, Sec. 2.5).
+
+The periodic steady state is found by harmonic balance, which for this LINEAR periodic system is an
+exact Fourier (Hill) expansion: the only coupling between harmonics is the scalar mesh deflection
+d = h^T q, so the (2H+1) x (2H+1) Toeplitz system for d is solved directly; no iteration, no transient.
+`time_integration` is the slow reference (implicit Radau to steady state).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import scipy.linalg as sla
+
+from housingfe.errors import InputError, SolverError
+from housingfe.levels import OMEGA0, band_sum, level, third_octave_bands
+from housingfe.source.gears import GearPair
+from housingfe.source.stiffness import Corrections
+
+N_DOF = 14       # after eliminating the prescribed far-end angle (DOF 15 of the thesis)
+WHEEL_THETA_Z = 11
+BEARING_DOFS = {"pinion": [0, 1, 2, 3, 4], "wheel": [6, 7, 8, 9, 10]}
+
+
+# ------------------------------------------------------------------------------------ parameters
+@dataclass(frozen=True)
+class Interior:
+    """Parameters of the lumped model (SI).  Masses [kg], inertias [kg m^2] (axial = polar about the
+    shaft axis, diametral = about a transverse axis through the gear centre), torsional shaft
+    stiffnesses [N m/rad], bearing stiffness diagonals [N/m, N/m, N/m, N m/rad, N m/rad] for x, y, z,
+    theta_x, theta_y of each shaft (Appendix C), loss factor eta [-]."""
+
+    pinion_mass: float
+    pinion_inertia_axial: float
+    pinion_inertia_diametral: float
+    wheel_mass: float
+    wheel_inertia_axial: float
+    wheel_inertia_diametral: float
+    coupling_inertia: tuple[float, float]          # DOF 13, 14
+    torsion_stiffness: tuple[float, float, float, float]   # shafts 1, 2, 3, 4
+    pinion_bearings: tuple[float, float, float, float, float]
+    wheel_bearings: tuple[float, float, float, float, float]
+    loss_factor: float = 0.1
+
+    def __post_init__(self):
+        values = [self.pinion_mass, self.pinion_inertia_axial, self.pinion_inertia_diametral, self.wheel_mass,
+                  self.wheel_inertia_axial, self.wheel_inertia_diametral, *self.coupling_inertia,
+                  *self.torsion_stiffness, *self.pinion_bearings, *self.wheel_bearings]
+        if not all(np.isfinite(values)) or min(values) <= 0:
+            raise InputError("interior: masses, inertias and stiffnesses must be finite and > 0")
+        if not 0 < self.loss_factor < 2:
+            raise InputError(f"interior: loss_factor: {self.loss_factor} is outside (0, 2)")
+
+
+@dataclass(frozen=True)
+class ShaftGeometry:
+    """Geometry from which `derive_interior` builds the lumped parameters (all m): bearing spans from
+    the gear faces, diameter of the shaft between the bearings, and for the torsion shafts outside the
+    gearbox (Appendix C: pi G d^4 / (32 l)) diameters and lengths of shafts 1-4."""
+
+    pinion_spans: tuple[float, float] = (0.06, 0.06)
+    pinion_shaft_diameter: float = 0.080
+    wheel_spans: tuple[float, float] = (0.06, 0.06)
+    wheel_shaft_diameter: float = 0.095
+    torsion_diameters: tuple[float, float, float, float] = (0.040, 0.060, 0.075, 0.055)
+    torsion_lengths: tuple[float, float, float, float] = (1.5, 0.25, 0.25, 1.5)
+    coupling_inertia: tuple[float, float] = (0.02, 0.05)
+
+
+# Appendix C's printed bearing stiffness diagonal (the only parameters that survived in the text).
+APPENDIX_C_BEARINGS = {
+    "pinion": (5.3e8, 7.3e8, 1.6e8, 5.2e6, 3.8e6),
+    "wheel": (5.3e8, 5.7e8, 1.3e8, 3.7e6, 3.4e6),
+}
+
+
+def _cylinder(density: float, diameter: float, length: float) -> tuple[float, float, float]:
+    """Mass [kg], polar and diametral (about its own centre) inertia [kg m^2] of a solid cylinder."""
+    m = density * math.pi * diameter**2 / 4 * length
+    r2 = diameter**2 / 4
+    return m, m * r2 / 2, m * (3 * r2 + length**2) / 12
+
+
+def derive_interior(pair: GearPair, geometry: ShaftGeometry = ShaftGeometry(), loss_factor: float = 0.1,
+                    bearings: dict | None = None) -> Interior:
+    """Lumped parameters from gear and shaft geometry (Appendix C's table did not survive): each gear
+    is a solid cylinder of the mean of tip and root diameter over its face width, plus its shaft
+    between the bearings (solid, `*_shaft_diameter`); diametral inertia about the gear centre by the
+    parallel-axis theorem; torsion shafts k = pi G d^4 / (32 l)."""
+    rho, E, nu = pair.density, pair.youngs_modulus, pair.poisson_ratio
+    G = E / (2 * (1 + nu))
+    out = {}
+    for g, name, spans, dshaft in ((0, "pinion", geometry.pinion_spans, geometry.pinion_shaft_diameter),
+                                   (1, "wheel", geometry.wheel_spans, geometry.wheel_shaft_diameter)):
+        width = pair.face_width[g] * (2 if pair.kind == "double_helical" else 1) + (
+            pair.helix_gap if pair.kind == "double_helical" else 0.0)
+        dg = 0.5 * float(pair.tip_diameter[g] + pair.root_diameter[g])
+        m, jp, jd = _cylinder(rho, dg, width)
+        for span, sign in ((spans[0], -1), (spans[1], 1)):
+            ms, jps, jds = _cylinder(rho, dshaft, span)
+            arm = 0.5 * width + 0.5 * span
+            m, jp, jd = m + ms, jp + jps, jd + jds + ms * arm**2
+        out[name] = (m, jp, jd)
+    k = tuple(math.pi * G * d**4 / (32 * l) for d, l in zip(geometry.torsion_diameters, geometry.torsion_lengths))
+    b = bearings or APPENDIX_C_BEARINGS
+    return Interior(*out["pinion"], *out["wheel"], coupling_inertia=geometry.coupling_inertia,
+                    torsion_stiffness=k, pinion_bearings=tuple(b["pinion"]), wheel_bearings=tuple(b["wheel"]),
+                    loss_factor=loss_factor)
+
+
+# ------------------------------------------------------------------------------------ matrices
+@dataclass
+class Matrices:
+    """M, K0 (everything except the mesh), mesh direction h, modal damping D, preload force per N m of
+    torque in shaft 1 (f_unit), all for the 14 free DOFs."""
+
+    M: np.ndarray
+    K0: np.ndarray
+    h: np.ndarray
+    D: np.ndarray
+    preload: np.ndarray
+    mean_mesh_stiffness: float
+
+
+def mesh_direction(pair: GearPair) -> np.ndarray:
+    """h (14,) with d = h^T q the mesh compression along the flank normal [m] (Appendix C: k_ij = S h_i h_j).
+    Positive rotations of both gears close the mesh (theta_z of the wheel counts the other way)."""
+    a, bb = pair.operating_pressure_angle, pair.base_helix_angle
+    rb1, rb2 = pair.base_diameter / 2
+    h = np.zeros(N_DOF)
+    h[0:3] = [math.sin(a) * math.cos(bb), math.cos(a) * math.cos(bb), -math.sin(bb)]
+    h[5] = rb1 * math.cos(bb)
+    h[6:9] = -h[0:3]
+    h[11] = rb2 * math.cos(bb)
+    return h
+
+
+def assemble(pair: GearPair, interior: Interior, mean_mesh_stiffness: float) -> Matrices:
+    """Mass, stiffness and damping matrices of the 14-DOF model (mean mesh stiffness for the modes)."""
+    it = interior
+    M = np.diag([it.pinion_mass] * 3 + [it.pinion_inertia_diametral] * 2 + [it.pinion_inertia_axial]
+                + [it.wheel_mass] * 3 + [it.wheel_inertia_diametral] * 2 + [it.wheel_inertia_axial]
+                + list(it.coupling_inertia))
+    K0 = np.zeros((N_DOF, N_DOF))
+    K0[np.arange(5), np.arange(5)] = it.pinion_bearings
+    K0[np.arange(6, 11), np.arange(6, 11)] = it.wheel_bearings
+    k1, k2, k3, k4 = it.torsion_stiffness
+
+    def spring(i, j, k):
+        K0[i, i] += k
+        K0[j, j] += k
+        K0[i, j] -= k
+        K0[j, i] -= k
+
+    spring(5, 12, k2)
+    spring(11, 13, k3)
+    K0[12, 12] += k1          # to the held far end (DOF 15)
+    K0[13, 13] += k4          # to the loading gearbox, torsionally held
+    h = mesh_direction(pair)
+    K = K0 + mean_mesh_stiffness * np.outer(h, h)
+    w2, phi = sla.eigh(K, M)
+    if w2.min() <= 0:
+        raise SolverError("dynamics: the mean system is not positive definite")
+    zeta = it.loss_factor / 2
+    Mphi = M @ phi
+    D = Mphi @ np.diag(2 * zeta * np.sqrt(w2)) @ Mphi.T
+    preload = np.zeros(N_DOF)
+    preload[12] = 1.0          # the held angle acts as k1 * theta_15 on DOF 12
+    return Matrices(M=M, K0=K0, h=h, D=D, preload=preload, mean_mesh_stiffness=mean_mesh_stiffness)
+
+
+def natural_frequencies(mats: Matrices) -> np.ndarray:
+    """Undamped natural frequencies [Hz] of the mean system."""
+    w2 = sla.eigh(mats.K0 + mats.mean_mesh_stiffness * np.outer(mats.h, mats.h), mats.M, eigvals_only=True)
+    return np.sqrt(np.abs(w2)) / (2 * math.pi)
+
+
+def preload_force(mats: Matrices, torque: float) -> np.ndarray:
+    """Constant force vector [N, N m] that makes shaft 1 carry `torque` [N m] in the static mean system
+    (Sec. 2.5: theta_15 is found from the static solution of eq. 2.56)."""
+    K = mats.K0 + mats.mean_mesh_stiffness * np.outer(mats.h, mats.h)
+    q = np.linalg.solve(K, mats.preload)          # response to a unit force k1 theta_15 = 1
+    k1 = mats.K0[12, 12] - (-mats.K0[12, 5])      # k1 = K0[12,12] - k2
+    torque_per_unit = 1.0 - k1 * q[12]            # torque in shaft 1 = k1 (theta15 - theta13)
+    return mats.preload * torque / torque_per_unit
+
+
+# ------------------------------------------------------------------------------------ excitation
+def engagement_force(pair: GearPair, corrections: Corrections, stiffness: np.ndarray, normal_force: float,
+                     n_samples: int | None = None) -> np.ndarray:
+    """Engagement/disengagement shock force F_e [N] over one mesh period (eq. 2.62, Fig. 2.14/2.16),
+    sampled at the positions of `stiffness` (S(t) [N/m], one period, uniformly spaced).
+
+    Our reading of eq. 2.62: the tooth pairs are springs spaced one transverse pitch apart on a contact
+    length eps_tot * p; every pair in contact is asked for the deflection delta_i = max(delta - e(s_i), 0)
+    with delta = F / S(t) and e the tip relief of the wheel (at the start, length l_2) and the pinion (at
+    the end, length l_1); F_e = S(t) (sum_i delta_i - mean) / eps_tot.  For the 3-D correction D the
+    relief ramps are those of Fig. F.1's profile direction (amount, length)."""
+    S = np.asarray(stiffness, dtype=float)
+    n = S.size if n_samples is None else n_samples
+    t = np.arange(n) / n
+    if n != S.size:
+        S = np.interp(t, np.arange(S.size) / S.size, S, period=1.0)
+    pitch = pair.transverse_base_pitch
+    eps = pair.total_contact_ratio
+    length = eps * pitch
+    delta = normal_force / S
+    total = np.zeros(n)
+    for k in range(int(math.ceil(eps)) + 1):
+        s = (t + k) * pitch                           # position of pair k on the contact length
+        inside = s < length
+        e = np.zeros(n)
+        ca1, l1 = corrections.tip_relief[0], corrections.tip_relief_length[0]
+        ca2, l2 = corrections.tip_relief[1], corrections.tip_relief_length[1]
+        if ca2 > 0:
+            e += ca2 * np.clip((l2 - s) / l2, 0, 1)
+        if ca1 > 0:
+            e += ca1 * np.clip((s - (length - l1)) / l1, 0, 1)
+        total += np.where(inside, np.maximum(delta - e, 0.0), 0.0)
+    return S * (total - total.mean()) / eps
+
+
+# ------------------------------------------------------------------------------------ harmonic balance
+@dataclass
+class SteadyState:
+    """Periodic steady state: q(t) = sum_n Q[n] exp(i n Omega t), n = -H..H (two-sided coefficients).
+    tooth_frequency [Hz]; Q (2H+1, 14) [m, rad]; mesh_force (2H+1,) [N] (S(t) d(t) + F_e(t))."""
+
+    tooth_frequency: float
+    harmonics: np.ndarray
+    Q: np.ndarray
+    mesh_force: np.ndarray
+
+    def one_sided(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Frequencies n f_tooth [Hz] (n >= 1) and one-sided complex amplitudes 2 X_n."""
+        pos = self.harmonics >= 1
+        return self.harmonics[pos] * self.tooth_frequency, 2 * values[pos]
+
+    def wheel_angular_velocity(self) -> tuple[np.ndarray, np.ndarray]:
+        """(f [Hz], one-sided complex amplitude of the wheel's angular velocity [rad/s])."""
+        omega = 2 * math.pi * self.tooth_frequency
+        return self.one_sided(1j * self.harmonics * omega * self.Q[:, WHEEL_THETA_Z])
+
+    def wheel_velocity_mean_square(self) -> tuple[np.ndarray, np.ndarray]:
+        """(f [Hz], mean square of each harmonic line of the wheel angular velocity [(rad/s)^2])."""
+        f, a = self.wheel_angular_velocity()
+        return f, 0.5 * np.abs(a) ** 2
+
+
+def _fourier_coefficients(samples: np.ndarray, H: int) -> np.ndarray:
+    """Two-sided coefficients c_n, n = -2H..2H, of a periodic real signal sampled uniformly (zero beyond
+    the Nyquist limit)."""
+    N = samples.size
+    X = np.fft.fft(samples) / N
+    out = np.zeros(4 * H + 1, dtype=complex)
+    for n in range(-2 * H, 2 * H + 1):
+        if abs(n) < N / 2:
+            out[n + 2 * H] = X[n % N]
+    return out
+
+
+def harmonic_balance(mats: Matrices, stiffness: np.ndarray, shock: np.ndarray, preload: np.ndarray,
+                     tooth_frequency: float, H: int = 40) -> SteadyState:
+    """Periodic steady state of M q'' + D q' + (K0 + S(t) h h^T) q = f0 - F_e(t) h (Hill expansion with
+    harmonics -H..H of the tooth frequency [Hz]).  stiffness, shock: one period, uniformly sampled [N/m, N]."""
+    if tooth_frequency <= 0:
+        raise InputError(f"dynamics: tooth frequency must be > 0 Hz, got {tooth_frequency}")
+    Om = 2 * math.pi * tooth_frequency
+    n = np.arange(-H, H + 1)
+    Xs = _fourier_coefficients(np.asarray(stiffness, float), H)      # index k + 2H
+    Es = _fourier_coefficients(np.asarray(shock, float), H)[H:3 * H + 1]
+    h = mats.h
+    g = np.empty(n.size, dtype=complex)
+    b = np.zeros(n.size, dtype=complex)
+    Zh = np.empty((n.size, N_DOF), dtype=complex)
+    Zf0 = None
+    for i, nn in enumerate(n):
+        Z = mats.K0 - (nn * Om) ** 2 * mats.M + 1j * nn * Om * mats.D
+        sol = np.linalg.solve(Z, np.column_stack([h, preload]) if nn == 0 else h[:, None])
+        Zh[i] = sol[:, 0]
+        g[i] = h @ sol[:, 0]
+        if nn == 0:
+            Zf0 = sol[:, 1]
+            b[i] = h @ Zf0
+    T = Xs[(n[:, None] - n[None, :]) + 2 * H]                          # Toeplitz X_{n-m}
+    A = np.eye(n.size) + g[:, None] * T
+    d = np.linalg.solve(A, b - g * Es)
+    mesh = T @ d + Es                                                  # S(t) d(t) + F_e(t), harmonics
+    Q = -Zh * mesh[:, None]
+    Q[H] += Zf0
+    return SteadyState(tooth_frequency=tooth_frequency, harmonics=n, Q=Q, mesh_force=mesh)
+
+
+def time_integration(mats: Matrices, stiffness: np.ndarray, shock: np.ndarray, preload: np.ndarray,
+                     tooth_frequency: float, periods: int, samples_per_period: int = 64,
+                     rtol: float = 1e-8, method: str = "Radau") -> tuple[np.ndarray, np.ndarray]:
+    """Slow reference: integrate from the static mean solution over `periods` mesh periods with scipy's
+    solve_ivp (S(t), F_e(t) as trigonometric interpolants, eq. 2.60).  Returns the last period's time
+    samples [s] and states q (samples, 14)."""
+    from scipy.integrate import solve_ivp
+
+    T = 1.0 / tooth_frequency
+    Xs = np.fft.rfft(np.asarray(stiffness, float)) / len(stiffness)
+    Es = np.fft.rfft(np.asarray(shock, float)) / len(shock)
+    ks = np.arange(Xs.size)
+
+    def trig(c, t):
+        ph = np.exp(2j * math.pi * ks * t / T)
+        w = np.where(ks == 0, 1.0, 2.0)
+        return float(np.real(np.sum(w * c * ph)))
+
+    Minv = np.linalg.inv(mats.M)
+    h = mats.h
+
+    def rhs(t, y):
+        q, v = y[:N_DOF], y[N_DOF:]
+        force = preload - mats.K0 @ q - trig(Xs, t) * h * (h @ q) - trig(Es, t) * h - mats.D @ v
+        return np.concatenate([v, Minv @ force])
+
+    def jac(t, y):
+        K = mats.K0 + trig(Xs, t) * np.outer(h, h)
+        J = np.zeros((2 * N_DOF, 2 * N_DOF))
+        J[:N_DOF, N_DOF:] = np.eye(N_DOF)
+        J[N_DOF:, :N_DOF] = -Minv @ K
+        J[N_DOF:, N_DOF:] = -Minv @ mats.D
+        return J
+
+    q0 = np.linalg.solve(mats.K0 + np.real(Xs[0]) * np.outer(h, h), preload)
+    t_eval = (periods - 1) * T + np.arange(samples_per_period) * T / samples_per_period
+    kw = {"jac": jac} if method in ("Radau", "BDF", "LSODA") else {}
+    sol = solve_ivp(rhs, (0, periods * T), np.concatenate([q0, np.zeros(N_DOF)]), method=method,
+                    t_eval=t_eval, rtol=rtol, atol=1e-14, **kw)
+    if not sol.success:
+        raise SolverError(f"dynamics: time integration failed: {sol.message}")
+    return sol.t, sol.y[:N_DOF].T
+
+
+# ------------------------------------------------------------------------------------ levels
+def wheel_levels(state: SteadyState, f_max: float | None = None) -> dict[str, np.ndarray]:
+    """L_omega of the wheel (eq. 2.61, omega0 = 5e-8 rad/s): narrow-band lines (f, dB) and 1/3-octave
+    bands (centre, dB) up to f_max [Hz]."""
+    f, ms = state.wheel_velocity_mean_square()
+    if f_max is not None:
+        keep = f <= f_max
+        f, ms = f[keep], ms[keep]
+    bands = third_octave_bands(max(10.0, f.min() / 1.2), f.max() * 1.1)
+    banded = band_sum(f, ms, bands)
+    return {"f": f, "L_omega": level(ms, OMEGA0), "band_center": bands.center, "band_nominal": bands.nominal,
+            "band_L_omega": level(banded, OMEGA0)}
+
+
+def tooth_band_level(state: SteadyState) -> float:
+    """L_omega [dB] in the 1/3-octave band that contains the tooth frequency."""
+    f, ms = state.wheel_velocity_mean_square()
+    bands = third_octave_bands(state.tooth_frequency / 1.3, state.tooth_frequency * 1.3)
+    banded = band_sum(f, ms, bands)
+    inside = (bands.lower <= state.tooth_frequency) & (state.tooth_frequency < bands.upper)
+    return float(level(banded[inside].sum(), OMEGA0))
+
+
+# ------------------------------------------------------------------------------------ bearing spectra
+@dataclass
+class BearingSpectra:
+    """Harmonic bearing loads for the housing model at one operating point.
+
+    frequency [Hz] (n f_tooth, n = 1..H); bearing names and axial positions z [m] (from the gear
+    centre plane, along the shaft); loads (n_bearings, 6, n_freq) complex one-sided amplitudes of
+    [F_x, F_y, F_z (N), M_x, M_y, M_z (N m)] that the SHAFT exerts on the housing at the bearing,
+    load(t) = Re(sum A exp(i 2 pi f t)); axes as in the lumped model (z along the shafts).
+    The lumped model has one 5-DOF spring per shaft (Appendix C); its reaction is split over the two
+    bearings of the shaft by statics (radial forces by the lever rule, the tilt moment as a force
+    couple, the axial force to the bearing at z < 0, the locating bearing)."""
+
+    speed_rpm: float
+    torque_Nm: float
+    frequency: np.ndarray
+    names: list[str]
+    z: np.ndarray
+    loads: np.ndarray
+
+
+def bearing_spectra(state: SteadyState, mats: Matrices, interior: Interior, geometry: ShaftGeometry,
+                    pair: GearPair, speed_rpm: float, torque: float) -> BearingSpectra:
+    """Bearing loads of both shafts from the steady state (see `BearingSpectra`)."""
+    H = (state.harmonics.size - 1) // 2
+    pos = state.harmonics >= 1
+    names, zs, loads = [], [], []
+    for g, shaft, spans, kb in ((0, "pinion", geometry.pinion_spans, interior.pinion_bearings),
+                                (1, "wheel", geometry.wheel_spans, interior.wheel_bearings)):
+        dofs = BEARING_DOFS[shaft]
+        react = 2 * (np.asarray(kb)[:, None] * state.Q[pos][:, dofs].T)        # (5, H): Fx Fy Fz Mx My
+        half = 0.5 * pair.face_width[g]
+        zl, zr = -(half + spans[0]), half + spans[1]
+        L = zr - zl
+        wl, wr = zr / L, -zl / L                       # lever rule for a force at z = 0
+        Fx, Fy, Fz, Mx, My = react
+        # a moment M_y about the centre = force couple F_x = -M_y / L at zl, + M_y / L at zr (and M_x ~ F_y)
+        left = np.array([wl * Fx - My / L, wl * Fy + Mx / L, Fz, 0 * Fz, 0 * Fz, 0 * Fz])
+        right = np.array([wr * Fx + My / L, wr * Fy - Mx / L, 0 * Fz, 0 * Fz, 0 * Fz, 0 * Fz])
+        names += [f"{shaft}_left", f"{shaft}_right"]
+        zs += [zl, zr]
+        loads += [left, right]
+    f = state.harmonics[pos] * state.tooth_frequency
+    return BearingSpectra(speed_rpm=speed_rpm, torque_Nm=torque, frequency=f, names=names, z=np.array(zs),
+                          loads=np.array(loads))
