@@ -58,3 +58,46 @@ def comparison_rows(fixed_tilt: bool = True, **bearing_overrides) -> list[tuple]
                 o = ours[shaft][i, j]
                 rows.append((shaft, f"k_{DOF_NAMES[i]},{DOF_NAMES[j]}", p, o, o / p))
     return rows
+
+
+def fluid_film_rows() -> list[tuple]:
+    """Thesis Sec. 3.5 operating points: (bearing, eps thesis, eps Ocvirk, eps finite Gumbel, eps finite Reynolds,
+    h0 thesis [um], h0 Ocvirk [um], h0 finite Reynolds [um])."""
+    from housingfe.bearings.fluid_film import (JournalBearing, journal_bearing_coefficients,
+                                               short_bearing_coefficients)
+
+    with open(REFERENCE, "rb") as fh:
+        data = tomllib.load(fh)["fluid_film_bearings"]
+    rows = []
+    for name in ("pinion", "wheel"):
+        d = data[name]
+        b = JournalBearing(d["D_mm"] * 1e-3, d["L_mm"] * 1e-3, d["radial_clearance_um"] * 1e-6, d["viscosity_Pa_s"])
+        load = (0.0, -d["F_N"])
+        omega = d["omega_rad_per_s"]
+        short = short_bearing_coefficients(b, omega, load)
+        gumbel = journal_bearing_coefficients(b, omega, load, cavitation="gumbel")
+        reynolds = journal_bearing_coefficients(b, omega, load)
+        rows.append((name, d["eccentricity_ratio"], short.eccentricity_ratio, gumbel.eccentricity_ratio,
+                     reynolds.eccentricity_ratio, d["h0_um"], short.min_film * 1e6, reynolds.min_film * 1e6))
+    return rows
+
+
+def _print_all() -> None:
+    from housingfe.report import format_table
+
+    head = ["shaft", "entry", "printed", "ours", "ours/printed"]
+    print("Sec. 4.6, tilt held at zero (default):")
+    print(format_table(head, comparison_rows(True), "{:.3g}"))
+    print("\nSec. 4.6, tilt free (Mx = My = 0):")
+    print(format_table(head, comparison_rows(False), "{:.3g}"))
+    print("\nSensitivity (tilt held): zero radial clearance instead of CN:")
+    print(format_table(head, comparison_rows(True, radial_clearance=0.0), "{:.3g}"))
+    print("\nSensitivity (tilt held): groove factors 0.515 / 0.515 instead of 0.52 / 0.53:")
+    print(format_table(head, comparison_rows(True, groove_inner=0.515, groove_outer=0.515), "{:.3g}"))
+    print("\nSec. 3.5 fluid-film bearings:")
+    print(format_table(["bearing", "eps thesis", "eps Ocvirk", "eps finite Gumbel", "eps finite Reynolds",
+                        "h0 thesis um", "h0 Ocvirk um", "h0 finite Reynolds um"], fluid_film_rows(), "{:.3f}"))
+
+
+if __name__ == "__main__":
+    _print_all()
