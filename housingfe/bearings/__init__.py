@@ -11,6 +11,8 @@ Public API (axis convention: z = shaft axis, DOF order x, y, z, theta_x, theta_y
         eccentricity and the non-symmetric 6x6 K and C of a plain journal bearing (finite-length Reynolds
         equation, force and tilt coefficients); short_bearing_coefficients: the Ocvirk short bearing.
 
+    transform_stiffness(K, R) -> K in global axes (R: columns = the bearing's x, y, z in global coordinates).
+
 `housingfe bearing DESIGNATION --load FX FY FZ MX MY [--json]` prints the same (see bearings.cli).
 """
 from __future__ import annotations
@@ -19,10 +21,11 @@ from housingfe.bearings.catalogue import designations, lookup
 from housingfe.bearings.fluid_film import (FluidFilmResult, JournalBearing, journal_bearing_coefficients,
                                            short_bearing_coefficients)
 from housingfe.bearings.rolling import (DOF_NAMES, BearingResult, RollingBearing, finite_difference_stiffness,
-                                        make_model, rolling_bearing_stiffness, stiffness_at)
+                                        make_model, rolling_bearing_stiffness, stiffness_at,
+                                        transform_stiffness)
 
 __all__ = ["DOF_NAMES", "BearingResult", "RollingBearing", "bearing_stiffness", "designations", "lookup",
-           "make_model", "stiffness_at", "finite_difference_stiffness", "register_cli", "FluidFilmResult",
+           "make_model", "stiffness_at", "transform_stiffness", "finite_difference_stiffness", "register_cli", "FluidFilmResult",
            "JournalBearing", "journal_bearing_coefficients", "short_bearing_coefficients"]
 
 

@@ -439,6 +439,18 @@ def finite_difference_stiffness(model: _Model, q: np.ndarray, rel_step: float = 
     return k
 
 
+def transform_stiffness(k_local: np.ndarray, rotation) -> np.ndarray:
+    """6x6 matrix from the bearing frame to global axes: T K T^T with T = diag(R, R).
+
+    rotation: 3x3 whose COLUMNS are the bearing's local x, y, z axes (z = shaft axis) in global coordinates.
+    Works for K and for the fluid-film C alike (units unchanged)."""
+    r = np.asarray(rotation, float)
+    if r.shape != (3, 3) or not np.allclose(r.T @ r, np.eye(3), atol=1e-9):
+        raise InputError("bearing rotation: need an orthonormal 3x3 matrix (columns = local x, y, z)")
+    t = np.kron(np.eye(2), r)
+    return t @ np.asarray(k_local, float) @ t.T
+
+
 def rolling_bearing_stiffness(bearing: RollingBearing, load, *, model: str | None = None,
                               preload_axial: float = 0.0,
                               fixed_tilt: tuple[float, float] | None = None) -> BearingResult:

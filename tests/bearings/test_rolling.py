@@ -159,3 +159,39 @@ def test_nonphysical_geometry_raises_input_error():
         RollingBearing("x", "ball", 0.06, 0.13, 0.03, 8, 0.022, 0.2)
     with pytest.raises(InputError, match="groove"):
         dataclasses.replace(lookup("6312"), groove_inner=0.49)
+
+
+def test_rotating_the_load_rotates_the_matrix():
+    # 8 balls at 45 deg pitch: a load turned by 90 deg about z sees the same ball pattern, so
+    # K(turned load) = T K T^T with T the 90 deg rotation
+    from housingfe.bearings import transform_stiffness
+    load = np.array([0.0, -10000.0, 4000.0, 30.0, -10.0])
+    r = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    turned = np.r_[r @ load[:3], r[:2, :2] @ load[3:]]
+    k = bearing_stiffness("6312", load).K
+    k_turned = bearing_stiffness("6312", turned).K
+    expected = transform_stiffness(k, r)
+    assert np.max(np.abs(k_turned - expected)) < 1e-7 * np.max(np.abs(k))
+    with pytest.raises(InputError, match="orthonormal"):
+        transform_stiffness(k, 2 * r)
+
+
+def test_tapered_roller_sliced_model():
+    # generic tapered roller bearing (alpha0 = 15 deg): carries combined load in one axial direction only,
+    # analytic = finite-difference Jacobian, tilt stiffness from the slicing
+    b = RollingBearing("tapered", "tapered_roller", 0.08, 0.17, 0.04, 15, 0.022, 0.125,
+                       contact_angle=math.radians(15.0), radial_clearance=0.0, roller_length=0.03)
+    res = bearing_stiffness(b, [2000.0, -10000.0, 5000.0, 50.0, 0.0])
+    m = make_model(b)
+    fd = finite_difference_stiffness(m, res.displacement)
+    assert np.max(np.abs(fd - res.K)) < 1e-5 * np.max(np.abs(res.K))
+    assert res.K[3, 3] > 0 and res.K[4, 4] > 0
+    # Lim's roller (one fixed contact angle, uniform load per roller): every element force passes through the
+    # pressure centre on the axis, so a radial load with zero moment has no equilibrium unless the tilt is held
+    with pytest.raises(InputError, match="cannot carry"):
+        bearing_stiffness(b, [0.0, -10000.0, 5000.0, 0.0, 0.0], model="lim-roller")
+    lim = bearing_stiffness(b, [0.0, -10000.0, 5000.0, 0.0, 0.0], model="lim-roller", fixed_tilt=(0.0, 0.0))
+    assert lim.load[3] == pytest.approx(np.sum(lim.element_loads * np.sin(lim.element_angles))
+                                        * math.sin(math.radians(15)) * 0.0625, rel=1e-9)   # Eq. (3.8)
+    with pytest.raises(InputError, match="cannot carry"):
+        bearing_stiffness(b, [0.0, -10000.0, -5000.0, 0.0, 0.0])
