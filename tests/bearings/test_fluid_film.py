@@ -91,3 +91,25 @@ def test_bad_operating_points():
         journal_bearing_coefficients(bearing, omega, (0.0, -100 * force))
     with pytest.raises(InputError, match="clearance"):
         JournalBearing(0.08, 0.05, -1e-4, 0.05)
+
+
+@pytest.mark.parametrize("eps", [0.3, 0.6, 0.85])
+def test_short_bearing_coefficients_match_closed_forms(eps):
+    # Friswell, Penny, Garvey & Lees, Dynamics of Rotating Machines (2010), short-bearing coefficients,
+    # load along -y, rotation from x to y: K = (F/C) a, C = (F/(C omega)) b, h0 = (pi^2 (1-e^2) + 16 e^2)^(-3/2)
+    e = eps
+    h0 = 1 / (math.pi**2 * (1 - e * e) + 16 * e * e) ** 1.5
+    s = math.sqrt(1 - e * e)
+    a = h0 * np.array([
+        [4 * (math.pi**2 * (2 - e * e) + 16 * e * e), math.pi * (math.pi**2 * (1 - e * e) ** 2 - 16 * e**4) / (e * s)],
+        [-math.pi * (math.pi**2 * (1 - e * e) * (1 + 2 * e * e) + 32 * e * e * (1 + e * e)) / (e * s),
+         4 * (math.pi**2 * (1 + 2 * e * e) + 32 * e * e * (1 + e * e) / (1 - e * e))]])
+    bxy = -8 * (math.pi**2 * (1 + 2 * e * e) - 16 * e * e)
+    b = h0 * np.array([[2 * math.pi * s * (math.pi**2 * (1 + 2 * e * e) - 16 * e * e) / e, bxy],
+                       [bxy, 2 * math.pi * (math.pi**2 * (1 - e * e) ** 2 + 48 * e * e) / (e * s)]])
+    bearing = JournalBearing(0.1, 0.02, 1e-4, 0.05)
+    omega = 100.0
+    w = short_bearing_load(bearing, omega, eps)
+    res = short_bearing_coefficients(bearing, omega, (0.0, -w))
+    assert res.K[:2, :2] * bearing.clearance / w == pytest.approx(a, rel=1e-5, abs=1e-6)
+    assert res.C[:2, :2] * bearing.clearance * omega / w == pytest.approx(b, rel=1e-5, abs=1e-6)
