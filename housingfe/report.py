@@ -11,26 +11,34 @@ from typing import Iterable, Iterator, Sequence
 
 
 @contextlib.contextmanager
-def atomic_output_dir(out_dir: str | os.PathLike, is_writer: bool = True) -> Iterator[Path]:
+def atomic_output_dir(out_dir: str | os.PathLike, comm=None) -> Iterator[Path]:
     """Yield a temporary folder beside `out_dir`; on success it replaces `out_dir`, on any error it is
-    removed, so a result folder that exists is always complete.  Only the writer rank touches disk."""
+    removed, so a result folder that exists is always complete.  With an MPI communicator every rank gets
+    the same folder (rank 0 creates and renames it); without one the caller is the only writer."""
     out = Path(out_dir)
+    rank = comm.rank if comm is not None else 0
     tmp = out.parent / f".{out.name}.tmp-{os.getpid()}"
-    if not is_writer:
-        yield tmp
-        return
-    out.parent.mkdir(parents=True, exist_ok=True)
-    if tmp.exists():
-        shutil.rmtree(tmp)
-    tmp.mkdir()
+    if comm is not None:
+        tmp = comm.bcast(tmp, root=0)
+    if rank == 0:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        if tmp.exists():
+            shutil.rmtree(tmp)
+        tmp.mkdir()
+    if comm is not None:
+        comm.barrier()
     try:
         yield tmp
+        if comm is not None:
+            comm.barrier()
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        if rank == 0:
+            shutil.rmtree(tmp, ignore_errors=True)
         raise
-    if out.exists():
-        shutil.rmtree(out)
-    os.replace(tmp, out)
+    if rank == 0:
+        if out.exists():
+            shutil.rmtree(out)
+        os.replace(tmp, out)
 
 
 def write_json(path: Path, data) -> None:

@@ -28,7 +28,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     checks = modal_checks(model, result)
     wall = time.perf_counter() - t_start
     summary = modal_summary(model, result, checks, wall)
-    with report.atomic_output_dir(out, is_writer=comm.rank == 0) as tmp:
+    with report.atomic_output_dir(out, comm) as tmp:
         report.write_modal_outputs(tmp, model, result, summary, comm)
     if comm.rank == 0:
         print(report.modal_summary_text(summary))

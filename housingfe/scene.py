@@ -234,7 +234,9 @@ def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) ->
 
 
 def _first_error(exc: ValidationError) -> str:
-    err = exc.errors()[0]
+    # a misspelt key also shows up as a missing one: name the unknown key, it is the cause
+    errors = sorted(exc.errors(), key=lambda e: e["type"] != "extra_forbidden")
+    err = errors[0]
     loc = ".".join(str(p) for p in err["loc"] if not (isinstance(p, str) and p in ("box", "plate")))
     msg = err["msg"]
     if err["type"] == "extra_forbidden":

@@ -1,0 +1,93 @@
+"""The command line as a user meets it: bad input gives one clear line and exit code 2, no traceback,
+no result folder; a good run writes a complete folder; 1 and 2 MPI ranks agree."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from housingfe.scene import SCENE_DIR
+
+BOX = (SCENE_DIR / "box-free.toml").read_text()
+FAST = ["--set", "mesh.size=0.04", "--set", "analysis.modal.f_max=2500.0", "--set", "output.pictures=false"]
+
+
+def housingfe(*args, cwd=None, mpi_ranks=None):
+    cmd = [sys.executable, "-m", "housingfe", *args]
+    if mpi_ranks:
+        cmd = [shutil.which("mpirun") or "mpirun", "-n", str(mpi_ranks), *cmd]
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    return subprocess.run(cmd, capture_output=True, text=True, cwd=cwd, env=env, timeout=300)
+
+
+BAD_SCENES = {
+    "unknown_key": (BOX.replace("length = 0.325", "lenght = 0.325"), "geometry.lenght: unknown key"),
+    "negative_thickness": (BOX.replace("wall_thickness = 0.008", "wall_thickness = -0.008"),
+                           "geometry.wall_thickness"),
+    "zero_thickness": (BOX.replace("flange_thickness = 0.015", "flange_thickness = 0.0"),
+                       "geometry.flange_thickness"),
+    "poisson": (BOX.replace('name = "steel"', 'name = "steel"\npoisson_ratio = 0.5'), "material.poisson_ratio"),
+    "f_max_zero": (BOX.replace("f_max = 4000.0", "f_max = 0.0"), "analysis.modal.f_max"),
+    "missing_key": (BOX.replace("height = 0.125", ""), "geometry.height: Field required"),
+    "wrong_type": (BOX.replace("width = 0.225", 'width = "wide"'), "geometry.width"),
+    "malformed": (BOX.replace("[mesh]", "[mesh"), "malformed TOML"),
+    "unknown_material": (BOX.replace('name = "steel"', 'name = "unobtainium"'), "material.name"),
+    "walls_too_thick": (BOX.replace("wall_thickness = 0.008", "wall_thickness = 0.2"),
+                        "geometry.wall_thickness"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_SCENES))
+def test_bad_scene_gives_one_line_and_exit_2(tmp_path, case):
+    text, expected = BAD_SCENES[case]
+    scene = tmp_path / f"{case}.toml"
+    scene.write_text(text)
+    out = tmp_path / "out"
+    proc = housingfe("run", str(scene), "--out", str(out))
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert lines[0].startswith("housingfe: error: ") and str(scene) in lines[0]
+    assert expected in lines[0], lines[0]
+    assert not out.exists() and not list(tmp_path.glob(".out*"))
+
+
+def test_unknown_scene_and_bad_override(tmp_path):
+    proc = housingfe("run", "no-such-scene")
+    assert proc.returncode == 2 and "no-such-scene" in proc.stderr and "Traceback" not in proc.stderr
+    proc = housingfe("run", "box-free", "--set", "mesh.size")
+    assert proc.returncode == 2 and "KEY=VALUE" in proc.stderr
+    proc = housingfe("run", str(tmp_path / "missing.toml"))
+    assert proc.returncode == 2 and "not found" in proc.stderr
+
+
+def test_scenes_lists_builtins():
+    proc = housingfe("scenes")
+    assert proc.returncode == 0
+    assert "box-free" in proc.stdout and "nafems-fv12" in proc.stdout
+
+
+def test_run_writes_complete_folder_and_mpi_agrees(tmp_path):
+    one, two = tmp_path / "one", tmp_path / "two"
+    proc = housingfe("run", "box-free", "--out", str(one), *FAST)
+    assert proc.returncode == 0, proc.stderr
+    modes = json.loads((one / "modes.json").read_text())
+    for key in ("scene", "frequencies_hz", "rigid_body_frequencies_hz", "mass_kg", "dofs", "complete",
+                "residuals", "wall_time_s"):
+        assert key in modes
+    assert modes["complete"] and len(modes["rigid_body_frequencies_hz"]) == 6
+    assert (one / "summary.txt").exists() and (one / "modes.xdmf").exists()
+    if not shutil.which("mpirun"):
+        pytest.skip("mpirun not installed")
+    proc = housingfe("run", "box-free", "--out", str(two), *FAST, mpi_ranks=2)
+    assert proc.returncode == 0, proc.stderr
+    modes2 = json.loads((two / "modes.json").read_text())
+    assert modes2["mpi_ranks"] == 2 and modes2["dofs"] == modes["dofs"]
+    f1, f2 = modes["frequencies_hz"], modes2["frequencies_hz"]
+    assert len(f1) == len(f2)
+    assert max(abs(a - b) / a for a, b in zip(f1, f2)) < 1e-8
+    assert Path(two / "modes.xdmf").exists()
