@@ -106,7 +106,7 @@ class GearBody:
     face_width: float
 
     @classmethod
-    def solid_disc(cls, outer_radius, bore_radius, width, base_radius, density=7850.0) -> "GearBody":
+    def solid_disc(cls, outer_radius, bore_radius, width, base_radius, density=7850.0) -> GearBody:
         """A steel disc (ring) of `outer_radius`, `bore_radius`, `width` [m] - the assumed gear blank."""
         mass = density * math.pi * (outer_radius**2 - bore_radius**2) * width
         polar = 0.5 * mass * (outer_radius**2 + bore_radius**2)
@@ -382,4 +382,4 @@ def bearing_load_spectra(pair: FukumaPair, z: float, rpm: float, te_harmonics_m,
 
 
 # re-exported so the CLI finds them here
-from housingfe.source.fukuma_run import bench_rows, run_scene  # noqa: E402
+from housingfe.source.fukuma_run import bench_rows, run_scene  # noqa: F401

@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Literal, Optional
+from typing import Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -79,8 +79,8 @@ class _Gear(_Strict):
     centre_distance_m: float = Field(gt=0)
     mesh_stiffness_N_per_m: float = Field(gt=0)
     zeta: float = Field(0.07, ge=0, lt=1)
-    blank_outer_radius_m: Optional[float] = Field(None, gt=0)
-    sensor_radius_m: Optional[float] = Field(None, gt=0)
+    blank_outer_radius_m: float | None = Field(None, gt=0)
+    sensor_radius_m: float | None = Field(None, gt=0)
 
 
 class _Sweep(_Strict):
@@ -113,7 +113,7 @@ class FukumaScene(_Strict):
     shaft: _Shaft
     gear: _Gear
     sweep: _Sweep = _Sweep()
-    loads: Optional[_Loads] = None
+    loads: _Loads | None = None
 
     @model_validator(mode="after")
     def _positions(self):
@@ -166,7 +166,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
 
     sc = parse_scene(scene, scene_path)
     out_dir = Path(out_dir)
-    pair, geo = build_pair(sc)
+    pair, _ = build_pair(sc)
     sw = sc.sweep
     zs = np.linspace(sw.z_min, sw.z_max, sw.points)
     rows, ratios = [], {rpm: [] for rpm in sw.speeds_rpm}
@@ -210,8 +210,8 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
         summary["bearing_loads"] = _bearing_outputs(sc, pair, out_dir)
     write_json(out_dir / "summary.json", summary)
     text = [f"{sc.scene.name}: {sc.scene.description}",
-            f"K_s Table 1 {s.shaft_stiffness_N_per_m:.5g} N/m, from r_eq {ks_from_radius:.5g} N/m "
-            f"({100 * summary['shaft_stiffness_rel_difference']:+.2f} %)", "",
+            (f"K_s Table 1 {s.shaft_stiffness_N_per_m:.5g} N/m, from r_eq {ks_from_radius:.5g} N/m "
+             f"({100 * summary['shaft_stiffness_rel_difference']:+.2f} %)"), "",
             format_table(["z", "zl mm", *[f"K_r {r:g}" for r in sw.speeds_rpm],
                           *[f"K_z {r:g}" for r in sw.speeds_rpm]],
                          [[float(z), float(z * s.length_m * 1e3), *[ratios[r][i]["K_r"] for r in sw.speeds_rpm],
@@ -266,8 +266,9 @@ def _plot(path, zl_mm, ratios, title):
 def bench_rows(quick: bool) -> list[dict]:
     """One row: time of a 37-point gear-position sweep (Series A); error = relative difference between
     Table 1's K_s and K_s computed from its equivalent radius (E = 206 GPa assumed)."""
-    from housingfe.source import fukuma as fk
     import tomllib
+
+    from housingfe.source import fukuma as fk
 
     path = Path(__file__).parents[1] / "scenes" / "fukuma-series-a.toml"
     scene = tomllib.loads(path.read_text())

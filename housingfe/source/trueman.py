@@ -20,8 +20,6 @@ Public API: `critical_speeds`, `mesh_transfer`, `mesh_torques`, `random_te`, `me
 from __future__ import annotations
 
 import math
-import time
-from pathlib import Path
 
 import numpy as np
 import scipy.linalg as sl
@@ -33,9 +31,21 @@ from housingfe.source import trueman_data as data
 from housingfe.source.trueman_model import DriveConfig, DriveModel, build_drive, vs_drive_ratios
 
 __all__ = [
-    "DriveConfig", "DriveModel", "build_drive", "vs_drive_ratios", "critical_speeds", "mesh_transfer",
-    "mesh_torques", "random_te", "mesh_load_envelopes", "mesh_torque_from_receptances",
-    "shaft_end_stiffness", "rpm_to_omega", "thesis_propagation_factor", "run_scene", "bench_rows",
+    "DriveConfig",
+    "DriveModel",
+    "bench_rows",
+    "build_drive",
+    "critical_speeds",
+    "mesh_load_envelopes",
+    "mesh_torque_from_receptances",
+    "mesh_torques",
+    "mesh_transfer",
+    "random_te",
+    "rpm_to_omega",
+    "run_scene",
+    "shaft_end_stiffness",
+    "thesis_propagation_factor",
+    "vs_drive_ratios",
 ]
 
 
@@ -209,4 +219,4 @@ def thesis_propagation_factor(cfg: DriveConfig, rpm: float) -> np.ndarray:
 
 
 # re-exported here so scenes and the benchmark only need this module
-from housingfe.source.trueman_run import bench_rows, run_scene  # noqa: E402
+from housingfe.source.trueman_run import bench_rows, run_scene

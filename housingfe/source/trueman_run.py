@@ -32,7 +32,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Literal, Optional
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -40,6 +40,9 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from housingfe.errors import InputError
 from housingfe.report import format_table, write_csv, write_json
 from housingfe.source import trueman_data as data
+
+if TYPE_CHECKING:
+    from housingfe.source.trueman_model import DriveConfig
 
 
 class _Strict(BaseModel):
@@ -67,12 +70,12 @@ class _Machine(_Strict):
 class _Configuration(_Strict):
     name: str
     published_rpm: list[float] = []
-    type: Optional[Literal["A", "B"]] = None
-    boxes: Optional[int] = Field(None, ge=1, le=100)
-    drive: Optional[Literal["headstock", "vs_drive"]] = None
+    type: Literal["A", "B"] | None = None
+    boxes: int | None = Field(None, ge=1, le=100)
+    drive: Literal["headstock", "vs_drive"] | None = None
     bushed: bool = False
     bush_damping_factor: float = Field(1.0, ge=0)
-    drawshaft_mid_diameter_m: Optional[float] = Field(None, gt=0, lt=0.2)
+    drawshaft_mid_diameter_m: float | None = Field(None, gt=0, lt=0.2)
     drawroll_inertia_factor: float = Field(1.0, gt=0)
     coupling_flexibility_factor: float = Field(1.0, gt=0)
     mesh_flexibility_factor: float = Field(1.0, gt=0)
@@ -112,7 +115,7 @@ class TruemanScene(_Strict):
     machine: _Machine = _Machine()
     configurations: list[_Configuration] = Field(min_length=1)
     critical_speeds: _Critical = _Critical()
-    forced: Optional[_Forced] = None
+    forced: _Forced | None = None
 
     @model_validator(mode="after")
     def _names(self):
@@ -135,7 +138,7 @@ def parse_scene(scene: dict, scene_path: str) -> TruemanScene:
         raise InputError(f"{scene_path}: {key}: {msg}") from None
 
 
-def drive_config(sc: TruemanScene, conf) -> "DriveConfig":
+def drive_config(sc: TruemanScene, conf) -> DriveConfig:
     """DriveConfig of one scene configuration (machine table as defaults)."""
     from housingfe.source.trueman_model import DriveConfig
 
@@ -297,13 +300,13 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
     if sc.forced is not None:
         forced = _forced_outputs(sc, out_dir)
         summary["forced"] = forced
-        text += ["", f"Forced response ({forced['configuration']}, {forced['machines']} machines, "
-                 f"seed {forced['seed']}): max dynamic mesh torque {forced['max_dynamic_torque_Nm']:.4g} N m "
-                 f"({forced['max_dynamic_torque_lbf_in']:.4g} lbf in) at {forced['at_rpm']:.0f} r.p.m., "
-                 f"mesh {forced['at_mesh']}",
-                 f"Tooth separation (|T_dyn| > mean torque {forced['mean_mesh_torque_Nm']:.3g} N m) at "
-                 f"{forced['separation_flagged_points']} speed/mesh points; first at "
-                 f"{forced['separation_first_rpm']} r.p.m.  A linear TE source is not valid there."]
+        text += ["", (f"Forced response ({forced['configuration']}, {forced['machines']} machines, "
+                      f"seed {forced['seed']}): max dynamic mesh torque {forced['max_dynamic_torque_Nm']:.4g} "
+                      f"N m ({forced['max_dynamic_torque_lbf_in']:.4g} lbf in) at {forced['at_rpm']:.0f} "
+                      f"r.p.m., mesh {forced['at_mesh']}"),
+                 (f"Tooth separation (|T_dyn| > mean torque {forced['mean_mesh_torque_Nm']:.3g} N m) at "
+                  f"{forced['separation_flagged_points']} speed/mesh points; first at "
+                  f"{forced['separation_first_rpm']} r.p.m.  A linear TE source is not valid there.")]
     write_json(out_dir / "summary.json", summary)
     (out_dir / "summary.txt").write_text("\n".join(text) + "\n")
 
@@ -317,8 +320,15 @@ def bench_rows(quick: bool) -> list[dict]:
       solved per speed with one sparse LU);
     - 100 Monte-Carlo machines over the same sweep (the per-speed transfer matrix is reused, so machines
       are a 60 x 60 matrix product each)."""
-    from housingfe.source.trueman import (DriveConfig, build_drive, critical_speeds, mesh_load_envelopes,
-                                          mesh_torques, random_te, rpm_to_omega)
+    from housingfe.source.trueman import (
+        DriveConfig,
+        build_drive,
+        critical_speeds,
+        mesh_load_envelopes,
+        mesh_torques,
+        random_te,
+        rpm_to_omega,
+    )
 
     rows = []
     cfg = DriveConfig()

@@ -2,6 +2,7 @@
 equivalent-mass limits, bearing-load equilibrium, scenes."""
 from __future__ import annotations
 
+import io
 import math
 import tomllib
 from pathlib import Path
@@ -137,14 +138,14 @@ def test_run_scene_outputs(name, tmp_path):
     scene, path = _load(name)
     scene["sweep"]["points"] = 9
     fk.run_scene(scene, path, tmp_path)
-    rows = list(csv.DictReader(open(tmp_path / "conversion_ratios.csv")))
+    rows = list(csv.DictReader(io.StringIO((tmp_path / "conversion_ratios.csv").read_text())))
     assert len(rows) == 9
     mid = rows[4]
     assert float(mid["z"]) == pytest.approx(0.5)
     assert abs(float(mid["K_z@700rpm"])) < 1e-9 and abs(float(mid["beta_V_per_N"])) < 1e-15
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert abs(summary["shaft_stiffness_rel_difference"]) < 0.01
-    loads = list(csv.DictReader(open(tmp_path / "bearing_loads.csv")))
+    loads = list(csv.DictReader(io.StringIO((tmp_path / "bearing_loads.csv").read_text())))
     assert len(loads) == 2 * 4 * 6 * 3
     assert (tmp_path / "conversion_ratios.png").stat().st_size > 1000
 

@@ -1,13 +1,13 @@
 """Trueman (1974) drive: published critical speeds, analytic TE cases, consistency of the global solve."""
 from __future__ import annotations
 
+import io
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 import scipy.sparse as sp
-
-from pathlib import Path
 
 from housingfe.errors import InputError
 from housingfe.source import trueman as tr
@@ -22,12 +22,12 @@ def _rel(ours, published):
 
 # ------------------------------------------------------------------ Table 6.1 and Sec. 6.9.1
 TABLE_CASES = [
-    ("standard A, solid gears", dict()),
-    ("type B", dict(machine_type="B", bushed=True)),
-    ("C with bushed gears", dict(bushed=True)),
-    ("A with 1/2 in drawshafts", dict(drawshaft_mid_diameter=0.5 * INCH)),
-    ("A with drawroll inertia -50 %", dict(drawroll_inertia_factor=0.5)),
-    ("A with coupling flexibility x100", dict(coupling_flexibility_factor=100.0)),
+    ("standard A, solid gears", {}),
+    ("type B", {"machine_type": "B", "bushed": True}),
+    ("C with bushed gears", {"bushed": True}),
+    ("A with 1/2 in drawshafts", {"drawshaft_mid_diameter": 0.5 * INCH}),
+    ("A with drawroll inertia -50 %", {"drawroll_inertia_factor": 0.5}),
+    ("A with coupling flexibility x100", {"coupling_flexibility_factor": 100.0}),
 ]
 
 
@@ -99,6 +99,7 @@ def test_thesis_propagation_step_is_not_physical():
         t_mesh = km * (x[1] - x[2] - e)
         t_crossed = kc * (x[0] - x[1])
         assert t_mesh == pytest.approx(analytic, rel=1e-9)
+        assert tr.mesh_transfer(model, w)[0, 0] * e == pytest.approx(analytic, rel=1e-9)
         assert t_crossed == pytest.approx(analytic, rel=1e-9)
         # eq. 5.6a direct term (receptances of each gear side without the mesh) is exact too
         h_bronze = 1.0 / kc + 1.0 / (-w**2 * jl)          # bronze root looking into the layshaft
@@ -232,12 +233,12 @@ def test_run_scene_type_b_writes_critical_speeds_and_envelopes(tmp_path):
     tr.run_scene(scene, path, tmp_path)
     crit = json.loads((tmp_path / "critical_speeds.json").read_text())
     assert _rel(crit["type B"], data.TABLE_6_1_RPM["type B"]).max() < 0.01
-    rows = list(csv.DictReader(open(tmp_path / "mesh_load_envelopes.csv")))
+    rows = list(csv.DictReader(io.StringIO((tmp_path / "mesh_load_envelopes.csv").read_text())))
     assert len(rows) == 7 * 60
     for r in rows:
         assert float(r["min_Nm"]) <= float(r["mean_Nm"]) <= float(r["max_Nm"])
     # every separation flag really has a dynamic torque above the mean transmitted torque
-    for r in csv.DictReader(open(tmp_path / "separation_flags.csv")):
+    for r in csv.DictReader(io.StringIO((tmp_path / "separation_flags.csv").read_text())):
         assert float(r["max_dynamic_Nm"]) > float(r["mean_transmitted_Nm"])
         assert int(r["machines_exceeding"]) >= 1
     assert (tmp_path / "mesh_load_envelopes.png").stat().st_size > 1000
