@@ -238,9 +238,14 @@ def test_run_scene_type_b_writes_critical_speeds_and_envelopes(tmp_path):
     for r in rows:
         assert float(r["min_Nm"]) <= float(r["mean_Nm"]) <= float(r["max_Nm"])
     # every separation flag really has a dynamic torque above the mean transmitted torque
-    for r in csv.DictReader(io.StringIO((tmp_path / "separation_flags.csv").read_text())):
+    flags = list(csv.DictReader(io.StringIO((tmp_path / "separation_flags.csv").read_text())))
+    for r in flags:
         assert float(r["max_dynamic_Nm"]) > float(r["mean_transmitted_Nm"])
         assert int(r["machines_exceeding"]) >= 1
+    # ... and no operating point above the mean torque is missed
+    limit = scene["forced"]["mean_mesh_torque_Nm"]
+    assert len(flags) == sum(float(r["max_Nm"]) > limit for r in rows)
+    assert len(flags) > 0                    # Type B at 1000-4000 r.p.m. separates somewhere (5 lbf in)
     assert (tmp_path / "mesh_load_envelopes.png").stat().st_size > 1000
 
 
