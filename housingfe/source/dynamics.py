@@ -316,8 +316,12 @@ def time_integration(mats: Matrices, stiffness: np.ndarray, shock: np.ndarray, p
     from scipy.integrate import solve_ivp
 
     T = 1.0 / tooth_frequency
-    Xs = np.fft.rfft(np.asarray(stiffness, float)) / len(stiffness)
-    Es = np.fft.rfft(np.asarray(shock, float)) / len(shock)
+    # trigonometric interpolants without the Nyquist term, as in `harmonic_balance`
+    n_s = len(stiffness)
+    Xs = np.fft.rfft(np.asarray(stiffness, float))[: (n_s + 1) // 2] / n_s
+    Es = np.fft.rfft(np.asarray(shock, float))[: (n_s + 1) // 2] / n_s
+    if len(shock) != n_s:
+        raise InputError("dynamics: stiffness and shock must be sampled at the same points")
     ks = np.arange(Xs.size)
 
     def trig(c, t):
