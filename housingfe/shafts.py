@@ -224,7 +224,7 @@ class Shaft:
 
     @classmethod
     def stepped(cls, segments, material: Material = STEEL, origin=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0),
-                elements_per_segment: int | list[int] = 4) -> "Shaft":
+                elements_per_segment: int | list[int] = 4) -> Shaft:
         """Shaft from segments [(length, outer_d[, inner_d]), ...] [m] laid end to end from `origin` along `axis`.
 
         Each segment is split into elements_per_segment equal elements (an int or one int per segment)."""

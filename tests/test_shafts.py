@@ -6,8 +6,16 @@ import pytest
 from scipy.linalg import eigh
 
 from housingfe.errors import InputError
-from housingfe.shafts import (STEEL, CircularSection, Material, RigidDisc, Shaft, beam_element_matrices, dof,
-                              local_beam_matrices)
+from housingfe.shafts import (
+    STEEL,
+    CircularSection,
+    Material,
+    RigidDisc,
+    Shaft,
+    beam_element_matrices,
+    dof,
+    local_beam_matrices,
+)
 
 E, NU, RHO = STEEL.E, STEEL.nu, STEEL.rho
 G = STEEL.G

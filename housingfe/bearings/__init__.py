@@ -18,15 +18,40 @@ Public API (axis convention: z = shaft axis, DOF order x, y, z, theta_x, theta_y
 from __future__ import annotations
 
 from housingfe.bearings.catalogue import designations, lookup
-from housingfe.bearings.fluid_film import (FluidFilmResult, JournalBearing, journal_bearing_coefficients,
-                                           short_bearing_coefficients)
-from housingfe.bearings.rolling import (DOF_NAMES, BearingResult, RollingBearing, finite_difference_stiffness,
-                                        make_model, rolling_bearing_stiffness, stiffness_at,
-                                        transform_stiffness)
+from housingfe.bearings.fluid_film import (
+    FluidFilmResult,
+    JournalBearing,
+    journal_bearing_coefficients,
+    short_bearing_coefficients,
+)
+from housingfe.bearings.rolling import (
+    DOF_NAMES,
+    BearingResult,
+    RollingBearing,
+    finite_difference_stiffness,
+    make_model,
+    rolling_bearing_stiffness,
+    stiffness_at,
+    transform_stiffness,
+)
 
-__all__ = ["DOF_NAMES", "BearingResult", "RollingBearing", "bearing_stiffness", "designations", "lookup",
-           "make_model", "stiffness_at", "transform_stiffness", "finite_difference_stiffness", "register_cli", "FluidFilmResult",
-           "JournalBearing", "journal_bearing_coefficients", "short_bearing_coefficients"]
+__all__ = [
+    "DOF_NAMES",
+    "BearingResult",
+    "FluidFilmResult",
+    "JournalBearing",
+    "RollingBearing",
+    "bearing_stiffness",
+    "designations",
+    "finite_difference_stiffness",
+    "journal_bearing_coefficients",
+    "lookup",
+    "make_model",
+    "register_cli",
+    "short_bearing_coefficients",
+    "stiffness_at",
+    "transform_stiffness",
+]
 
 
 def bearing_stiffness(bearing: str | RollingBearing, load, *, model: str | None = None,

@@ -51,7 +51,7 @@ _SPHERICAL_CONTACT_ANGLE_DEG = 9.0
 def normalise(designation: str) -> str:
     """'SKF 7316 B' -> '7316B' (upper case, no spaces, no 'SKF' prefix)."""
     key = designation.upper().replace(" ", "").replace("-", "")
-    return key[3:] if key.startswith("SKF") else key
+    return key.removeprefix("SKF")
 
 
 def designations() -> list[str]:

@@ -153,7 +153,7 @@ class _Model:
     def reference_deflection(self, load: np.ndarray) -> float:
         """Typical element deflection [m] for this load: scales the Newton iteration."""
         force = max(np.linalg.norm(load[:3]), np.linalg.norm(load[3:]) / self.moment_arm(), 1.0)
-        return (force / (len(self.psi) * self.bearing.rows * self.k_n)) ** (1.0 / self.exponent)
+        return (force / (len(self.psi) * self.k_n)) ** (1.0 / self.exponent)     # psi: every element, all rows
 
     def moment_arm(self) -> float:
         return self.bearing.pitch_diameter / 2.0

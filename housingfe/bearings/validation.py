@@ -63,8 +63,11 @@ def comparison_rows(fixed_tilt: bool = True, **bearing_overrides) -> list[tuple]
 def fluid_film_rows() -> list[tuple]:
     """Thesis Sec. 3.5 operating points: (bearing, eps thesis, eps Ocvirk, eps finite Gumbel, eps finite Reynolds,
     h0 thesis [um], h0 Ocvirk [um], h0 finite Reynolds [um])."""
-    from housingfe.bearings.fluid_film import (JournalBearing, journal_bearing_coefficients,
-                                               short_bearing_coefficients)
+    from housingfe.bearings.fluid_film import (
+        JournalBearing,
+        journal_bearing_coefficients,
+        short_bearing_coefficients,
+    )
 
     with open(REFERENCE, "rb") as fh:
         data = tomllib.load(fh)["fluid_film_bearings"]

@@ -39,19 +39,25 @@ def _timed(fn, repeat: int):
 
 def rolling_rows(quick: bool) -> list[list]:
     """One row per (case, FD step): Newton iterations, time per analytic matrix, time and error of FD."""
-    from housingfe.bearings import (bearing_stiffness, finite_difference_stiffness, lookup, make_model,
-                                    stiffness_at)
+    from housingfe.bearings import (
+        bearing_stiffness,
+        finite_difference_stiffness,
+        lookup,
+        make_model,
+        stiffness_at,
+    )
 
     rows = []
     cases = CASES[:3] if quick else CASES
     repeat = 3 if quick else 20
     for designation, model, load in cases:
-        res, t_solve = _timed(lambda: bearing_stiffness(designation, load, model=model), repeat)
+        res, t_solve = _timed(lambda d=designation, f=load, mo=model: bearing_stiffness(d, f, model=mo), repeat)
         m = make_model(lookup(designation), model)
-        _, t_k = _timed(lambda: stiffness_at(m, res.displacement), repeat)
+        _, t_k = _timed(lambda m=m, q=res.displacement: stiffness_at(m, q), repeat)
         scale = np.max(np.abs(res.K))
         for step in FD_STEPS:
-            fd, t_fd = _timed(lambda: finite_difference_stiffness(m, res.displacement, rel_step=step), repeat)
+            fd, t_fd = _timed(lambda m=m, q=res.displacement, h=step: finite_difference_stiffness(m, q, rel_step=h),
+                               repeat)
             rows.append([designation, model, res.iterations, round(t_solve * 1e3, 3), round(t_k * 1e3, 4), step,
                          round(t_fd * 1e3, 3), float(np.max(np.abs(fd - res.K)) / scale)])
     return rows
@@ -69,7 +75,7 @@ def fluid_film_rows(quick: bool) -> list[list]:
     idx = np.ix_([0, 1, 3, 4], [0, 1, 3, 4])
     rows = []
     for nt, nz in grids:
-        res, t = _timed(lambda: journal_bearing_coefficients(bearing, omega, load, n_theta=nt, n_z=nz), 1)
+        res, t = _timed(lambda a=nt, b=nz: journal_bearing_coefficients(bearing, omega, load, n_theta=a, n_z=b), 1)
         k_err = np.max(np.abs(res.K[idx] - ref.K[idx]) / np.abs(np.diag(ref.K)[[0, 1, 3, 4]])[:, None])
         rows.append([f"{nt}x{nz}", round(t, 3), res.eccentricity_ratio,
                      abs(res.eccentricity_ratio - ref.eccentricity_ratio), float(k_err)])

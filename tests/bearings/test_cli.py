@@ -24,3 +24,11 @@ def test_text_output_and_bad_input(capsys):
     err = capsys.readouterr().err
     assert "6999" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert main(["bearing", "7316B", "--load", "0", "-1000", "-4000", "0", "0"]) == 2
+
+
+def test_preload_axial_adds_to_fz(capsys):
+    assert main(["bearing", "6215", "--load", "0", "-5000", "0", "0", "0", "--preload-axial", "3000", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    ref = bearing_stiffness("6215", [0, -5000, 3000, 0, 0])
+    assert np.allclose(data["K"], ref.K, rtol=1e-12, atol=0)
+    assert data["load"][2] == 3000.0

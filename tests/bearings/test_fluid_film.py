@@ -7,9 +7,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from housingfe.bearings.fluid_film import (JournalBearing, ReynoldsSolver, journal_bearing_coefficients,
-                                           short_bearing_coefficients, short_bearing_film_force,
-                                           short_bearing_load)
+from housingfe.bearings.fluid_film import (
+    JournalBearing,
+    ReynoldsSolver,
+    journal_bearing_coefficients,
+    short_bearing_coefficients,
+    short_bearing_film_force,
+    short_bearing_load,
+)
 from housingfe.errors import InputError
 
 REF = tomllib.loads((Path(__file__).parents[2] / "housingfe/data/roosmalen1994.toml").read_text())

@@ -5,8 +5,13 @@ import math
 import numpy as np
 import pytest
 
-from housingfe.bearings import (bearing_stiffness, finite_difference_stiffness, lookup, make_model,
-                                RollingBearing)
+from housingfe.bearings import (
+    RollingBearing,
+    bearing_stiffness,
+    finite_difference_stiffness,
+    lookup,
+    make_model,
+)
 from housingfe.errors import InputError
 
 LOADS = {
