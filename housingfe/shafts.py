@@ -216,11 +216,13 @@ class RigidDisc:
 
 @dataclass
 class Shaft:
-    """A straight shaft of Timoshenko elements: nodes (n, 3) [m], elements (i, j, section), discs {node: disc}."""
+    """A straight shaft of Timoshenko elements: nodes (n, 3) [m], elements (i, j, section), discs {node: disc},
+    supports {node: 6x6 stiffness to ground}."""
     nodes: np.ndarray
     elements: list
     material: Material = STEEL
     discs: dict = field(default_factory=dict)
+    supports: dict = field(default_factory=dict)
 
     @classmethod
     def stepped(cls, segments, material: Material = STEEL, origin=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0),
@@ -276,6 +278,16 @@ class Shaft:
                              old.diametral_inertia + disc.diametral_inertia)
         self.discs[node] = disc
 
+    def add_support(self, node: int, stiffness) -> None:
+        """Connect a node to ground (a rigid housing) through a 6x6 stiffness in global axes, e.g. a bearing's
+        `transform_stiffness(result.K, R)` [N/m, N/rad, N m/rad]; adds to one already there."""
+        k = np.asarray(stiffness, float)
+        if k.shape != (6, 6) or not np.all(np.isfinite(k)):
+            raise InputError(f"shaft: support stiffness on node {node}: need a finite 6x6 matrix")
+        if not (0 <= node < len(self.nodes)):
+            raise InputError(f"shaft: support node {node} out of range 0..{len(self.nodes) - 1}")
+        self.supports[node] = self.supports.get(node, np.zeros((6, 6))) + k
+
     def matrices(self) -> tuple[np.ndarray, np.ndarray]:
         """Global stiffness K and mass M (dense, n_dofs x n_dofs; DOF 6*node + (ux, uy, uz, tx, ty, tz))."""
         n = self.n_dofs
@@ -288,6 +300,9 @@ class Shaft:
         for node, disc in self.discs.items():
             idx = slice(6 * node, 6 * node + 6)
             m[idx, idx] += disc.mass_matrix(self.axis)
+        for node, k_support in self.supports.items():
+            idx = slice(6 * node, 6 * node + 6)
+            k[idx, idx] += k_support
         return k, m
 
 

@@ -212,3 +212,29 @@ def test_bad_input():
         Shaft.stepped([(-0.1, 0.02)])
     with pytest.raises(InputError):
         Material(E=-1.0)
+
+
+def test_stiff_shaft_on_two_bearings_rigid_body_frequencies():
+    # a short, very stiff shaft (E x 1e4) on two identical supports at its ends behaves as a rigid body:
+    # bounce sqrt(2 k / m), rocking sqrt((2 k (L/2)^2 + 2 k_t) / I_d), with I_d of the rod about its centre
+    d, length = 0.05, 0.4
+    stiff = Material(E=E * 1e4, nu=NU, rho=RHO)
+    shaft = Shaft.stepped([(length, d)], material=stiff, elements_per_segment=8)
+    k_r, k_a, k_t = 4e8, 1e8, 2e5
+    support = np.diag([k_r, k_r, k_a, k_t, k_t, 0.0])
+    shaft.add_support(0, support)
+    shaft.add_support(len(shaft.nodes) - 1, support)
+    k, m = shaft.matrices()
+    sec = CircularSection(d)
+    mass = RHO * sec.area * length
+    i_d = mass * length**2 / 12 + RHO * sec.second_moment * length
+    # torsion is free (bearings): drop it by holding theta_z at node 0
+    kr, mr, _ = clamp(k, m, [dof(0, 5)])
+    f = natural_frequencies(kr, mr, 6)
+    bounce = math.sqrt(2 * k_r / mass) / (2 * math.pi)
+    axial = math.sqrt(2 * k_a / mass) / (2 * math.pi)
+    rock = math.sqrt((2 * k_r * (length / 2) ** 2 + 2 * k_t) / i_d) / (2 * math.pi)
+    for expected in (bounce, axial, rock):
+        assert f[np.argmin(np.abs(f - expected))] == pytest.approx(expected, rel=1e-3)
+    with pytest.raises(InputError):
+        shaft.add_support(0, np.eye(5))

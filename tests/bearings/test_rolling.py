@@ -92,6 +92,17 @@ def test_stribeck_maximum_ball_load(z):
     assert stribeck == pytest.approx(4.37, rel=0.01 if z >= 16 else 0.05)
 
 
+@pytest.mark.parametrize("z", [16, 40])
+def test_stribeck_maximum_roller_load(z):
+    # line contact (n = 10/9), zero clearance: Q_max = F_r / sum cos^(19/9); Stribeck's limit 4.08 F_r / Z
+    b = dataclasses.replace(lookup("NJ316"), n_elements=z, radial_clearance=0.0)
+    fr = 20000.0
+    res = bearing_stiffness(b, [fr, 0, 0, 0, 0], model="lim-roller")
+    c = np.cos(2 * np.pi * np.arange(z) / z)
+    assert res.element_loads.max() == pytest.approx(fr / np.sum(c[c > 0] ** (19 / 9)), rel=1e-9)
+    assert res.element_loads.max() * z / fr == pytest.approx(4.08, rel=0.01)
+
+
 def test_stiffness_grows_with_axial_preload():
     diag = [np.diag(bearing_stiffness("6312", [0, -5000.0, 0, 0, 0], preload_axial=p).K)[:5]
             for p in (500.0, 1000.0, 2000.0, 4000.0)]
