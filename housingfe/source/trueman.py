@@ -44,7 +44,8 @@ __all__ = [
     "rpm_to_omega",
     "run_scene",
     "shaft_end_stiffness",
-    "thesis_propagation_factor",
+    "thesis_propagation_factors",
+    "thesis_style_transfer",
     "vs_drive_ratios",
 ]
 
@@ -190,18 +191,17 @@ def shaft_end_stiffness(k_far, omega, length, diameter, shear_modulus, density):
     return (k_far - z * t) / (1.0 + k_far / z * t)
 
 
-def thesis_propagation_factor(cfg: DriveConfig, rpm: float) -> np.ndarray:
-    """|K_B / K_4| per mesh [-]: the factor by which the thesis's program (Appendix C) scales every INDUCED
-    mesh torque relative to a physically consistent solution.
+def thesis_propagation_factors(model: DriveModel, omega: float) -> np.ndarray:
+    """K_B / K_4 per mesh (complex) at circular frequency omega [rad/s]: the factor by which the thesis's
+    program (Appendix C) scales every INDUCED mesh torque relative to a physically consistent solution.
 
     The program injects theta = T_D / K_4 at the bronze gear (K_4: mesh in series with the steel-gear side,
     eq. 5.1) where the true bronze displacement is T_D / K_B (K_B: the bronze gear's own side - crossed mesh,
-    layshaft, bronze gear and its drawshaft - without the mesh).  Both stiffnesses are evaluated here on the
-    global model with the mesh removed, at drawroll speed `rpm`."""
-    model = build_drive(cfg, rpm)
-    omega = float(rpm_to_omega(rpm))
+    layshaft, bronze gear and its drawshaft - without the mesh).  Everything the bronze gear drives responds
+    in proportion to its displacement, so every remote contribution of that source is scaled by K_B / K_4.
+    Both stiffnesses are driving-point values of the global model with the mesh removed."""
     z_full = model.dynamic_stiffness(omega)
-    out = np.empty(len(model.mesh_dofs))
+    out = np.empty(len(model.mesh_dofs), dtype=complex)
     for j, (a, b) in enumerate(model.mesh_dofs):
         kbar = model.mesh_stiffness[j] + 1j * omega * model.mesh_damping[j]
         z = z_full.tolil()
@@ -214,8 +214,18 @@ def thesis_propagation_factor(cfg: DriveConfig, rpm: float) -> np.ndarray:
         x = sla.splu(z.tocsc()).solve(rhs)
         k_b = 1.0 / x[a, 0]
         k_4 = 1.0 / (1.0 / kbar + x[b, 1])
-        out[j] = abs(k_b / k_4)
+        out[j] = k_b / k_4
     return out
+
+
+def thesis_style_transfer(model: DriveModel, omega: float) -> np.ndarray:
+    """Emulation of the thesis's superposition (NOT physical; for explaining its published loads): the
+    mesh-torque transfer matrix with each source's direct term exact (eq. 5.6a) and its induced terms
+    scaled by K_B / K_4 (`thesis_propagation_factors`).  Same shape and convention as `mesh_transfer`."""
+    h = mesh_transfer(model, omega)
+    scaled = h * thesis_propagation_factors(model, omega)[None, :]
+    np.fill_diagonal(scaled, np.diag(h))
+    return scaled
 
 
 # re-exported here so scenes and the benchmark only need this module

@@ -25,7 +25,7 @@ Scene layout (TOML, SI units; every key optional unless marked):
     histogram_rpm = 2355
 
 Outputs in out_dir: critical_speeds.json / .csv, mesh_load_envelopes.csv / .png,
-separation_flags.csv, mesh_force_spectra.csv, summary.json, summary.txt.
+separation_flags.csv, mesh_force_spectra.csv, thesis_emulation.csv, summary.json, summary.txt.
 """
 from __future__ import annotations
 
@@ -241,6 +241,7 @@ def _forced_outputs(sc: TruemanScene, out_dir: Path) -> dict:
               ([f"{r:.3f}", f"{freq[s]:.5g}", b, p, f"{ft[s, i]:.6g}", f"{fr[s, i]:.6g}", f"{fa[s, i]:.6g}"]
                for s, r in enumerate(rpm) for i, (b, p) in enumerate(labels)))
     _plot_envelopes(out_dir / "mesh_load_envelopes.png", rpm, lo, mean, hi, labels, cfg, f)
+    emulation = _thesis_emulation(cfg, f, te, labels, out_dir)
     worst = np.unravel_index(np.argmax(hi), hi.shape)
     return {
         "configuration": conf.name, "machines": f.machines, "seed": f.seed, "speeds": len(rpm),
@@ -250,7 +251,33 @@ def _forced_outputs(sc: TruemanScene, out_dir: Path) -> dict:
         "mean_mesh_torque_Nm": f.mean_mesh_torque_Nm,
         "separation_flagged_points": len(flags),
         "separation_first_rpm": float(min(rpm[s] for s, _ in flags)) if flags else None,
+        "thesis_emulation": emulation,
     }
+
+
+def _thesis_emulation(cfg, f, te, labels, out_dir: Path) -> dict:
+    """Per-mesh loads at `histogram_rpm` from the consistent solution and from an emulation of the thesis's
+    superposition (induced terms scaled by K_B / K_4), to show where its published magnitudes come from."""
+    from housingfe.source.trueman import mesh_transfer, rpm_to_omega, thesis_style_transfer
+    from housingfe.source.trueman_model import build_drive
+
+    model = build_drive(cfg, f.histogram_rpm)
+    omega = float(rpm_to_omega(f.histogram_rpm))
+    ours = np.abs(te @ mesh_transfer(model, omega).T)
+    thesis = np.abs(te @ thesis_style_transfer(model, omega).T)
+    write_csv(out_dir / "thesis_emulation.csv",
+              ["rpm", "box", "position", "consistent_min_Nm", "consistent_mean_Nm", "consistent_max_Nm",
+               "thesis_style_min_Nm", "thesis_style_mean_Nm", "thesis_style_max_Nm"],
+              ([f"{f.histogram_rpm:.3f}", b, p, *(f"{v:.6g}" for v in (ours[:, i].min(), ours[:, i].mean(),
+                                                                       ours[:, i].max(), thesis[:, i].min(),
+                                                                       thesis[:, i].mean(), thesis[:, i].max()))]
+               for i, (b, p) in enumerate(labels)))
+    tail = [i for i, (b, _) in enumerate(labels) if b == cfg.boxes]
+    return {"rpm": f.histogram_rpm,
+            "last_box_consistent_lbf_in": [float(ours[:, tail].min() / data.LBF_IN),
+                                           float(ours[:, tail].max() / data.LBF_IN)],
+            "last_box_thesis_style_lbf_in": [float(thesis[:, tail].min() / data.LBF_IN),
+                                             float(thesis[:, tail].max() / data.LBF_IN)]}
 
 
 def _plot_envelopes(path, rpm, lo, mean, hi, labels, cfg, f):

@@ -111,6 +111,11 @@ def test_thesis_propagation_step_is_not_physical():
         t_thesis = k196 * (analytic / k4)
         if w < wn:
             assert abs(t_thesis) > 3.0 * abs(analytic)     # inflated: tends to (J_L / J_S) T at low speed
+    # the library's factor K_B / K_4 (global model, mesh removed) is the same scaling
+    w = 0.3 * wn
+    k4 = 1.0 / (1.0 / km + 1.0 / (-w**2 * js))
+    k196 = 1.0 / (1.0 / kc + 1.0 / (-w**2 * jl))
+    assert tr.thesis_propagation_factors(model, w)[0] == pytest.approx(k196 / k4, rel=1e-9)
     low = 0.05 * wn
     k4 = 1.0 / (1.0 / km + 1.0 / (-low**2 * js))
     k196 = 1.0 / (1.0 / kc + 1.0 / (-low**2 * jl))
