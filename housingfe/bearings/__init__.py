@@ -17,41 +17,35 @@ Public API (axis convention: z = shaft axis, DOF order x, y, z, theta_x, theta_y
 """
 from __future__ import annotations
 
-from housingfe.bearings.catalogue import designations, lookup
-from housingfe.bearings.fluid_film import (
-    FluidFilmResult,
-    JournalBearing,
-    journal_bearing_coefficients,
-    short_bearing_coefficients,
-)
-from housingfe.bearings.rolling import (
-    DOF_NAMES,
-    BearingResult,
-    RollingBearing,
-    finite_difference_stiffness,
-    make_model,
-    rolling_bearing_stiffness,
-    stiffness_at,
-    transform_stiffness,
-)
+import importlib
+from typing import TYPE_CHECKING
 
-__all__ = [
-    "DOF_NAMES",
-    "BearingResult",
-    "FluidFilmResult",
-    "JournalBearing",
-    "RollingBearing",
-    "bearing_stiffness",
-    "designations",
-    "finite_difference_stiffness",
-    "journal_bearing_coefficients",
-    "lookup",
-    "make_model",
-    "register_cli",
-    "short_bearing_coefficients",
-    "stiffness_at",
-    "transform_stiffness",
-]
+# The names below are loaded on first use (PEP 562) so that building the CLI parser, which imports this
+# package for register_cli, does not pay for scipy.
+_LAZY = {
+    "designations": "catalogue", "lookup": "catalogue",
+    "FluidFilmResult": "fluid_film", "JournalBearing": "fluid_film",
+    "journal_bearing_coefficients": "fluid_film", "short_bearing_coefficients": "fluid_film",
+    "DOF_NAMES": "rolling", "BearingResult": "rolling", "RollingBearing": "rolling",
+    "finite_difference_stiffness": "rolling", "make_model": "rolling", "rolling_bearing_stiffness": "rolling",
+    "stiffness_at": "rolling", "transform_stiffness": "rolling",
+}
+
+__all__ = ["DOF_NAMES", "BearingResult", "FluidFilmResult", "JournalBearing", "RollingBearing",
+           "bearing_stiffness", "designations", "finite_difference_stiffness", "journal_bearing_coefficients",
+           "lookup", "make_model", "register_cli", "short_bearing_coefficients", "stiffness_at",
+           "transform_stiffness"]
+
+if TYPE_CHECKING:
+    from housingfe.bearings.rolling import BearingResult, RollingBearing
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f"housingfe.bearings.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'housingfe.bearings' has no attribute {name!r}")
 
 
 def bearing_stiffness(bearing: str | RollingBearing, load, *, model: str | None = None,
@@ -64,6 +58,9 @@ def bearing_stiffness(bearing: str | RollingBearing, load, *, model: str | None 
     prescribes the tilt instead of the moments (result.load then holds the moments it takes).
     Returns BearingResult (K [N/m, N/rad, N m/rad], displacement [m, rad], element_loads [N]).
     Raises InputError for an unknown designation or a load the bearing cannot carry."""
+    from housingfe.bearings.catalogue import lookup
+    from housingfe.bearings.rolling import rolling_bearing_stiffness
+
     geometry = lookup(bearing) if isinstance(bearing, str) else bearing
     return rolling_bearing_stiffness(geometry, load, model=model, preload_axial=preload_axial,
                                      fixed_tilt=fixed_tilt)

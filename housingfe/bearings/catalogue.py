@@ -22,9 +22,12 @@ Estimation rules (stated before any result was computed, not tuned to any publis
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
-from housingfe.bearings.rolling import RollingBearing
 from housingfe.errors import InputError
+
+if TYPE_CHECKING:
+    from housingfe.bearings.rolling import RollingBearing
 
 _INCH = 25.4e-3
 _MM = 1e-3
@@ -65,6 +68,8 @@ def _ball_diameter(d: float, outer: float) -> float:
 
 def lookup(designation: str) -> RollingBearing:
     """RollingBearing for a catalogue designation (e.g. 'SKF 6312'); unknown -> InputError."""
+    from housingfe.bearings.rolling import RollingBearing  # scipy-heavy: keep `housingfe --help` fast
+
     key = normalise(designation)
     if key not in _BOUNDARY:
         raise InputError(f"bearing designation {designation!r}: not in the catalogue "
