@@ -24,7 +24,7 @@ def register(subparsers) -> None:
     p.add_argument("--preload-axial", type=float, default=0.0, metavar="N",
                    help="axial preload added to FZ [N]")
     p.add_argument("--model", default=None,
-                   choices=["lim-ball", "lim-roller", "sliced-roller", "self-aligning"],
+                   choices=["lim-ball", "lim-roller", "sliced-roller", "sliced-roller-thesis", "self-aligning"],
                    help="default: lim-ball for balls, sliced-roller (thesis Sec. 3.3.2) for rollers, "
                         "self-aligning for spherical roller bearings")
     p.add_argument("--fixed-tilt", action="store_true",

@@ -261,8 +261,11 @@ class SlicedRoller(_Model):
     """
     name = "sliced-roller"
     exponent = 10.0 / 9.0
+    tilt_factor = 1.0       # approach of slice a: delta_j - tilt_factor * a * gamma_j
 
     def __init__(self, bearing: RollingBearing, slices: int = 20):
+        if slices < 2:
+            raise InputError(f"{bearing.designation}: slices={slices}: need at least 2 slices per roller")
         super().__init__(bearing)
         b = bearing
         self.slices = slices
@@ -275,7 +278,8 @@ class SlicedRoller(_Model):
         tilt = np.zeros_like(g_centre)
         tilt[:, 3], tilt[:, 4] = self.sin, -self.cos                                # d(gamma_j)/dq
         # (Z, slices, 5) -> (Z*slices, 5)
-        self.g = (g_centre[:, None, :] - self.a[None, :, None] * tilt[:, None, :]).reshape(-1, 5)
+        arm = self.tilt_factor * self.a
+        self.g = (g_centre[:, None, :] - arm[None, :, None] * tilt[:, None, :]).reshape(-1, 5)
         self.gap = b.radial_clearance * math.cos(alpha)
         inner_race = b.pitch_diameter / 2.0 - b.element_diameter / 2.0
         outer_race = b.pitch_diameter / 2.0 + b.element_diameter / 2.0
@@ -291,7 +295,16 @@ class SlicedRoller(_Model):
         return energy, force, jac, per_roller, np.full(len(self.psi), self.bearing.contact_angle)
 
 
+class SlicedRollerThesis(SlicedRoller):
+    """The sliced roller with the thesis' own Eq. (3.16): slice a moves by delta_j - a sin(gamma_j/2), i.e. half
+    the ring tilt (the roller's rotation) instead of the approach of the two rings.  For comparison with the
+    thesis' numbers only; its tilt stiffness from the slicing is 1/4 of "sliced-roller"."""
+    name = "sliced-roller-thesis"
+    tilt_factor = 0.5
+
+
 _MODELS = {"lim-ball": LimBall, "lim-roller": LimRoller, "sliced-roller": SlicedRoller,
+           "sliced-roller-thesis": SlicedRollerThesis,
            "self-aligning": SelfAligningRoller}
 
 

@@ -211,3 +211,13 @@ def test_tapered_roller_sliced_model():
                                         * math.sin(math.radians(15)) * 0.0625, rel=1e-9)   # Eq. (3.8)
     with pytest.raises(InputError, match="cannot carry"):
         bearing_stiffness(b, [0.0, -10000.0, -5000.0, 0.0, 0.0])
+
+
+def test_thesis_half_tilt_variant_has_quarter_slicing_tilt_stiffness():
+    # Eq. (3.16) uses gamma/2: the slice arm halves, so k_theta_theta (pure slicing term for alpha0 = 0) / 4
+    q = np.array([0.0, -3e-5, 0.0, 0.0, 0.0])
+    b = lookup("NJ316")
+    full = make_model(b, "sliced-roller").evaluate(q)[2]
+    half = make_model(b, "sliced-roller-thesis").evaluate(q)[2]
+    assert half[3, 3] == pytest.approx(full[3, 3] / 4, rel=1e-12)
+    assert half[1, 1] == pytest.approx(full[1, 1], rel=1e-12)
