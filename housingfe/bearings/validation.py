@@ -85,6 +85,25 @@ def fluid_film_rows() -> list[tuple]:
     return rows
 
 
+def published_rows() -> list[dict]:
+    """Our numbers next to the thesis' in the `housingfe.published.row` format (for `housingfe validate`):
+    every printed Sec. 4.6 matrix entry and the Sec. 3.5 eccentricity ratios (Ocvirk and finite bearing)."""
+    from housingfe.published import row
+
+    units = ("N/m", "N/rad", "N m/rad")        # by the number of rotational DOFs in the entry
+    out = []
+    for shaft, entry, printed, ours, _ in comparison_rows():
+        unit = units[entry.count("theta")]
+        out.append(row("bearings", f"Sec. 4.6 {shaft} ({SEC_4_6[shaft][0]}) {entry}", float(ours), float(printed),
+                       unit, "van Roosmalen 1994, Sec. 4.6"))
+    for name, eps_thesis, eps_short, _, eps_finite, *_ in fluid_film_rows():
+        out.append(row("bearings", f"Sec. 3.5 {name} eccentricity ratio (Ocvirk short bearing)", eps_short,
+                       eps_thesis, "-", "van Roosmalen 1994, Sec. 3.5"))
+        out.append(row("bearings", f"Sec. 3.5 {name} eccentricity ratio (finite Reynolds)", eps_finite,
+                       eps_thesis, "-", "van Roosmalen 1994, Sec. 3.5"))
+    return out
+
+
 def _print_all() -> None:
     from housingfe.report import format_table
 

@@ -34,3 +34,13 @@ def test_free_tilt_flips_the_printed_coupling_signs():
     free = {r[:2]: r[4] for r in comparison_rows(fixed_tilt=False)}
     assert free[("pinion", "k_y,z")] < 0 and free[("pinion", "k_z,theta_x")] < 0
     assert free[("pinion", "k_x,x")] == pytest.approx(0.85, abs=0.1)
+
+
+def test_published_rows_for_validate():
+    from housingfe.bearings.validation import published_rows
+
+    rows = published_rows()
+    assert len(rows) == 23 + 4
+    units = {r["quantity"].split()[-1]: r["unit"] for r in rows if "Sec. 4.6" in r["quantity"]}
+    assert units["k_x,x"] == "N/m" and units["k_x,theta_y"] == "N/rad" and units["k_theta_x,theta_x"] == "N m/rad"
+    assert all(r["source"].startswith("van Roosmalen 1994") for r in rows)
