@@ -1,6 +1,6 @@
 """Analytic tooth stiffness and load distribution (van Roosmalen 1994, Sec. 2.2-2.4, Appendix A).
 
-The contact lines of all tooth pairs in mesh are discretised into points (one per face-width slice).
+The part of every contact line inside the path of contact is discretised into points (segment middles).
 The compliance between two points i, j (normal deflection at i per unit normal force at j) is
 
     c_ij = [tooth plate, same tooth pair only]  sum_g G_g(w_i, w_j) g_g(i) g_g(j)       (eq. 2.31-2.32)
@@ -168,37 +168,50 @@ def weber_banaschek(pair: GearPair, gear: int, n: int = 80) -> _ToothFlex:
 
 
 # ----------------------------------------------------------------------------- Schmidt plate
-def plate_green(length: float, S1: float, S2: float, S3: float, xi: float, x: np.ndarray) -> np.ndarray:
-    """Edge deflection f(x) [m] of Schmidt's cantilever plate of width `length` [m] for a unit point
-    force [N] at xi: S1 f'''' - S2 f'' + S3 f = delta(x - xi), free ends f'' = 0 and
-    f''' - (S2/S1) f' = 0 (eq. 2.7, 2.22-2.29).  S1 [N m^2], S2 [N], S3 [N/m^2]."""
+def plate_green_matrix(length: float, S1: float, S2: float, S3: float, xi, x) -> np.ndarray:
+    """Edge deflections G[i, j] [m] at x_i of Schmidt's cantilever plate of width `length` [m] for a
+    unit point force [N] at xi_j: S1 f'''' - S2 f'' + S3 f = delta(x - xi), free ends f'' = 0 and
+    f''' - (S2/S1) f' = 0 (eq. 2.7, 2.22-2.29).  S1 [N m^2], S2 [N], S3 [N/m^2].  One 8x8 system per
+    load point (Appendix A), assembled from the exact exponential solution; complex roots cover both of
+    Appendix A's cases."""
+    xi = np.atleast_1d(np.asarray(xi, dtype=float))
+    x = np.atleast_1d(np.asarray(x, dtype=float))
     a, b = S2 / S1, S3 / S1
     disc = np.sqrt(complex(a * a / 4 - b))
     lam = np.array([np.sqrt(a / 2 + disc), -np.sqrt(a / 2 + disc), np.sqrt(a / 2 - disc), -np.sqrt(a / 2 - disc)])
+    grow = lam.real > 0
+    n = xi.size
     # basis exp(lam (x - ref)) with ref chosen so that no basis function exceeds 1 in its region
-    ref_left = np.where(lam.real > 0, xi, 0.0)
-    ref_right = np.where(lam.real > 0, length, xi)
+    ref_l = np.where(grow[None, :], xi[:, None], 0.0)             # (n, 4)
+    ref_r = np.where(grow[None, :], length, xi[:, None])
 
-    def rows(pt, ref, order):
-        return lam**order * np.exp(lam * (pt - ref))
+    def rows(pt, ref, order):                                     # pt (n,) -> (n, 4)
+        return lam**order * np.exp(lam * (pt[:, None] - ref))
 
-    A = np.zeros((8, 8), dtype=complex)
-    rhs = np.zeros(8, dtype=complex)
-    A[0, :4] = rows(0.0, ref_left, 2)
-    A[1, :4] = rows(0.0, ref_left, 3) - a * rows(0.0, ref_left, 1)
-    A[2, 4:] = rows(length, ref_right, 2)
-    A[3, 4:] = rows(length, ref_right, 3) - a * rows(length, ref_right, 1)
-    for k, order in enumerate((0, 1, 2)):            # continuity of f, f', f'' at xi
-        A[4 + k, :4] = rows(xi, ref_left, order)
-        A[4 + k, 4:] = -rows(xi, ref_right, order)
-    A[7, :4] = -rows(xi, ref_left, 3)                # jump of f''' = P / S1
-    A[7, 4:] = rows(xi, ref_right, 3)
-    rhs[7] = 1.0 / S1
-    coef = np.linalg.solve(A, rhs)
-    x = np.asarray(x, dtype=float)
-    left = (np.exp(np.outer(x, lam) - lam * ref_left) @ coef[:4])
-    right = (np.exp(np.outer(x, lam) - lam * ref_right) @ coef[4:])
-    return np.where(x <= xi, left, right).real
+    zero, ell = np.zeros(n), np.full(n, length)
+    A = np.zeros((n, 8, 8), dtype=complex)
+    A[:, 0, :4] = rows(zero, ref_l, 2)
+    A[:, 1, :4] = rows(zero, ref_l, 3) - a * rows(zero, ref_l, 1)
+    A[:, 2, 4:] = rows(ell, ref_r, 2)
+    A[:, 3, 4:] = rows(ell, ref_r, 3) - a * rows(ell, ref_r, 1)
+    for k, order in enumerate((0, 1, 2)):                          # continuity of f, f', f'' at xi
+        A[:, 4 + k, :4] = rows(xi, ref_l, order)
+        A[:, 4 + k, 4:] = -rows(xi, ref_r, order)
+    A[:, 7, :4] = -rows(xi, ref_l, 3)                              # jump of f''' = P / S1
+    A[:, 7, 4:] = rows(xi, ref_r, 3)
+    rhs = np.zeros((n, 8, 1), dtype=complex)
+    rhs[:, 7, 0] = 1.0 / S1
+    coef = np.linalg.solve(A, rhs)[..., 0]                         # (n, 8)
+    el = np.exp(lam[None, None, :] * (x[:, None, None] - ref_l[None, :, :]))   # (nx, n, 4)
+    er = np.exp(lam[None, None, :] * (x[:, None, None] - ref_r[None, :, :]))
+    left = np.einsum("ijk,jk->ij", el, coef[:, :4])
+    right = np.einsum("ijk,jk->ij", er, coef[:, 4:])
+    return np.where(x[:, None] <= xi[None, :], left, right).real
+
+
+def plate_green(length: float, S1: float, S2: float, S3: float, xi: float, x) -> np.ndarray:
+    """Edge deflection f(x) [m] for a unit force [N] at xi (one column of `plate_green_matrix`)."""
+    return plate_green_matrix(length, S1, S2, S3, [xi], x)[:, 0]
 
 
 def plate_coefficients(flex: _ToothFlex, nu: float) -> tuple[float, float, float]:
@@ -239,7 +252,7 @@ class MeshModel:
     shaft and torsion influence matrices over the face-width slices.
 
     torque_configuration 1 or 2 (Fig. 2.7): 1 = both torques enter at face w = 0, 2 = the wheel torque
-    leaves at the opposite face.  n_slices: points per contact line per helix."""
+    leaves at the opposite face.  n_slices: points per contact line (on the part in contact)."""
 
     pair: GearPair
     shafts: tuple[ShaftBending, ShaftBending] | None = None
@@ -252,69 +265,54 @@ class MeshModel:
         if self.torque_configuration not in (1, 2):
             raise InputError(f"stiffness: torque_configuration: must be 1 or 2, got {self.torque_configuration}")
         if self.n_slices < 2:
-            raise InputError("stiffness: n_slices: need at least 2 slices")
+            raise InputError("stiffness: n_slices: need at least 2 points per contact line")
         p = self.pair
         nu, E = p.poisson_ratio, p.youngs_modulus
         self.G_shear = E / (2 * (1 + nu))
         self.flex = [weber_banaschek(p, 0), weber_banaschek(p, 1)]
-        b = p.contact_width
-        self.dw = b / self.n_slices
-        w_local = (np.arange(self.n_slices) + 0.5) * self.dw
-        helices = 2 if p.kind == "double_helical" else 1
-        # axial position of every slice over all helices, and the helix it belongs to
-        self.w = np.concatenate([w_local + h * (b + p.helix_gap) for h in range(helices)])
-        self.helix = np.repeat(np.arange(helices), self.n_slices)
-        self.w_local = np.tile(w_local, helices)
-        # plate Green's functions (per gear, per helix identical)
-        self.green = []
-        for g in (0, 1):
-            S1, S2, S3 = plate_coefficients(self.flex[g], nu)
-            if self.include_plate_coupling:
-                Gm = np.array([plate_green(b, S1, S2, S3, xi, w_local) for xi in w_local]).T
-            else:                                         # independent slices (no plate coupling)
-                Gm = np.eye(self.n_slices) / (S3 * self.dw)
-            self.green.append(Gm)
+        self.helices = 2 if p.kind == "double_helical" else 1
+        self.plate = [plate_coefficients(f, nu) for f in self.flex]
         self.f_etot = [f.c_tooth[-1] + f.c_root[-1] for f in self.flex]
-        cb2 = math.cos(p.base_helix_angle) ** 2
-        total_width = float(self.w[-1] + 0.5 * self.dw)
-        body = np.zeros((len(self.w), len(self.w)))
-        rb = p.base_diameter / 2
-        for g in (0, 1):
-            Ip = math.pi * (float(p.pitch_diameter[g]) / 2) ** 4 / 2
-            wi, wj = np.meshgrid(self.w, self.w, indexing="ij")
-            if g == 1 and self.torque_configuration == 2:
-                twist_length = total_width - np.maximum(wi, wj)
-            else:
-                twist_length = np.minimum(wi, wj)
-            body += cb2 * rb[g] ** 2 * twist_length / (self.G_shear * Ip)
-            if self.shafts is not None:
-                body += cb2 * beam_influence(self.w, self.shafts[g], float(p.root_diameter[g]),
-                                             total_width, 0.0, E)
-        self.body = body
+        self.total_width = self.helices * p.contact_width + (self.helices - 1) * p.helix_gap
 
     # -------------------------------------------------------------- contact points
     def contact_points(self, u: float) -> dict[str, np.ndarray]:
-        """Contact points at mesh position u [m] (0 <= u < p_bt, along the transverse line of action):
-        for every slice and tooth pair whose contact line crosses the slice inside the path of contact
-        A <= s <= E.  Returns slice index, tooth-pair index and position s [m]."""
+        """Contact points at mesh position u [m] (along the transverse line of action).  The part of
+        every contact line inside the path of contact A <= s <= E is cut exactly and divided into
+        `n_slices` equal segments; a point sits at each segment's middle.  Returns per point: position
+        s [m], axial position within its helix w_local [m] and over the gear w [m], segment width
+        [m] (axial), helix and tooth-pair index."""
         p = self.pair
         A, E_ = p.path_of_contact
         pbt = p.transverse_base_pitch
         tb = math.tan(p.base_helix_angle)
         b = p.contact_width
-        # helix 0: contact line s = u + k pbt + w tan(beta_b); helix 1 mirrored
-        offset = np.where(self.helix == 0, self.w_local, b - self.w_local) * tb
+        n = self.n_slices
+        out = {k: [] for k in ("s", "w_local", "w", "width", "helix", "pair")}
         k_lo = math.floor((A - u - b * tb) / pbt) - 1
         k_hi = math.ceil((E_ - u) / pbt) + 1
-        slices, pairs, pos = [], [], []
-        for k in range(k_lo, k_hi + 1):
-            s = u + k * pbt + offset
-            ok = (s >= A) & (s <= E_)
-            idx = np.flatnonzero(ok)
-            slices.append(idx)
-            pairs.append(np.full(idx.size, k))
-            pos.append(s[idx])
-        return {"slice": np.concatenate(slices), "pair": np.concatenate(pairs), "s": np.concatenate(pos)}
+        for hx in range(self.helices):
+            for k in range(k_lo, k_hi + 1):
+                s0 = u + k * pbt                       # s at the helix' leading face (offset 0)
+                if tb > 0:
+                    # offset o = distance from the face where s = s0, o in [0, b]: s = s0 + o tan(beta_b)
+                    o_a, o_b = max(0.0, (A - s0) / tb), min(b, (E_ - s0) / tb)
+                else:
+                    o_a, o_b = (0.0, b) if A <= s0 <= E_ else (1.0, 0.0)
+                if o_b - o_a <= 1e-12 * b:
+                    continue
+                width = (o_b - o_a) / n
+                o = o_a + (np.arange(n) + 0.5) * width
+                w_local = o if hx == 0 else b - o      # helix 1 has the opposite hand
+                out["s"].append(s0 + o * tb)
+                out["w_local"].append(w_local)
+                out["w"].append(w_local + hx * (b + p.helix_gap))
+                out["width"].append(np.full(n, width))
+                out["helix"].append(np.full(n, hx))
+                out["pair"].append(np.full(n, k))
+        if not out["s"]:
+            return {k: np.zeros(0) for k in out}
+        return {k: np.concatenate(v) for k, v in out.items()}
 
     def _flex_at(self, s: np.ndarray) -> dict[str, np.ndarray]:
         p = self.pair
@@ -332,8 +330,7 @@ class MeshModel:
         """Initial gap [m] along the normal at each contact point from the flank corrections."""
         p, c = self.pair, self.corrections
         A, E_ = p.path_of_contact
-        s, w = pts["s"], self.w_local[pts["slice"]]
-        hx = self.helix[pts["slice"]]
+        s, w, hx = pts["s"], pts["w_local"], pts["helix"]
         b = p.contact_width
         # the corner Q where a helix' contact starts/ends depends on the helix hand
         w_from_pinion_corner = np.where(hx == 0, w, b - w)
@@ -348,43 +345,76 @@ class MeshModel:
             else:
                 gap += amt * np.maximum(0.0, 1 - dist / length)
         if c.width_relief > 0:
-            gap += c.width_relief * np.maximum(0.0, 1 - self.w[pts["slice"]] / c.width_relief_length)
+            gap += c.width_relief * np.maximum(0.0, 1 - pts["w"] / c.width_relief_length)
         return gap
+
+    def body_compliance(self, w: np.ndarray) -> np.ndarray:
+        """Compliance [m/N] between axial positions w through shaft bending and wheel-body torsion of
+        both gears, projected on the flank normal (cos^2(beta_b))."""
+        p = self.pair
+        cb2 = math.cos(p.base_helix_angle) ** 2
+        rb = p.base_diameter / 2
+        wi, wj = np.meshgrid(w, w, indexing="ij")
+        body = np.zeros_like(wi)
+        for g in (0, 1):
+            Ip = math.pi * (float(p.pitch_diameter[g]) / 2) ** 4 / 2
+            if g == 1 and self.torque_configuration == 2:
+                twist_length = self.total_width - np.maximum(wi, wj)
+            else:
+                twist_length = np.minimum(wi, wj)
+            body += cb2 * rb[g] ** 2 * twist_length / (self.G_shear * Ip)
+            if self.shafts is not None:
+                body += cb2 * beam_influence(w, self.shafts[g], float(p.root_diameter[g]), self.total_width,
+                                             0.0, p.youngs_modulus, n_grid=600)
+        return body
 
     def compliance(self, pts: dict[str, np.ndarray]) -> np.ndarray:
         """Linear part of the compliance matrix [m/N] between the contact points (no Hertz)."""
-        sl, pr = pts["slice"], pts["pair"]
+        pr, hx, wl = pts["pair"], pts["helix"], pts["w_local"]
         fl = self._flex_at(pts["s"])
-        same_pair = (pr[:, None] == pr[None, :]) & (self.helix[sl][:, None] == self.helix[sl][None, :])
-        loc = sl % self.n_slices
-        C = self.body[np.ix_(sl, sl)].copy()
+        same_pair = (pr[:, None] == pr[None, :]) & (hx[:, None] == hx[None, :])
+        C = self.body_compliance(pts["w"])
+        b = self.pair.contact_width
         for g in (0, 1):
+            S1, S2, S3 = self.plate[g]
             gg = np.sqrt(fl[f"c{g}"] / self.f_etot[g])
-            C += same_pair * self.green[g][np.ix_(loc, loc)] * np.outer(gg, gg)
+            plate = np.zeros_like(C)
+            for key in set(zip(pr.tolist(), hx.tolist())):      # one plate per tooth pair and helix
+                idx = np.flatnonzero((pr == key[0]) & (hx == key[1]))
+                if self.include_plate_coupling:
+                    plate[np.ix_(idx, idx)] = plate_green_matrix(b, S1, S2, S3, wl[idx], wl[idx])
+                else:                                   # independent slices (no plate coupling)
+                    plate[idx, idx] = 1.0 / (S3 * pts["width"][idx])
+            C += plate * np.outer(gg, gg)
         return C
 
     def hertz(self, pts, forces: np.ndarray) -> np.ndarray:
         """Hertzian approach [m] of each contact point under its normal force [N] (eq. 2.40), with the
-        contact-line length of one slice dw / cos(beta_b)."""
+        contact-line length of its segment width / cos(beta_b)."""
         p = self.pair
         fl = self._flex_at(pts["s"])
         E, nu = p.youngs_modulus, p.poisson_ratio
-        L = self.dw / math.cos(p.base_helix_angle)
+        L = pts["width"] / math.cos(p.base_helix_angle)
         rho_v = fl["rho0"] * fl["rho1"] / (fl["rho0"] + fl["rho1"])
         F = np.maximum(forces, 1e-9)
         arg = fl["t0"] * fl["t1"] * math.pi * E * L / (2 * rho_v * (1 - nu**2) * F)
         return 2 * F * (1 - nu**2) / (math.pi * E * L) * (np.log(np.maximum(arg, 1.0 + 1e-12)) - nu / (1 - nu))
 
     # -------------------------------------------------------------- load distribution
-    def load_distribution(self, u: float, total_force: float, tol: float = 1e-10, max_iter: int = 60):
+    def load_distribution(self, u: float, total_force: float, tol: float = 1e-10, max_iter: int = 60,
+                          _cache: dict | None = None):
         """Force distribution [N] and mean approach [m] at mesh position u for a total normal force
         [N] (Sec. 2.3).  Returns (points, forces, delta)."""
-        pts = self.contact_points(u)
+        if _cache is not None and _cache.get("u") == u:
+            pts, C, e = _cache["pts"], _cache["C"], _cache["e"]
+        else:
+            pts = self.contact_points(u)
+            if pts["s"].size == 0:
+                raise SolverError(f"stiffness: no contact at mesh position {u}")
+            C, e = self.compliance(pts), self.gaps(pts)
+            if _cache is not None:
+                _cache.update(u=u, pts=pts, C=C, e=e)
         n = pts["s"].size
-        if n == 0:
-            raise SolverError(f"stiffness: no contact at mesh position {u}")
-        C = self.compliance(pts)
-        e = self.gaps(pts)
         active = np.ones(n, dtype=bool)
         F = np.full(n, total_force / n)
         for _ in range(max_iter):
@@ -419,8 +449,9 @@ class MeshModel:
 
     def stiffness_at(self, u: float, total_force: float, rel_step: float = 1e-3) -> dict[str, float]:
         """Mean approach delta [m] and mesh stiffness [N/m] (dF / d delta, eq. 2.55) at position u."""
-        _, F, d0 = self.load_distribution(u, total_force)
-        _, _, d1 = self.load_distribution(u, total_force * (1 + rel_step))
+        cache: dict = {}      # the compliance matrix does not depend on the load
+        _, F, d0 = self.load_distribution(u, total_force, _cache=cache)
+        _, _, d1 = self.load_distribution(u, total_force * (1 + rel_step), _cache=cache)
         k = total_force * rel_step / (d1 - d0)
         return {"delta": d0, "stiffness": k, "n_points": int(np.count_nonzero(F > 0))}
 
