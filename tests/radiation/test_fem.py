@@ -68,3 +68,14 @@ def test_bad_fem_input():
         fem.helmholtz_fem_radiation(fem.sphere_geometry(A, 0.03, outer_radius_m=0.05), [100.0])
     with pytest.raises(InputError, match="frequencies"):
         fem.helmholtz_fem_radiation(fem.sphere_geometry(A, 0.03), [-1.0])
+
+
+def test_user_msh_file_gives_the_same_power(tmp_path):
+    # the path the housing will take: a gmsh file with physical groups air = 1, vibrating = 10
+    msh = tmp_path / "sphere.msh"
+    geometry = fem.sphere_geometry(A, h_m=0.04, h_surface_m=0.03)
+    f = _frequencies(np.array([0.5, 2.0]))
+    built = fem.helmholtz_fem_radiation(geometry, f, save_msh=str(msh))
+    loaded = fem.helmholtz_fem_radiation(fem.FemGeometry("msh", outer_radius=1.5 * A, h=0.04, path=str(msh)), f)
+    assert [r.power_w for r in loaded.results] == pytest.approx([r.power_w for r in built.results], rel=1e-9)
+    assert loaded.ndofs == built.ndofs

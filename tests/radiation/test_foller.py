@@ -138,3 +138,14 @@ def test_bad_table_raises_input_error_naming_key(tmp_path, text, key):
 def test_unknown_builtin_raises_input_error():
     with pytest.raises(InputError):
         foller.load_plate_table("builtin:no-such-box")
+
+
+def test_mean_plate_sigma_weights_by_area_and_velocity():
+    # eq. 4.13: a plate that does not vibrate does not count
+    thin, thick = Plate("thin", 1, 1.0, 4.0, 0.002, 6000.0), Plate("thick", 1, 0.5, 3.0, 0.02, 600.0)
+    f = np.array([100.0, 300.0])
+    only_thin = foller.mean_plate_sigma(f, [thin, thick], mean_square_velocities=[1.0, 0.0])
+    assert only_thin == pytest.approx(foller.plate_sigma(f, thin))
+    equal = foller.mean_plate_sigma(f, [thin, thick])
+    expected = (1.0 * foller.plate_sigma(f, thin) + 0.5 * foller.plate_sigma(f, thick)) / 1.5
+    assert equal == pytest.approx(expected)
