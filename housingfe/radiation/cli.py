@@ -49,6 +49,9 @@ def _plot(path: Path, result: foller.FollerResult, title: str) -> None:
                 label="plates with acoustic cancellation (4.13, 4.14)")
     ax.semilogx(f, result.index_db(f), "r-", lw=2, alpha=0.6,
                 label="estimate" + (" (compact: piston only)" if result.is_compact else " (minimum)"))
+    construction = f[f <= result.fc_mean]
+    ax.semilogx(construction, result.point_P_dB + foller.SLOPE_DB_PER_DECADE * np.log10(construction / result.fc_mean),
+                "k:", lw=0.8)
     ax.plot([result.fc_mean], [result.point_P_dB], "ko")
     ax.annotate(f"P ({result.fc_mean:.0f} Hz, {result.point_P_dB:.1f} dB)",
                 (result.fc_mean, result.point_P_dB), textcoords="offset points", xytext=(5, 5))
