@@ -13,7 +13,7 @@ Sub-command: `housingfe radiation foller <table.toml|builtin:scale-model|builtin
 from housingfe.radiation.analytic import (AIR_DENSITY, SPEED_OF_SOUND, equivalent_radiated_power,
                                           piston_sigma, plate_critical_frequency, radiation_index_db,
                                           sphere_power, sphere_sigma, steel_rule_critical_frequency)
-from housingfe.radiation.fem import (FemGeometry, FemSweep, baffled_piston_geometry,
+from housingfe.radiation.fem import (FemGeometry, FemSweep, baffled_piston_geometry, box_geometry,
                                      helmholtz_fem_radiation, sphere_geometry)
 from housingfe.radiation.foller import FollerResult, Plate, foller_radiation_index, load_plate_table
 from housingfe.radiation.numerical import (RadiationResult, baffled_plates_radiated_power,
@@ -25,7 +25,8 @@ from housingfe.radiation.power import (SoundPowerSpectrum, area_level_db, power_
 __all__ = [
     "AIR_DENSITY", "SPEED_OF_SOUND", "equivalent_radiated_power", "piston_sigma", "plate_critical_frequency",
     "radiation_index_db", "sphere_power", "sphere_sigma", "steel_rule_critical_frequency",
-    "FemGeometry", "FemSweep", "baffled_piston_geometry", "helmholtz_fem_radiation", "sphere_geometry",
+    "FemGeometry", "FemSweep", "baffled_piston_geometry", "box_geometry", "helmholtz_fem_radiation",
+    "sphere_geometry",
     "FollerResult", "Plate", "foller_radiation_index", "load_plate_table",
     "RadiationResult", "baffled_plates_radiated_power", "rayleigh_radiated_power",
     "SoundPowerSpectrum", "area_level_db", "power_level_db", "radiation_index_from_levels",

@@ -57,6 +57,25 @@ def _piston_model(gmsh, radius, R, d):
     return _classify(gmsh, radius, R, d, half=True, disc=True)
 
 
+def _box_model(gmsh, box, R):
+    """A box body (lx, ly, lz) centred at the origin, air up to the sphere R; all six faces vibrate."""
+    occ = gmsh.model.occ
+    lx, ly, lz = box
+    body = occ.addBox(-lx / 2, -ly / 2, -lz / 2, lx, ly, lz)
+    air = occ.addSphere(0, 0, 0, R)
+    occ.cut([(3, air)], [(3, body)])
+    occ.synchronize()
+    vols = gmsh.model.getEntities(3)
+    if len(vols) != 1:
+        raise RuntimeError(f"box geometry: expected one air volume, got {vols}")
+    faces = [t for _, t in gmsh.model.getBoundary(vols, oriented=False)
+             if abs(occ.getMass(2, t) - 4 * np.pi * R**2) > 1e-3 * R**2]
+    if len(faces) != 6:
+        raise RuntimeError(f"box geometry: expected 6 box faces, got {faces}")
+    gmsh.model.addPhysicalGroup(3, [vols[0][1]], AIR)
+    gmsh.model.addPhysicalGroup(2, faces, VIBRATING)
+
+
 def _classify(gmsh, radius, R, d, half, disc):
     """Physical groups by measured volume/area: air between the body and R, PML from R to R + d,
     the vibrating surface (sphere of `radius`, or the disc of `radius` on z = 0)."""
@@ -110,6 +129,8 @@ def build_mesh(geometry: dict, save_msh: str | None = None):
         args = (geometry["radius"], geometry["outer_radius"], geometry["pml_thickness"])
         if geometry["kind"] == "sphere":
             _sphere_model(gmsh, *args)
+        elif geometry["kind"] == "box":
+            _box_model(gmsh, geometry["box"], geometry["outer_radius"])
         elif geometry["kind"] == "baffled_piston":
             _piston_model(gmsh, *args)
         else:

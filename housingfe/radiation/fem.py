@@ -41,7 +41,8 @@ class FemGeometry:
     """Air-domain geometry for the FE model (lengths in m).
 
     kind: "sphere" (pulsating sphere of `radius`), "baffled_piston" (disc of `radius` on z = 0 in a
-    rigid baffle, half-space z > 0) or "msh" (a gmsh file `path` with physical volume 1 = air, surface
+    rigid baffle, half-space z > 0), "box" (a closed box of edge lengths `box` centred at the origin, all
+    faces vibrating) or "msh" (a gmsh file `path` with physical volume 1 = air, surface
     10 = vibrating, outer boundary the sphere r = outer_radius about the origin).  h: element size in the
     air, h_surface: element size on the vibrating surface."""
 
@@ -52,12 +53,15 @@ class FemGeometry:
     h_surface: float | None = None
     pml_thickness: float = 0.0
     path: str | None = None
+    box: tuple | None = None
 
     def to_json(self) -> dict:
         data = {"kind": self.kind, "outer_radius": self.outer_radius, "h": self.h, "radius": self.radius,
                 "h_surface": self.h_surface or self.h, "pml_thickness": self.pml_thickness}
         if self.path:
             data["path"] = str(self.path)
+        if self.box:
+            data["box"] = [float(v) for v in self.box]
         return data
 
 
@@ -76,6 +80,19 @@ def baffled_piston_geometry(radius_m: float, h_m: float, outer_radius_m: float |
                        pml_thickness_m)
 
 
+def box_geometry(edges_m, h_m: float, outer_radius_m: float | None = None,
+                 h_surface_m: float | None = None) -> FemGeometry:
+    """A closed box (lx, ly, lz in m) centred at the origin with all faces vibrating, air up to
+    outer_radius_m (default 1.5 half-diagonal); element sizes in m.  The velocity is best given as
+    samples (points, values) on the faces."""
+    edges = tuple(float(e) for e in edges_m)
+    if len(edges) != 3 or min(edges) <= 0:
+        raise InputError("box: need three positive edge lengths (m)")
+    half_diagonal = 0.5 * float(np.linalg.norm(edges))
+    return FemGeometry("box", outer_radius_m or 1.5 * half_diagonal, h_m, half_diagonal, h_surface_m, 0.0,
+                       None, edges)
+
+
 @dataclass(frozen=True)
 class FemSweep:
     """Results of one FE sweep: per-frequency `RadiationResult`s (their `seconds` is assembly + solve
@@ -90,7 +107,7 @@ class FemSweep:
 
 
 def _check(geometry: FemGeometry, truncation: str, degree: int, frequencies: np.ndarray):
-    if geometry.kind not in ("sphere", "baffled_piston", "msh"):
+    if geometry.kind not in ("sphere", "baffled_piston", "box", "msh"):
         raise InputError(f"geometry.kind: unknown {geometry.kind!r}")
     if truncation not in TRUNCATIONS:
         raise InputError(f"truncation: choose one of {', '.join(TRUNCATIONS)}, got {truncation!r}")
@@ -101,7 +118,7 @@ def _check(geometry: FemGeometry, truncation: str, degree: int, frequencies: np.
     if geometry.h <= 0 or (geometry.h_surface is not None and geometry.h_surface <= 0):
         raise InputError("h: element sizes must be positive")
     if geometry.kind != "msh" and not 0 < geometry.radius < geometry.outer_radius:
-        raise InputError("outer_radius: must exceed the radiator radius")
+        raise InputError("outer_radius: must exceed the radiator radius (box: its half-diagonal)")
     if geometry.kind == "msh" and not (geometry.path and Path(geometry.path).is_file()):
         raise InputError(f"path: mesh file not found: {geometry.path!r}")
     if frequencies.ndim != 1 or frequencies.size == 0 or np.any(~np.isfinite(frequencies)) \

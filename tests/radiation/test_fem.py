@@ -79,3 +79,16 @@ def test_user_msh_file_gives_the_same_power(tmp_path):
     loaded = fem.helmholtz_fem_radiation(fem.FemGeometry("msh", outer_radius=1.5 * A, h=0.04, path=str(msh)), f)
     assert [r.power_w for r in loaded.results] == pytest.approx([r.power_w for r in built.results], rel=1e-9)
     assert loaded.ndofs == built.ndofs
+
+
+def test_breathing_box_tends_to_monopole_at_low_frequency():
+    # a closed body with uniform normal velocity is a monopole of volume velocity v S when kL << 1:
+    # P = rho c k^2 (v S)^2 / (8 pi), so sigma -> k^2 S / (4 pi)  (box of Sec. 4.2: 325 x 225 x 125 mm)
+    edges = (0.325, 0.225, 0.125)
+    S = 2 * (edges[0] * edges[1] + edges[0] * edges[2] + edges[1] * edges[2])
+    f = np.array([20.0, 50.0])
+    sweep = fem.helmholtz_fem_radiation(fem.box_geometry(edges, h_m=0.06, h_surface_m=0.04), f)
+    k = 2 * np.pi * f / C
+    err = _db_error(sweep.results, k**2 * S / (4 * np.pi))
+    assert abs(err[0]) < 0.05 and abs(err[1]) < 0.15, err
+    assert sweep.results[0].area_m2 == pytest.approx(S, rel=1e-9)
