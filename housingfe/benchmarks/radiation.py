@@ -4,7 +4,9 @@ Cases with analytic references (ka = 0.1 ... 5, radius a = 0.1 m):
 - pulsating sphere, sigma = (ka)^2 / (1 + (ka)^2)   - exterior Helmholtz FE (BGT2 on r = 1.5 a)
 - oscillating sphere (v_n = cos theta, sampled), sigma = (ka)^4 / (4 + (ka)^4) - FE
 - baffled piston, sigma = 1 - J1(2ka)/(ka)          - FE (BGT2 or PML) and the Rayleigh integral
-Writes radiation_bench.csv (one row per case/setting/ka), radiation_bench_summary.csv, radiation_bench.png.
+Writes radiation_bench.csv (one row per case/setting/ka), radiation_bench_summary.csv, radiation_bench.png,
+and (full run) radiation_box_comparison.csv: a box with its faces in their (1,1) mode, closed-body FE
+next to baffled plates and Föller's estimate - an illustration of the later housing check, not a verification.
 
 The comparison of Föller's box estimate with the numerical sigma of the real housing needs the housing's
 forced response: `compare_box_estimate_with_numerical` takes its surface data when it exists.
@@ -147,6 +149,57 @@ def compare_box_estimate_with_numerical(plates, points, normals, weights, veloci
     return float(box.L_sigma_db[0]), ray.radiation_index_db
 
 
+BOX = (0.325, 0.225, 0.125)  # m, the free box of Sec. 4.2 (reconstructed dimensions, STACK-NOTES)
+
+
+def box_surface_samples(edges=BOX, n: int = 24):
+    """Midpoint-rule samples of the six faces of a box centred at the origin: points (m), outward
+    normals, weights (m^2), face ids, and the (1,1) plate-mode shape of each face (max 1)."""
+    pts, nrm, wts, ids, shape = [], [], [], [], []
+    for axis in range(3):
+        u_ax, v_ax = [a for a in range(3) if a != axis]
+        lu, lv = edges[u_ax], edges[v_ax]
+        u = (np.arange(n) + 0.5) / n
+        U, V = np.meshgrid(u, u, indexing="ij")
+        for side in (-1.0, 1.0):
+            p = np.zeros((n * n, 3))
+            p[:, u_ax] = (U.ravel() - 0.5) * lu
+            p[:, v_ax] = (V.ravel() - 0.5) * lv
+            p[:, axis] = side * edges[axis] / 2
+            normal = np.zeros(3)
+            normal[axis] = side
+            pts.append(p)
+            nrm.append(np.tile(normal, (n * n, 1)))
+            wts.append(np.full(n * n, lu * lv / n**2))
+            ids.append(np.full(n * n, 2 * axis + (side > 0)))
+            shape.append(np.sin(np.pi * U.ravel()) * np.sin(np.pi * V.ravel()))
+    return (np.vstack(pts), np.vstack(nrm), np.concatenate(wts), np.concatenate(ids), np.concatenate(shape))
+
+
+def _box_plates(edges=BOX, thickness: float = 0.008):
+    """The six faces as Föller plates (steel, f_c from the material)."""
+    plates = []
+    for axis, name in enumerate(("x", "y", "z")):
+        lu, lv = [edges[a] for a in range(3) if a != axis]
+        plates.append(foller.Plate.from_material(f"face {name}", 2, lu * lv, 2 * (lu + lv), thickness,
+                                                 210e9, 7850.0, 0.3))
+    return plates
+
+
+def _run_box_comparison():
+    """Illustration (no reference solution): a closed box whose faces all vibrate in phase in their (1,1)
+    plate mode, radiation index from the closed-body FE, from baffled plates (Rayleigh) and Föller."""
+    f = np.array([100.0, 200.0, 400.0, 800.0, 1600.0])
+    pts, nrm, w, ids, shape = box_surface_samples()
+    v = shape.astype(complex)
+    sweep = fem.helmholtz_fem_radiation(fem.box_geometry(BOX, h_m=0.03, h_surface_m=0.02), f, velocity=(pts, v))
+    rows = []
+    for r in sweep.results:
+        L_box, L_ray = compare_box_estimate_with_numerical(_box_plates(), pts, nrm, w, v, ids, r.frequency_hz)
+        rows.append((r.frequency_hz, r.radiation_index_db, L_ray, L_box, r.seconds))
+    return rows, sweep.ndofs
+
+
 def main(out_dir: Path, quick: bool = False) -> None:
     """Run the radiation benchmark; print a table and write CSV + PNG into out_dir."""
     out_dir = Path(out_dir)
@@ -161,4 +214,13 @@ def main(out_dir: Path, quick: bool = False) -> None:
               ["case", "method", "setting", "dofs_or_points", "ka", "sigma", "sigma_analytic", "error_db",
                "seconds"], rows)
     _plot(out_dir / "radiation_bench.png", rows, summary)
-    print(f"wrote {out_dir}/radiation_bench.csv, radiation_bench_summary.csv, radiation_bench.png")
+    written = ["radiation_bench.csv", "radiation_bench_summary.csv", "radiation_bench.png"]
+    if not quick:
+        box_rows, ndofs = _run_box_comparison()
+        box_header = ["f [Hz]", "L_sigma FE closed box [dB]", "L_sigma baffled plates [dB]",
+                      "L_sigma Föller [dB]", "FE s per frequency"]
+        print(f"\nbox {BOX} m, faces in phase in their (1,1) mode (illustration, no reference; FE {ndofs} DOFs)")
+        print(format_table(box_header, box_rows, floatfmt="{:.2f}"))
+        write_csv(out_dir / "radiation_box_comparison.csv", box_header, box_rows)
+        written.append("radiation_box_comparison.csv")
+    print(f"wrote {', '.join(str(out_dir / w) for w in written)}")
