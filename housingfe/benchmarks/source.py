@@ -44,6 +44,15 @@ def _rel_err(a: np.ndarray, ref: np.ndarray) -> float:
     return float(np.max(np.abs(a - ref)) / np.max(np.abs(ref)))
 
 
+def _curve_error(curve, ref) -> float:
+    """Relative error of the mean stiffness and of its first three Fourier harmonics (relative to the
+    first harmonic of the reference): the quantities the dynamics uses.  (Max - min is not used: with
+    tip relief the loaded contact edge falls between points and adds +-0.1 % wiggles.)"""
+    X, R = curve.fourier(), ref.fourier()
+    harm = np.max(np.abs(X[1:4] - R[1:4])) / abs(R[1])
+    return float(max(abs(curve.mean / ref.mean - 1), harm))
+
+
 def stiffness_rows(quick: bool) -> list[dict]:
     """Time of one stiffness curve against its discretisation error."""
     from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
@@ -59,8 +68,8 @@ def stiffness_rows(quick: bool) -> list[dict]:
         curve = stiffness_curve(model, force, positions)
         wall = time.perf_counter() - t0
         rows.append({"case": f"stiffness curve, {slices} slices x {positions} positions", "wall_s": wall,
-                     "error": max(abs(curve.mean / ref.mean - 1), abs(curve.amplitude / ref.amplitude - 1)),
-                     "note": f"mean and amplitude vs {ref_slices} x {ref_positions} (incl. model set-up)"})
+                     "error": _curve_error(curve, ref),
+                     "note": f"mean, harmonics 1-3 vs {ref_slices} x {ref_positions} (incl. model set-up)"})
     return rows
 
 
