@@ -32,6 +32,7 @@ class HousingModel:
     M: object
     rigid_modes_expected: int
     timings: dict = field(default_factory=dict)
+    materials: object = None
 
     @property
     def dofs(self) -> int:
@@ -60,17 +61,61 @@ def build_model(scene: HousingScene, comm) -> HousingModel:
                          f"({housing.quality['measure']}); change mesh.size or mesh.element")
     t0 = time.perf_counter()
     V = elasticity.displacement_space(housing.mesh, scene.mesh.degree)
+    materials = material_field(scene, housing, material)
     bcs = boundary_conditions(scene, housing, V)
-    K, M = elasticity.assemble_stiffness_mass(V, material, bcs)
+    K, M = elasticity.assemble_stiffness_mass(V, materials, bcs, foundation_forms(scene, housing, V))
     timings = {"mesh_s": housing.mesh_time_s, "assembly_s": time.perf_counter() - t0}
-    return HousingModel(scene, housing, material, V, bcs, K, M, 0 if bcs else 6, timings)
+    free = not bcs and not any(s.kind == "elastic" for s in scene.supports)
+    return HousingModel(scene, housing, material, V, bcs, K, M, 6 if free else 0, timings, materials)
+
+
+def material_field(scene: HousingScene, housing: HousingMesh, default: Material):
+    """Per-cell material properties: the scene material, overridden in the named regions."""
+    from housingfe.solvers.elasticity import MaterialField
+
+    groups = {}
+    for name, spec in scene.regions.items():
+        if name not in housing.cell_groups:
+            raise InputError(f"regions.{name}: no such cell group (known: {', '.join(sorted(housing.cell_groups))})")
+        groups[housing.cell_groups[name]] = spec.resolve()
+    return MaterialField(housing.mesh, default, housing.cell_tags, groups)
+
+
+def foundation_forms(scene: HousingScene, housing: HousingMesh, V) -> list:
+    """Stiffness forms of the elastic supports."""
+    import ufl
+
+    from housingfe.solvers.elasticity import foundation_form
+
+    forms = []
+    ds = ufl.Measure("ds", domain=housing.mesh, subdomain_data=housing.facet_tags)
+    for i, support in enumerate(scene.supports):
+        if support.kind == "elastic":
+            tags = _surface_tags(housing, support.surface, f"supports[{i}].surface")
+            forms.append(foundation_form(V, ds(tags), support.normal_stiffness, support.tangential_stiffness or 0.0))
+    return forms
+
+
+def _surface_tags(housing: HousingMesh, name: str, key: str) -> tuple[int, ...]:
+    if name not in housing.facet_groups:
+        raise InputError(f"{key}: no surface {name!r} (known: {', '.join(sorted(housing.facet_groups))})")
+    return housing.facet_tag_values(name)
 
 
 def boundary_conditions(scene: HousingScene, housing: HousingMesh, V) -> list:
-    """Dirichlet conditions the scene asks for (plate edges: clamped / simply supported)."""
+    """Dirichlet conditions the scene asks for: supports (fixed / normal) and plate edge conditions."""
     from housingfe.solvers.elasticity import clamp_bc
 
     bcs = []
+    for i, support in enumerate(scene.supports):
+        if support.kind == "elastic":
+            continue
+        _surface_tags(housing, support.surface, f"supports[{i}].surface")
+        facets = housing.facets(support.surface)
+        if support.kind == "fixed":
+            bcs += clamp_bc(V, facets)
+        else:
+            bcs += clamp_bc(V, facets, components=(_normal_axis(housing, facets, f"supports[{i}]"),))
     geometry = scene.geometry
     if geometry.kind == "plate":
         for edge, condition in geometry.edges.model_dump().items():
@@ -80,3 +125,22 @@ def boundary_conditions(scene: HousingScene, housing: HousingMesh, V) -> list:
             elif condition == "simply_supported":
                 bcs += clamp_bc(V, facets, components=(2,))
     return bcs
+
+
+def _normal_axis(housing: HousingMesh, facets, key: str) -> int:
+    """The coordinate axis normal to a plane, axis-aligned set of facets (for `normal` supports)."""
+    import numpy as np
+    from dolfinx.mesh import compute_midpoints
+    from mpi4py import MPI
+
+    mesh = housing.mesh
+    mids = compute_midpoints(mesh, mesh.topology.dim - 1, facets)
+    lo = mids.min(axis=0) if len(mids) else np.full(3, np.inf)
+    hi = mids.max(axis=0) if len(mids) else np.full(3, -np.inf)
+    lo = np.array([mesh.comm.allreduce(v, op=MPI.MIN) for v in lo])
+    hi = np.array([mesh.comm.allreduce(v, op=MPI.MAX) for v in hi])
+    spread = hi - lo
+    axis = int(np.argmin(spread))
+    if spread[axis] > 1e-9 * max(1.0, float(spread.max())):
+        raise InputError(f"{key}: a normal support needs a plane, axis-aligned surface")
+    return axis

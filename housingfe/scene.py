@@ -8,11 +8,12 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
-from typing import Annotated, Literal, Optional, Union
+from typing import Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, ValidationError, model_validator
 
 from housingfe.errors import InputError
+from housingfe.geometry.specs import Geometry
 from housingfe.materials import LIBRARY, Material
 
 SCENE_DIR = Path(__file__).parent / "scenes"
@@ -26,61 +27,6 @@ class SceneInfo(_Strict):
     name: str
     kind: Literal["housing", "source"]
     description: str = ""
-
-
-class BoxGeometry(_Strict):
-    """The open welded box of Sec. 4.2 (lengths in m; H from the flange underside to the top)."""
-
-    kind: Literal["box"]
-    length: PositiveFloat
-    width: PositiveFloat
-    height: PositiveFloat
-    wall_thickness: PositiveFloat
-    flange_thickness: PositiveFloat
-    flange_width: PositiveFloat
-    bolt_patch_size: PositiveFloat = 0.024
-
-    @model_validator(mode="after")
-    def _consistent(self):
-        if 2 * self.wall_thickness >= min(self.length, self.width):
-            raise ValueError("wall_thickness: walls thicker than half the length/width leave no box")
-        if self.flange_thickness + self.wall_thickness >= self.height:
-            raise ValueError("height: must exceed flange_thickness + wall_thickness")
-        if self.bolt_patch_size >= self.flange_width:
-            raise ValueError("bolt_patch_size: must be smaller than flange_width")
-        return self
-
-    @property
-    def min_thickness(self) -> float:
-        return min(self.wall_thickness, self.flange_thickness)
-
-
-EdgeCondition = Literal["free", "clamped", "simply_supported"]
-
-
-class PlateEdges(_Strict):
-    x0: EdgeCondition = "free"
-    x1: EdgeCondition = "free"
-    y0: EdgeCondition = "free"
-    y1: EdgeCondition = "free"
-
-
-class PlateGeometry(_Strict):
-    """Rectangular plate a x b x h (m) with per-edge conditions; simply supported = zero transverse
-    displacement on the edge face."""
-
-    kind: Literal["plate"]
-    a: PositiveFloat
-    b: PositiveFloat
-    h: PositiveFloat
-    edges: PlateEdges = PlateEdges()
-
-    @property
-    def min_thickness(self) -> float:
-        return self.h
-
-
-Geometry = Annotated[Union[BoxGeometry, PlateGeometry], Field(discriminator="kind")]
 
 
 class MaterialSpec(_Strict):
@@ -149,10 +95,32 @@ class ReferenceSpec(_Strict):
     source: str = ""
 
 
+class SupportSpec(_Strict):
+    """A support on a named surface group of the geometry.
+
+    fixed: all displacement components zero.  normal: zero displacement normal to a plane, axis-aligned
+    surface.  elastic: distributed springs, normal_stiffness and tangential_stiffness per unit area (N/m^3).
+    """
+
+    surface: str
+    kind: Literal["fixed", "normal", "elastic"]
+    normal_stiffness: Optional[PositiveFloat] = None
+    tangential_stiffness: Optional[float] = Field(None, ge=0.0)
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.kind == "elastic" and self.normal_stiffness is None:
+            raise ValueError("normal_stiffness: required for an elastic support (N/m^3)")
+        return self
+
+
 class HousingScene(_Strict):
     scene: SceneInfo
     geometry: Geometry
     material: MaterialSpec = MaterialSpec()
+    # materials of named cell groups (e.g. a gasket layer), overriding `material` there
+    regions: dict[str, MaterialSpec] = {}
+    supports: list[SupportSpec] = []
     mesh: MeshSpec = MeshSpec()
     analysis: Analyses
     output: OutputSpec = OutputSpec()

@@ -19,22 +19,57 @@ def displacement_space(mesh, degree: int = 2):
     return fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
 
 
-def _stress(u, material: Material):
-    lam, mu = material.lame
+class MaterialField:
+    """Piecewise-constant material properties over the mesh (one value per cell, DG0): Lamé constants
+    (Pa), density (kg/m^3) and loss factor (-).  Cells of a named group take that group's material, the
+    rest the default material."""
+
+    def __init__(self, mesh, default: Material, cell_tags=None, groups: dict[int, Material] | None = None):
+        Q = fem.FunctionSpace(mesh, ("DG", 0))
+        self.lam, self.mu = fem.Function(Q, name="lambda"), fem.Function(Q, name="mu")
+        self.rho, self.eta = fem.Function(Q, name="rho"), fem.Function(Q, name="eta")
+        self._fill(default, None)
+        for tag, material in (groups or {}).items():
+            self._fill(material, cell_tags.find(tag))
+        for f in (self.lam, self.mu, self.rho, self.eta):
+            f.x.scatter_forward()
+
+    def _fill(self, m: Material, cells) -> None:
+        lam, mu = m.lame
+        for f, value in ((self.lam, lam), (self.mu, mu), (self.rho, m.density), (self.eta, m.loss_factor)):
+            if cells is None:
+                f.x.array[:] = value
+            else:
+                f.x.array[cells] = value
+
+
+def _stress(u, lam, mu):
     eps = ufl.sym(ufl.grad(u))
     return 2.0 * mu * eps + lam * ufl.tr(eps) * ufl.Identity(len(u))
 
 
-def stiffness_form(V, material: Material):
-    """Bilinear form of the elastic strain energy, K (N/m)."""
+def stiffness_form(V, materials: MaterialField, weight=None):
+    """Bilinear form of the elastic strain energy, K (N/m); `weight` (e.g. the loss factor field)
+    multiplies the integrand, giving the hysteretic damping matrix for weight = eta."""
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    return fem.form(ufl.inner(_stress(u, material), ufl.sym(ufl.grad(v))) * ufl.dx)
+    integrand = ufl.inner(_stress(u, materials.lam, materials.mu), ufl.sym(ufl.grad(v)))
+    return fem.form((integrand if weight is None else weight * integrand) * ufl.dx)
 
 
-def mass_form(V, material: Material):
+def mass_form(V, materials: MaterialField):
     """Bilinear form of the kinetic energy, M (kg)."""
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    return fem.form(material.density * ufl.inner(u, v) * ufl.dx)
+    return fem.form(materials.rho * ufl.inner(u, v) * ufl.dx)
+
+
+def foundation_form(V, ds, normal_stiffness: float, tangential_stiffness: float):
+    """Distributed springs on a surface (elastic foundation): k_n (u.n)(v.n) + k_t (u_t . v_t),
+    stiffness per unit area in N/m^3."""
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    n = ufl.FacetNormal(V.mesh)
+    un, vn = ufl.dot(u, n), ufl.dot(v, n)
+    ut, vt = u - un * n, v - vn * n
+    return fem.form((normal_stiffness * un * vn + tangential_stiffness * ufl.inner(ut, vt)) * ds)
 
 
 def clamp_bc(V, facets: np.ndarray, components: tuple[int, ...] | None = None) -> list:
@@ -52,12 +87,18 @@ def clamp_bc(V, facets: np.ndarray, components: tuple[int, ...] | None = None) -
     return bcs
 
 
-def assemble_stiffness_mass(V, material: Material, bcs: list) -> tuple[PETSc.Mat, PETSc.Mat]:
-    """Assemble K and M.  Constrained rows/columns get 1 on K's diagonal and 0 on M's, so their
-    eigenvalues go to infinity and never enter the spectrum of interest."""
-    K = assemble_matrix(stiffness_form(V, material), bcs=bcs, diagonal=1.0)
+def assemble_stiffness_mass(V, materials: MaterialField, bcs: list, extra_stiffness: list = ()
+                            ) -> tuple[PETSc.Mat, PETSc.Mat]:
+    """Assemble K (plus any extra stiffness forms, e.g. foundations) and M.  Constrained rows/columns get 1
+    on K's diagonal and 0 on M's, so their eigenvalues go to infinity and never enter the spectrum of
+    interest."""
+    K = assemble_matrix(stiffness_form(V, materials), bcs=bcs, diagonal=1.0)
     K.assemble()
-    M = assemble_matrix(mass_form(V, material), bcs=bcs, diagonal=0.0)
+    for form in extra_stiffness:
+        Ke = assemble_matrix(form, bcs=bcs, diagonal=0.0)
+        Ke.assemble()
+        K.axpy(1.0, Ke, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+    M = assemble_matrix(mass_form(V, materials), bcs=bcs, diagonal=0.0)
     M.assemble()
     for A in (K, M):
         A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
