@@ -10,27 +10,70 @@ Public API (SI units; velocities are complex peak phasors, mean squares are rms^
 - sound power (eq. 4.16): `sound_power_level`, `radiation_index_from_levels`, `sound_power_spectrum`.
 Sub-command: `housingfe radiation foller <table.toml|builtin:scale-model|builtin:test-gearbox>`.
 """
-from housingfe.radiation.analytic import (AIR_DENSITY, SPEED_OF_SOUND, equivalent_radiated_power,
-                                          piston_sigma, plate_critical_frequency, radiation_index_db,
-                                          sphere_power, sphere_sigma, steel_rule_critical_frequency)
-from housingfe.radiation.fem import (FemGeometry, FemSweep, baffled_piston_geometry, box_geometry,
-                                     helmholtz_fem_radiation, sphere_geometry)
+from housingfe.radiation.analytic import (
+    AIR_DENSITY,
+    SPEED_OF_SOUND,
+    equivalent_radiated_power,
+    piston_sigma,
+    plate_critical_frequency,
+    radiation_index_db,
+    sphere_power,
+    sphere_sigma,
+    steel_rule_critical_frequency,
+)
+from housingfe.radiation.fem import (
+    FemGeometry,
+    FemSweep,
+    baffled_piston_geometry,
+    box_geometry,
+    helmholtz_fem_radiation,
+    sphere_geometry,
+)
 from housingfe.radiation.foller import FollerResult, Plate, foller_radiation_index, load_plate_table
-from housingfe.radiation.numerical import (RadiationResult, baffled_plates_radiated_power,
-                                           rayleigh_radiated_power)
-from housingfe.radiation.power import (SoundPowerSpectrum, area_level_db, power_level_db,
-                                       radiation_index_from_levels, sound_power_level,
-                                       sound_power_spectrum)
+from housingfe.radiation.numerical import (
+    RadiationResult,
+    baffled_plates_radiated_power,
+    rayleigh_radiated_power,
+)
+from housingfe.radiation.power import (
+    SoundPowerSpectrum,
+    area_level_db,
+    power_level_db,
+    radiation_index_from_levels,
+    sound_power_level,
+    sound_power_spectrum,
+)
 
 __all__ = [
-    "AIR_DENSITY", "SPEED_OF_SOUND", "equivalent_radiated_power", "piston_sigma", "plate_critical_frequency",
-    "radiation_index_db", "sphere_power", "sphere_sigma", "steel_rule_critical_frequency",
-    "FemGeometry", "FemSweep", "baffled_piston_geometry", "box_geometry", "helmholtz_fem_radiation",
+    "AIR_DENSITY",
+    "SPEED_OF_SOUND",
+    "FemGeometry",
+    "FemSweep",
+    "FollerResult",
+    "Plate",
+    "RadiationResult",
+    "SoundPowerSpectrum",
+    "area_level_db",
+    "baffled_piston_geometry",
+    "baffled_plates_radiated_power",
+    "box_geometry",
+    "equivalent_radiated_power",
+    "foller_radiation_index",
+    "helmholtz_fem_radiation",
+    "load_plate_table",
+    "piston_sigma",
+    "plate_critical_frequency",
+    "power_level_db",
+    "radiation_index_db",
+    "radiation_index_from_levels",
+    "rayleigh_radiated_power",
+    "register_cli",
+    "sound_power_level",
+    "sound_power_spectrum",
     "sphere_geometry",
-    "FollerResult", "Plate", "foller_radiation_index", "load_plate_table",
-    "RadiationResult", "baffled_plates_radiated_power", "rayleigh_radiated_power",
-    "SoundPowerSpectrum", "area_level_db", "power_level_db", "radiation_index_from_levels",
-    "sound_power_level", "sound_power_spectrum", "register_cli",
+    "sphere_power",
+    "sphere_sigma",
+    "steel_rule_critical_frequency",
 ]
 
 

@@ -107,8 +107,8 @@ def _classify(gmsh, radius, R, d, half, disc):
 def build_mesh(geometry: dict, save_msh: str | None = None):
     """Mesh (second-order tets) of a built-in geometry in memory; returns (mesh, cell_tags, facet_tags)."""
     import gmsh
-    from mpi4py import MPI
     from dolfinx.io import gmshio
+    from mpi4py import MPI
 
     gmsh.initialize()
     try:
@@ -235,7 +235,7 @@ def solve(job: dict) -> dict:
         a += beta * ufl.inner(p, q) * ds(OUTER)
         if truncation == "bgt2":
             n = ufl.FacetNormal(mesh)
-            grad_s = lambda u: ufl.grad(u) - ufl.dot(ufl.grad(u), n) * n  # noqa: E731
+            grad_s = lambda u: ufl.grad(u) - ufl.dot(ufl.grad(u), n) * n
             a += 1.0 / (2.0 * beta) * ufl.inner(grad_s(p), grad_s(q)) * ds(OUTER)
     else:
         raise ValueError(f"unknown truncation {truncation!r}")

@@ -169,7 +169,8 @@ def helmholtz_fem_radiation(geometry: FemGeometry, frequencies_hz, velocity=1.0,
         (tmp / "job.json").write_text(json.dumps(job))
         cmd = [sys.executable, "-m", "housingfe.radiation._fem_worker", str(tmp / "job.json"),
                str(tmp / "result.json")]
-        proc = subprocess.run(cmd, env=complex_env(), capture_output=True, text=True, timeout=timeout_s)
+        proc = subprocess.run(cmd, env=complex_env(), capture_output=True, text=True, timeout=timeout_s,
+                              check=False)  # a failure is reported below with the worker's stderr
         if proc.returncode != 0:
             tail = (proc.stderr or proc.stdout).strip().splitlines()[-5:]
             raise SolverError("exterior Helmholtz FE solve failed: " + " | ".join(tail))

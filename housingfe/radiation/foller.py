@@ -59,7 +59,7 @@ class Plate:
     @classmethod
     def from_material(cls, name: str, count: int, area_m2: float, perimeter_m: float, thickness_m: float,
                       youngs_modulus_pa: float, density_kg_m3: float, poisson_ratio: float,
-                      c: float = SPEED_OF_SOUND) -> "Plate":
+                      c: float = SPEED_OF_SOUND) -> Plate:
         """A plate whose critical frequency (Hz) follows from its material and thickness (SI units)."""
         fc = float(plate_critical_frequency(thickness_m, youngs_modulus_pa, density_kg_m3, poisson_ratio, c))
         return cls(name, count, area_m2, perimeter_m, thickness_m, fc)
@@ -210,7 +210,7 @@ def _plate_from_row(row, where: str) -> Plate:
         raise InputError(f"{where}: a plate must be a table or a 6-element row")
     unknown = set(row) - _TABLE_KEYS
     if unknown:
-        raise InputError(f"{where}: {sorted(unknown)[0]}: unknown key")
+        raise InputError(f"{where}: {min(unknown)}: unknown key")
     for key in ("name", "count", "area_m2", "perimeter_m", "thickness_m"):
         if key not in row:
             raise InputError(f"{where}: {key}: missing")
@@ -270,7 +270,7 @@ def load_plate_table(spec: str) -> tuple[list[Plate], float]:
         raise InputError(f"{spec}: not valid TOML ({exc})") from None
     unknown = set(data) - _USER_FILE_KEYS
     if unknown:
-        raise InputError(f"{spec}: {sorted(unknown)[0]}: unknown key")
+        raise InputError(f"{spec}: {min(unknown)}: unknown key")
     c = data.get("c", SPEED_OF_SOUND)
     if not isinstance(c, (int, float)) or not np.isfinite(c) or c <= 0:
         raise InputError(f"{spec}: c: must be a positive number (m/s)")

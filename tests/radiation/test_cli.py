@@ -13,7 +13,8 @@ def test_foller_builtin_writes_appendix_e_numbers(tmp_path, capsys):
     summary = json.loads((out / "summary.json").read_text())
     assert round(summary["point_P_dB"], 1) == 1.8
     assert round(summary["L_125"], 1) == -11.7
-    rows = list(csv.DictReader(open(out / "foller.csv")))
+    with open(out / "foller.csv") as fh:
+        rows = list(csv.DictReader(fh))
     by_band = {float(r["band_nominal_hz"]): float(r["L_sigma_db"]) for r in rows}
     # the CSV is at exact IEC 61260 centres: 125.89 Hz lies 25 lg(125.89/125) = 0.08 dB above App. E's -11.7
     assert by_band[125.0] == pytest.approx(-11.69 + 0.077, abs=0.02)
