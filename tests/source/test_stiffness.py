@@ -165,3 +165,20 @@ def test_bad_corrections_are_input_errors():
         Corrections.from_table({"pinion_um": 3, "pinon_mm": 2})
     with pytest.raises(InputError, match="amount and a length"):
         Corrections.from_table({"pinion_um": 3})
+
+
+def test_double_helical_helices_share_the_load_equally_without_body_coupling():
+    # with rigid wheel bodies (no torsion, no shaft bending) the two helices are mirror images:
+    # each carries half the load, point by point mirrored across the face
+    pair = GearPair.from_table(REF["double_helical"])
+    model = MeshModel(pair, n_slices=8)
+    model.G_shear = math.inf
+    pts, F, _ = model.load_distribution(0.3 * pair.transverse_base_pitch, 50e3)
+    h0, h1 = pts["helix"] == 0, pts["helix"] == 1
+    assert F[h0].sum() == pytest.approx(25e3, rel=1e-9) and F[h1].sum() == pytest.approx(25e3, rel=1e-9)
+    key0 = sorted(zip(np.round(pts["s"][h0], 12), F[h0], pts["w_local"][h0]))
+    key1 = sorted(zip(np.round(pts["s"][h1], 12), F[h1], pts["w_local"][h1]))
+    assert np.allclose([k[1] for k in key0], [k[1] for k in key1], rtol=1e-9)
+    # opposite hand: the same point of the path of contact sits at mirrored face positions
+    b = pair.contact_width
+    assert np.allclose([k[2] for k in key0], [b - k[2] for k in key1], atol=1e-12)
