@@ -3,7 +3,8 @@
 Public API (SI units; velocities are complex peak phasors, mean squares are rms^2; see analytic.py):
 - analytic radiators: `sphere_sigma`, `sphere_power`, `piston_sigma`, `plate_critical_frequency`,
   `equivalent_radiated_power` (ERP, sigma = 1);
-- Föller's box model: `Plate`, `foller_radiation_index` -> `FollerResult`, `load_plate_table`;
+- Föller's box model: `Plate`, `plate_from_triangles`, `foller_radiation_index` -> `FollerResult`,
+  `load_plate_table`;
 - numerical radiation efficiency from surface data: `rayleigh_radiated_power` (plane baffled radiator),
   `baffled_plates_radiated_power` (housing, plate by plate), `helmholtz_fem_radiation` (closed bodies,
   exterior Helmholtz FE in a complex-PETSc subprocess);
@@ -29,7 +30,13 @@ from housingfe.radiation.fem import (
     helmholtz_fem_radiation,
     sphere_geometry,
 )
-from housingfe.radiation.foller import FollerResult, Plate, foller_radiation_index, load_plate_table
+from housingfe.radiation.foller import (
+    FollerResult,
+    Plate,
+    foller_radiation_index,
+    load_plate_table,
+    plate_from_triangles,
+)
 from housingfe.radiation.numerical import (
     RadiationResult,
     baffled_plates_radiated_power,
@@ -63,6 +70,7 @@ __all__ = [
     "load_plate_table",
     "piston_sigma",
     "plate_critical_frequency",
+    "plate_from_triangles",
     "power_level_db",
     "radiation_index_db",
     "radiation_index_from_levels",

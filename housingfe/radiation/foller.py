@@ -65,6 +65,33 @@ class Plate:
         return cls(name, count, area_m2, perimeter_m, thickness_m, fc)
 
 
+def plate_from_triangles(name: str, vertices, triangles, thickness_m: float, fc_hz: float | None = None,
+                         youngs_modulus_pa: float | None = None, density_kg_m3: float | None = None,
+                         poisson_ratio: float | None = None, count: int = 1) -> Plate:
+    """A `Plate` from the surface triangulation of one plate (e.g. the facets carrying one tag of the housing
+    mesh): area = sum of triangle areas (m^2), perimeter = total length of the edges used by exactly one
+    triangle (m).  vertices (m, 3) in m, triangles (t, 3) vertex indices (shared vertices must be merged).
+    Give fc_hz, or the material (E in Pa, density in kg/m^3, Poisson ratio) to compute it from thickness_m."""
+    x = np.asarray(vertices, dtype=float)
+    tri = np.asarray(triangles, dtype=np.int64)
+    if x.ndim != 2 or x.shape[1] != 3 or tri.ndim != 2 or tri.shape[1] != 3 or tri.size == 0:
+        raise InputError(f"plate {name!r}: need vertices (m, 3) and triangles (t, 3)")
+    if tri.min() < 0 or tri.max() >= len(x):
+        raise InputError(f"plate {name!r}: triangles: vertex index out of range")
+    a, b, c = x[tri[:, 0]], x[tri[:, 1]], x[tri[:, 2]]
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
+    edges = np.sort(np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]]), axis=1)
+    unique, uses = np.unique(edges, axis=0, return_counts=True)
+    boundary = unique[uses == 1]
+    perimeter = np.linalg.norm(x[boundary[:, 0]] - x[boundary[:, 1]], axis=1).sum()
+    if fc_hz is not None:
+        return Plate(name, count, float(area), float(perimeter), thickness_m, fc_hz)
+    if None in (youngs_modulus_pa, density_kg_m3, poisson_ratio):
+        raise InputError(f"plate {name!r}: fc_hz: give it or the material (E, density, Poisson ratio)")
+    return Plate.from_material(name, count, float(area), float(perimeter), thickness_m, youngs_modulus_pa,
+                               density_kg_m3, poisson_ratio)
+
+
 @dataclass(frozen=True)
 class FollerResult:
     """The quantities of Appendix E and the radiation index over frequency.

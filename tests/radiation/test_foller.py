@@ -149,3 +149,34 @@ def test_mean_plate_sigma_weights_by_area_and_velocity():
     equal = foller.mean_plate_sigma(f, [thin, thick])
     expected = (1.0 * foller.plate_sigma(f, thin) + 0.5 * foller.plate_sigma(f, thick)) / 1.5
     assert equal == pytest.approx(expected)
+
+
+def _grid_triangles(lx, ly, nx, ny, hole=None):
+    """Structured triangulation of [0, lx] x [0, ly] (z = 0); `hole` = (i0, i1, j0, j1) cells left out."""
+    xs, ys = np.linspace(0, lx, nx + 1), np.linspace(0, ly, ny + 1)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    vertices = np.column_stack([X.ravel(), Y.ravel(), np.zeros(X.size)])
+    tris = []
+    for i in range(nx):
+        for j in range(ny):
+            if hole and hole[0] <= i < hole[1] and hole[2] <= j < hole[3]:
+                continue
+            v0, v1, v2, v3 = i * (ny + 1) + j, (i + 1) * (ny + 1) + j, (i + 1) * (ny + 1) + j + 1, i * (ny + 1) + j + 1
+            tris += [(v0, v1, v2), (v0, v2, v3)]
+    return vertices, np.array(tris)
+
+
+def test_plate_from_triangles_rectangle_and_plate_with_opening():
+    v, t = _grid_triangles(0.4, 0.3, 8, 6)
+    plate = foller.plate_from_triangles("front", v, t, 0.01, fc_hz=1200.0)
+    assert plate.area_m2 == pytest.approx(0.12)
+    assert plate.perimeter_m == pytest.approx(1.4)
+    # a 0.1 x 0.1 m opening (a bearing bore) removes area and adds its edge to the perimeter
+    v, t = _grid_triangles(0.4, 0.3, 8, 6, hole=(2, 4, 2, 4))
+    steel = foller.plate_from_triangles("bore", v, t, 0.01, youngs_modulus_pa=210e9, density_kg_m3=7850.0,
+                                        poisson_ratio=0.3)
+    assert steel.area_m2 == pytest.approx(0.12 - 0.01)
+    assert steel.perimeter_m == pytest.approx(1.4 + 0.4)
+    assert steel.fc_hz == pytest.approx(1200.0, rel=0.01)
+    with pytest.raises(InputError, match="fc_hz"):
+        foller.plate_from_triangles("x", v, t, 0.01)
