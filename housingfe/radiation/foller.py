@@ -115,6 +115,7 @@ class FollerResult:
     L_piston_db: np.ndarray = field(repr=False)
     L_plates_db: np.ndarray = field(repr=False)
     L_sigma_db: np.ndarray = field(repr=False)
+    mean_square_velocities: tuple | None = field(default=None, repr=False)
 
     def index_db(self, frequency_hz) -> np.ndarray:
         """Estimated radiation index L_sigma in dB at any frequencies (Hz)."""
@@ -209,9 +210,10 @@ def foller_radiation_index(plates, frequencies_hz, c: float = SPEED_OF_SOUND,
     L_plates = 10.0 * np.log10(mean_plate_sigma(f, plates, mean_square_velocities, c))
     # Compact housings: no acoustic cancellation, the two straight lines alone (Appendix E).
     L_sigma = L_piston if is_compact else np.minimum(L_piston, L_plates)
+    v2 = None if mean_square_velocities is None else tuple(float(v) for v in mean_square_velocities)
     return FollerResult(plates, float(c), S_mean, U_mean, fc_mean, float(sigma_P), float(point_db),
                         zero_db_crossing(fc_mean, point_db), float(compactness), is_compact,
-                        f, L_piston, L_plates, L_sigma)
+                        f, L_piston, L_plates, L_sigma, v2)
 
 
 def radiation_index_from_plates(result: FollerResult, frequency_hz) -> np.ndarray:
@@ -220,7 +222,8 @@ def radiation_index_from_plates(result: FollerResult, frequency_hz) -> np.ndarra
     L_piston = piston_line_db(f, result.fc_mean, result.point_P_dB)
     if result.is_compact:
         return L_piston
-    return np.minimum(L_piston, 10.0 * np.log10(mean_plate_sigma(f, result.plates, None, result.c)))
+    plates_sigma = mean_plate_sigma(f, result.plates, result.mean_square_velocities, result.c)
+    return np.minimum(L_piston, 10.0 * np.log10(plates_sigma))
 
 
 # ------------------------------------------------------------------ tables (TOML)

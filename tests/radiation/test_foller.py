@@ -180,3 +180,11 @@ def test_plate_from_triangles_rectangle_and_plate_with_opening():
     assert steel.fc_hz == pytest.approx(1200.0, rel=0.01)
     with pytest.raises(InputError, match="fc_hz"):
         foller.plate_from_triangles("x", v, t, 0.01)
+
+
+def test_index_db_reuses_per_plate_velocities():
+    plates = [Plate("big", 6, 1.0, 4.0, 0.002, 6000.0), Plate("small", 1, 0.1, 1.3, 0.002, 6000.0)]
+    f = np.array([1000.0, 3000.0])
+    res = foller_radiation_index(plates, f, mean_square_velocities=[0.0, 1.0])
+    assert not res.is_compact
+    assert res.index_db(f) == pytest.approx(res.L_sigma_db)
