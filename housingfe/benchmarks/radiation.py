@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.radiation import analytic, fem, foller, numerical
-from housingfe.report import format_table, write_csv
+from housingfe.report import atomic_output_dir, format_table, write_csv
 
 A = 0.1  # m
 KA = np.array([0.1, 0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0])
@@ -204,26 +204,26 @@ def _run_box_comparison():
 
 
 def main(out_dir: Path, quick: bool = False) -> None:
-    """Run the radiation benchmark; print a table and write CSV + PNG into out_dir."""
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    """Run the radiation benchmark; print the tables and write CSV + PNG into out_dir (atomically)."""
     rows_r, summary_r = _run_rayleigh(quick)
     rows_f, summary_f = _run_fem(quick)
     rows, summary = rows_f + rows_r, summary_f + summary_r
     header = ["case", "method", "setting", "dofs/points", "max |err| dB", "s per frequency", "mesh+setup s"]
     print(format_table(header, summary, floatfmt="{:.3g}"))
-    write_csv(out_dir / "radiation_bench_summary.csv", header, summary)
-    write_csv(out_dir / "radiation_bench.csv",
-              ["case", "method", "setting", "dofs_or_points", "ka", "sigma", "sigma_analytic", "error_db",
-               "seconds"], rows)
-    _plot(out_dir / "radiation_bench.png", rows, summary)
-    written = ["radiation_bench.csv", "radiation_bench_summary.csv", "radiation_bench.png"]
+    box_header = ["f [Hz]", "L_sigma FE closed box [dB]", "L_sigma baffled plates [dB]",
+                  "L_sigma Föller [dB]", "FE s per frequency"]
+    box_rows = None
     if not quick:
         box_rows, ndofs = _run_box_comparison()
-        box_header = ["f [Hz]", "L_sigma FE closed box [dB]", "L_sigma baffled plates [dB]",
-                      "L_sigma Föller [dB]", "FE s per frequency"]
         print(f"\nbox {BOX} m, faces in phase in their (1,1) mode (illustration, no reference; FE {ndofs} DOFs)")
         print(format_table(box_header, box_rows, floatfmt="{:.2f}"))
-        write_csv(out_dir / "radiation_box_comparison.csv", box_header, box_rows)
-        written.append("radiation_box_comparison.csv")
-    print(f"wrote {', '.join(str(out_dir / w) for w in written)}")
+    with atomic_output_dir(out_dir) as tmp:
+        write_csv(tmp / "radiation_bench_summary.csv", header, summary)
+        write_csv(tmp / "radiation_bench.csv",
+                  ["case", "method", "setting", "dofs_or_points", "ka", "sigma", "sigma_analytic", "error_db",
+                   "seconds"], rows)
+        _plot(tmp / "radiation_bench.png", rows, summary)
+        if box_rows is not None:
+            write_csv(tmp / "radiation_box_comparison.csv", box_header, box_rows)
+    print(f"wrote {out_dir}/radiation_bench.csv, radiation_bench_summary.csv, radiation_bench.png"
+          + ("" if quick else ", radiation_box_comparison.csv"))
