@@ -138,9 +138,13 @@ class Matrices:
     mean_mesh_stiffness: float
 
 
-def mesh_direction(pair: GearPair) -> np.ndarray:
+def mesh_direction(pair: GearPair, axial_moment: bool = True) -> np.ndarray:
     """h (14,) with d = h^T q the mesh compression along the flank normal [m] (Appendix C: k_ij = S h_i h_j).
-    Positive rotations of both gears close the mesh (theta_z of the wheel counts the other way)."""
+    Positive rotations of both gears close the mesh (theta_z of the wheel counts the other way).  The
+    centre line is the x axis (wheel at +x) and the contact is taken at the operating pitch point, mid
+    face.  axial_moment=True adds the tilt coupling theta_y: the axial force component F sin(beta_b)
+    acts at the operating pitch radius r_w (h_4 = r_w1 sin(beta_b), h_10 = r_w2 sin(beta_b)); Appendix C
+    lists only the x, y, z, theta_z terms, which leaves the bearing moments unexcited."""
     a, bb = pair.operating_pressure_angle, pair.base_helix_angle
     rb1, rb2 = pair.base_diameter / 2
     h = np.zeros(N_DOF)
@@ -148,10 +152,15 @@ def mesh_direction(pair: GearPair) -> np.ndarray:
     h[5] = rb1 * math.cos(bb)
     h[6:9] = -h[0:3]
     h[11] = rb2 * math.cos(bb)
+    if axial_moment and pair.kind == "single_helical":     # double helical: the two helices' moments cancel
+        rw1 = rb1 / math.cos(a)
+        rw2 = rb2 / math.cos(a)
+        h[4] = rw1 * math.sin(bb)
+        h[10] = rw2 * math.sin(bb)
     return h
 
 
-def assemble(pair: GearPair, interior: Interior, mean_mesh_stiffness: float) -> Matrices:
+def assemble(pair: GearPair, interior: Interior, mean_mesh_stiffness: float, axial_moment: bool = True) -> Matrices:
     """Mass, stiffness and damping matrices of the 14-DOF model (mean mesh stiffness for the modes)."""
     it = interior
     M = np.diag([it.pinion_mass] * 3 + [it.pinion_inertia_diametral] * 2 + [it.pinion_inertia_axial]
@@ -172,7 +181,7 @@ def assemble(pair: GearPair, interior: Interior, mean_mesh_stiffness: float) -> 
     spring(11, 13, k3)
     K0[12, 12] += k1          # to the held far end (DOF 15)
     K0[13, 13] += k4          # to the loading gearbox, torsionally held
-    h = mesh_direction(pair)
+    h = mesh_direction(pair, axial_moment)
     K = K0 + mean_mesh_stiffness * np.outer(h, h)
     w2, phi = sla.eigh(K, M)
     if w2.min() <= 0:
@@ -397,6 +406,7 @@ class BearingSpectra:
     names: list[str]
     z: np.ndarray
     loads: np.ndarray
+    lumped: np.ndarray | None = None      # (2, 5, n_freq): unsplit [Fx, Fy, Fz, Mx, My] per shaft at the gear centre
 
 
 def bearing_spectra(state: SteadyState, mats: Matrices, interior: Interior, geometry: ShaftGeometry,
@@ -404,11 +414,12 @@ def bearing_spectra(state: SteadyState, mats: Matrices, interior: Interior, geom
     """Bearing loads of both shafts from the steady state (see `BearingSpectra`)."""
     H = (state.harmonics.size - 1) // 2
     pos = state.harmonics >= 1
-    names, zs, loads = [], [], []
+    names, zs, loads, lumped = [], [], [], []
     for g, shaft, spans, kb in ((0, "pinion", geometry.pinion_spans, interior.pinion_bearings),
                                 (1, "wheel", geometry.wheel_spans, interior.wheel_bearings)):
         dofs = BEARING_DOFS[shaft]
         react = 2 * (np.asarray(kb)[:, None] * state.Q[pos][:, dofs].T)        # (5, H): Fx Fy Fz Mx My
+        lumped.append(react)
         half = 0.5 * pair.face_width[g]
         zl, zr = -(half + spans[0]), half + spans[1]
         L = zr - zl
@@ -422,4 +433,4 @@ def bearing_spectra(state: SteadyState, mats: Matrices, interior: Interior, geom
         loads += [left, right]
     f = state.harmonics[pos] * state.tooth_frequency
     return BearingSpectra(speed_rpm=speed_rpm, torque_Nm=torque, frequency=f, names=names, z=np.array(zs),
-                          loads=np.array(loads))
+                          loads=np.array(loads), lumped=np.array(lumped))

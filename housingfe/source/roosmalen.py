@@ -265,7 +265,11 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
         "components": ["Fx", "Fy", "Fz", "Mx", "My", "Mz"],
         "operating_points": [{"speed_rpm": b.speed_rpm, "torque_Nm": b.torque_Nm, "frequency_hz": b.frequency,
                               "bearings": [{"name": n, "z_m": float(z), "re": ld.real, "im": ld.imag}
-                                           for n, z, ld in zip(b.names, b.z, b.loads)]} for b in spectra]})
+                                           for n, z, ld in zip(b.names, b.z, b.loads)],
+                              "lumped_at_gear_centre": [{"shaft": sh, "components": ["Fx", "Fy", "Fz", "Mx", "My"],
+                                                         "re": lp.real, "im": lp.imag}
+                                                        for sh, lp in zip(("pinion", "wheel"), b.lumped)]}
+                             for b in spectra]})
 
     # ---- torque run at one speed
     torque_rows = []

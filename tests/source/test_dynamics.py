@@ -141,3 +141,38 @@ def test_correction_ranking_at_2000Nm_follows_the_thesis():
                                                                           PAIR.tooth_frequency(rpm), 20))
                                 for rpm in (800, 1000, 1200, 1400)])
     assert levels["uncorrected"] > levels["A"] > levels["D"]
+
+
+def test_bearing_split_preserves_the_lumped_reaction():
+    # the four bearing forces must add up to the lumped shaft reaction and reproduce its moments
+    mats = _matrices()
+    interior = dyn.derive_interior(PAIR, GEOMETRY)
+    n = 32
+    shock = 1000 * np.cos(2 * math.pi * np.arange(n) / n)
+    st = dyn.harmonic_balance(mats, np.full(n, K_MEAN), shock, np.zeros(dyn.N_DOF), 400.0, H=4)
+    bs = dyn.bearing_spectra(st, mats, interior, GEOMETRY, PAIR, 1000.0, 0.0)
+    for shaft, (i, j) in enumerate(((0, 1), (2, 3))):
+        Fx, Fy, Fz, Mx, My = bs.lumped[shaft]
+        left, right = bs.loads[i], bs.loads[j]
+        assert np.allclose(left[0] + right[0], Fx) and np.allclose(left[1] + right[1], Fy)
+        assert np.allclose(left[2] + right[2], Fz)
+        # moments about the gear centre (M = r x F): M_y = sum z F_x, M_x = -sum z F_y
+        tol = 1e-9 * np.abs(bs.loads).max()
+        assert np.allclose(bs.z[i] * left[0] + bs.z[j] * right[0], My, atol=tol)
+        assert np.allclose(-(bs.z[i] * left[1] + bs.z[j] * right[1]), Mx, atol=tol)
+        assert np.abs(My).max() > 1e-3 * np.abs(Fx).max()     # the helical mesh tilts the shafts
+
+
+def test_static_tilt_moment_is_axial_force_times_pitch_radius():
+    # helical mesh: the axial tooth force F_n sin(beta_b) acts at the operating pitch radius, so the
+    # pinion bearings carry the moment F_n sin(beta_b) r_w1 about y, and the wheel's r_w2 in turn
+    mats = _matrices()
+    torque = 2000.0
+    q = np.linalg.solve(mats.K0 + K_MEAN * np.outer(mats.h, mats.h), dyn.preload_force(mats, torque))
+    interior = dyn.derive_interior(PAIR, GEOMETRY)
+    fn = normal_force_from_torque(PAIR, torque)
+    rw1, rw2 = PAIR.base_diameter / 2 / math.cos(PAIR.operating_pressure_angle)
+    sb = math.sin(PAIR.base_helix_angle)
+    assert interior.pinion_bearings[4] * q[4] == pytest.approx(-fn * sb * rw1, rel=1e-9)
+    assert interior.wheel_bearings[4] * q[10] == pytest.approx(-fn * sb * rw2, rel=1e-9)
+    assert interior.pinion_bearings[2] * q[2] == pytest.approx(fn * sb, rel=1e-9)    # axial force on the pinion
