@@ -137,12 +137,15 @@ def complex_env() -> dict:
 
 def helmholtz_fem_radiation(geometry: FemGeometry, frequencies_hz, velocity=1.0, truncation: str = "bgt2",
                             degree: int = 2, rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND,
-                            save_msh: str | None = None, timeout_s: float = 3600.0) -> FemSweep:
+                            save_msh: str | None = None, timeout_s: float = 3600.0,
+                            velocity_is_rms: bool = False) -> FemSweep:
     """Radiated power (W) and radiation efficiency per frequency (Hz) from an exterior Helmholtz FE model.
 
     velocity: a complex peak normal velocity (m/s) uniform over the vibrating surface, or a pair
     (points (n,3) m, values (n,) complex m/s) sampled on it (nearest sample per surface DOF).
+    With velocity_is_rms the values are rms phasors (scaled by sqrt(2) to peak).
     One mesh and one form compilation serve the whole sweep; each frequency is one sparse LU (MUMPS)."""
+    scale = np.sqrt(2.0) if velocity_is_rms else 1.0
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))
     _check(geometry, truncation, degree, f)
     if not (rho > 0 and c > 0):
@@ -150,14 +153,14 @@ def helmholtz_fem_radiation(geometry: FemGeometry, frequencies_hz, velocity=1.0,
     with tempfile.TemporaryDirectory(prefix="housingfe-fem-") as tmp:
         tmp = Path(tmp)
         if not isinstance(velocity, (tuple, list)):
-            v = complex(velocity)
+            v = complex(velocity) * scale
             velocity_spec = {"uniform": [v.real, v.imag]}
         else:
             if len(velocity) != 2:
                 raise InputError("velocity: need (points (n,3), values (n,))")
             points, values = velocity
             points = np.asarray(points, dtype=float)
-            values = np.asarray(values, dtype=complex)
+            values = np.asarray(values, dtype=complex) * scale
             if points.ndim != 2 or points.shape[1] != 3 or values.shape != (points.shape[0],):
                 raise InputError("velocity: need (points (n,3), values (n,))")
             np.savez(tmp / "velocity.npz", points=points, values=values)

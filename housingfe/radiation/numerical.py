@@ -1,6 +1,7 @@
 """Numerical radiated power and radiation efficiency from a surface normal-velocity field.
 
-Convention: velocities are complex *peak* phasors v_hat (m/s) of a harmonic motion at frequency f.
+Convention: velocities are complex *peak* phasors v_hat (m/s) of a harmonic motion at frequency f
+(pass `velocity_is_rms=True` for rms phasors, as the housing's forced response uses: they are scaled by sqrt(2)).
 The time-averaged power is P = 1/2 Re integral(p_hat conj(v_hat)) dS (W) and the radiation efficiency is
 
     sigma = P / (rho c S <v~^2>),   <v~^2> = integral(|v_hat|^2 / 2) dS / S   (eq. 4.8, rms^2 average).
@@ -107,12 +108,19 @@ def _result(frequency_hz, power, weights, velocity, rho, c, seconds) -> Radiatio
     return RadiationResult(float(frequency_hz), power, sigma, area, mean_square, seconds)
 
 
+def _as_peak(velocity, velocity_is_rms: bool):
+    return velocity * np.sqrt(2.0) if velocity_is_rms else velocity
+
+
 def rayleigh_radiated_power(points, normals, weights, velocity, frequency_hz: float,
-                            rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND) -> RadiationResult:
+                            rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND,
+                            velocity_is_rms: bool = False) -> RadiationResult:
     """Radiated power and radiation efficiency of a *plane* radiator in an infinite rigid baffle
     (Rayleigh integral).  points (n,3) m, unit normals (n,3) pointing into the fluid, area weights (n,)
-    m^2, complex peak normal velocity (n,) m/s, frequency in Hz, rho in kg/m^3, c in m/s."""
+    m^2, complex peak (or, with velocity_is_rms, rms) normal velocity (n,) m/s, frequency in Hz, rho in
+    kg/m^3, c in m/s."""
     x, n, w, v = check_surface_data(points, normals, weights, velocity)
+    v = _as_peak(v, velocity_is_rms)
     _check_frequency(frequency_hz, rho, c)
     _check_planar(x, n, "points")
     t0 = time.perf_counter()
@@ -121,12 +129,14 @@ def rayleigh_radiated_power(points, normals, weights, velocity, frequency_hz: fl
 
 
 def baffled_plates_radiated_power(points, normals, weights, velocity, plate_ids, frequency_hz: float,
-                                  rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND) -> RadiationResult:
+                                  rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND,
+                                  velocity_is_rms: bool = False) -> RadiationResult:
     """Housing estimate: every plate (points sharing a plate id) radiates as if set in its own infinite
     rigid baffle and the plates are uncorrelated, so their powers add.  Inputs as in
     `rayleigh_radiated_power` plus `plate_ids` (n,) (e.g. the facet tags of the lead's housing mesh).
     This is the check of Föller's box approximation against the computed surface velocity."""
     x, n, w, v = check_surface_data(points, normals, weights, velocity)
+    v = _as_peak(v, velocity_is_rms)
     _check_frequency(frequency_hz, rho, c)
     ids = np.asarray(plate_ids)
     if ids.shape != w.shape:

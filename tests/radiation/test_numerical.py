@@ -71,3 +71,14 @@ def test_bad_surface_data_raises_input_error(change):
         v = v[:-1]
     with pytest.raises(InputError):
         numerical.rayleigh_radiated_power(pts, nrm, w, v, 100.0)
+
+
+def test_rms_velocity_input_doubles_power_keeps_sigma():
+    # the same phasor read as rms carries twice the mean square, hence twice the power
+    pts, nrm, w = numerical.disc_quadrature(0.1, 8, 24)
+    v = np.full(len(w), 1e-3 + 0j)
+    peak = numerical.rayleigh_radiated_power(pts, nrm, w, v, 500.0)
+    rms = numerical.rayleigh_radiated_power(pts, nrm, w, v, 500.0, velocity_is_rms=True)
+    assert rms.power_w == pytest.approx(2 * peak.power_w, rel=1e-12)
+    assert rms.mean_square_velocity == pytest.approx(1e-6, rel=1e-12)
+    assert rms.sigma == pytest.approx(peak.sigma, rel=1e-12)
