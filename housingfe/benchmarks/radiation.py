@@ -4,6 +4,7 @@ Cases with analytic references (ka = 0.1 ... 5, radius a = 0.1 m):
 - pulsating sphere, sigma = (ka)^2 / (1 + (ka)^2)   - exterior Helmholtz FE (BGT2 on r = 1.5 a)
 - oscillating sphere (v_n = cos theta, sampled), sigma = (ka)^4 / (4 + (ka)^4) - FE
 - baffled piston, sigma = 1 - J1(2ka)/(ka)          - FE (BGT2 or PML) and the Rayleigh integral
+- 60-degree cap vibrating on a rigid sphere (one 'plate' of a closed body), spherical-harmonic series - FE
 Writes radiation_bench.csv (one row per case/setting/ka), radiation_bench_summary.csv, radiation_bench.png,
 and (full run) radiation_box_comparison.csv: a box with its faces in their (1,1) mode, closed-body FE
 next to baffled plates and Föller's estimate - an illustration of the later housing check, not a verification.
@@ -46,6 +47,12 @@ def _fem_cases(quick: bool):
         cases.append(("oscillating sphere", "FE bgt2 R=1.5a", f"h={h}a hs={hs}a",
                       fem.sphere_geometry(A, h * A, h_surface_m=hs * A), dipole, "bgt2",
                       lambda ka: ka**4 / (4 + ka**4)))
+    cap_pts = _fibonacci_sphere(20000, A)
+    cap = (cap_pts, (cap_pts[:, 2] / A > np.cos(np.pi / 3)).astype(complex))
+    for h, hs in sphere_h[:1] if quick else sphere_h[:2]:
+        cases.append(("cap on sphere", "FE bgt2 R=1.5a", f"h={h}a hs={hs}a",
+                      fem.sphere_geometry(A, h * A, h_surface_m=hs * A), cap, "bgt2",
+                      lambda ka: analytic.sphere_cap_sigma(ka, np.pi / 3)))
     for h, hs in piston_h:
         cases.append(("baffled piston", "FE bgt2 R=2a", f"h={h}a hs={hs}a",
                       fem.baffled_piston_geometry(A, h * A, h_surface_m=hs * A), 1.0, "bgt2", analytic.piston_sigma))
@@ -119,9 +126,11 @@ def _plot(path: Path, rows, summary) -> None:
     ax2.semilogx(ka, 10 * np.log10(analytic.sphere_sigma(ka)), "k-", label="pulsating sphere (4.9)")
     ax2.semilogx(ka, 10 * np.log10(analytic.piston_sigma(ka)), "k--", label="baffled piston")
     ax2.semilogx(ka, 10 * np.log10(ka**4 / (4 + ka**4)), "k:", label="oscillating sphere")
+    ax2.semilogx(ka, 10 * np.log10(analytic.sphere_cap_sigma(ka, np.pi / 3)), "k-.", lw=0.8,
+                 label="60 deg cap on sphere")
     first_setting = {}
     markers = {"FE bgt2": "o", "FE bgt1": "^", "FE pml ": "v", "Rayleig": "x"}
-    colors = {"pulsating sphere": "C0", "baffled piston": "C1", "oscillating sphere": "C2"}
+    colors = {"pulsating sphere": "C0", "baffled piston": "C1", "oscillating sphere": "C2", "cap on sphere": "C3"}
     labelled = set()
     for case, method, setting, n, k, sigma, ref, e, dt in rows:
         if first_setting.setdefault((case, method), setting) != setting:

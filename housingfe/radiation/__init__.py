@@ -1,7 +1,7 @@
 """Sound radiation (van Roosmalen 1994, Sec. 4.7, Appendix E).
 
 Public API (SI units; velocities are complex peak phasors, mean squares are rms^2; see analytic.py):
-- analytic radiators: `sphere_sigma`, `sphere_power`, `piston_sigma`, `plate_critical_frequency`,
+- analytic radiators: `sphere_sigma`, `sphere_power`, `sphere_cap_sigma`, `piston_sigma`, `plate_critical_frequency`,
   `equivalent_radiated_power` (ERP, sigma = 1);
 - Föller's box model: `Plate`, `plate_from_triangles`, `foller_radiation_index` -> `FollerResult`,
   `load_plate_table`;
@@ -18,6 +18,8 @@ from housingfe.radiation.analytic import (
     piston_sigma,
     plate_critical_frequency,
     radiation_index_db,
+    sphere_cap_sigma,
+    sphere_modal_resistance,
     sphere_power,
     sphere_sigma,
     steel_rule_critical_frequency,
@@ -78,7 +80,9 @@ __all__ = [
     "register_cli",
     "sound_power_level",
     "sound_power_spectrum",
+    "sphere_cap_sigma",
     "sphere_geometry",
+    "sphere_modal_resistance",
     "sphere_power",
     "sphere_sigma",
     "steel_rule_critical_frequency",

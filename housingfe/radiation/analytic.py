@@ -10,7 +10,7 @@ Conventions used throughout `housingfe.radiation`:
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import j1
+from scipy.special import eval_legendre, j1, spherical_jn, spherical_yn
 
 from housingfe.errors import InputError
 
@@ -58,6 +58,35 @@ def sphere_power(radius_m: float, velocity_amplitude_m_s, frequency_hz,
     vR = _non_negative("velocity_amplitude_m_s", velocity_amplitude_m_s)
     ka = wavenumber(frequency_hz, c) * R
     return 2.0 * np.pi * _positive("rho", rho) * c * R**2 * vR**2 * sphere_sigma(ka)
+
+
+def sphere_modal_resistance(n: int, ka) -> np.ndarray:
+    """Normalised radiation resistance Re(z_n)/(rho c) of the n-th spherical harmonic on a sphere,
+    z_n = i rho c h_n(ka) / h_n'(ka) (spherical Hankel function); n = 0 gives eq. 4.9, n = 1 gives
+    (ka)^4 / (4 + (ka)^4)."""
+    x = _positive("ka", ka)
+    h = spherical_jn(n, x) + 1j * spherical_yn(n, x)
+    dh = spherical_jn(n, x, True) + 1j * spherical_yn(n, x, True)
+    return (1j * h / dh).real
+
+
+def sphere_cap_sigma(ka, half_angle_rad: float, n_terms: int | None = None) -> np.ndarray:
+    """Radiation efficiency of a rigid sphere (radius a) on which a polar cap of half-angle theta_0 vibrates
+    radially with uniform velocity, the rest at rest (a 'plate' of a closed body).  Spherical-harmonic series
+    (e.g. Morse & Ingard, Theoretical Acoustics, Sec. 7.2): v(theta) = sum V_n P_n(cos theta) with
+    V_0 = (1 - cos theta_0)/2, V_n = (P_{n-1}(cos theta_0) - P_{n+1}(cos theta_0))/2, and
+    sigma = sum Re(z_n/rho c) V_n^2 / (2n+1) / ((1 - cos theta_0)/2), normalised with the *whole* sphere's
+    area and surface-averaged mean-square velocity (i.e. with the cap's own area and velocity)."""
+    if not 0.0 < half_angle_rad <= np.pi:
+        raise InputError(f"half_angle_rad: must lie in (0, pi], got {half_angle_rad!r}")
+    x = np.atleast_1d(_positive("ka", ka))
+    x0 = np.cos(half_angle_rad)
+    terms = n_terms or int(40 + 3 * x.max())
+    total = np.zeros_like(x)
+    for n in range(terms):
+        Vn = 0.5 * (1.0 - x0) if n == 0 else 0.5 * (eval_legendre(n - 1, x0) - eval_legendre(n + 1, x0))
+        total += sphere_modal_resistance(n, x) * Vn**2 / (2 * n + 1)
+    return total / (0.5 * (1.0 - x0))
 
 
 def piston_sigma(ka) -> np.ndarray:

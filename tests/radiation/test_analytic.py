@@ -72,3 +72,20 @@ def test_erp_is_rho_c_S_v2():
 def test_non_physical_input_raises_input_error(call):
     with pytest.raises(InputError):
         call()
+
+
+def test_sphere_modal_resistance_dipole_closed_form():
+    ka = np.array([0.1, 0.5, 1.0, 2.0, 5.0])
+    assert analytic.sphere_modal_resistance(1, ka) == pytest.approx(ka**4 / (4 + ka**4), rel=1e-10)
+
+
+def test_sphere_cap_series_limits():
+    ka = np.array([0.1, 1.0, 3.0, 5.0])
+    # the whole sphere vibrating is the pulsating sphere (eq. 4.9)
+    assert analytic.sphere_cap_sigma(ka, np.pi) == pytest.approx(analytic.sphere_sigma(ka), rel=1e-10)
+    # kR << 1: a monopole of volume velocity v S_cap, sigma -> k^2 S_cap / (4 pi) (R = 1)
+    theta0 = np.pi / 3
+    s_cap = 2 * np.pi * (1 - np.cos(theta0))
+    assert analytic.sphere_cap_sigma(0.01, theta0) == pytest.approx(0.01**2 * s_cap / (4 * np.pi), rel=1e-3)
+    # a small cap at high frequency radiates like a baffled piston of the same area (sigma -> 1)
+    assert analytic.sphere_cap_sigma(40.0, 0.2) == pytest.approx(1.0, abs=0.03)
