@@ -22,11 +22,12 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.distance import cdist
 
 from housingfe.errors import InputError
 from housingfe.radiation.analytic import AIR_DENSITY, SPEED_OF_SOUND
 
-_BLOCK = 2048  # rows of the resistance matrix built at once (memory ~ BLOCK * n * 8 bytes)
+_BLOCK_ENTRIES = 4_000_000  # entries of the resistance matrix built at once (~32 MB per temporary array)
 
 
 @dataclass(frozen=True)
@@ -93,10 +94,11 @@ def rayleigh_power_w(points, weights, velocity, frequency_hz: float,
     k = 2.0 * np.pi * frequency_hz / c
     q = weights * velocity  # volume velocity per point, m^3/s
     total = 0.0
-    for start in range(0, len(points), _BLOCK):
-        block = slice(start, start + _BLOCK)
-        r = np.linalg.norm(points[block, None, :] - points[None, :, :], axis=2)
-        total += np.real(np.conj(q[block]) @ (np.sinc(k * r / np.pi) @ q))
+    rows = max(1, _BLOCK_ENTRIES // len(points))
+    for start in range(0, len(points), rows):
+        block = slice(start, start + rows)
+        kr = cdist(points[block], points) * k
+        total += np.real(np.conj(q[block]) @ (np.sinc(kr / np.pi) @ q))
     return float(0.5 * rho * c * k**2 / (2.0 * np.pi) * total)
 
 
