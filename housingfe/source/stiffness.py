@@ -24,6 +24,7 @@ Assumptions where the thesis' figures are missing are listed in docs/source.md.
 """
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, replace
 
@@ -130,6 +131,7 @@ def _virtual_spur(pair: GearPair) -> GearPair:
                     youngs_modulus=pair.youngs_modulus, poisson_ratio=pair.poisson_ratio)
 
 
+@functools.lru_cache(maxsize=32)   # GearPair is frozen (hashable); the profile generation takes ~0.5 s
 def weber_banaschek(pair: GearPair, gear: int, n: int = 80) -> _ToothFlex:
     """Tooth and root flexibility of gear 0/1 after Weber & Banaschek (eq. 2.34-2.39), Hertz distance
     t and normal curvature radius, tabulated over the active flank.  Units: see `_ToothFlex`."""
