@@ -101,7 +101,7 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the `housingfe` console script; returns the process exit code."""
     import logging
 
-    logging.getLogger().setLevel(logging.WARNING)  # FFCx/distutils report each JIT compile at INFO
+    logging.disable(logging.INFO)  # FFCx/distutils report each JIT compile at INFO
     parser = build_parser()
     args = parser.parse_args(argv)
     try:

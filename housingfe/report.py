@@ -9,6 +9,8 @@ import shutil
 from pathlib import Path
 from typing import Iterable, Iterator, Sequence
 
+import numpy as np
+
 
 @contextlib.contextmanager
 def atomic_output_dir(out_dir: str | os.PathLike, comm=None) -> Iterator[Path]:
@@ -200,3 +202,180 @@ def plot_mode_shapes(path: Path, model, result, count: int) -> None:
         plotter.view_isometric()
     plotter.screenshot(str(path))
     plotter.close()
+
+
+# --------------------------------------------------------------------------------------- harmonic results
+def _band_rows(forced):
+    """(load, band nominal, band centre, {solver: (Lv, TF)}, {N: TF_points}) for every band."""
+    from housingfe.response import band_levels, transfer_band_levels
+    from housingfe import levels as lv
+
+    spec = forced.spec
+    rows = []
+    solvers = list(forced.responses)
+    main = solvers[-1] if "direct" not in solvers else solvers[0]
+    for j, lc in enumerate(forced.loads):
+        per_solver = {}
+        bands = None
+        for s in solvers:
+            r = forced.responses[s][j]
+            bands, L, TF = transfer_band_levels(r, max(spec.f_min, 10.0), spec.f_max)
+            per_solver[s] = (L, TF)
+        r = forced.responses[main][j]
+        points = {}
+        for N, ms in r.point_mean_square_velocity.items():
+            _, Lp = band_levels(r.frequencies, ms * r.amplitude**2, max(spec.f_min, 10.0), spec.f_max, lv.V0)
+            points[N] = Lp - per_solver[main][0] + per_solver[main][1]
+        for b in range(len(bands.center)):
+            rows.append((lc.name, bands.nominal[b], bands.center[b], {s: (v[0][b], v[1][b]) for s, v in per_solver.items()},
+                         {N: p[b] for N, p in points.items()}))
+    return rows, solvers
+
+
+def band_comparison(forced, reference: str = "direct") -> dict:
+    """Per solver: max |band TF - reference band TF| (dB) over all load cases and bands, and the rows."""
+    rows, solvers = _band_rows(forced)
+    out = {}
+    if reference not in solvers:
+        return out
+    for s in solvers:
+        if s == reference:
+            continue
+        diffs = [r[3][s][1] - r[3][reference][1] for r in rows if np.isfinite(r[3][reference][1])]
+        out[s] = {"max_abs_dB": float(np.max(np.abs(diffs))), "mean_dB": float(np.mean(diffs))}
+    return out
+
+
+def harmonic_summary_text(forced) -> str:
+    """Human-readable summary of the forced response."""
+    spec = forced.spec
+    lines = [f"forced response: {len(forced.loads)} load case(s), {forced.facts['frequencies']} lines "
+             f"{spec.f_min:g}..{spec.f_max:g} Hz (df = {spec.df:g} Hz), surface {spec.surface} "
+             f"S = {forced.facts['surface_area_m2']:.4f} m^2; solvers: {', '.join(forced.responses)}"]
+    lines.append("timings: " + ", ".join(f"{k} {v:.2f} s" for k, v in forced.timings.items()))
+    for s, d in band_comparison(forced).items():
+        lines.append(f"{s} vs direct: max |band TF difference| {d['max_abs_dB']:.2f} dB, mean {d['mean_dB']:+.2f} dB")
+    rows, solvers = _band_rows(forced)
+    main = solvers[0]
+    header = ["load", "band Hz"] + [f"TF {s} dB" for s in solvers]
+    table = [[r[0], f"{r[1]:g}"] + [round(float(r[3][s][1]), 2) for s in solvers] for r in rows]
+    lines.append(f"1/3-octave TF (dB re {main}):")
+    lines.append(format_table(header, table))
+    return "\n".join(lines)
+
+
+def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
+    """frf.csv, bands.csv, receptance.csv, harmonic.json, TF plots, deflection shapes (XDMF)."""
+    import numpy as np
+
+    if forced.spec.deflection_shapes_hz:
+        write_deflection_shapes(folder / "deflection_shapes.xdmf", model, forced, comm)
+    if comm.rank != 0:
+        return
+    spec = forced.spec
+    counts = sorted(forced.observer.samples)
+    frf = []
+    for s, resps in forced.responses.items():
+        for r in resps:
+            for k, f in enumerate(r.frequencies):
+                frf.append([r.name, s, f, r.velocity_level_db[k], r.transfer_db[k]]
+                           + [float(_db(r.point_mean_square_velocity[N][k])) for N in counts])
+    write_csv(folder / "frf.csv", ["load_case", "solver", "frequency_hz", "Lv_dB", "TF_dB"]
+              + [f"TF_points{N}_dB" for N in counts], frf)
+    rows, solvers = _band_rows(forced)
+    header = ["load_case", "band_nominal_hz", "band_center_hz", "Lv_dB", "TF_dB", "solver"]
+    header += [f"TF_{s}_dB" for s in solvers[1:]] + [f"TF_points{N}_dB" for N in counts]
+    write_csv(folder / "bands.csv", header,
+              [[r[0], r[1], r[2], r[3][solvers[0]][0], r[3][solvers[0]][1], solvers[0]]
+               + [r[3][s][1] for s in solvers[1:]] + [r[4][N] for N in counts] for r in rows])
+    main = forced.responses[solvers[0]]
+    rec = []
+    for i, ri in enumerate(main):
+        for j, lj in enumerate(forced.loads):
+            for k, f in enumerate(ri.frequencies):
+                h = ri.receptance[j, k]
+                rec.append([lj.name, ri.name, f, h.real, h.imag, abs(h)])
+    write_csv(folder / "receptance.csv", ["response_at", "load_case", "frequency_hz", "real", "imag", "abs"], rec)
+    write_json(folder / "harmonic.json", {
+        "scene": model.scene.scene.name, "solvers": solvers, "timings_s": forced.timings, **forced.facts,
+        "band_comparison_vs_direct": band_comparison(forced),
+        "sample_points": {N: {"points_m": s.points, "weights_m2": s.weights}
+                          for N, s in forced.observer.samples.items()},
+        "load_cases": [{"name": lc.name, "kind": lc.kind, "patch_area_m2": lc.patch_area, "centre_m": lc.centre}
+                       for lc in forced.loads]})
+    (folder / "summary_forced.txt").write_text(harmonic_summary_text(forced) + "\n")
+    if model.scene.output.pictures:
+        plot_transfer_functions(folder / "tf_bands.png", forced, rows, solvers)
+
+
+def _db(ms):
+    import numpy as np
+
+    from housingfe import levels
+
+    return levels.level(np.asarray(ms), levels.V0)
+
+
+def plot_transfer_functions(path: Path, forced, rows, solvers) -> None:
+    """Per load case: TF per 1/3-octave band (bars, like the thesis' Fig. 4.5) and narrow band."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    n = len(forced.loads)
+    fig, axes = plt.subplots(n, 2, figsize=(12, 3.6 * n), squeeze=False)
+    for j, lc in enumerate(forced.loads):
+        ax = axes[j, 0]
+        sel = [r for r in rows if r[0] == lc.name]
+        x = np.arange(len(sel))
+        width = 0.8 / len(solvers)
+        for k, s in enumerate(solvers):
+            ax.bar(x + k * width, [r[3][s][1] for r in sel], width, label=s)
+        ax.set_xticks(x + 0.4 - width / 2, [f"{r[1]:g}" for r in sel], rotation=90, fontsize=7)
+        ax.set_ylabel("TF (dB)")
+        ax.set_title(f"{lc.name}: 1/3-octave TF")
+        ax.legend(fontsize=7)
+        lo = np.nanmin([r[3][s][1] for r in sel for s in solvers])
+        ax.set_ylim(lo - 10, None)
+        ax = axes[j, 1]
+        for s in solvers:
+            r = forced.responses[s][j]
+            ax.plot(r.frequencies, r.transfer_db, lw=0.8, label=s)
+        ax.set_xlabel("frequency (Hz)")
+        ax.set_ylabel("TF (dB re v0/F0)")
+        ax.set_title(f"{lc.name}: narrow band")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_deflection_shapes(path: Path, model, forced, comm) -> None:
+    """Operating deflection shapes (real and imaginary part) at the requested frequencies (modal solver)."""
+    from dolfinx import fem, io
+
+    from housingfe.forced_response import deflection_shape
+
+    mesh = model.V.mesh
+    V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
+    uh = fem.Function(model.V)
+    re, im = fem.Function(V1, name="real"), fem.Function(V1, name="imag")
+    step = 0
+    with io.XDMFFile(comm, str(path), "w") as xdmf:
+        xdmf.write_mesh(mesh)
+        for j in range(len(forced.loads)):
+            for f in forced.spec.deflection_shapes_hz:
+                shape = deflection_shape(forced, j, f)
+                if shape is None:
+                    return
+                _, ur, ui = shape
+                for vec, out in ((ur, re), (ui, im)):
+                    vec.copy(uh.vector)
+                    uh.x.scatter_forward()
+                    out.interpolate(uh)
+                step += 1
+                xdmf.write_function(re, float(step))
+                xdmf.write_function(im, float(step))

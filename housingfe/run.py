@@ -24,15 +24,27 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     from housingfe.solvers import modal
 
     model = build_model(scene, comm)
-    result = modal.solve_modes(model.K, model.M, scene.analysis.modal.f_max, tol=scene.analysis.modal.tolerance)
-    checks = modal_checks(model, result)
-    wall = time.perf_counter() - t_start
-    summary = modal_summary(model, result, checks, wall)
+    modal_spec, harmonic_spec = scene.analysis.modal, scene.analysis.harmonic
+    modes = None
+    if modal_spec is not None:
+        modes = modal.solve_modes(model.K, model.M, modal_spec.f_max, tol=modal_spec.tolerance)
+        summary = modal_summary(model, modes, modal_checks(model, modes), time.perf_counter() - t_start)
+    forced = None
+    if harmonic_spec is not None:
+        from housingfe import forced_response
+
+        forced = forced_response.run(model, harmonic_spec)
     with report.atomic_output_dir(out, comm) as tmp:
-        report.write_modal_outputs(tmp, model, result, summary, comm)
+        if modes is not None:
+            report.write_modal_outputs(tmp, model, modes, summary, comm)
+        if forced is not None:
+            report.write_harmonic_outputs(tmp, model, forced, comm)
     if comm.rank == 0:
-        print(report.modal_summary_text(summary))
-        print(f"results: {out}/")
+        if modes is not None:
+            print(report.modal_summary_text(summary))
+        if forced is not None:
+            print(report.harmonic_summary_text(forced))
+        print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
 
 

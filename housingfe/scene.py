@@ -36,6 +36,7 @@ class MaterialSpec(_Strict):
     youngs_modulus: Optional[PositiveFloat] = None
     poisson_ratio: Optional[float] = None
     density: Optional[PositiveFloat] = None
+    loss_factor: Optional[float] = Field(None, ge=0.0, lt=1.0)
 
     @model_validator(mode="after")
     def _check(self):
@@ -51,7 +52,8 @@ class MaterialSpec(_Strict):
         return Material(self.name,
                         self.youngs_modulus if self.youngs_modulus is not None else base.youngs_modulus,
                         self.poisson_ratio if self.poisson_ratio is not None else base.poisson_ratio,
-                        self.density if self.density is not None else base.density)
+                        self.density if self.density is not None else base.density,
+                        self.loss_factor if self.loss_factor is not None else base.loss_factor)
 
 
 class MeshSpec(_Strict):
@@ -72,12 +74,106 @@ class ModalSpec(_Strict):
     tolerance: PositiveFloat = 1e-10
 
 
+class Spectrum(_Strict):
+    """A tabulated amplitude spectrum: values (rms, load units) at frequencies (Hz), interpolated linearly
+    in log-frequency, held constant outside the table."""
+
+    frequencies: list[PositiveFloat] = Field(min_length=1)
+    values: list[float] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _check(self):
+        if len(self.frequencies) != len(self.values):
+            raise ValueError("values: must have as many entries as frequencies")
+        if any(b <= a for a, b in zip(self.frequencies, self.frequencies[1:])):
+            raise ValueError("frequencies: must increase")
+        return self
+
+
+class LoadSpec(_Strict):
+    """One load case.  force: `amplitude` N along `direction`, spread uniformly over the facets of
+    `surface` within `radius` of `point` (a true point load is singular in solids).  moment: a couple of
+    `amplitude` N m about `direction`, as a linear traction field over the same kind of patch.  pressure:
+    uniform `amplitude` Pa on the whole surface, pushing along -n.  Amplitudes are rms; `spectrum` scales
+    them per frequency (flat when absent)."""
+
+    name: str
+    kind: Literal["force", "moment", "pressure"]
+    surface: str
+    point: Optional[list[float]] = Field(None, min_length=3, max_length=3)
+    direction: Optional[list[float]] = Field(None, min_length=3, max_length=3)
+    radius: PositiveFloat = 0.005
+    amplitude: float = 1.0
+    spectrum: Optional[Spectrum] = None
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.kind != "pressure":
+            if self.point is None:
+                raise ValueError("point: required for a force or moment load (m)")
+            if self.direction is None or sum(c * c for c in self.direction) == 0:
+                raise ValueError("direction: required and non-zero for a force or moment load")
+        return self
+
+
+class DampingSpec(_Strict):
+    """Damping.  loss_factor: hysteretic eta, global; loss_factor_bands: eta over frequency (e.g. per
+    1/3-octave band from T60, eq. 4.2), log-interpolated; modal_damping_ratio: viscous xi per mode (with
+    the direct solver it is applied as eta = 2 xi, which is exact at each resonance)."""
+
+    loss_factor: Optional[float] = Field(None, ge=0.0, lt=1.0)
+    loss_factor_bands: Optional[Spectrum] = None
+    modal_damping_ratio: Optional[float] = Field(None, ge=0.0, lt=0.5)
+
+    @model_validator(mode="after")
+    def _one(self):
+        given = [x is not None for x in (self.loss_factor, self.loss_factor_bands, self.modal_damping_ratio)]
+        if sum(given) > 1:
+            raise ValueError("loss_factor: give only one of loss_factor, loss_factor_bands, modal_damping_ratio")
+        return self
+
+
+class HarmonicSpec(_Strict):
+    """Forced harmonic response on lines f_min, f_min + df, ... <= f_max (Hz).
+
+    solver: "modal" (superposition with residual flexibility), "direct" (one factorisation per line),
+    "both" (modal, checked against direct), or "auto" (modal unless non-proportional terms are present).
+    modal_basis_factor: modes up to this multiple of f_max are kept dynamically; the rest enter through
+    the residual (static) flexibility when `residual` is true.
+    """
+
+    f_min: PositiveFloat = 4.88
+    f_max: PositiveFloat
+    df: PositiveFloat = 4.88
+    solver: Literal["auto", "modal", "direct", "both"] = "auto"
+    residual: bool = True
+    modal_basis_factor: float = Field(1.5, ge=1.0, le=4.0)
+    surface: str = "outer"
+    sample_points: list[PositiveInt] = [18, 36, 48, 94]
+    deflection_shapes_hz: list[PositiveFloat] = []
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.f_min > self.f_max:
+            raise ValueError("f_min: must not exceed f_max")
+        return self
+
+    @property
+    def frequencies(self):
+        import numpy as np
+
+        n = int(np.floor((self.f_max - self.f_min) / self.df + 1e-9)) + 1
+        return self.f_min + self.df * np.arange(n)
+
+
 class Analyses(_Strict):
     modal: Optional[ModalSpec] = None
+    harmonic: Optional[HarmonicSpec] = None
 
     @property
     def f_max(self) -> float:
-        return self.modal.f_max if self.modal else 0.0
+        """Highest frequency any requested analysis needs (Hz): sets the mesh size."""
+        return max(self.modal.f_max if self.modal else 0.0, self.harmonic.f_max if self.harmonic else 0.0)
 
 
 class OutputSpec(_Strict):
@@ -123,13 +219,21 @@ class HousingScene(_Strict):
     supports: list[SupportSpec] = []
     mesh: MeshSpec = MeshSpec()
     analysis: Analyses
+    loads: list[LoadSpec] = []
+    damping: DampingSpec = DampingSpec()
     output: OutputSpec = OutputSpec()
     reference: Optional[ReferenceSpec] = None
 
     @model_validator(mode="after")
     def _needs_analysis(self):
-        if self.analysis.modal is None:
-            raise ValueError("analysis: the scene requests no analysis (add [analysis.modal])")
+        if self.analysis.modal is None and self.analysis.harmonic is None:
+            raise ValueError("analysis: the scene requests no analysis (add [analysis.modal] or "
+                             "[analysis.harmonic])")
+        if self.analysis.harmonic is not None and not self.loads:
+            raise ValueError("loads: a harmonic analysis needs at least one [[loads]] entry")
+        names = [load.name for load in self.loads]
+        if len(set(names)) != len(names):
+            raise ValueError("loads: load case names must be unique")
         return self
 
 

@@ -1,0 +1,100 @@
+"""Load cases as FE load vectors: forces and couples spread over small surface patches, pressures.
+
+Each load vector is assembled for a unit amplitude (1 N, 1 N m, 1 Pa); amplitudes and spectra scale it per
+frequency.  Responses per unit load are transfer functions directly (F0 = 1 N, l0 = 1 m).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import ufl
+from dolfinx import fem, mesh as dmesh
+from dolfinx.fem.petsc import assemble_vector
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from housingfe.errors import InputError
+
+
+@dataclass
+class LoadCase:
+    """A load vector for unit amplitude, with its spectrum.
+
+    vector: PETSc Vec (N per unit load); kind: force | moment | pressure; amplitude(f): rms load (N, N m
+    or Pa) at frequencies f (Hz); patch_area: loaded area (m^2); centre: patch centroid (m)."""
+
+    name: str
+    kind: str
+    vector: PETSc.Vec
+    spec: object
+    patch_area: float
+    centre: np.ndarray
+
+    def amplitude(self, frequencies) -> np.ndarray:
+        """rms load amplitude at the given frequencies (N, N m or Pa)."""
+        f = np.asarray(frequencies, dtype=float)
+        scale = self.spec.amplitude
+        if self.spec.spectrum is None:
+            return np.full(f.shape, scale)
+        table = self.spec.spectrum
+        return scale * np.interp(np.log(f), np.log(table.frequencies), table.values)
+
+
+def assemble_load(spec, housing, V, bcs) -> LoadCase:
+    """The load vector of one scene load (unit amplitude); Dirichlet rows are zeroed."""
+    from dolfinx.fem.petsc import set_bc
+
+    if spec.surface not in housing.facet_groups:
+        raise InputError(f"loads.{spec.name}.surface: no surface {spec.surface!r} "
+                         f"(known: {', '.join(sorted(housing.facet_groups))})")
+    facets = housing.facets(spec.surface)
+    v = ufl.TestFunction(V)
+    mesh = V.mesh
+    if spec.kind == "pressure":
+        ds = ufl.Measure("ds", domain=mesh, subdomain_data=housing.facet_tags)(housing.facet_tag_values(spec.surface))
+        n = ufl.FacetNormal(mesh)
+        form = -ufl.inner(n, v) * ds
+        area = _integrate(1.0 * ds, mesh.comm)
+        centre = np.array([_integrate(ufl.SpatialCoordinate(mesh)[i] * ds, mesh.comm) for i in range(3)]) / area
+    else:
+        patch = _patch(mesh, facets, np.asarray(spec.point, dtype=float), spec.radius)
+        ds = ufl.Measure("ds", domain=mesh, subdomain_data=patch)(1)
+        x = ufl.SpatialCoordinate(mesh)
+        area = _integrate(1.0 * ds, mesh.comm)
+        centre = np.array([_integrate(x[i] * ds, mesh.comm) for i in range(3)]) / area
+        direction = np.asarray(spec.direction, dtype=float)
+        direction = direction / np.linalg.norm(direction)
+        if spec.kind == "force":
+            traction = ufl.as_vector(direction / area)
+        else:
+            r = x - ufl.as_vector(centre)
+            J = np.array([[_integrate((ufl.dot(r, r) * (i == j) - r[i] * r[j]) * ds, mesh.comm)
+                           for j in range(3)] for i in range(3)])
+            theta = np.linalg.solve(J, direction)      # rotation-like field carrying a unit couple
+            traction = ufl.cross(ufl.as_vector(theta), r)
+        form = ufl.inner(traction, v) * ds
+    vec = assemble_vector(fem.form(form))
+    vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+    set_bc(vec, bcs)
+    return LoadCase(spec.name, spec.kind, vec, spec, area, centre)
+
+
+def _integrate(expr, comm) -> float:
+    return comm.allreduce(fem.assemble_scalar(fem.form(expr)), op=MPI.SUM)
+
+
+def _patch(mesh, facets: np.ndarray, point: np.ndarray, radius: float):
+    """MeshTags (value 1) of the surface facets whose midpoints lie within `radius` of `point`; if none
+    does (coarse mesh), the facets nearest to the point."""
+    fdim = mesh.topology.dim - 1
+    mids = dmesh.compute_midpoints(mesh, fdim, facets) if len(facets) else np.zeros((0, 3))
+    dist = np.linalg.norm(mids - point, axis=1)
+    chosen = facets[dist <= radius]
+    if mesh.comm.allreduce(len(chosen), op=MPI.SUM) == 0:
+        nearest = mesh.comm.allreduce(float(dist.min()) if len(dist) else np.inf, op=MPI.MIN)
+        if not np.isfinite(nearest):
+            raise InputError("loads: the load surface has no facets")
+        chosen = facets[dist <= nearest * (1 + 1e-9) + 1e-12]
+    chosen = np.unique(chosen).astype(np.int32)
+    return dmesh.meshtags(mesh, fdim, chosen, np.ones(len(chosen), dtype=np.int32))

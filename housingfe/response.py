@@ -1,0 +1,252 @@
+"""Responses of the housing: surface-averaged mean-square normal velocity (exact area integral and
+area-weighted sample points, eq. 5.4), transfer functions, band levels and receptances.
+
+Conventions: loads and responses are rms phasors; <v^2>(f) = omega^2 u^H W u / S with
+W = int_S (u.n)(v.n) dS, the exact area integral over the radiating surface S.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import ufl
+from dolfinx import fem, geometry
+from dolfinx import mesh as dmesh
+from dolfinx.cpp import mesh as _cpp_mesh
+from dolfinx.fem.petsc import assemble_matrix
+from mpi4py import MPI
+
+from housingfe import levels
+from housingfe.errors import InputError
+
+
+# ------------------------------------------------------------------------------ sample points
+@dataclass
+class SamplePoints:
+    """N points on the radiating surface with outward normals and area weights (m^2, summing to S)."""
+
+    points: np.ndarray
+    normals: np.ndarray
+    weights: np.ndarray
+
+
+def _surface_facet_data(housing, surface: str):
+    """Owned facets of a surface: midpoints, unit outward normals, areas, atomic group tag (all ranks)."""
+    mesh = housing.mesh
+    fdim = mesh.topology.dim - 1
+    n_owned = mesh.topology.index_map(fdim).size_local
+    mids, normals, areas, groups = [], [], [], []
+    mesh.topology.create_connectivity(fdim, mesh.topology.dim)
+    f2c = mesh.topology.connectivity(fdim, mesh.topology.dim)
+    for value in housing.facet_tag_values(surface):
+        facets = housing.facet_tags.find(value)
+        facets = facets[facets < n_owned]
+        if not len(facets):
+            continue
+        geom = _cpp_mesh.entities_to_geometry(mesh._mesh, fdim, facets, False)
+        x = mesh.geometry.x[geom]
+        if geom.shape[1] == 4:   # quadrilateral (dolfinx vertex order 0,1,2,3 = tensor product)
+            cross = np.cross(x[:, 3] - x[:, 0], x[:, 2] - x[:, 1])
+        else:
+            cross = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+            cross *= 1.0
+        area = np.linalg.norm(cross, axis=1) * (0.5 if geom.shape[1] in (3, 4) else 1.0)
+        n = cross / np.linalg.norm(cross, axis=1)[:, None]
+        mid = dmesh.compute_midpoints(mesh, fdim, facets)
+        cells = np.array([f2c.links(f)[0] for f in facets])
+        centroid = dmesh.compute_midpoints(mesh, mesh.topology.dim, cells)
+        sign = np.sign(np.einsum("ij,ij->i", mid - centroid, n))
+        mids.append(mid), normals.append(n * sign[:, None]), areas.append(area)
+        groups.append(np.full(len(facets), value))
+    data = [np.concatenate(a) if a else np.zeros((0, 3) if k < 2 else 0) for k, a in
+            enumerate((mids, normals, areas, groups))]
+    gathered = mesh.comm.allgather(data)
+    return [np.concatenate([g[k] for g in gathered]) for k in range(4)]
+
+
+def sample_points(housing, surface: str, count: int, seed: int = 0) -> SamplePoints:
+    """`count` area-weighted sample points on `surface`: points are shared out among the surface's atomic
+    groups (plates) in proportion to area; inside a group, area-weighted k-means on the facet midpoints
+    gives clusters; each point is the facet midpoint nearest its cluster centre and carries the cluster's
+    area.  Deterministic (fixed seed) and identical on every rank."""
+    mids, normals, areas, groups = _surface_facet_data(housing, surface)
+    total = areas.sum()
+    tags = np.unique(groups)
+    share = np.array([areas[groups == t].sum() for t in tags]) / total * count
+    alloc = np.floor(share).astype(int)
+    for i in np.argsort(share - alloc)[::-1][:count - alloc.sum()]:
+        alloc[i] += 1
+    rng = np.random.default_rng(seed)
+    pts, nrm, w = [], [], []
+    for t, k in zip(tags, alloc):
+        sel = np.flatnonzero(groups == t)
+        k = min(k, len(sel))
+        if k == 0:
+            continue
+        labels = _weighted_kmeans(mids[sel], areas[sel], k, rng)
+        for c in range(k):
+            members = sel[labels == c]
+            if not len(members):
+                continue
+            centre = np.average(mids[members], axis=0, weights=areas[members])
+            rep = members[np.argmin(np.linalg.norm(mids[members] - centre, axis=1))]
+            pts.append(mids[rep]), nrm.append(normals[rep]), w.append(areas[members].sum())
+    return SamplePoints(np.array(pts), np.array(nrm), np.array(w))
+
+
+def _weighted_kmeans(x: np.ndarray, w: np.ndarray, k: int, rng, iterations: int = 30) -> np.ndarray:
+    centres = x[rng.choice(len(x), size=k, replace=False)]
+    labels = np.zeros(len(x), dtype=int)
+    for _ in range(iterations):
+        labels = np.argmin(((x[:, None, :] - centres[None]) ** 2).sum(-1), axis=1)
+        for c in range(k):
+            m = labels == c
+            if m.any():
+                centres[c] = np.average(x[m], axis=0, weights=w[m])
+    return labels
+
+
+class PointEvaluator:
+    """Normal displacement of a field at sample points (each point evaluated on one owning rank)."""
+
+    def __init__(self, V, samples: SamplePoints):
+        mesh = V.mesh
+        self.V, self.samples = V, samples
+        tree = geometry.BoundingBoxTree(mesh, mesh.topology.dim)
+        candidates = geometry.compute_collisions(tree, samples.points)
+        colliding = geometry.compute_colliding_cells(mesh, candidates, samples.points)
+        n_owned = mesh.topology.index_map(mesh.topology.dim).size_local
+        rank = mesh.comm.rank
+        mine = np.full(len(samples.points), -1)
+        for i in range(len(samples.points)):
+            cells = [c for c in colliding.links(i) if c < n_owned]
+            if cells:
+                mine[i] = cells[0]
+        owner = np.where(mine >= 0, rank, mesh.comm.size)
+        owner = mesh.comm.allreduce(owner, op=MPI.MIN)
+        if np.any(owner == mesh.comm.size):
+            raise InputError("sample points: a point lies outside the mesh")
+        self.local = np.flatnonzero(owner == rank)
+        self.cells = mine[self.local]
+        self.u = fem.Function(V)
+
+    def normal_values(self, vec) -> np.ndarray:
+        """u . n at every sample point (m per unit of the vector), on all ranks."""
+        vec.copy(self.u.vector)
+        self.u.x.scatter_forward()
+        out = np.zeros(len(self.samples.points))
+        if len(self.local):
+            vals = self.u.eval(self.samples.points[self.local], self.cells)
+            out[self.local] = np.einsum("ij,ij->i", vals, self.samples.normals[self.local])
+        return self.V.mesh.comm.allreduce(out, op=MPI.SUM)
+
+
+# ----------------------------------------------------------------------------------- observers
+@dataclass
+class Reduced:
+    """What the responses need of a set of vectors Psi: G = Psi^T W Psi, point values per sample set,
+    projections on the load vectors (for receptances)."""
+
+    gram: np.ndarray
+    points: dict
+    loads: np.ndarray
+
+
+class SurfaceObserver:
+    """The radiating surface (W, S), the sample-point sets and the load vectors of a model."""
+
+    def __init__(self, model, surface: str, sample_counts, load_cases):
+        housing, V = model.housing, model.V
+        if surface not in housing.facet_groups:
+            raise InputError(f"analysis.harmonic.surface: no surface {surface!r} "
+                             f"(known: {', '.join(sorted(housing.facet_groups))})")
+        ds = ufl.Measure("ds", domain=housing.mesh, subdomain_data=housing.facet_tags)(
+            housing.facet_tag_values(surface))
+        n = ufl.FacetNormal(housing.mesh)
+        u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+        self.W = assemble_matrix(fem.form(ufl.dot(u, n) * ufl.dot(v, n) * ds))
+        self.W.assemble()
+        self.area = housing.mesh.comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds)), op=MPI.SUM)
+        self.samples = {N: sample_points(housing, surface, N) for N in sample_counts}
+        self.evaluators = {N: PointEvaluator(V, s) for N, s in self.samples.items()}
+        self.load_vectors = [lc.vector for lc in load_cases]
+
+    def reduce(self, vectors) -> Reduced:
+        """Project a list of PETSc vectors (see Reduced)."""
+        Wv = []
+        for x in vectors:
+            y = self.W.createVecLeft()
+            self.W.mult(x, y)
+            Wv.append(y)
+        gram = np.array([[a.dot(b) for b in Wv] for a in vectors])
+        points = {N: np.array([ev.normal_values(x) for x in vectors]).T for N, ev in self.evaluators.items()}
+        loads = np.array([[f.dot(x) for x in vectors] for f in self.load_vectors])
+        return Reduced(gram, points, loads)
+
+
+# ----------------------------------------------------------------------------------- responses
+@dataclass
+class LoadResponse:
+    """Per unit load, on the frequency grid: exact surface-averaged <v^2> (m^2/s^2 per unit^2), the same
+    from each sample-point set, and receptances to every load case (m per N or rad-ish per N m)."""
+
+    name: str
+    kind: str
+    frequencies: np.ndarray
+    mean_square_velocity: np.ndarray
+    point_mean_square_velocity: dict
+    receptance: np.ndarray
+    amplitude: np.ndarray
+    extras: dict = field(default_factory=dict)
+
+    @property
+    def transfer_db(self) -> np.ndarray:
+        """TF = L_v - L_load in dB (TF_F re v0/F0, TF_M re v0/(F0 l0), pressure re v0/(1 Pa))."""
+        return levels.level(self.mean_square_velocity, levels.V0)
+
+    @property
+    def velocity_level_db(self) -> np.ndarray:
+        """L_v (dB re 5e-8 m/s) for the scene's load amplitude and spectrum."""
+        return levels.level(self.mean_square_velocity * self.amplitude**2, levels.V0)
+
+
+def responses(result, observer: SurfaceObserver, load_cases) -> list[LoadResponse]:
+    """Evaluate a HarmonicResult on the observer: surface <v^2>, point <v^2>, receptances."""
+    f = result.frequencies
+    w2 = (2 * math.pi * f) ** 2
+    out = []
+    for j, lc in enumerate(load_cases):
+        ms = np.zeros(len(f))
+        pms = {N: np.zeros(len(f)) for N in observer.samples}
+        rec = np.zeros((len(load_cases), len(f)), dtype=complex)
+        for block in result.blocks[j]:
+            c = block.coeffs
+            r = block.reduced
+            ms[block.index] = np.real(np.einsum("kf,kl,lf->f", c.conj(), r.gram, c)) * w2[block.index] / observer.area
+            for N, P in r.points.items():
+                vals = P @ c
+                wts = observer.samples[N].weights
+                pms[N][block.index] = (wts @ np.abs(vals) ** 2) / wts.sum() * w2[block.index]
+            rec[:, block.index] = r.loads @ c
+        out.append(LoadResponse(lc.name, lc.kind, f, ms, pms, rec, lc.amplitude(f)))
+    return out
+
+
+def band_levels(freqs: np.ndarray, mean_square: np.ndarray, f_lo: float, f_hi: float, reference: float):
+    """1/3-octave band levels (dB) of a narrow-band mean-square spectrum: energy sum of the lines in each
+    band (IEC 61260 base-10 edges).  Returns (bands, levels); bands with no line get nan."""
+    bands = levels.third_octave_bands(f_lo, f_hi)
+    sums = levels.band_sum(freqs, mean_square, bands)
+    counts = levels.band_sum(freqs, np.ones_like(freqs), bands)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return bands, np.where(counts > 0, levels.level(sums, reference), np.nan)
+
+
+def transfer_band_levels(resp: LoadResponse, f_lo: float, f_hi: float):
+    """Band TF (dB): band L_v of the response minus band level of the load (both energy sums), so a
+    flat unit spectrum gives the band of the unit-load transfer function."""
+    f = resp.frequencies
+    bands, lv = band_levels(f, resp.mean_square_velocity * resp.amplitude**2, f_lo, f_hi, levels.V0)
+    _, lf = band_levels(f, resp.amplitude**2, f_lo, f_hi, 1.0)
+    return bands, lv, lv - lf

@@ -1,0 +1,212 @@
+"""Forced harmonic response: (K (1 + i eta) + i omega C - omega^2 M) u = f.
+
+Two solvers, one result type (`HarmonicResult`): for every load case, blocks of vectors Psi with
+coefficients c(omega), u(omega) = Psi c(omega).  The vectors go through a `reduce` function (surface
+Gram matrix, point values, load projections: see housingfe.response) as soon as they exist, so a long
+direct sweep never keeps its solution vectors.
+
+* direct: one sparse factorisation per frequency, in the real 2x2 block form
+  [[K_r, K_i], [K_i, -K_r]] [u_r; -u_i] = [f_r; f_i] with K_r = K - omega^2 M, K_i = eta K + omega C,
+  a symmetric indefinite system factorised by MUMPS (LDL^T).  It runs in the same real-PETSc process as
+  everything else (a complex PETSc build would need its own process, see docs/forced-response.md).
+* modal: superposition of the modes up to `basis_factor * f_max`, the rigid-body modes, and the
+  residual flexibility of all modes left out.  For a free-free structure K is singular, so the residual
+  uses the inertia-relief form: r = (K - s M)^-1 P f - sum_basis phi_n phi_n^T f / (omega_n^2 - s), with
+  P = I - M Phi_r Phi_r^T removing the rigid-body part of the load and a small negative shift s (the
+  residual of the truncated modes, exact up to s / omega_n^2 ~ 1e-4 relative).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+from petsc4py import PETSc
+
+from housingfe.errors import SolverError
+
+EtaFunction = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass
+class Damping:
+    """eta(f): hysteretic loss factor at the excitation frequency (Hz -> -); modal_ratio: viscous xi per
+    mode (modal solver; the direct solver applies eta = 2 xi); D: optional structural damping matrix
+    (per-material loss factors, K_eta = int eta sigma:eps) replacing eta(f) K."""
+
+    eta: EtaFunction
+    modal_ratio: float | None = None
+    D: PETSc.Mat | None = None
+
+    def hysteretic(self, f: np.ndarray) -> np.ndarray:
+        if self.modal_ratio is not None:
+            return np.full(np.shape(f), 2.0 * self.modal_ratio)
+        return self.eta(np.asarray(f, dtype=float))
+
+
+@dataclass
+class Block:
+    """Reduced vectors and their coefficients on the frequency indices `index`."""
+
+    reduced: object
+    coeffs: np.ndarray
+    index: np.ndarray
+
+
+@dataclass
+class HarmonicResult:
+    """blocks[j]: the blocks of load case j; together they cover every frequency once."""
+
+    frequencies: np.ndarray
+    blocks: list
+    solver: str
+    timings: dict = field(default_factory=dict)
+    modal_vectors: list | None = None   # Psi of each load case (modal solver), for deflection shapes
+
+
+# ------------------------------------------------------------------------------------------ modal
+def modal_superposition(K, M, modal_result, loads, frequencies, damping: Damping, reduce, *,
+                        residual: bool = True, shift: float | None = None) -> HarmonicResult:
+    """Modal superposition (+ residual flexibility) for every load case on `frequencies` (Hz)."""
+    t0 = time.perf_counter()
+    omega = 2 * math.pi * np.asarray(frequencies, dtype=float)
+    lam = modal_result.eigenvalues
+    n_rigid = modal_result.rigid_count
+    phis = modal_result.vectors
+    rigid, elastic = phis[:n_rigid], phis[n_rigid:]
+    lam_e = lam[n_rigid:]
+    eta = damping.hysteretic(frequencies)
+    if damping.D is not None and damping.modal_ratio is None:
+        eta_modal = np.array([phi.dot(_mult(damping.D, phi)) / l for phi, l in zip(elastic, lam_e)])
+        denominators = lam_e[:, None] * (1 + 1j * eta_modal[:, None]) - omega[None, :] ** 2
+    elif damping.modal_ratio is not None:
+        w_n = np.sqrt(lam_e)
+        denominators = (lam_e[:, None] - omega[None, :] ** 2
+                        + 2j * damping.modal_ratio * w_n[:, None] * omega[None, :])
+    else:
+        denominators = lam_e[:, None] * (1 + 1j * eta[None, :]) - omega[None, :] ** 2
+    _check_not_singular(denominators, lam_e, frequencies)
+
+    shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
+    ksp = _factor(_shifted(K, M, shift), "residual_") if residual else None
+    blocks, kept = [], []
+    every = np.arange(len(omega))
+    for load in loads:
+        f = load.vector
+        p_rigid = np.array([phi.dot(f) for phi in rigid])
+        p_el = np.array([phi.dot(f) for phi in elastic])
+        c = [p_rigid[:, None] / (-omega[None, :] ** 2), p_el[:, None] / denominators]
+        basis = list(rigid) + list(elastic)
+        if residual:
+            r = _residual_vector(ksp, M, f, rigid, elastic, lam_e, shift)
+            basis.append(r)
+            damp = 1.0 / (1 + 1j * eta) if damping.modal_ratio is None else np.ones_like(omega)
+            c.append(damp[None, :])
+        blocks.append([Block(reduce(basis), np.vstack(c), every)])
+        kept.append(basis)
+    if ksp is not None:
+        ksp.destroy()
+    return HarmonicResult(np.asarray(frequencies, float), blocks, "modal+residual" if residual else "modal",
+                          {"modal_superposition_s": time.perf_counter() - t0}, modal_vectors=kept)
+
+
+def _residual_vector(ksp, M, f, rigid, elastic, lam_e, shift) -> PETSc.Vec:
+    """Static response of the modes outside the basis to the rigid-body-free part of f."""
+    pf = f.copy()
+    for phi in rigid:                       # P f = f - M phi_r (phi_r^T f)
+        pf.axpy(-phi.dot(f), _mult(M, phi))
+    r = f.duplicate()
+    ksp.solve(pf, r)
+    for phi, lam in zip(elastic, lam_e):
+        r.axpy(-phi.dot(f) / (lam - shift), phi)
+    for phi in rigid:                       # keep r M-orthogonal to the rigid modes (round-off)
+        r.axpy(-phi.dot(_mult(M, r)), phi)
+    return r
+
+
+def _check_not_singular(denominators: np.ndarray, lam_e: np.ndarray, frequencies) -> None:
+    tiny = 1e-12 * np.abs(lam_e)[:, None]
+    hit = np.argwhere(np.abs(denominators) <= tiny)
+    if len(hit):
+        n, k = hit[0]
+        raise SolverError(f"undamped system driven exactly at an eigenfrequency ({frequencies[k]:.6g} Hz, "
+                          f"mode {n + 1}): the response is infinite; add damping or move the line")
+
+
+# ----------------------------------------------------------------------------------------- direct
+def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None) -> HarmonicResult:
+    """Direct solution per frequency in the real 2x2 block form (MUMPS LDL^T), all load cases per factor."""
+    t0 = time.perf_counter()
+    eta = damping.hysteretic(frequencies)
+    blocks = [[] for _ in loads]
+    t_factor = 0.0
+    pair = np.array([[1.0], [1j]])
+    for k, (f_hz, eta_f) in enumerate(zip(frequencies, eta)):
+        w = 2 * math.pi * f_hz
+        Kr = K.copy()
+        Kr.axpy(-w * w, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        if damping.D is not None and damping.modal_ratio is None:
+            Ki = damping.D.copy()
+        else:
+            Ki = K.copy()
+            Ki.scale(eta_f)
+        if C is not None:
+            Ki.axpy(w, C, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        mKr = Kr.copy()
+        mKr.scale(-1.0)
+        nest = PETSc.Mat().createNest([[Kr, Ki], [Ki, mKr]], comm=K.getComm())
+        row_is, _ = nest.getNestISs()
+        A = nest.convert("aij", PETSc.Mat())   # petsc4py converts in place unless given an output
+        A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        t1 = time.perf_counter()
+        ksp = _factor(A, "direct_")
+        try:
+            ksp.setUp()
+        except PETSc.Error as exc:
+            raise SolverError(f"direct solver: singular system at {f_hz:.6g} Hz (undamped resonance?)") from exc
+        t_factor += time.perf_counter() - t1
+        for j, load in enumerate(loads):
+            b, x = A.createVecRight(), A.createVecRight()
+            b.set(0.0)
+            sub = b.getSubVector(row_is[0])
+            load.vector.copy(sub)
+            b.restoreSubVector(row_is[0], sub)
+            ksp.solve(b, x)
+            ur = x.getSubVector(row_is[0]).copy()
+            ui = x.getSubVector(row_is[1]).copy()
+            ui.scale(-1.0)
+            blocks[j].append(Block(reduce([ur, ui]), pair, np.array([k])))
+        for m in (Kr, Ki, mKr, nest, A, ksp):
+            m.destroy()
+    n = len(frequencies)
+    return HarmonicResult(np.asarray(frequencies, float), blocks, "direct",
+                          {"direct_s": time.perf_counter() - t0, "direct_factor_s": t_factor,
+                           "direct_s_per_frequency": (time.perf_counter() - t0) / max(n, 1)})
+
+
+# ---------------------------------------------------------------------------------------- helpers
+def _shifted(K, M, shift: float) -> PETSc.Mat:
+    A = K.copy()
+    A.axpy(-shift, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+    A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    return A
+
+
+def _factor(A: PETSc.Mat, prefix: str) -> PETSc.KSP:
+    ksp = PETSc.KSP().create(A.getComm())
+    ksp.setOptionsPrefix(prefix)
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("cholesky")
+    pc.setFactorSolverType("mumps")
+    ksp.setFromOptions()
+    return ksp
+
+
+def _mult(A: PETSc.Mat, x: PETSc.Vec) -> PETSc.Vec:
+    y = A.createVecLeft()
+    A.mult(x, y)
+    return y
