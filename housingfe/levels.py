@@ -50,17 +50,17 @@ class Bands:
 
 
 def fractional_octave_bands(f_min: float, f_max: float, fraction: int = 3) -> Bands:
-    """IEC 61260-1 base-10 bands (1/fraction octave, fraction 1 or 3) whose exact centre lies in
-    [f_min, f_max] (Hz)."""
+    """IEC 61260-1 base-10 bands (1/fraction octave, fraction 1 or 3) whose nominal centre frequency lies
+    in [f_min, f_max] (Hz)."""
     if fraction not in (1, 3):
         raise ValueError("fraction must be 1 (octaves) or 3 (one-third octaves)")
-    x = np.arange(-40, 25)
+    x = np.arange(-40, 25) if fraction == 3 else np.arange(-14, 9)
     center = 1000.0 * _G ** (x / fraction)
-    keep = (center >= f_min * 0.999) & (center <= f_max * 1.001)
-    x, center = x[keep], center[keep]
-    half = _G ** (1.0 / (2 * fraction))
     nominal_table = np.array(NOMINAL_THIRD_OCTAVES, dtype=float)
     nominal = np.array([nominal_table[np.argmin(abs(np.log(nominal_table / c)))] for c in center])
+    keep = (nominal >= f_min * (1 - 1e-9)) & (nominal <= f_max * (1 + 1e-9))
+    half = _G ** (1.0 / (2 * fraction))
+    center, nominal = center[keep], nominal[keep]
     return Bands(nominal=nominal, center=center, lower=center / half, upper=center * half)
 
 

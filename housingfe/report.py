@@ -266,13 +266,10 @@ def harmonic_summary_text(forced) -> str:
 
 def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
     """frf.csv, bands.csv, receptance.csv, harmonic.json, TF plots, deflection shapes (XDMF)."""
-    import numpy as np
-
     if forced.spec.deflection_shapes_hz:
         write_deflection_shapes(folder / "deflection_shapes.xdmf", model, forced, comm)
     if comm.rank != 0:
         return
-    spec = forced.spec
     counts = sorted(forced.observer.samples)
     frf = []
     for s, resps in forced.responses.items():
@@ -309,8 +306,6 @@ def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
 
 
 def _db(ms):
-    import numpy as np
-
     from housingfe import levels
 
     return levels.level(np.asarray(ms), levels.V0)

@@ -140,11 +140,14 @@ def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | No
     """Direct solution per frequency in the real 2x2 block form (MUMPS LDL^T), all load cases per factor."""
     t0 = time.perf_counter()
     eta = damping.hysteretic(frequencies)
+    undamped = C is None and (damping.D is None or damping.modal_ratio is not None) and not np.any(eta)
     blocks = [[] for _ in loads]
     t_factor = 0.0
     pair = np.array([[1.0], [1j]])
     for k, (f_hz, eta_f) in enumerate(zip(frequencies, eta)):
         w = 2 * math.pi * f_hz
+        if undamped:
+            _check_undamped_line(K, M, w * w, f_hz)
         Kr = K.copy()
         Kr.axpy(-w * w, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
         if damping.D is not None and damping.modal_ratio is None:
@@ -184,6 +187,21 @@ def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | No
     return HarmonicResult(np.asarray(frequencies, float), blocks, "direct",
                           {"direct_s": time.perf_counter() - t0, "direct_factor_s": t_factor,
                            "direct_s_per_frequency": (time.perf_counter() - t0) / max(n, 1)})
+
+
+def _check_undamped_line(K, M, w2: float, f_hz: float, tol: float = 1e-9) -> None:
+    """Without damping, K - w^2 M is singular at an eigenfrequency: detect an eigenvalue within a relative
+    `tol` of w^2 by two inertia counts (Sylvester) instead of returning a silent inf/nan."""
+    from housingfe.solvers.modal import count_eigenvalues_below
+
+    try:
+        below = count_eigenvalues_below(K, M, w2 * (1 - tol))
+        above = count_eigenvalues_below(K, M, w2 * (1 + tol))
+    except SolverError:
+        below, above = 0, 1
+    if above != below:
+        raise SolverError(f"undamped system driven exactly at an eigenfrequency ({f_hz:.6g} Hz): the response "
+                          "is infinite; add damping or move the line")
 
 
 # ---------------------------------------------------------------------------------------- helpers

@@ -83,7 +83,7 @@ def count_eigenvalues_below(K: PETSc.Mat, M: PETSc.Mat, sigma: float) -> int:
     ksp.destroy()
     A.destroy()
     if nzero:
-        raise SolverError(f"K - sigma M is singular at f_max (an eigenvalue sits exactly at f_max); "
+        raise SolverError("K - sigma M is singular at f_max (an eigenvalue sits exactly at f_max); "
                           "move f_max slightly")
     return int(nneg)
 
