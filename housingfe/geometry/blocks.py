@@ -22,6 +22,24 @@ TET_ALGORITHM = 10
 FaceClassifier = Callable[[np.ndarray, np.ndarray], Sequence[str]]
 
 
+@dataclass(frozen=True)
+class Bore:
+    """A round hole along a coordinate axis, cut out of the blocks (all lengths in m).
+
+    name: the surface group of the bore face; groups: further surface groups it belongs to.
+    centre: a point on the axis; axis: 0, 1 or 2 (x, y, z); radius; span: (start, end) along the axis,
+    overshooting the material it cuts (OCC booleans dislike coplanar faces).
+    The disc of the bore must lie inside material cells wherever the axis runs through material (checked).
+    """
+
+    name: str
+    centre: tuple[float, float, float]
+    axis: int
+    radius: float
+    span: tuple[float, float]
+    groups: tuple[str, ...] = ()
+
+
 @dataclass
 class BlockModel:
     """A solid made of grid cells.
@@ -31,6 +49,7 @@ class BlockModel:
     classify_face: names of the surface groups of a boundary face (see FaceClassifier).
     thin_dimensions: lengths (m) treated as wall thicknesses: curves that short get `layers` elements.
     points: named reference points (m), e.g. bolt centres, kept as metadata.
+    bores: round holes cut out of the blocks (tetrahedral meshes only).
     """
 
     grid: tuple[np.ndarray, np.ndarray, np.ndarray]
@@ -38,9 +57,21 @@ class BlockModel:
     classify_face: FaceClassifier
     thin_dimensions: tuple[float, ...] = ()
     points: dict[str, list[tuple[float, float, float]]] = field(default_factory=dict)
+    bores: tuple[Bore, ...] = ()
+    # tetrahedral meshes: build the solid from maximal boxes of same-feature cells instead of one box per
+    # cell (far fewer OCC booleans; the mesh no longer follows every grid plane, which tets need not)
+    merge_for_tets: bool = False
+    # plane coordinates (per axis) that merged boxes must not straddle: the edges of tagged patches
+    merge_barriers: tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]] = ((), (), ())
 
     def contains(self, point) -> bool:
-        """True if the point (m) lies strictly inside a material cell."""
+        """True if the point (m) lies strictly inside the material (inside a cell, outside every bore)."""
+        if not self.in_cells(point):
+            return False
+        return not any(_in_bore(b, point) for b in self.bores)
+
+    def in_cells(self, point) -> bool:
+        """True if the point (m) lies strictly inside a material cell (bores ignored)."""
         index = []
         for axis, planes in enumerate(self.grid):
             i = int(np.searchsorted(planes, point[axis])) - 1
@@ -50,13 +81,15 @@ class BlockModel:
         return tuple(index) in self.cells
 
     def volume(self) -> float:
-        """Exact volume (m^3) of the material cells."""
-        gx, gy, gz = self.grid
-        return float(sum((gx[i + 1] - gx[i]) * (gy[j + 1] - gy[j]) * (gz[k + 1] - gz[k])
-                         for i, j, k in self.cells))
+        """Exact volume (m^3) of the material: cells minus bores."""
+        return self._volume_and_moment()[0]
 
     def centroid(self) -> np.ndarray:
-        """Exact centroid (m) of the material cells."""
+        """Exact centroid (m) of the material: cells minus bores."""
+        total, moment = self._volume_and_moment()
+        return moment / total
+
+    def _volume_and_moment(self) -> tuple[float, np.ndarray]:
         gx, gy, gz = self.grid
         total, moment = 0.0, np.zeros(3)
         for i, j, k in self.cells:
@@ -64,7 +97,56 @@ class BlockModel:
             c = np.array([gx[i] + gx[i + 1], gy[j] + gy[j + 1], gz[k] + gz[k + 1]]) / 2
             total += v
             moment += v * c
-        return moment / total
+        for bore in self.bores:
+            for start, end in self.bore_segments(bore):
+                v = math.pi * bore.radius**2 * (end - start)
+                c = np.array(bore.centre, dtype=float)
+                c[bore.axis] = (start + end) / 2
+                total -= v
+                moment -= v * c
+        return total, moment
+
+    def bore_segments(self, bore: Bore) -> list[tuple[float, float]]:
+        """Intervals (m, along the bore axis) where the bore runs through material.  Raises ValueError if
+        the bore's disc is not wholly inside material cells there (the exact volume would be wrong and the
+        bore would break out of the part)."""
+        planes = self.grid[bore.axis]
+        cuts = [p for p in planes if bore.span[0] < p < bore.span[1]]
+        stations = [bore.span[0], *cuts, bore.span[1]]
+        segments: list[tuple[float, float]] = []
+        for a, b in zip(stations[:-1], stations[1:]):
+            mid = np.array(bore.centre, dtype=float)
+            mid[bore.axis] = (a + b) / 2
+            if not self.in_cells(mid):
+                continue
+            if not all(self.in_cells(p) for p in _disc_rim(bore, mid)):
+                raise ValueError(f"bore {bore.name}: the disc of radius {bore.radius} m breaks out of the "
+                                 f"material near {np.round(mid, 4).tolist()}")
+            if segments and abs(segments[-1][1] - a) < 1e-12:
+                segments[-1] = (segments[-1][0], b)
+            else:
+                segments.append((a, b))
+        return segments
+
+
+def _in_bore(bore: Bore, point) -> bool:
+    p = np.asarray(point, dtype=float) - np.asarray(bore.centre, dtype=float)
+    if not bore.span[0] < point[bore.axis] < bore.span[1]:
+        return False
+    p[bore.axis] = 0.0
+    return float(np.linalg.norm(p)) < bore.radius
+
+
+def _disc_rim(bore: Bore, centre: np.ndarray, n: int = 36, margin: float = 1.0 + 1e-6) -> list[np.ndarray]:
+    """Points just outside the rim of the bore's disc at `centre`."""
+    a, b = [ax for ax in range(3) if ax != bore.axis]
+    out = []
+    for phi in np.linspace(0.0, 2 * math.pi, n, endpoint=False):
+        p = centre.copy()
+        p[a] += margin * bore.radius * math.cos(phi)
+        p[b] += margin * bore.radius * math.sin(phi)
+        out.append(p)
+    return out
 
 
 def unique_planes(values: Sequence[float], tol: float = 1e-9) -> np.ndarray:
@@ -109,11 +191,27 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) 
     import gmsh
 
     occ = gmsh.model.occ
+    if model.bores and element != "tet":
+        from housingfe.errors import InputError
+
+        raise InputError("mesh.element: a geometry with round bores needs element = \"tet\"")
+    for bore in model.bores:
+        model.bore_segments(bore)  # raises if a bore breaks out of the material
     gx, gy, gz = model.grid
-    keys = sorted(model.cells)
-    tags = []
-    for i, j, k in keys:
-        tags.append(occ.addBox(gx[i], gy[j], gz[k], gx[i + 1] - gx[i], gy[j + 1] - gy[j], gz[k + 1] - gz[k]))
+    if element == "tet" and model.merge_for_tets:
+        boxes = merged_boxes(model.cells, _barrier_indices(model))
+    else:
+        boxes = [((i, j, k), (i + 1, j + 1, k + 1), model.cells[(i, j, k)]) for i, j, k in sorted(model.cells)]
+    tags, owners = [], []
+    for (i0, j0, k0), (i1, j1, k1), name in boxes:
+        lo = (gx[i0], gy[j0], gz[k0])
+        hi = (gx[i1], gy[j1], gz[k1])
+        block = occ.addBox(*lo, hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2])
+        # bores are cut block by block before the fragment, so the fragment's map still says which feature
+        # every volume belongs to
+        for piece in _cut_bores(block, lo, hi, model.bores):
+            tags.append(piece)
+            owners.append(name)
     if len(tags) > 1:
         _, out_map = occ.fragment([(3, t) for t in tags[:1]], [(3, t) for t in tags[1:]])
     else:
@@ -121,9 +219,9 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) 
     occ.synchronize()
     # out_map[n] lists the volumes that input n became; blocks never overlap, so each maps to one volume.
     feature_volumes: dict[str, list[int]] = {}
-    for key, pieces in zip(keys, out_map):
+    for owner, pieces in zip(owners, out_map):
         for dim, tag in pieces:
-            feature_volumes.setdefault(model.cells[key], []).append(tag)
+            feature_volumes.setdefault(owner, []).append(tag)
 
     cell_groups = {}
     for n, name in enumerate(sorted(feature_volumes), start=1):
@@ -146,6 +244,72 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) 
     return {"cells": cell_groups, "facets": facet_groups}
 
 
+def _barrier_indices(model: BlockModel) -> tuple[set[int], set[int], set[int]]:
+    """Grid plane indices of the merge barriers."""
+    out = []
+    for planes, barrier in zip(model.grid, model.merge_barriers):
+        out.append({int(np.argmin(np.abs(planes - c))) for c in barrier})
+    return tuple(out)
+
+
+def merged_boxes(cells: dict[tuple[int, int, int], str],
+                 barriers: tuple[set[int], set[int], set[int]] = (set(), set(), set())) -> list[tuple[tuple, tuple, str]]:
+    """Cover the cells by few boxes of one feature each: (lo index, hi index (exclusive), name).  Greedy:
+    grow a run along x, then the run's rectangle along y, then along z, over unclaimed cells of the same
+    feature, never across a barrier plane (given by grid plane index per axis)."""
+    free = dict(cells)
+    out = []
+    for start in sorted(cells):
+        if start not in free:
+            continue
+        name = free[start]
+        i0, j0, k0 = start
+
+        def all_free(i_range, j_range, k_range):
+            return all(free.get((i, j, k)) == name for i in i_range for j in j_range for k in k_range)
+
+        bi, bj, bk = barriers
+        i1 = i0 + 1
+        while i1 not in bi and all_free([i1], [j0], [k0]):
+            i1 += 1
+        j1 = j0 + 1
+        while j1 not in bj and all_free(range(i0, i1), [j1], [k0]):
+            j1 += 1
+        k1 = k0 + 1
+        while k1 not in bk and all_free(range(i0, i1), range(j0, j1), [k1]):
+            k1 += 1
+        for i in range(i0, i1):
+            for j in range(j0, j1):
+                for k in range(k0, k1):
+                    del free[(i, j, k)]
+        out.append(((i0, j0, k0), (i1, j1, k1), name))
+    return out
+
+
+def _cut_bores(block: int, lo, hi, bores: Sequence[Bore]) -> list[int]:
+    """Volume tags of a box block after cutting the bores that cross it (the block itself if none)."""
+    import gmsh
+
+    occ = gmsh.model.occ
+    pieces = [block]
+    for bore in bores:
+        a, b = [ax for ax in range(3) if ax != bore.axis]
+        # nearest point of the block's cross-section rectangle to the bore axis
+        da = max(lo[a] - bore.centre[a], 0.0, bore.centre[a] - hi[a])
+        db = max(lo[b] - bore.centre[b], 0.0, bore.centre[b] - hi[b])
+        overlaps_axially = bore.span[0] < hi[bore.axis] and bore.span[1] > lo[bore.axis]
+        if math.hypot(da, db) >= bore.radius - 1e-12 or not overlaps_axially:
+            continue
+        base = list(bore.centre)
+        base[bore.axis] = bore.span[0]
+        direction = [0.0, 0.0, 0.0]
+        direction[bore.axis] = bore.span[1] - bore.span[0]
+        cylinder = occ.addCylinder(*base, *direction, bore.radius)
+        out, _ = occ.cut([(3, t) for t in pieces], [(3, cylinder)], removeObject=True, removeTool=True)
+        pieces = [t for d, t in out if d == 3]
+    return pieces
+
+
 def _classify_boundary(model: BlockModel) -> dict[str, list[int]]:
     """Physical surface groups.  A dolfinx facet tag holds one value per facet, so each face gets one
     atomic group named by all its names ("outer/outer_top"); every name maps to the union of the
@@ -155,8 +319,11 @@ def _classify_boundary(model: BlockModel) -> dict[str, list[int]]:
     boundary = gmsh.model.getBoundary(gmsh.model.getEntities(3), combined=True, oriented=False)
     atomic: dict[tuple[str, ...], list[int]] = {}
     for dim, tag in boundary:
-        centre = np.array(gmsh.model.occ.getCenterOfMass(2, abs(tag)))
-        names = tuple(model.classify_face(centre, _outward_normal(abs(tag), centre, model)))
+        if gmsh.model.getType(2, abs(tag)) != "Plane":
+            names = _bore_of_face(abs(tag), model)
+        else:
+            centre = np.array(gmsh.model.occ.getCenterOfMass(2, abs(tag)))
+            names = tuple(model.classify_face(centre, _outward_normal(abs(tag), centre, model)))
         atomic.setdefault(names, []).append(abs(tag))
     facet_groups: dict[str, list[int]] = {}
     for n, names in enumerate(sorted(atomic), start=1):
@@ -167,15 +334,31 @@ def _classify_boundary(model: BlockModel) -> dict[str, list[int]]:
     return facet_groups
 
 
+def _bore_of_face(face: int, model: BlockModel) -> tuple[str, ...]:
+    """Surface names of a curved boundary face: the bore whose cylinder it lies on."""
+    import gmsh
+
+    umin, umax = gmsh.model.getParametrizationBounds(2, face)
+    point = np.array(gmsh.model.getValue(2, face, [(umin[0] + umax[0]) / 2, (umin[1] + umax[1]) / 2]))
+    for bore in model.bores:
+        r = point - np.asarray(bore.centre)
+        r[bore.axis] = 0.0
+        along = bore.span[0] <= point[bore.axis] <= bore.span[1]
+        if along and abs(np.linalg.norm(r) - bore.radius) < 1e-6 * max(1.0, bore.radius):
+            return (bore.name, *bore.groups)
+    raise ValueError(f"curved face {face} near {np.round(point, 4).tolist()} lies on no bore")
+
+
 def _outward_normal(face: int, centre: np.ndarray, model: BlockModel) -> np.ndarray:
-    """Outward normal of an axis-aligned boundary face: the axis direction pointing out of the solid."""
+    """Outward normal of an axis-aligned boundary face: the axis direction pointing out of the solid.
+    Tested against the cells only: the centre of mass of a face with a bore hole may lie in the hole."""
     import gmsh
 
     xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(2, face)
     axis = int(np.argmin([xmax - xmin, ymax - ymin, zmax - zmin]))
     normal = np.zeros(3)
     normal[axis] = 1.0
-    return -normal if model.contains(centre + 1e-7 * normal) else normal
+    return -normal if model.in_cells(centre + 1e-7 * normal) else normal
 
 
 def _set_mesh_options(element: str) -> None:

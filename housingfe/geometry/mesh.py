@@ -64,6 +64,17 @@ def block_model_for(geometry) -> BlockModel:
                          geometry.flange_thickness, geometry.flange_width, geometry.bolt_patch_size)
     if geometry.kind == "plate":
         return plate_model(geometry.a, geometry.b, geometry.h)
+    if geometry.kind == "box-halves":
+        from housingfe.geometry.housings import box_halves_model
+
+        return box_halves_model(geometry.length, geometry.width, geometry.height, geometry.wall_thickness,
+                                geometry.flange_thickness, geometry.flange_width, geometry.bolt_patch_size,
+                                geometry.joint, geometry.joint_thickness, geometry.bearing_point_offset,
+                                geometry.bearing_point_size)
+    if geometry.kind == "gearbox":
+        from housingfe.geometry.housings import gearbox_model
+
+        return gearbox_model(geometry)
     raise InputError(f"geometry.kind: no builder for {geometry.kind!r}")
 
 

@@ -4,7 +4,7 @@ Each geometry kind has a spec here and a block-model builder registered in housi
 """
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal, Optional, Union
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, model_validator
 
@@ -65,7 +65,127 @@ class PlateGeometry(_Strict):
         return self.h
 
 
+class BoxHalvesGeometry(BoxGeometry):
+    """Two Sec. 4.2 boxes joined at their flanges (Sec. 4.4), lengths in m.
+
+    joint "monolithic" welds the flanges into one plate (the thesis' model); "layer" puts a joint layer of
+    joint_thickness (cell group "joint"; give it a material in [regions.joint]) between them, taken half from
+    each flange.  bearing_point_offset: the Sec. 4.4 bearing-like point lies this far outside the mid-plane
+    of the front plate on the joint (15 mm in the thesis)."""
+
+    kind: Literal["box-halves"]
+    joint: Literal["monolithic", "layer"] = "monolithic"
+    joint_thickness: PositiveFloat = 0.15e-3
+    bearing_point_offset: PositiveFloat = 0.015
+    bearing_point_size: PositiveFloat = 0.010
+
+    @model_validator(mode="after")
+    def _joint_fits(self):
+        if self.joint == "layer" and self.joint_thickness >= self.flange_thickness:
+            raise ValueError("joint_thickness: must be thinner than flange_thickness (half is taken from each)")
+        inner_edge = self.wall_thickness / 2 + self.bearing_point_offset - self.bearing_point_size / 2
+        if inner_edge <= self.wall_thickness:
+            raise ValueError("bearing_point_offset: the bearing point patch overlaps the front plate")
+        if self.bearing_point_offset + self.bearing_point_size / 2 > self.flange_width:
+            raise ValueError("bearing_point_offset: the bearing point patch runs off the flange")
+        return self
+
+
+class BearingPlateSpec(_Strict):
+    """The thick front/back plate carrying the bearing bores (m): flush with the inner wall face, standing
+    out by thickness - wall_thickness; `width` along x from x_start (measured from the housing end at
+    -length/2); it reaches `below` under and `above` over the split plane."""
+
+    thickness: PositiveFloat
+    width: PositiveFloat
+    below: PositiveFloat
+    above: PositiveFloat
+    x_start: float = Field(0.0, ge=0.0)
+
+
+class BoreSpec(_Strict):
+    """A bearing bore through both bearing plates (m): axis along y at x (from the housing centre) on the
+    split plane; `bearing` names the bearing whose outer ring it takes (metadata)."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_]+$")
+    bearing: str = ""
+    x: float
+    diameter: PositiveFloat
+
+
+class RimSpec(_Strict):
+    """Solid rim around the outside of the walls at the split (m): width outward x height."""
+
+    width: PositiveFloat
+    height: PositiveFloat
+
+
+class FeetSpec(_Strict):
+    """Two feet along the bottom of the front and back walls (m): inner edge flush with the inner wall
+    face, `width` across, `thickness` high, the full housing length.  on_base: the feet rest on a base,
+    so their underside does not radiate (supports are set in the scene)."""
+
+    width: PositiveFloat
+    thickness: PositiveFloat
+    on_base: bool = False
+    bolts_per_foot: int = Field(3, ge=1, le=12)
+    bolt_patch_size: PositiveFloat = 0.024
+
+
+class GearboxGeometry(_Strict):
+    """A welded gearbox housing without bottom plate (Sec. 4.5 model, Ch. 5 test gearbox), lengths in m.
+
+    length (x), width (y, along the shafts) and height (z, from the feet underside to the top) are outer
+    wall dimensions; split_height is the plane of the bearing centres (the split of a bolted housing)."""
+
+    kind: Literal["gearbox"]
+    length: PositiveFloat
+    width: PositiveFloat
+    height: PositiveFloat
+    wall_thickness: PositiveFloat
+    split_height: PositiveFloat
+    bearing_plate: BearingPlateSpec
+    bores: list[BoreSpec] = []
+    rim: Optional[RimSpec] = None
+    feet: Optional[FeetSpec] = None
+    excitation_patch_size: PositiveFloat = 0.010
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        t, bp = self.wall_thickness, self.bearing_plate
+        if 2 * t >= min(self.length, self.width):
+            raise ValueError("wall_thickness: walls thicker than half the length/width leave no housing")
+        if not t < self.split_height < self.height - t:
+            raise ValueError("split_height: must lie between the bottom and the top plate")
+        if bp.thickness <= t:
+            raise ValueError("bearing_plate.thickness: must exceed wall_thickness")
+        if bp.x_start + bp.width > self.length + 1e-12:
+            raise ValueError("bearing_plate.width: x_start + width exceeds the housing length")
+        if self.split_height - bp.below <= (self.feet.thickness if self.feet else 0.0):
+            raise ValueError("bearing_plate.below: reaches down into the feet / below the housing")
+        if self.split_height + bp.above >= self.height - t:
+            raise ValueError("bearing_plate.above: reaches up into the top plate")
+        names = [b.name for b in self.bores]
+        if len(set(names)) != len(names):
+            raise ValueError("bores: bore names must be unique")
+        from housingfe.geometry.housings import bore_ligaments
+
+        for name, gap in bore_ligaments(self).items():
+            # a ligament thinner than the wall would be a sliver of material: bad geometry, bad tets
+            if gap < t:
+                raise ValueError(f"bores: bore {name!r} leaves a ligament of {gap * 1e3:.1f} mm to the bearing "
+                                 f"plate edge or the next bore (less than wall_thickness)")
+        if self.rim is not None and self.rim.height >= bp.below + bp.above:
+            raise ValueError("rim.height: taller than the bearing plate")
+        return self
+
+    @property
+    def min_thickness(self) -> float:
+        return self.wall_thickness
+
+
 # A new geometry kind: add its spec to this union and its builder to housingfe.geometry.mesh.block_model_for.
-Geometry = Annotated[Union[BoxGeometry, PlateGeometry], Field(discriminator="kind")]
+Geometry = Annotated[Union[BoxGeometry, PlateGeometry, BoxHalvesGeometry, GearboxGeometry],
+                     Field(discriminator="kind")]
 
 
