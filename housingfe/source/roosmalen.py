@@ -231,8 +231,10 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
         rows_spec += [[rpm, float(f), float(L)] for f, L in zip(lv["f"], lv["L_omega"])]
         rows_band += [[rpm, float(n), float(cc), float(L)] for n, cc, L in
                       zip(lv["band_nominal"], lv["band_center"], lv["band_L_omega"])]
-        ax.step(lv["band_center"], lv["band_L_omega"], where="mid", label=f"{rpm:g} rpm (1/3 oct.)")
-        ax.plot(lv["f"], lv["L_omega"], ".", ms=3)
+        filled = np.isfinite(lv["band_L_omega"])            # bands without a harmonic line stay empty
+        line, = ax.step(lv["band_center"][filled], lv["band_L_omega"][filled], where="mid",
+                        label=f"{rpm:g} rpm: 1/3 octaves (lines: narrow band)")
+        ax.plot(lv["f"], lv["L_omega"], ".", ms=4, color=line.get_color())
     write_csv(out_dir / "L_omega_narrowband.csv", ["speed_rpm", "frequency_hz", "L_omega_dB"], rows_spec)
     write_csv(out_dir / "L_omega_third_octave.csv", ["speed_rpm", "band_nominal_hz", "band_center_hz",
                                                      "L_omega_dB"], rows_band)
