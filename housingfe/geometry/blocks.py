@@ -172,11 +172,12 @@ def cells_where(grid, predicate: Callable[[float, float, float], str | None]) ->
 
 
 def divisions(length: float, size: float, thin: Sequence[float], layers: int) -> int:
-    """Number of elements along an edge of `length` (m) for target element size `size` (m); edges as
-    short as a wall thickness get `layers` elements."""
-    if any(abs(length - t) < 1e-9 for t in thin) or length < 0.999 * min(thin, default=0.0):
-        return max(layers, math.ceil(length / size - 1e-9))
-    return max(1, math.ceil(length / size - 1e-9))
+    """Number of elements along an edge of `length` (m) for target element size `size` (m); edges no longer
+    than a wall thickness get at least `layers` elements.  (gmsh bounding boxes carry ~1e-7 m of
+    tolerance, hence the 1 um slack.)"""
+    if length <= max(thin, default=0.0) + 1e-6:
+        return max(layers, math.ceil(length / size - 1e-6))
+    return max(1, math.ceil(length / size - 1e-6))
 
 
 def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) -> dict[str, dict[str, int]]:
