@@ -61,8 +61,9 @@ class BlockModel:
     # tetrahedral meshes: build the solid from maximal boxes of same-feature cells instead of one box per
     # cell (far fewer OCC booleans; the mesh no longer follows every grid plane, which tets need not)
     merge_for_tets: bool = False
-    # plane coordinates (per axis) that merged boxes must not straddle: the edges of tagged patches
-    merge_barriers: tuple[tuple[float, ...], tuple[float, ...], tuple[float, ...]] = ((), (), ())
+    # cells merge only with cells of the same feature and the same key here (e.g. the patches they carry,
+    # so that a patch keeps its own faces); missing cells have key None
+    merge_keys: dict[tuple[int, int, int], object] = field(default_factory=dict)
 
     def contains(self, point) -> bool:
         """True if the point (m) lies strictly inside the material (inside a cell, outside every bore)."""
@@ -200,7 +201,7 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) 
         model.bore_segments(bore)  # raises if a bore breaks out of the material
     gx, gy, gz = model.grid
     if element == "tet" and model.merge_for_tets:
-        boxes = merged_boxes(model.cells, _barrier_indices(model))
+        boxes = merged_boxes(model.cells, model.merge_keys)
     else:
         boxes = [((i, j, k), (i + 1, j + 1, k + 1), model.cells[(i, j, k)]) for i, j, k in sorted(model.cells)]
     tags, owners = [], []
@@ -245,20 +246,13 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int) 
     return {"cells": cell_groups, "facets": facet_groups}
 
 
-def _barrier_indices(model: BlockModel) -> tuple[set[int], set[int], set[int]]:
-    """Grid plane indices of the merge barriers."""
-    out = []
-    for planes, barrier in zip(model.grid, model.merge_barriers):
-        out.append({int(np.argmin(np.abs(planes - c))) for c in barrier})
-    return tuple(out)
-
-
 def merged_boxes(cells: dict[tuple[int, int, int], str],
-                 barriers: tuple[set[int], set[int], set[int]] = (set(), set(), set())) -> list[tuple[tuple, tuple, str]]:
+                 keys: dict | None = None) -> list[tuple[tuple, tuple, str]]:
     """Cover the cells by few boxes of one feature each: (lo index, hi index (exclusive), name).  Greedy:
     grow a run along x, then the run's rectangle along y, then along z, over unclaimed cells of the same
-    feature, never across a barrier plane (given by grid plane index per axis)."""
-    free = dict(cells)
+    feature and the same merge key."""
+    keys = keys or {}
+    free = {c: (name, keys.get(c)) for c, name in cells.items()}
     out = []
     for start in sorted(cells):
         if start not in free:
@@ -269,21 +263,20 @@ def merged_boxes(cells: dict[tuple[int, int, int], str],
         def all_free(i_range, j_range, k_range):
             return all(free.get((i, j, k)) == name for i in i_range for j in j_range for k in k_range)
 
-        bi, bj, bk = barriers
         i1 = i0 + 1
-        while i1 not in bi and all_free([i1], [j0], [k0]):
+        while all_free([i1], [j0], [k0]):
             i1 += 1
         j1 = j0 + 1
-        while j1 not in bj and all_free(range(i0, i1), [j1], [k0]):
+        while all_free(range(i0, i1), [j1], [k0]):
             j1 += 1
         k1 = k0 + 1
-        while k1 not in bk and all_free(range(i0, i1), range(j0, j1), [k1]):
+        while all_free(range(i0, i1), range(j0, j1), [k1]):
             k1 += 1
         for i in range(i0, i1):
             for j in range(j0, j1):
                 for k in range(k0, k1):
                     del free[(i, j, k)]
-        out.append(((i0, j0, k0), (i1, j1, k1), name))
+        out.append(((i0, j0, k0), (i1, j1, k1), name[0]))
     return out
 
 

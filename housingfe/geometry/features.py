@@ -146,9 +146,24 @@ def assemble(parts: Sequence[Part], cavities: Sequence[Part] = (), patches: Sequ
                 names += [patch.name, *patch.groups]
         return list(dict.fromkeys(names))
 
-    # merged tet blocks must keep every patch edge, or a patch would vanish inside a larger face
-    barriers = tuple(tuple(sorted({c for p in patches for c in (p.lo[a], p.hi[a]) if p.lo[a] != p.hi[a]}))
-                     for a in range(3))
     return BlockModel(grid=grid, cells=cells, classify_face=classify, thin_dimensions=tuple(sorted(set(thin))),
                       points=dict(points or {}), bores=tuple(bores), merge_for_tets=True,
-                      merge_barriers=barriers)
+                      merge_keys=_patch_keys(grid, cells, patches))
+
+
+def _patch_keys(grid, cells: dict, patches: Sequence[Patch]) -> dict:
+    """For merged tet blocks: the patches each cell touches, so that a cell under a patch never merges with
+    one outside it (the patch would vanish inside a larger face).  Only the cells at a patch are split:
+    a patch edge does not cut the rest of the housing into slivers."""
+    keys: dict = {}
+    for n, patch in enumerate(patches):
+        axis = int(np.argmax(np.abs(patch.normal)))
+        for key in cells:
+            lo = [grid[a][key[a]] for a in range(3)]
+            hi = [grid[a][key[a] + 1] for a in range(3)]
+            touches = all(lo[a] < patch.hi[a] - 1e-12 and hi[a] > patch.lo[a] + 1e-12
+                          for a in range(3) if a != axis)
+            side = hi[axis] if patch.normal[axis] > 0 else lo[axis]
+            if touches and abs(side - patch.lo[axis]) < 1e-12:
+                keys[key] = keys.get(key, ()) + (n,)
+    return keys
