@@ -53,7 +53,7 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
         modal[summary["scene"]] = summary
         rows += summary.get("published", [])
         rows += scene_rows(summary["scene"], summary)
-    rows += geometry_rows(names)
+    rows += geometry_rows(names if scenes else list(APPENDIX_E))
     rows += joint_rows(modal)
     if not scenes:
         rows += provider_rows()
@@ -169,7 +169,7 @@ def geometry_rows(names: list[str]) -> list[dict]:
     out = []
     for name in names:
         scene, _ = load_housing_scene(name)
-        table_name = next((t for s, t in APPENDIX_E.items() if scene.scene.name.startswith(s)), None)
+        table_name = APPENDIX_E.get(scene.scene.name)
         if table_name is None or scene.geometry.kind != "gearbox":
             continue
         table = thesis()["radiation"][table_name]
