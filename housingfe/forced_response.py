@@ -22,6 +22,7 @@ class ForcedResult:
     results: dict
     timings: dict = field(default_factory=dict)
     facts: dict = field(default_factory=dict)
+    sound_power: list | None = None
 
 
 def damping_model(scene, model) -> harmonic.Damping:
@@ -75,7 +76,12 @@ def run(model, spec) -> ForcedResult:
     scene = model.scene
     t0 = time.perf_counter()
     loads = [assemble_load(load, model.housing, model.V, model.bcs) for load in scene.loads]
-    observer = SurfaceObserver(model, spec.surface, spec.sample_points, loads)
+    extra, plate_ids = {}, None
+    if scene.radiation is not None and scene.radiation.model == "numerical":
+        from housingfe.radiation.housing import RADIATION_POINTS, radiation_points
+
+        extra[RADIATION_POINTS], plate_ids = radiation_points(model, scene.radiation)
+    observer = SurfaceObserver(model, spec.surface, spec.sample_points, loads, extra)
     damping = damping_model(scene, model)
     freqs = spec.frequencies
     timings = {"loads_and_observer_s": time.perf_counter() - t0}
@@ -101,7 +107,14 @@ def run(model, spec) -> ForcedResult:
             name = "direct"
         timings[f"{name}_s"] = time.perf_counter() - t1
         results[name], resp[name] = result, responses(result, observer, loads)
-    return ForcedResult(spec, loads, resp, observer, results, timings, facts)
+    forced = ForcedResult(spec, loads, resp, observer, results, timings, facts)
+    if scene.radiation is not None:
+        from housingfe.radiation.housing import sound_power
+
+        t1 = time.perf_counter()
+        forced.sound_power = sound_power(forced, model, plate_ids)
+        timings["radiation_s"] = time.perf_counter() - t1
+    return forced
 
 
 def deflection_shape(result: ForcedResult, load_index: int, frequency: float):

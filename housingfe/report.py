@@ -303,6 +303,8 @@ def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
     (folder / "summary_forced.txt").write_text(harmonic_summary_text(forced) + "\n")
     if model.scene.output.pictures:
         plot_transfer_functions(folder / "tf_bands.png", forced, rows, solvers)
+    if forced.sound_power:
+        write_sound_power(folder, forced, model.scene.output.pictures)
 
 
 def _db(ms):
@@ -374,3 +376,58 @@ def write_deflection_shapes(path: Path, model, forced, comm) -> None:
                 step += 1
                 xdmf.write_function(re, float(step))
                 xdmf.write_function(im, float(step))
+
+
+# ------------------------------------------------------------------------------------------ sound power
+def sound_power_rows(forced) -> list:
+    """Rows of sound_power.csv: per load case, every line and every 1/3-octave band (and the totals)."""
+    from housingfe import levels
+    from housingfe.response import band_levels
+
+    rows = []
+    solver = next(iter(forced.responses))
+    for sp, resp in zip(forced.sound_power, forced.responses[solver]):
+        s = sp.spectrum
+        LS = 10 * np.log10(forced.observer.area)
+        for k, f in enumerate(s.frequencies_hz):
+            rows.append([sp.load_case, sp.model, "line", f, resp.velocity_level_db[k], sp.radiation_index_db[k],
+                         s.L_W_db[k], s.L_W_db[k] + float(levels.a_weighting_db(f))])
+        _, Lv_band = band_levels(resp.frequencies, resp.mean_square_velocity * resp.amplitude**2,
+                                 s.bands.nominal.min(), s.bands.nominal.max(), levels.V0)
+        for b, fc in enumerate(s.bands.center):
+            rows.append([sp.load_case, sp.model, "band", s.bands.nominal[b], Lv_band[b],
+                         s.band_L_W_db[b] - Lv_band[b] - LS, s.band_L_W_db[b], s.band_L_WA_db[b]])
+        rows.append([sp.load_case, sp.model, "total", "", "", "", s.total_L_W_db, s.total_L_WA_db])
+    return rows
+
+
+def write_sound_power(folder: Path, forced, pictures: bool) -> None:
+    """sound_power.csv and, with pictures, sound_power.png (L_sigma over frequency and L_W per band)."""
+    rows = sound_power_rows(forced)
+    write_csv(folder / "sound_power.csv", ["load_case", "model", "kind", "band_center_hz", "Lv_dB",
+                                          "Lsigma_dB", "Lw_dB", "LwA_dB"], rows)
+    if not pictures:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4))
+    for sp in forced.sound_power:
+        a1.semilogx(sp.spectrum.frequencies_hz, sp.radiation_index_db, lw=0.8, label=f"{sp.load_case} ({sp.model})")
+        a2.plot(np.arange(len(sp.spectrum.bands.nominal)), sp.spectrum.band_L_W_db, "o-", ms=3,
+                label=f"{sp.load_case}: total {sp.spectrum.total_L_W_db:.1f} dB, {sp.spectrum.total_L_WA_db:.1f} dB(A)")
+    nominal = forced.sound_power[0].spectrum.bands.nominal
+    a2.set_xticks(np.arange(len(nominal)), [f"{v:g}" for v in nominal], rotation=90, fontsize=7)
+    a1.set_xlabel("frequency (Hz)")
+    a1.set_ylabel("radiation index L_sigma (dB)")
+    a1.grid(alpha=0.3, which="both")
+    a1.legend(fontsize=7)
+    a2.set_xlabel("1/3-octave band (Hz)")
+    a2.set_ylabel("L_W (dB re 1 pW, per unit load)")
+    a2.grid(alpha=0.3)
+    a2.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(folder / "sound_power.png", dpi=110)
+    plt.close(fig)

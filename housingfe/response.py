@@ -65,6 +65,35 @@ def _surface_facet_data(housing, surface: str):
     return [np.concatenate([g[k] for g in gathered]) for k in range(4)]
 
 
+def facet_points(housing, surface: str) -> tuple[SamplePoints, np.ndarray]:
+    """Every facet of a surface as a point (midpoint, outward normal, area weight), with its atomic
+    group tag (one id per plate); identical on every rank."""
+    mids, normals, areas, groups = _surface_facet_data(housing, surface)
+    return SamplePoints(mids, normals, areas), groups
+
+
+def surface_outline(housing, surface: str) -> tuple[np.ndarray, np.ndarray]:
+    """The surface as a triangulation (vertices m, triangles) with shared vertices merged, all ranks."""
+    mesh = housing.mesh
+    fdim = mesh.topology.dim - 1
+    n_owned = mesh.topology.index_map(fdim).size_local
+    tris = []
+    for value in housing.facet_tag_values(surface):
+        facets = housing.facet_tags.find(value)
+        facets = facets[facets < n_owned]
+        if not len(facets):
+            continue
+        x = mesh.geometry.x[_cpp_mesh.entities_to_geometry(mesh._mesh, fdim, facets, False)]
+        if x.shape[1] == 4:   # tensor-product quad 0-1-3-2 -> two triangles
+            tris += [x[:, [0, 1, 3]], x[:, [0, 3, 2]]]
+        else:
+            tris.append(x[:, :3])
+    local = np.concatenate(tris) if tris else np.zeros((0, 3, 3))
+    corners = np.concatenate(mesh.comm.allgather(local)).reshape(-1, 3)
+    vertices, index = np.unique(np.round(corners, 9), axis=0, return_inverse=True)
+    return vertices, index.reshape(-1, 3)
+
+
 def sample_points(housing, surface: str, count: int, seed: int = 0) -> SamplePoints:
     """`count` area-weighted sample points on `surface`: points are shared out among the surface's atomic
     groups (plates) in proportion to area; inside a group, area-weighted k-means on the facet midpoints
@@ -156,7 +185,7 @@ class Reduced:
 class SurfaceObserver:
     """The radiating surface (W, S), the sample-point sets and the load vectors of a model."""
 
-    def __init__(self, model, surface: str, sample_counts, load_cases):
+    def __init__(self, model, surface: str, sample_counts, load_cases, extra_points: dict | None = None):
         housing, V = model.housing, model.V
         if surface not in housing.facet_groups:
             raise InputError(f"analysis.harmonic.surface: no surface {surface!r} "
@@ -169,7 +198,9 @@ class SurfaceObserver:
         self.W.assemble()
         self.area = housing.mesh.comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds)), op=MPI.SUM)
         self.samples = {N: sample_points(housing, surface, N) for N in sample_counts}
-        self.evaluators = {N: PointEvaluator(V, s) for N, s in self.samples.items()}
+        # named point sets whose complex values are kept per line (e.g. the facets of radiating plates)
+        self.extra_samples = dict(extra_points or {})
+        self.evaluators = {N: PointEvaluator(V, s) for N, s in {**self.samples, **self.extra_samples}.items()}
         self.load_vectors = [lc.vector for lc in load_cases]
 
     def reduce(self, vectors) -> Reduced:
@@ -219,6 +250,7 @@ def responses(result, observer: SurfaceObserver, load_cases) -> list[LoadRespons
     for j, lc in enumerate(load_cases):
         ms = np.zeros(len(f))
         pms = {N: np.zeros(len(f)) for N in observer.samples}
+        kept = {name: np.zeros((len(s.weights), len(f)), dtype=complex) for name, s in observer.extra_samples.items()}
         rec = np.zeros((len(load_cases), len(f)), dtype=complex)
         for block in result.blocks[j]:
             c = block.coeffs
@@ -226,10 +258,13 @@ def responses(result, observer: SurfaceObserver, load_cases) -> list[LoadRespons
             ms[block.index] = np.real(np.einsum("kf,kl,lf->f", c.conj(), r.gram, c)) * w2[block.index] / observer.area
             for N, P in r.points.items():
                 vals = P @ c
+                if N in kept:
+                    kept[N][:, block.index] = vals
+                    continue
                 wts = observer.samples[N].weights
                 pms[N][block.index] = (wts @ np.abs(vals) ** 2) / wts.sum() * w2[block.index]
             rec[:, block.index] = r.loads @ c
-        out.append(LoadResponse(lc.name, lc.kind, f, ms, pms, rec, lc.amplitude(f)))
+        out.append(LoadResponse(lc.name, lc.kind, f, ms, pms, rec, lc.amplitude(f), {"point_values": kept}))
     return out
 
 

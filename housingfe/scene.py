@@ -166,6 +166,31 @@ class HarmonicSpec(_Strict):
         return self.f_min + self.df * np.arange(n)
 
 
+class RadiationPlate(_Strict):
+    """A radiating plate of the housing: a surface group and its thickness (m); `count` identical copies
+    are counted once more each in Föller's means."""
+
+    surface: str
+    thickness: PositiveFloat
+    count: PositiveInt = 1
+
+
+class RadiationSpec(_Strict):
+    """Sound power from the forced response (eq. 4.16): L_W = L_v + 10 lg(S/S0) + L_sigma with L_sigma from
+    "erp" (sigma = 1), "foller" (the box model of Sec. 4.7 on the plates below, areas and perimeters taken
+    from the mesh) or "numerical" (Rayleigh integral per plate over the computed velocity field)."""
+
+    model: Literal["erp", "foller", "numerical"]
+    plates: list[RadiationPlate] = []
+
+    @model_validator(mode="after")
+    def _check(self):
+        if self.model != "erp" and not self.plates:
+            raise ValueError(f"plates: the {self.model} model needs the radiating plates "
+                             "(surface and thickness of each)")
+        return self
+
+
 class Analyses(_Strict):
     modal: Optional[ModalSpec] = None
     harmonic: Optional[HarmonicSpec] = None
@@ -221,6 +246,7 @@ class HousingScene(_Strict):
     analysis: Analyses
     loads: list[LoadSpec] = []
     damping: DampingSpec = DampingSpec()
+    radiation: Optional[RadiationSpec] = None
     output: OutputSpec = OutputSpec()
     reference: Optional[ReferenceSpec] = None
 
@@ -229,6 +255,8 @@ class HousingScene(_Strict):
         if self.analysis.modal is None and self.analysis.harmonic is None:
             raise ValueError("analysis: the scene requests no analysis (add [analysis.modal] or "
                              "[analysis.harmonic])")
+        if self.radiation is not None and self.analysis.harmonic is None:
+            raise ValueError("radiation: sound power needs a forced response ([analysis.harmonic])")
         if self.analysis.harmonic is not None and not self.loads:
             raise ValueError("loads: a harmonic analysis needs at least one [[loads]] entry")
         names = [load.name for load in self.loads]
