@@ -345,14 +345,18 @@ def _bore_of_face(face: int, model: BlockModel) -> tuple[str, ...]:
 
 def _outward_normal(face: int, centre: np.ndarray, model: BlockModel) -> np.ndarray:
     """Outward normal of an axis-aligned boundary face: the axis direction pointing out of the solid.
-    Tested against the cells only: the centre of mass of a face with a bore hole may lie in the hole."""
+    Material is tested with the bores first (a cover closing a bore has material on one side only); if the
+    centre lies in a bore on both sides (the centre of mass of a face with a hole in it), with the cells."""
     import gmsh
 
     xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(2, face)
     axis = int(np.argmin([xmax - xmin, ymax - ymin, zmax - zmin]))
     normal = np.zeros(3)
     normal[axis] = 1.0
-    return -normal if model.in_cells(centre + 1e-7 * normal) else normal
+    ahead, behind = centre + 1e-7 * normal, centre - 1e-7 * normal
+    if model.contains(ahead) != model.contains(behind):
+        return -normal if model.contains(ahead) else normal
+    return -normal if model.in_cells(ahead) else normal
 
 
 def _set_mesh_options(element: str) -> None:
