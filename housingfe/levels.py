@@ -54,7 +54,7 @@ def fractional_octave_bands(f_min: float, f_max: float, fraction: int = 3) -> Ba
     in [f_min, f_max] (Hz)."""
     if fraction not in (1, 3):
         raise ValueError("fraction must be 1 (octaves) or 3 (one-third octaves)")
-    x = np.arange(-40, 25) if fraction == 3 else np.arange(-14, 9)
+    x = np.arange(-20, 14) if fraction == 3 else np.arange(-6, 5)   # 10 (16) Hz .. 20 (16) kHz
     center = 1000.0 * _G ** (x / fraction)
     nominal_table = np.array(NOMINAL_THIRD_OCTAVES, dtype=float)
     nominal = np.array([nominal_table[np.argmin(abs(np.log(nominal_table / c)))] for c in center])

@@ -51,28 +51,28 @@ def assemble_load(spec, housing, V, bcs) -> LoadCase:
     facets = housing.facets(spec.surface)
     v = ufl.TestFunction(V)
     mesh = V.mesh
+    x = ufl.SpatialCoordinate(mesh)
     if spec.kind == "pressure":
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=housing.facet_tags)(housing.facet_tag_values(spec.surface))
-        n = ufl.FacetNormal(mesh)
-        form = -ufl.inner(n, v) * ds
-        area = _integrate(1.0 * ds, mesh.comm)
-        centre = np.array([_integrate(ufl.SpatialCoordinate(mesh)[i] * ds, mesh.comm) for i in range(3)]) / area
+        form = -ufl.inner(ufl.FacetNormal(mesh), v) * ds
+        area, first, _ = _moments(x, ds, mesh.comm)
+        centre = first / area
     else:
         patch = _patch(mesh, facets, np.asarray(spec.point, dtype=float), spec.radius)
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=patch)(1)
-        x = ufl.SpatialCoordinate(mesh)
-        area = _integrate(1.0 * ds, mesh.comm)
-        centre = np.array([_integrate(x[i] * ds, mesh.comm) for i in range(3)]) / area
+        area, first, second = _moments(x, ds, mesh.comm)
+        centre = first / area
         direction = np.asarray(spec.direction, dtype=float)
         direction = direction / np.linalg.norm(direction)
         if spec.kind == "force":
-            traction = ufl.as_vector(direction / area)
+            traction = fem.Constant(mesh, PETSc.ScalarType(direction / area))
         else:
-            r = x - ufl.as_vector(centre)
-            J = np.array([[_integrate((ufl.dot(r, r) * (i == j) - r[i] * r[j]) * ds, mesh.comm)
-                           for j in range(3)] for i in range(3)])
+            # area inertia tensor about the centroid: J = int (|r|^2 I - r r^T), r = x - c
+            rr = second - area * np.outer(centre, centre)
+            J = np.trace(rr) * np.eye(3) - rr
             theta = np.linalg.solve(J, direction)      # rotation-like field carrying a unit couple
-            traction = ufl.cross(ufl.as_vector(theta), r)
+            traction = ufl.cross(fem.Constant(mesh, PETSc.ScalarType(theta)),
+                                 x - fem.Constant(mesh, PETSc.ScalarType(centre)))
         form = ufl.inner(traction, v) * ds
     vec = assemble_vector(fem.form(form))
     vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
@@ -82,6 +82,15 @@ def assemble_load(spec, housing, V, bcs) -> LoadCase:
 
 def _integrate(expr, comm) -> float:
     return comm.allreduce(fem.assemble_scalar(fem.form(expr)), op=MPI.SUM)
+
+
+def _moments(x, ds, comm):
+    """Area (m^2), first moments int x (m^3) and second moments int x x^T (m^4) over ds.  The forms hold
+    no numbers, so they are compiled once and reused for every patch."""
+    area = _integrate(1.0 * ds, comm)
+    first = np.array([_integrate(x[i] * ds, comm) for i in range(3)])
+    second = np.array([[_integrate(x[i] * x[j] * ds, comm) for j in range(3)] for i in range(3)])
+    return area, first, second
 
 
 def _patch(mesh, facets: np.ndarray, point: np.ndarray, radius: float):
