@@ -308,20 +308,26 @@ def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_
         raise InputError("coupling: a constraint refers to an eliminated DOF (chained constraints)")
     P = sp.csr_matrix((v_all, (r_all, col_of[c_all])), shape=(n_full, len(independent)))
 
-    K_full = _pad(K_fe, n_full) + Kx.matrix(n_full)
-    M_full = _pad(M_fe, n_full) + Mx.matrix(n_full)
-    Kc = (P.T @ K_full @ P).tocsr()
-    Mc = (P.T @ M_full @ P).tocsr()
-    Cc = (P.T @ Cx.matrix(n_full) @ P).tocsr() if Cx else None
+    # K and M in one complex product, Z = K + i M: P is real, so P^T Z P = K_c + i M_c, and K_c, M_c come
+    # out on one sparsity pattern, which the solvers need (they add K and M with SAME_NONZERO_PATTERN).
+    # Pt as CSR and products grouped as Pt @ (Z @ P): all CSR, no CSC conversion of the big matrix.
+    Pt = P.T.tocsr()
+    Zc = Pt @ (_pad(_complex(K_fe, M_fe), n_full) @ P)
+    if Kx or Mx:
+        Zc = Zc + Pt @ ((Kx.matrix(n_full) + 1j * Mx.matrix(n_full)) @ P)
+    Zc.sort_indices()
+    Cc = (Pt @ (Cx.matrix(n_full) @ P)).tocsr() if Cx else None
     t2 = time.perf_counter()
-    pattern = _union_pattern(Kc, Mc, Cc)
-    K, M = _petsc(Kc, pattern), _petsc(Mc, pattern)
-    C = _petsc(Cc, pattern) if Cc is not None else None
-    symmetric = abs(Kc - Kc.T).max() <= 1e-12 * abs(Kc).max()
-    for A in (K, M):
-        A.setOption(PETSc.Mat.Option.SYMMETRIC, bool(symmetric) or A is M)
+    K, M = _petsc(Zc, Zc.data.real), _petsc(Zc, Zc.data.imag)
+    C = None
+    if Cc is not None:
+        Cc.sort_indices()
+        C = _petsc(Cc, Cc.data)
+    symmetric = Kx.symmetric()          # the FE K is symmetric; only springs (fluid films) can break it
+    K.setOption(PETSc.Mat.Option.SYMMETRIC, symmetric)
+    M.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     t3 = time.perf_counter()
-    return CoupledSystem(K, M, C, P, n_fe, nodes, bool(symmetric),
+    return CoupledSystem(K, M, C, P, n_fe, nodes, symmetric,
                          {"couple_s": t3 - t0, "extra_assembly_s": t1 - t0, "transform_s": t2 - t1,
                           "to_petsc_s": t3 - t2})
 
@@ -392,6 +398,12 @@ class _Triplets:
     def __bool__(self):
         return bool(self.v)
 
+    def symmetric(self) -> bool:
+        """True if every block added was symmetric (blocks are square, on the same DOFs both ways)."""
+        return all(np.allclose(v.reshape(int(round(np.sqrt(v.size))), -1),
+                               v.reshape(int(round(np.sqrt(v.size))), -1).T, rtol=1e-12,
+                               atol=1e-12 * np.abs(v).max(initial=0.0)) for v in self.v)
+
     def add(self, ri, ci, block):
         block = np.asarray(block, float)
         self.r.append(np.repeat(ri, len(ci)))
@@ -409,6 +421,13 @@ class _Triplets:
 def _to_scipy(A: PETSc.Mat) -> sp.csr_matrix:
     indptr, indices, data = A.getValuesCSR()
     return sp.csr_matrix((data, indices, indptr), shape=A.getSize())
+
+
+def _complex(K: sp.csr_matrix, M: sp.csr_matrix) -> sp.csr_matrix:
+    """K + i M; without a sparse addition when both share one pattern (dolfinx assembles them so)."""
+    if np.array_equal(K.indptr, M.indptr) and np.array_equal(K.indices, M.indices):
+        return sp.csr_matrix((K.data + 1j * M.data, K.indices, K.indptr), shape=K.shape)
+    return K + 1j * M
 
 
 def _pad(A: sp.csr_matrix, n: int) -> sp.csr_matrix:
@@ -454,38 +473,12 @@ def _bore_nodes(model, surface: str, _unused) -> tuple[np.ndarray, np.ndarray]:
     return np.asarray(nodes), w
 
 
-def _union_pattern(*mats) -> sp.csr_matrix:
-    """Sparsity pattern (values 1) of the union of the given matrices, diagonal always included."""
-    n = mats[0].shape[0]
-    acc = sp.identity(n, format="csr")
-    for A in mats:
-        if A is not None:
-            B = A.copy()
-            B.data = np.ones_like(B.data)
-            acc = acc + B
-    acc.sort_indices()
-    acc.data[:] = 1.0
-    return acc
-
-
-def _on_pattern(A: sp.csr_matrix, pattern: sp.csr_matrix) -> np.ndarray:
-    """The values of A at the entries of `pattern` (zeros where A has none)."""
-    A = A.tocoo()
-    n = pattern.shape[1]
-    keys_a = A.row.astype(np.int64) * n + A.col
-    prow = np.repeat(np.arange(pattern.shape[0]), np.diff(pattern.indptr))
-    keys_p = prow.astype(np.int64) * n + pattern.indices
-    out = np.zeros(len(keys_p))
-    pos = np.searchsorted(keys_p, keys_a)
-    np.add.at(out, pos, A.data)
-    return out
-
-
-def _petsc(A: sp.csr_matrix, pattern: sp.csr_matrix) -> PETSc.Mat:
+def _petsc(pattern: sp.csr_matrix, values: np.ndarray) -> PETSc.Mat:
+    """A sequential PETSc AIJ with the (sorted) CSR structure of `pattern` and the given values."""
     n = pattern.shape[0]
-    vals = _on_pattern(A, pattern)
-    M = PETSc.Mat().createAIJ(size=(n, n), csr=(pattern.indptr.astype(PETSc.IntType),
-                                                pattern.indices.astype(PETSc.IntType), vals),
-                              comm=PETSc.COMM_SELF)
-    M.assemble()
-    return M
+    # WithArrays: PETSc takes the arrays as they are (no row-by-row insertion); petsc4py keeps them alive.
+    A = PETSc.Mat().createAIJWithArrays(size=(n, n), csr=(pattern.indptr.astype(PETSc.IntType),
+                                                          pattern.indices.astype(PETSc.IntType),
+                                                          np.ascontiguousarray(values)), comm=PETSc.COMM_SELF)
+    A.assemble()
+    return A
