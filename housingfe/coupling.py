@@ -117,6 +117,23 @@ def spring(a: str, b: str | None, K6, C6=None) -> Element:
     return Element((a, b), rel.T @ K6 @ rel, None, None if C6 is None else rel.T @ C6 @ rel)
 
 
+def bearing(shaft_node: str, master: str | None, K_local, axis, C_local=None) -> Element:
+    """A bearing between a shaft node and a bore master (or ground): the 6x6 K (and fluid-film C) in the
+    bearing frame (z = shaft axis, as housingfe.bearings returns them), rotated to global axes with
+    `axis_frame(axis)`.  Rotation about the shaft axis stays free: its local row and column are zeroed."""
+    from housingfe.bearings import transform_stiffness
+
+    free_spin = np.ones(6)
+    free_spin[5] = 0.0
+    frame = axis_frame(axis)
+
+    def glob(a):
+        a = _check6(a, f"bearing {shaft_node}-{master}") * np.outer(free_spin, free_spin)
+        return transform_stiffness(a, frame)
+
+    return spring(shaft_node, master, glob(K_local), None if C_local is None else glob(C_local))
+
+
 def point_mass(node: str, M6) -> Element:
     """A 6x6 mass matrix (kg, kg m^2) lumped on a node, e.g. RigidDisc.mass_matrix(axis)."""
     return Element((node,), None, _check6(M6, f"mass on {node}"), None)
@@ -262,13 +279,13 @@ def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_
 
     # The transformation u_full = P q.
     t1 = time.perf_counter()
-    coords, weights_all = _surface_data(model)
+    coords = model.V.tabulate_dof_coordinates()          # one row per FE node (blocked DOF index)
     rows, cols, vals = [], [], []
     eliminated = np.zeros(n_full, bool)
     dependent = {}                  # full DOF -> (list of (full column, value)) for rbe3 masters
     slaves_used = np.zeros(n_fe, bool)
     for c in connections:
-        node_ids, w = _bore_nodes(model, c.surface, weights_all)
+        node_ids, w = surface_nodes(model, c.surface)
         dofs = (3 * node_ids[:, None] + np.arange(3)[None, :]).ravel()
         if np.any(constrained[dofs]):
             raise InputError(f"connection {c.name}: surface {c.surface!r} has Dirichlet-constrained DOFs")
@@ -393,19 +410,18 @@ class _Triplets:
     """COO accumulator of dense element blocks."""
 
     def __init__(self):
-        self.r, self.c, self.v = [], [], []
+        self.r, self.c, self.v, self.blocks = [], [], [], []
 
     def __bool__(self):
         return bool(self.v)
 
     def symmetric(self) -> bool:
         """True if every block added was symmetric (blocks are square, on the same DOFs both ways)."""
-        return all(np.allclose(v.reshape(int(round(np.sqrt(v.size))), -1),
-                               v.reshape(int(round(np.sqrt(v.size))), -1).T, rtol=1e-12,
-                               atol=1e-12 * np.abs(v).max(initial=0.0)) for v in self.v)
+        return all(np.allclose(b, b.T, rtol=1e-12, atol=1e-12 * np.abs(b).max(initial=0.0)) for b in self.blocks)
 
     def add(self, ri, ci, block):
         block = np.asarray(block, float)
+        self.blocks.append(block)
         self.r.append(np.repeat(ri, len(ci)))
         self.c.append(np.tile(ci, len(ri)))
         self.v.append(block.ravel())
@@ -447,13 +463,7 @@ def _dirichlet_dofs(model) -> np.ndarray:
     return mask
 
 
-def _surface_data(model):
-    """DOF-node coordinates (m) and the consistent surface weight of every node on every tagged surface."""
-    x = model.V.tabulate_dof_coordinates()
-    return x, None
-
-
-def _bore_nodes(model, surface: str, _unused) -> tuple[np.ndarray, np.ndarray]:
+def surface_nodes(model, surface: str) -> tuple[np.ndarray, np.ndarray]:
     """Nodes (blocked DOF indices) of a surface and their consistent area weights int N_i dA (m^2)."""
     import ufl
     from dolfinx import fem
@@ -465,6 +475,7 @@ def _bore_nodes(model, surface: str, _unused) -> tuple[np.ndarray, np.ndarray]:
     ds = ufl.Measure("ds", domain=housing.mesh, subdomain_data=housing.facet_tags)
     v = ufl.TestFunction(V)
     one = fem.Constant(housing.mesh, np.array([1.0, 0.0, 0.0], dtype=PETSc.ScalarType))
+    # int N_i dA: the x-component of the load vector of a unit x-traction (P2 triangle vertices get 0)
     b = assemble_vector(fem.form(ufl.inner(one, v) * ds(housing.facet_tag_values(surface))))
     w = b.getArray(readonly=True)[3 * nodes].copy()
     b.destroy()

@@ -1,0 +1,170 @@
+"""`housingfe bench coupling`: cost of the coupled gearbox model (bores + bearings + shafts + gears) against the
+bare housing, next to the error of the thesis' star rods against the exact RBE2 tie.
+
+Model: scene gearbox-model (free-free welded housing with four bearing bores).  Each bore gets a master node at
+its centre; two stepped Timoshenko shafts along y carry a rigid pinion and wheel joined by a mesh spring on
+the line of action; SKF 6312 / 6215 stiffness matrices (housingfe.bearings, at an assumed 5 kN radial load)
+join the shaft ends to the bore masters.  Expected rigid-body modes: the housing's six plus the turning of
+the gear train (spin about the shaft axes is free in the bearings) = 7.
+
+Timing: "bare" = assembly + eigensolve of the housing; "coupled" = the same assembly + couple() + eigensolve of
+the coupled system, both to the same f_max.  Error column: largest relative frequency difference below f_max
+against the RBE2 model (for star rods: the penalty error; for RBE3: the modelling difference).
+Writes coupling.csv, coupling.png and prints the table.
+"""
+from __future__ import annotations
+
+import argparse
+import time
+from pathlib import Path
+
+import numpy as np
+
+from housingfe.report import atomic_output_dir, format_table, write_csv
+
+BORES = [("pinion", "front"), ("pinion", "back"), ("wheel", "front"), ("wheel", "back")]
+BEARINGS = {"pinion": "SKF 6312", "wheel": "SKF 6215"}
+SHAFT_DIAMETER = {"pinion": 0.060, "wheel": 0.075}    # m: the bearings' bore diameters
+PITCH_RADIUS = {"pinion": 0.045, "wheel": 0.115}      # m: centre distance 0.160 m
+GEAR_WIDTH = 0.030                                     # m
+MESH_STIFFNESS = 14e9 * GEAR_WIDTH                     # N/m: 14 N/(m um) per mm face width (scene value)
+PRESSURE_ANGLE = np.radians(20.0)
+RADIAL_LOAD = 5000.0                                   # N, assumed, for the bearing stiffness
+ROD_STIFFNESSES = (1e8, 1e10, 1e12)                    # N/m per rod
+
+
+def _model(quick: bool):
+    from mpi4py import MPI
+
+    from housingfe.model import build_model
+    from housingfe.scene import load_housing_scene
+
+    f_max = 1500.0 if quick else 3000.0
+    size = 0.03 if quick else 0.02
+    scene, _ = load_housing_scene("gearbox-model", [f"mesh.size={size}", f"analysis.modal.f_max={f_max}"])
+    t0 = time.perf_counter()
+    model = build_model(scene, MPI.COMM_WORLD)
+    return model, f_max, time.perf_counter() - t0
+
+
+def bore_centre(model, surface: str) -> np.ndarray:
+    """Centre (m) of the bounding box of a bore surface's nodes: on the axis, mid-plate."""
+    from housingfe.coupling import surface_nodes
+
+    nodes, _ = surface_nodes(model, surface)
+    x = model.V.tabulate_dof_coordinates()[nodes]
+    return (x.min(axis=0) + x.max(axis=0)) / 2
+
+
+def gearbox_parts(model, kind: str, rod_stiffness: float | None = None) -> dict:
+    """Connections, shafts, bearings, gears and the gear mesh of the benchmark (keyword arguments of couple)."""
+    from housingfe import coupling as cp
+    from housingfe.bearings import bearing_stiffness
+    from housingfe.shafts import RigidDisc, Shaft
+
+    axis = np.array([0.0, 1.0, 0.0])
+    centres = {(s, side): bore_centre(model, f"bore_{s}_{side}") for s, side in BORES}
+    connections = [cp.BoreConnection(f"{s}_{side}", f"bore_{s}_{side}", tuple(centres[s, side]), tuple(axis), kind,
+                                     rod_stiffness) for s, side in BORES]
+    shafts, elements = {}, []
+    for s in ("pinion", "wheel"):
+        front, back = centres[s, "front"], centres[s, "back"]
+        half = (back[1] - front[1]) / 2
+        shaft = Shaft.stepped([(half, SHAFT_DIAMETER[s]), (half, SHAFT_DIAMETER[s])], origin=front, axis=axis,
+                              elements_per_segment=4)
+        shafts[s] = shaft
+        k = bearing_stiffness(BEARINGS[s], (RADIAL_LOAD, 0.0, 0.0, 0.0, 0.0)).K
+        elements += [cp.bearing(f"{s}:0", f"{s}_front", k, axis), cp.bearing(f"{s}:8", f"{s}_back", k, axis)]
+        disc = RigidDisc.cylinder(2 * PITCH_RADIUS[s], GEAR_WIDTH)
+        elements.append(cp.point_mass(f"{s}:4", disc.mass_matrix(axis)))
+    pitch_point = shafts["pinion"].nodes[4] + np.array([PITCH_RADIUS["pinion"], 0.0, 0.0])
+    line_of_action = np.array([np.sin(PRESSURE_ANGLE), 0.0, np.cos(PRESSURE_ANGLE)])
+    mesh = cp.GearMesh("pinion:4", "wheel:4", MESH_STIFFNESS, tuple(pitch_point), tuple(line_of_action))
+    return {"connections": connections, "shafts": shafts, "elements": elements, "gear_meshes": [mesh]}
+
+
+def _solve(K, M, f_max):
+    from housingfe.solvers import modal
+
+    t0 = time.perf_counter()
+    res = modal.solve_modes(K, M, f_max)
+    return res, time.perf_counter() - t0
+
+
+def run(quick: bool) -> tuple[list, dict]:
+    from housingfe import coupling as cp
+
+    model, f_max, t_build = _model(quick)
+    t_asm = model.timings["assembly_s"]
+    bare, t_bare = _solve(model.K, model.M, f_max)
+    rows = [["bare housing", model.dofs, int(model.K.getInfo()["nz_used"]), 0.0, 0.0, t_asm, t_bare, 0.0,
+             bare.rigid_count, len(bare.eigenvalues),
+             float(bare.frequencies_hz[bare.rigid_count]), float("nan")]]
+    cases = [("rbe2", None), ("rbe3", None)] + [("star", k) for k in ROD_STIFFNESSES]
+    results = {}
+    for kind, k in cases:
+        parts = gearbox_parts(model, kind, k)
+        t0 = time.perf_counter()
+        system = cp.couple(model, **parts)
+        t_couple = time.perf_counter() - t0
+        res, t_solve = _solve(system.K, system.M, f_max)
+        results[kind, k] = res
+        extra = (t_couple + t_solve - t_bare) / (t_asm + t_bare)
+        name = kind if k is None else f"star k={k:.0e} N/m"
+        rows.append([name, system.size, int(system.K.getInfo()["nz_used"]), t_couple,
+                     100 * t_couple / (t_asm + t_bare), t_asm, t_solve, 100 * extra, res.rigid_count,
+                     len(res.eigenvalues), float(res.frequencies_hz[res.rigid_count]), float("nan")])
+    ref = results["rbe2", None].frequencies_hz
+    for row, key in zip(rows[1:], [(kind, k) for kind, k in cases]):
+        f = results[key].frequencies_hz
+        n = min(len(f), len(ref))
+        el = slice(7, n)
+        row[-1] = float(np.max(np.abs(f[el] / ref[el] - 1))) if n > 7 else float("nan")
+    info = {"f_max": f_max, "build_s": t_build, "star": [(k, rows[3 + i][-1]) for i, k in enumerate(ROD_STIFFNESSES)]}
+    return rows, info
+
+
+HEADER = ["model", "DOFs", "nnz", "couple_s", "couple_%", "assembly_s", "eigensolve_s", "extra_time_%", "rigid", "modes",
+          "first_elastic_Hz", "max_rel_diff_vs_rbe2"]
+
+
+def main(out_dir, quick: bool = False) -> None:
+    rows, info = run(quick)
+    with atomic_output_dir(out_dir) as out:
+        write_csv(out / "coupling.csv", HEADER, rows)
+        _plot(out / "coupling.png", rows, info)
+    print(f"gearbox-model, modes to {info['f_max']:g} Hz; couple_% = couple / (assembly + bare solve); "
+          "extra_time_% = (couple + coupled solve - bare solve) / (assembly + bare solve)")
+    print(format_table(HEADER, rows))
+
+
+def _plot(path: Path, rows, info) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4))
+    names = [r[0] for r in rows]
+    t_asm, t_cpl, t_sol = ([r[HEADER.index(c)] for r in rows] for c in ("assembly_s", "couple_s", "eigensolve_s"))
+    a.barh(names, t_asm, label="assembly")
+    a.barh(names, t_cpl, left=t_asm, label="couple")
+    a.barh(names, t_sol, left=np.add(t_asm, t_cpl), label="eigensolve")
+    a.set_xlabel("time (s)")
+    a.legend()
+    ks, errs = zip(*info["star"])
+    b.loglog(ks, errs, "o-")
+    b.set_xlabel("rod stiffness (N/m per rod)")
+    b.set_ylabel("max relative frequency error vs RBE2")
+    b.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default="results/bench-coupling")
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args()
+    main(args.out, args.quick)
