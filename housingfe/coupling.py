@@ -302,9 +302,13 @@ def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_
                 vals.append(arms[:, :, k].ravel())
             eliminated[dofs] = True
         elif c.kind == "rbe3":
-            R = rbe3_matrix(r, w)                                                 # (6, 3N)
+            # nodes of zero weight (P2 triangle vertices) have zero columns in R: leaving them out keeps
+            # explicit zeros out of P and of the (dense, rank-6) coupling block of the spring
+            used = np.abs(w) > 1e-12 * np.abs(w).max()
+            R = rbe3_matrix(r[used], w[used])                                     # (6, 3N)
+            used_dofs = dofs.reshape(-1, 3)[used].ravel()
             for k in range(6):
-                dependent[moff + k] = (dofs, R[k])
+                dependent[moff + k] = (used_dofs, R[k])
             eliminated[moff:moff + 6] = True
         else:
             _star_rods(Kx, dofs, moff, r, c.rod_stiffness)

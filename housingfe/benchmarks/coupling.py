@@ -83,12 +83,16 @@ def gearbox_parts(model, kind: str, rod_stiffness: float | None = None) -> dict:
     return {"connections": connections, "shafts": shafts, "elements": elements, "gear_meshes": [mesh]}
 
 
-def _solve(K, M, f_max):
+def _solve(K, M, f_max, repeat: int = 2, **kw):
+    """Modes below f_max and the best wall time of `repeat` solves (the machine is shared: best-of)."""
     from housingfe.solvers import modal
 
-    t0 = time.perf_counter()
-    res = modal.solve_modes(K, M, f_max)
-    return res, time.perf_counter() - t0
+    best = np.inf
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        res = modal.solve_modes(K, M, f_max, **kw)
+        best = min(best, time.perf_counter() - t0)
+    return res, best
 
 
 def run(quick: bool) -> tuple[list, dict]:
@@ -101,7 +105,7 @@ def run(quick: bool) -> tuple[list, dict]:
              bare.rigid_count, len(bare.eigenvalues),
              float(bare.frequencies_hz[bare.rigid_count]), float("nan")]]
     cases = [("rbe2", None), ("rbe3", None)] + [("star", k) for k in ROD_STIFFNESSES]
-    results = {}
+    results, info = {}, {"f_max": f_max, "build_s": t_build}
     for kind, k in cases:
         parts = gearbox_parts(model, kind, k)
         t0 = time.perf_counter()
@@ -114,17 +118,26 @@ def run(quick: bool) -> tuple[list, dict]:
         rows.append([name, system.size, int(system.K.getInfo()["nz_used"]), t_couple,
                      100 * t_couple / (t_asm + t_bare), t_asm, t_solve, 100 * extra, res.rigid_count,
                      len(res.eigenvalues), float(res.frequencies_hz[res.rigid_count]), float("nan")])
+    # the coupled models have more modes below f_max (shaft, gear and bearing modes): the bare housing asked
+    # for as many eigenpairs is the baseline of equal work
+    n_most = max(len(r.eigenvalues) for r in results.values())
+    _, t_bare_n = _solve(model.K, model.M, f_max, nev=n_most, require_complete=False)
+    for row in rows[1:]:
+        row.insert(HEADER.index("extra_time_%") + 1, 100 * (row[3] + row[6] - t_bare_n) / (t_asm + t_bare_n))
+    rows[0].insert(HEADER.index("extra_time_%") + 1, float("nan"))
+    info["bare_same_nev_s"] = t_bare_n
     ref = results["rbe2", None].frequencies_hz
     for row, key in zip(rows[1:], [(kind, k) for kind, k in cases]):
         f = results[key].frequencies_hz
         n = min(len(f), len(ref))
         el = slice(7, n)
         row[-1] = float(np.max(np.abs(f[el] / ref[el] - 1))) if n > 7 else float("nan")
-    info = {"f_max": f_max, "build_s": t_build, "star": [(k, rows[3 + i][-1]) for i, k in enumerate(ROD_STIFFNESSES)]}
+    info["star"] = [(k, rows[3 + i][-1]) for i, k in enumerate(ROD_STIFFNESSES)]
     return rows, info
 
 
-HEADER = ["model", "DOFs", "nnz", "couple_s", "couple_%", "assembly_s", "eigensolve_s", "extra_time_%", "rigid", "modes",
+HEADER = ["model", "DOFs", "nnz", "couple_s", "couple_%", "assembly_s", "eigensolve_s", "extra_time_%",
+          "extra_vs_same_nev_%", "rigid", "modes",
           "first_elastic_Hz", "max_rel_diff_vs_rbe2"]
 
 
@@ -134,7 +147,8 @@ def main(out_dir, quick: bool = False) -> None:
         write_csv(out / "coupling.csv", HEADER, rows)
         _plot(out / "coupling.png", rows, info)
     print(f"gearbox-model, modes to {info['f_max']:g} Hz; couple_% = couple / (assembly + bare solve); "
-          "extra_time_% = (couple + coupled solve - bare solve) / (assembly + bare solve)")
+          "extra_time_% = (couple + coupled solve - bare solve) / (assembly + bare solve); extra_vs_same_nev_%: "
+          f"the same against the bare housing asked for as many eigenpairs ({info['bare_same_nev_s']:.3g} s)")
     print(format_table(HEADER, rows))
 
 
