@@ -7,6 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 import scipy.linalg as sl
+from scipy.optimize import brentq
 
 from housingfe import coupling as cp
 from housingfe.errors import InputError
@@ -166,15 +167,35 @@ def test_gear_mesh_torsion(comm):
     r1, r2, k_mesh = 0.05, 0.08, 1e7
     g1, g2 = RigidDisc.cylinder(2 * r1, 0.02), RigidDisc.cylinder(2 * r2, 0.02)
     nodes = {"g1": (0.0, 0.0, 0.5), "g2": (r1 + r2, 0.0, 0.5)}
-    ground = np.diag([1e15, 1e15, 1e15, 1e12, 1e12, 0.0])    # spin about z free
+    # a bearing matrix with a (wrong) spin stiffness: cp.bearing must free the rotation about the shaft axis
+    local = np.diag([1e15, 1e15, 1e15, 1e12, 1e12, 1e9])
     elements = [cp.point_mass("g1", g1.mass_matrix((0, 0, 1))), cp.point_mass("g2", g2.mass_matrix((0, 0, 1))),
-                cp.spring("g1", None, ground), cp.spring("g2", None, ground)]
+                cp.bearing("g1", None, local, (0, 0, 1)), cp.bearing("g2", None, local, (0, 0, 1))]
     mesh = cp.GearMesh("g1", "g2", k_mesh, point=(r1, 0.0, 0.5), direction=(0.0, 1.0, 0.0))
     system = cp.couple(model, [], elements, gear_meshes=[mesh], extra_nodes=nodes)
     res = modal.solve_modes(system.K, system.M, 2000.0)
     exact = math.sqrt(k_mesh * (r1**2 / g1.polar_inertia + r2**2 / g2.polar_inertia)) / (2 * math.pi)
     assert res.rigid_count == 1
     assert abs(res.frequencies_hz[1] / exact - 1) < 1e-5
+
+
+def test_tie_rod_axial_mode(stiff_block):
+    """A tie rod (beam) from a grounded node to a 10 kg mass free only along the rod: the rod-with-tip-mass
+    frequency beta c / L, beta tan beta = m_rod / m_tip (Rayleigh: one element is within ~1e-4)."""
+    L, d, m_tip = 0.3, 0.02, 10.0
+    sec = CircularSection(d)
+    ground = np.diag([1e14] * 6)
+    slide = np.diag([0.0] + [1e14] * 5)                    # free along x only
+    system = cp.couple(stiff_block, [], [cp.spring("a", None, ground), cp.spring("b", None, slide),
+                                         cp.point_mass("b", np.diag([m_tip] * 3 + [0.0] * 3))],
+                       tie_rods=[cp.TieRod("a", "b", sec)], extra_nodes={"a": (0.0, 0.0, 0.3), "b": (L, 0.0, 0.3)})
+    res = modal.solve_modes(system.K, system.M, 1000.0)
+    steel = Shaft.stepped([(L, d)]).material
+    ratio = steel.rho * sec.area * L / m_tip
+    beta = brentq(lambda b: b * math.tan(b) - ratio, 1e-6, 1.0)
+    exact = beta * math.sqrt(steel.E / steel.rho) / L / (2 * math.pi)
+    assert res.rigid_count == 6 and len(res.eigenvalues) == 7      # the free block's six + the rod
+    assert abs(res.frequencies_hz[6] / exact - 1) < 1e-3
 
 
 def test_direct_harmonic_with_nonsymmetric_bearing(stiff_block):
