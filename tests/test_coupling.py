@@ -64,6 +64,19 @@ def test_rigid_block_on_spring_has_analytic_frequencies(stiff_block, kind):
     assert np.max(np.abs(f / exact - 1)) < 1e-5
 
 
+def test_rbe2_bore_follows_master_in_fe_vector(stiff_block):
+    """Map back to the FE model: on the bore, the housing displacement of a mode is u_m + theta_m x r."""
+    con = cp.BoreConnection("bore", "bottom", BOTTOM_CENTRE, (0, 0, 1), "rbe2")
+    system = cp.couple(stiff_block, [con], [cp.spring("bore", None, K_SPRING)])
+    q = modal.solve_modes(system.K, system.M, 200.0).vectors[2]
+    u = system.fe_vector(q, stiff_block.V).getArray().reshape(-1, 3)
+    um = system.node_displacement(q, "bore")
+    nodes, _ = cp.surface_nodes(stiff_block, "bottom")
+    x = stiff_block.V.tabulate_dof_coordinates()[nodes]
+    expected = um[:3] + np.cross(um[3:], x - np.asarray(BOTTOM_CENTRE))
+    assert np.allclose(u[nodes], expected, rtol=0, atol=1e-12 * np.abs(expected).max())
+
+
 def test_rbe3_reproduces_rigid_motions_exactly():
     rng = np.random.default_rng(1)
     r, w = rng.normal(size=(12, 3)), rng.uniform(0.1, 1.0, 12)
