@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from housingfe.errors import InputError
 from housingfe.published import THESIS, row, thesis
 from housingfe.scene import builtin_scenes, load_housing_scene
 
@@ -70,7 +71,7 @@ def default_scenes() -> list[str]:
     for name in builtin_scenes():
         try:
             scene, _ = load_housing_scene(name)
-        except Exception:  # source scenes and the like
+        except InputError:  # source scenes
             continue
         if scene.reference is not None:
             out.append(name)

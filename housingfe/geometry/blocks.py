@@ -8,6 +8,7 @@ boundary faces are classified by their position so tags are exact, not found by 
 """
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from typing import Callable, Sequence
@@ -115,7 +116,7 @@ class BlockModel:
         cuts = [p for p in planes if bore.span[0] < p < bore.span[1]]
         stations = [bore.span[0], *cuts, bore.span[1]]
         segments: list[tuple[float, float]] = []
-        for a, b in zip(stations[:-1], stations[1:]):
+        for a, b in itertools.pairwise(stations):
             mid = np.array(bore.centre, dtype=float)
             mid[bore.axis] = (a + b) / 2
             if not self.in_cells(mid):
@@ -260,7 +261,7 @@ def merged_boxes(cells: dict[tuple[int, int, int], str],
         name = free[start]
         i0, j0, k0 = start
 
-        def all_free(i_range, j_range, k_range):
+        def all_free(i_range, j_range, k_range, name=name):
             return all(free.get((i, j, k)) == name for i in i_range for j in j_range for k in k_range)
 
         i1 = i0 + 1

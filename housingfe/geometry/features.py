@@ -16,8 +16,8 @@ Tag rules of `assemble` (the same for every housing):
 """
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Iterable, Sequence
 
 import numpy as np
 

@@ -18,8 +18,8 @@ from housingfe.geometry.blocks import BlockModel
 from housingfe.geometry.features import (
     Part,
     assemble,
-    box_part,
     bore_through,
+    box_part,
     face_grid_points,
     face_patch,
     rim_parts,

@@ -4,7 +4,7 @@ Each geometry kind has a spec here and a block-model builder registered in housi
 """
 from __future__ import annotations
 
-from typing import Annotated, Literal, Optional, Union
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, model_validator
 
@@ -146,8 +146,8 @@ class GearboxGeometry(_Strict):
     split_height: PositiveFloat
     bearing_plate: BearingPlateSpec
     bores: list[BoreSpec] = []
-    rim: Optional[RimSpec] = None
-    feet: Optional[FeetSpec] = None
+    rim: RimSpec | None = None
+    feet: FeetSpec | None = None
     excitation_patch_size: PositiveFloat = 0.010
 
     @model_validator(mode="after")
@@ -185,7 +185,7 @@ class GearboxGeometry(_Strict):
 
 
 # A new geometry kind: add its spec to this union and its builder to housingfe.geometry.mesh.block_model_for.
-Geometry = Annotated[Union[BoxGeometry, PlateGeometry, BoxHalvesGeometry, GearboxGeometry],
+Geometry = Annotated[BoxGeometry | PlateGeometry | BoxHalvesGeometry | GearboxGeometry,
                      Field(discriminator="kind")]
 
 

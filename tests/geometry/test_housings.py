@@ -191,3 +191,15 @@ def test_stiff_joint_layer_converges_to_monolithic():
     assert n >= 4 and steel.rigid_count == soft.rigid_count == 6
     assert np.allclose(steel_f[:n], mono[:n], rtol=3e-3)
     assert np.all(soft_f[:n] < steel_f[:n])
+
+
+def test_feet_on_a_base_do_not_radiate(comm):
+    """test-gearbox: feet bolted to the base, so their contact faces and bolt patches leave `outer`."""
+    from housingfe.geometry import build_mesh
+
+    g = load_scene("test-gearbox").geometry
+    hm = build_mesh(g, "tet", 0.04, 1, comm)
+    outer = set(hm.facets("outer"))
+    assert len(hm.facets("foot_bottom")) > 0 and not set(hm.facets("foot_bottom")) & outer
+    assert _area(hm, "foot_bottom", comm) == pytest.approx(2 * g.length * g.feet.width, rel=1e-10)
+    assert len(hm.facets("foot_bolts")) > 0 and set(hm.facets("foot_bolts")) <= set(hm.facets("foot_bottom"))
