@@ -184,7 +184,6 @@ class CoupledSystem:
     nodes: dict
     symmetric: bool
     timings: dict = field(default_factory=dict)
-    rigid_modes_expected: int | None = None
 
     @property
     def size(self) -> int:
