@@ -35,7 +35,8 @@ PACKAGE = Path(__file__).parent
 # the sources a modal result depends on: a result older than any of them is recomputed
 MODAL_SOURCES = ("geometry", "solvers", "model.py", "scene.py", "run.py", "materials.py", "published.py", "data")
 # modules whose published_rows() join the table when they exist
-ROW_PROVIDERS = ("housingfe.bearings.validation", "housingfe.radiation.validation", "housingfe.source.validation")
+ROW_PROVIDERS = ("housingfe.bearings.validation", "housingfe.radiation.validation", "housingfe.source.validation",
+                 "housingfe.radiation", "housingfe.source", "housingfe.response", "housingfe.coupling")
 # Appendix E tables that a gearbox scene's reconstruction is checked against
 APPENDIX_E = {"gearbox-model": "scale_model", "test-gearbox": "test_gearbox"}
 
