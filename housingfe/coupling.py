@@ -332,7 +332,10 @@ def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_
     # out on one sparsity pattern, which the solvers need (they add K and M with SAME_NONZERO_PATTERN).
     # Pt as CSR and products grouped as Pt @ (Z @ P): all CSR, no CSC conversion of the big matrix.
     Pt = P.T.tocsr()
-    Zc = Pt @ (_pad(_complex(K_fe, M_fe), n_full) @ P)
+    if eliminated[:n_fe].any():
+        Zc = Pt @ (_pad(_complex(K_fe, M_fe), n_full) @ P)
+    else:   # P is the identity on the FE DOFs (rbe3, star): the FE block passes through untouched
+        Zc = _pad(_complex(K_fe, M_fe), len(independent))
     if Kx or Mx:
         Zc = Zc + Pt @ ((Kx.matrix(n_full) + 1j * Mx.matrix(n_full)) @ P)
     Zc.sort_indices()
