@@ -241,15 +241,15 @@ def test_harmonic_solvers_on_coupled_system(stiff_block):
 
 
 def test_direct_harmonic_with_nonsymmetric_bearing(stiff_block):
-    """Non-symmetric K and C (fluid film) on the master: the direct solver (LU via its options prefix) agrees with
-    a dense complex solve of (K + i w C - w^2 M) q = f."""
+    """A journal bearing (Ocvirk short bearing: non-symmetric K, cross-coupled C) plus K_SPRING on the master:
+    the direct solver (LU via its options prefix) agrees with a dense complex solve of (K + i w C - w^2 M) q = f."""
     from petsc4py import PETSc
 
-    Kb = K_SPRING.copy()
-    Kb[0, 1], Kb[1, 0], Kb[2, 4] = 4e5, -3e5, 2e3        # cross-coupled, non-symmetric film stiffness
-    Cb = 50.0 * np.diag([1, 2, 3, 0.01, 0.01, 0.01]) + 10.0 * np.triu(np.ones((6, 6)), 1)
+    from housingfe.bearings import JournalBearing, short_bearing_coefficients
+
+    film = short_bearing_coefficients(JournalBearing(0.05, 0.025, 50e-6, 0.02), 300.0, (0.0, -1000.0))
     con = cp.BoreConnection("bore", "bottom", BOTTOM_CENTRE, (0, 0, 1), "rbe3")
-    system = cp.couple(stiff_block, [con], [cp.spring("bore", None, Kb, Cb)])
+    system = cp.couple(stiff_block, [con], [cp.bearing("bore", None, K_SPRING + film.K, (0, 0, 1), film.C)])
     assert not system.symmetric
     f = system.load(node_loads={"bore": [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]})
     freqs = np.array([60.0, 90.0])
