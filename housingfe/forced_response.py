@@ -35,6 +35,8 @@ def damping_model(scene, model) -> harmonic.Damping:
         t = spec.loss_factor_bands
         logf, vals = np.log(t.frequencies), np.asarray(t.values, float)
         return harmonic.Damping(lambda f: np.interp(np.log(f), logf, vals))
+    if spec.modal_damping_ratios is not None:
+        return harmonic.Damping(lambda f: np.zeros(np.shape(f)), modal_ratios=tuple(spec.modal_damping_ratios))
     if spec.modal_damping_ratio is not None:
         return harmonic.Damping(lambda f: np.zeros(np.shape(f)), modal_ratio=spec.modal_damping_ratio)
     D = _material_damping_matrix(model)
@@ -64,6 +66,11 @@ def _max():
 def choose_solver(spec, damping: harmonic.Damping) -> list[str]:
     """Solvers to run: 'auto' is modal for proportional damping, direct when a non-proportional damping
     matrix is present."""
+    if damping.modal_ratios and spec.solver in ("direct", "both"):
+        from housingfe.errors import InputError
+
+        raise InputError("damping.modal_damping_ratios: per-mode damping exists only in the modal solver; "
+                         "use solver = \"modal\" or a loss factor")
     if spec.solver == "both":
         return ["modal", "direct"]
     if spec.solver == "auto":

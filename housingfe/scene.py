@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import tomllib
 from pathlib import Path
-from typing import Literal, Optional
+from typing import Annotated, Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, ValidationError, model_validator
 
@@ -124,12 +124,15 @@ class DampingSpec(_Strict):
     loss_factor: Optional[float] = Field(None, ge=0.0, lt=1.0)
     loss_factor_bands: Optional[Spectrum] = None
     modal_damping_ratio: Optional[float] = Field(None, ge=0.0, lt=0.5)
+    # per elastic mode, in ascending order; modes beyond the list take its last value
+    modal_damping_ratios: Optional[list[Annotated[float, Field(ge=0.0, lt=0.5)]]] = Field(None, min_length=1)
 
     @model_validator(mode="after")
     def _one(self):
-        given = [x is not None for x in (self.loss_factor, self.loss_factor_bands, self.modal_damping_ratio)]
+        given = [x is not None for x in (self.loss_factor, self.loss_factor_bands, self.modal_damping_ratio,
+                                         self.modal_damping_ratios)]
         if sum(given) > 1:
-            raise ValueError("loss_factor: give only one of loss_factor, loss_factor_bands, modal_damping_ratio")
+            raise ValueError("loss_factor: give only one of loss_factor, loss_factor_bands, modal_damping_ratio(s)")
         return self
 
 

@@ -39,8 +39,20 @@ class Damping:
     eta: EtaFunction
     modal_ratio: float | None = None
     D: PETSc.Mat | None = None
+    modal_ratios: tuple | None = None   # per elastic mode (ascending); the last value repeats
+
+    def ratios(self, n_modes: int) -> np.ndarray | None:
+        """Viscous xi of each of n_modes elastic modes, or None for hysteretic damping."""
+        if self.modal_ratios:
+            r = np.asarray(self.modal_ratios, float)
+            return np.concatenate([r[:n_modes], np.full(max(0, n_modes - len(r)), r[-1])])
+        if self.modal_ratio is not None:
+            return np.full(n_modes, self.modal_ratio)
+        return None
 
     def hysteretic(self, f: np.ndarray) -> np.ndarray:
+        if self.modal_ratios:   # direct solver: eta = 2 xi of the first mode (documented approximation)
+            return np.full(np.shape(f), 2.0 * self.modal_ratios[0])
         if self.modal_ratio is not None:
             return np.full(np.shape(f), 2.0 * self.modal_ratio)
         return self.eta(np.asarray(f, dtype=float))
@@ -78,13 +90,13 @@ def modal_superposition(K, M, modal_result, loads, frequencies, damping: Damping
     rigid, elastic = phis[:n_rigid], phis[n_rigid:]
     lam_e = lam[n_rigid:]
     eta = damping.hysteretic(frequencies)
-    if damping.D is not None and damping.modal_ratio is None:
+    xi = damping.ratios(len(lam_e))
+    if damping.D is not None and xi is None:
         eta_modal = np.array([phi.dot(_mult(damping.D, phi)) / l for phi, l in zip(elastic, lam_e)])
         denominators = lam_e[:, None] * (1 + 1j * eta_modal[:, None]) - omega[None, :] ** 2
-    elif damping.modal_ratio is not None:
+    elif xi is not None:
         w_n = np.sqrt(lam_e)
-        denominators = (lam_e[:, None] - omega[None, :] ** 2
-                        + 2j * damping.modal_ratio * w_n[:, None] * omega[None, :])
+        denominators = lam_e[:, None] - omega[None, :] ** 2 + 2j * xi[:, None] * w_n[:, None] * omega[None, :]
     else:
         denominators = lam_e[:, None] * (1 + 1j * eta[None, :]) - omega[None, :] ** 2
     _check_not_singular(denominators, lam_e, frequencies)
@@ -102,7 +114,7 @@ def modal_superposition(K, M, modal_result, loads, frequencies, damping: Damping
         if residual:
             r = _residual_vector(ksp, M, f, rigid, elastic, lam_e, shift)
             basis.append(r)
-            damp = 1.0 / (1 + 1j * eta) if damping.modal_ratio is None else np.ones_like(omega)
+            damp = 1.0 / (1 + 1j * eta) if xi is None else np.ones_like(omega)
             c.append(damp[None, :])
         blocks.append([Block(reduce(basis), np.vstack(c), every)])
         kept.append(basis)
