@@ -238,95 +238,12 @@ def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_
     t0 = time.perf_counter()
     K_fe, M_fe = _to_scipy(model.K), _to_scipy(model.M)
     n_fe = K_fe.shape[0]
-    constrained = _dirichlet_dofs(model)
-
-    nodes, order = {}, []          # name -> (position, full offset)
-
-    def add_node(name, position):
-        if name in nodes:
-            raise InputError(f"coupling: node name {name!r} used twice")
-        nodes[name] = (np.asarray(position, float), n_fe + 6 * len(order))
-        order.append(name)
-
-    for c in connections:
-        add_node(c.name, c.centre)
-    for sname, shaft in (shafts or {}).items():
-        for i, x in enumerate(shaft.nodes):
-            add_node(f"{sname}:{i}", x)
-    for name, x in (extra_nodes or {}).items():
-        add_node(name, x)
-    n_full = n_fe + 6 * len(order)
-
-    # Extra stiffness / mass / damping in the full space, as COO triplets.
-    Kx, Mx, Cx = _Triplets(), _Triplets(), _Triplets()
-    for sname, shaft in (shafts or {}).items():
-        ks, ms = shaft.matrices()
-        idx = np.concatenate([_node_dofs(nodes, f"{sname}:{i}") for i in range(len(shaft.nodes))])
-        Kx.add(idx, idx, ks)
-        Mx.add(idx, idx, ms)
-    for e in list(elements) + [_gear_element(g, nodes) for g in gear_meshes] + [_tie_rod(t, nodes)
-                                                                                for t in tie_rods]:
-        idx = _element_dofs(e, nodes)
-        for trip, mat in ((Kx, e.K), (Mx, e.M), (Cx, e.C)):
-            if mat is not None:
-                mat = np.asarray(mat, float)
-                if mat.shape[0] == 6 * len(e.nodes) and len(idx) < mat.shape[0]:
-                    keep = np.concatenate([np.arange(6 * j, 6 * j + 6) for j, n in enumerate(e.nodes)
-                                           if n is not None])
-                    mat = mat[np.ix_(keep, keep)]
-                trip.add(idx, idx, mat)
-
-    # The transformation u_full = P q.
+    nodes = _register_nodes(n_fe, connections, shafts, extra_nodes)
+    n_full = n_fe + 6 * len(nodes)
+    Kx, Mx, Cx = _extra_matrices(nodes, shafts, list(elements) + [_gear_element(g, nodes) for g in gear_meshes]
+                                 + [_tie_rod(t, nodes) for t in tie_rods])
     t1 = time.perf_counter()
-    coords = model.V.tabulate_dof_coordinates()          # one row per FE node (blocked DOF index)
-    rows, cols, vals = [], [], []
-    eliminated = np.zeros(n_full, bool)
-    dependent = {}                  # full DOF -> (list of (full column, value)) for rbe3 masters
-    slaves_used = np.zeros(n_fe, bool)
-    for c in connections:
-        node_ids, w = surface_nodes(model, c.surface)
-        dofs = (3 * node_ids[:, None] + np.arange(3)[None, :]).ravel()
-        if np.any(constrained[dofs]):
-            raise InputError(f"connection {c.name}: surface {c.surface!r} has Dirichlet-constrained DOFs")
-        if np.any(slaves_used[dofs]):
-            raise InputError(f"connection {c.name}: surface {c.surface!r} shares nodes with another connection")
-        slaves_used[dofs] = True
-        r = coords[node_ids] - np.asarray(c.centre, float)
-        moff = nodes[c.name][1]
-        if c.kind == "rbe2":
-            arms = np.stack([rigid_arm(ri) for ri in r])                        # (N, 3, 6)
-            for k in range(6):
-                rows.append(dofs)
-                cols.append(np.full(len(dofs), moff + k))
-                vals.append(arms[:, :, k].ravel())
-            eliminated[dofs] = True
-        elif c.kind == "rbe3":
-            # nodes of zero weight (P2 triangle vertices) have zero columns in R: leaving them out keeps
-            # explicit zeros out of P and of the (dense, rank-6) coupling block of the spring
-            used = np.abs(w) > 1e-12 * np.abs(w).max()
-            R = rbe3_matrix(r[used], w[used])                                     # (6, 3N)
-            used_dofs = dofs.reshape(-1, 3)[used].ravel()
-            for k in range(6):
-                dependent[moff + k] = (used_dofs, R[k])
-            eliminated[moff:moff + 6] = True
-        else:
-            _star_rods(Kx, dofs, moff, r, c.rod_stiffness)
-
-    independent = np.flatnonzero(~eliminated)
-    col_of = np.full(n_full, -1)
-    col_of[independent] = np.arange(len(independent))
-    # identity part for independent DOFs
-    rows.append(independent)
-    cols.append(independent)
-    vals.append(np.ones(len(independent)))
-    r_all, c_all, v_all = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
-    for moff_k, (dofs, coef) in dependent.items():
-        r_all = np.concatenate([r_all, np.full(len(dofs), moff_k)])
-        c_all = np.concatenate([c_all, dofs])
-        v_all = np.concatenate([v_all, coef])
-    if np.any(col_of[c_all] < 0):
-        raise InputError("coupling: a constraint refers to an eliminated DOF (chained constraints)")
-    P = sp.csr_matrix((v_all, (r_all, col_of[c_all])), shape=(n_full, len(independent)))
+    P, eliminated = _transformation(model, connections, nodes, n_full, Kx)
 
     # K and M in one complex product, Z = K + i M: P is real, so P^T Z P = K_c + i M_c, and K_c, M_c come
     # out on one sparsity pattern, which the solvers need (they add K and M with SAME_NONZERO_PATTERN).
@@ -335,7 +252,7 @@ def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_
     if eliminated[:n_fe].any():
         Zc = Pt @ (_pad(_complex(K_fe, M_fe), n_full) @ P)
     else:   # P is the identity on the FE DOFs (rbe3, star): the FE block passes through untouched
-        Zc = _pad(_complex(K_fe, M_fe), len(independent))
+        Zc = _pad(_complex(K_fe, M_fe), P.shape[1])
     if Kx or Mx:
         Zc = Zc + Pt @ ((Kx.matrix(n_full) + 1j * Mx.matrix(n_full)) @ P)
     Zc.sort_indices()
@@ -353,6 +270,86 @@ def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_
     return CoupledSystem(K, M, C, P, n_fe, nodes, symmetric,
                          {"couple_s": t3 - t0, "extra_assembly_s": t1 - t0, "transform_s": t2 - t1,
                           "to_petsc_s": t3 - t2})
+
+
+def _register_nodes(n_fe: int, connections, shafts, extra_nodes) -> dict:
+    """name -> (position (m), offset of its 6 DOFs in the full vector): masters, shaft nodes, free nodes."""
+    nodes = {}
+    named = [(c.name, c.centre) for c in connections]
+    for sname, shaft in (shafts or {}).items():
+        named += [(f"{sname}:{i}", x) for i, x in enumerate(shaft.nodes)]
+    named += list((extra_nodes or {}).items())
+    for name, position in named:
+        if name in nodes:
+            raise InputError(f"coupling: node name {name!r} used twice")
+        nodes[name] = (np.asarray(position, float), n_fe + 6 * len(nodes))
+    return nodes
+
+
+def _extra_matrices(nodes: dict, shafts, elements) -> tuple:
+    """Stiffness, mass and damping of the shafts and lumped elements in the full space (COO triplets)."""
+    Kx, Mx, Cx = _Triplets(), _Triplets(), _Triplets()
+    for sname, shaft in (shafts or {}).items():
+        ks, ms = shaft.matrices()
+        idx = np.concatenate([_node_dofs(nodes, f"{sname}:{i}") for i in range(len(shaft.nodes))])
+        Kx.add(idx, idx, ks)
+        Mx.add(idx, idx, ms)
+    for e in elements:
+        idx = _element_dofs(e, nodes)
+        # ground ends (None) carry no DOFs: keep the rows/columns of the real nodes only
+        keep = np.concatenate([np.arange(6 * j, 6 * j + 6) for j, n in enumerate(e.nodes) if n is not None])
+        for trip, mat in ((Kx, e.K), (Mx, e.M), (Cx, e.C)):
+            if mat is not None:
+                mat = np.asarray(mat, float)
+                trip.add(idx, idx, mat[np.ix_(keep, keep)] if mat.shape[0] == 6 * len(e.nodes) else mat)
+    return Kx, Mx, Cx
+
+
+def _transformation(model, connections, nodes: dict, n_full: int, Kx) -> tuple[sp.csr_matrix, np.ndarray]:
+    """P (u_full = P q) from the bore connections and the mask of eliminated full DOFs; star rods go into Kx."""
+    n_fe = model.K.getSize()[0]
+    constrained = _dirichlet_dofs(model)
+    coords = model.V.tabulate_dof_coordinates()          # one row per FE node (blocked DOF index)
+    rows, cols, vals = [], [], []
+    eliminated = np.zeros(n_full, bool)
+    slaves_used = np.zeros(n_fe, bool)
+    for c in connections:
+        node_ids, w = surface_nodes(model, c.surface)
+        dofs = (3 * node_ids[:, None] + np.arange(3)[None, :]).ravel()
+        if np.any(constrained[dofs]):
+            raise InputError(f"connection {c.name}: surface {c.surface!r} has Dirichlet-constrained DOFs")
+        if np.any(slaves_used[dofs]):
+            raise InputError(f"connection {c.name}: surface {c.surface!r} shares nodes with another connection")
+        slaves_used[dofs] = True
+        r = coords[node_ids] - np.asarray(c.centre, float)
+        mdofs = _node_dofs(nodes, c.name)
+        if c.kind == "rbe2":          # slave rows: u_s = [I, -[r]x] (u_m, theta_m)
+            arms = np.stack([rigid_arm(ri) for ri in r])                        # (N, 3, 6)
+            rows.append(np.repeat(dofs, 6))
+            cols.append(np.tile(mdofs, len(dofs)))
+            vals.append(arms.reshape(-1, 6).ravel())
+            eliminated[dofs] = True
+        elif c.kind == "rbe3":        # master rows: (u_m, theta_m) = R u_s
+            # nodes of zero weight (P2 triangle vertices) have zero columns in R: leaving them out keeps
+            # explicit zeros out of P and of the (dense, rank-6) coupling block of the spring
+            used = np.abs(w) > 1e-12 * np.abs(w).max()
+            R = rbe3_matrix(r[used], w[used])                                     # (6, 3N)
+            used_dofs = dofs.reshape(-1, 3)[used].ravel()
+            rows.append(np.repeat(mdofs, len(used_dofs)))
+            cols.append(np.tile(used_dofs, 6))
+            vals.append(R.ravel())
+            eliminated[mdofs] = True
+        else:
+            _star_rods(Kx, dofs, mdofs[0], r, c.rod_stiffness)
+    independent = np.flatnonzero(~eliminated)
+    col_of = np.full(n_full, -1)
+    col_of[independent] = np.arange(len(independent))
+    r_all = np.concatenate(rows + [independent])
+    c_all = np.concatenate(cols + [independent])
+    v_all = np.concatenate(vals + [np.ones(len(independent))])
+    if np.any(col_of[c_all] < 0):
+        raise InputError("coupling: a constraint refers to an eliminated DOF (chained constraints)")
+    return sp.csr_matrix((v_all, (r_all, col_of[c_all])), shape=(n_full, len(independent))), eliminated
 
 
 def rbe3_matrix(r: np.ndarray, w: np.ndarray) -> np.ndarray:
