@@ -425,6 +425,8 @@ def sound_power_rows(forced) -> list:
 def write_sound_power(folder: Path, forced, pictures: bool) -> None:
     """sound_power.csv and, with pictures, sound_power.png (L_sigma over frequency and L_W per band)."""
     rows = sound_power_rows(forced)
+    if forced.sound_power[0].foller is not None:
+        write_json(folder / "foller.json", forced.sound_power[0].foller)
     write_csv(folder / "sound_power.csv", ["load_case", "model", "kind", "band_center_hz", "Lv_dB",
                                           "Lsigma_dB", "Lw_dB", "LwA_dB"], rows)
     if not pictures:

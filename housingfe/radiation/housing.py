@@ -25,6 +25,7 @@ class HousingSoundPower:
     radiation_index_db: np.ndarray
     spectrum: SoundPowerSpectrum
     plates: tuple = ()
+    foller: dict | None = None   # Appendix E quantities of the housing's own plates
 
 
 def housing_plates(model, spec) -> list[Plate]:
@@ -69,12 +70,19 @@ def sound_power(forced, model, plate_ids=None) -> list[HousingSoundPower]:
         if spec.model == "erp":
             L_sigma = np.zeros(len(f))
         elif spec.model == "foller":
-            L_sigma = foller_radiation_index(plates, f).L_sigma_db
+            fr = foller_radiation_index(plates, f)
+            L_sigma = fr.L_sigma_db
         else:
             L_sigma = _rayleigh_index(resp, forced.observer.extra_samples[RADIATION_POINTS], plate_ids)
         spectrum = sound_power_spectrum(f, resp.velocity_level_db, area, L_sigma, f_min=max(f.min(), 10.0),
                                         f_max=f.max())
-        out.append(HousingSoundPower(resp.name, spec.model, L_sigma, spectrum, tuple(plates)))
+        facts = None
+        if spec.model == "foller":
+            facts = {k: getattr(fr, k) for k in ("S_mean", "U_mean", "fc_mean", "sigma_P", "point_P_dB",
+                                                  "zero_dB_crossing_hz", "compactness_lhs", "is_compact")}
+            facts["plates"] = [{"surface": p.name, "count": p.count, "area_m2": p.area_m2, "perimeter_m": p.perimeter_m,
+                                "thickness_m": p.thickness_m, "fc_hz": p.fc_hz} for p in plates]
+        out.append(HousingSoundPower(resp.name, spec.model, L_sigma, spectrum, tuple(plates), facts))
     return out
 
 
