@@ -291,3 +291,58 @@ def test_gearbox_with_real_bores(comm):
     res = modal.solve_modes(system.K, system.M, 600.0)
     assert res.rigid_count == 7 and res.complete
     assert system.symmetric
+
+
+SPEC = """
+[[bores]]
+name = "bore"
+surface = "bottom"
+axis = [0.0, 0.0, 1.0]
+kind = "rbe3"
+
+[[bearings]]
+shaft_node = "bore"          # the master itself, to ground
+axis = [0.0, 0.0, 1.0]
+stiffness = [1e6, 2e6, 3e6, 1e4, 2e4, 0.5e4]
+
+[[shafts]]
+name = "s"
+origin = [0.1, 0.05, -0.3]
+axis = [0.0, 0.0, 1.0]
+segments = [[0.1, 0.02], [0.1, 0.02]]
+elements_per_segment = 2
+discs = [{ node = 2, outer_diameter = 0.05, width = 0.01 }]
+
+[[bearings]]
+shaft_node = "s:0"
+designation = "SKF 6312"
+load = [5000.0, 0.0, 0.0, 0.0, 0.0]
+
+[[tie_rods]]
+a = "s:4"
+b = "bore"
+diameter = 0.01
+"""
+
+
+def test_scene_section(stiff_block):
+    """The [coupling] section: the block part of the model gives the spring-mass answer (bottom-face centre from
+    the surface's bounding box; the bearing() frame frees the spin, so one rigid mode), shafts, bearings from the
+    catalogue and tie rods are built; unknown keys are errors that name the key."""
+    import tomllib
+
+    spec = tomllib.loads(SPEC)
+    only_block = {"bores": spec["bores"], "bearings": spec["bearings"][:1]}
+    system = cp.couple_from_spec(stiff_block, only_block)
+    assert np.allclose(system.nodes["bore"][0], BOTTOM_CENTRE)
+    res = modal.solve_modes(system.K, system.M, 200.0)
+    f = res.frequencies_hz
+    k6 = K_SPRING.copy()
+    k6[5, 5] = 0.0
+    exact = rigid_block_frequencies(k6 + 1e-9 * np.eye(6), BOTTOM_CENTRE)
+    assert res.rigid_count == 1 and np.max(np.abs(f[1:] / exact[1:] - 1)) < 1e-5
+    full = cp.couple_from_spec(stiff_block, spec)
+    assert {"s:0", "s:4"} <= set(full.nodes) and full.size == system.size + 30
+    bad = dict(spec, bores=[dict(spec["bores"][0], kindd="rbe2")])
+    with pytest.raises(InputError, match="kindd"):
+        cp.couple_from_spec(stiff_block, bad)

@@ -53,15 +53,6 @@ def _model(quick: bool):
     return model, f_max, time.perf_counter() - t0
 
 
-def bore_centre(model, surface: str) -> np.ndarray:
-    """Centre (m) of the bounding box of a bore surface's nodes: on the axis, mid-plate."""
-    from housingfe.coupling import surface_nodes
-
-    nodes, _ = surface_nodes(model, surface)
-    x = model.V.tabulate_dof_coordinates()[nodes]
-    return (x.min(axis=0) + x.max(axis=0)) / 2
-
-
 def gearbox_parts(model, kind: str, rod_stiffness: float | None = None) -> dict:
     """Connections, shafts, bearings, gears and the gear mesh of the benchmark (keyword arguments of couple)."""
     from housingfe import coupling as cp
@@ -69,7 +60,7 @@ def gearbox_parts(model, kind: str, rod_stiffness: float | None = None) -> dict:
     from housingfe.shafts import RigidDisc, Shaft
 
     axis = np.array([0.0, 1.0, 0.0])
-    centres = {(s, side): bore_centre(model, f"bore_{s}_{side}") for s, side in BORES}
+    centres = {(s, side): cp.surface_centre(model, f"bore_{s}_{side}") for s, side in BORES}
     connections = [cp.BoreConnection(f"{s}_{side}", f"bore_{s}_{side}", tuple(centres[s, side]), tuple(axis), kind,
                                      rod_stiffness) for s, side in BORES]
     shafts, elements = {}, []
