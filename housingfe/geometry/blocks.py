@@ -317,7 +317,7 @@ def _classify_boundary(model: BlockModel) -> dict[str, list[int]]:
         if gmsh.model.getType(2, abs(tag)) != "Plane":
             names = _bore_of_face(abs(tag), model)
         else:
-            centre = np.array(gmsh.model.occ.getCenterOfMass(2, abs(tag)))
+            centre = _point_on_face(abs(tag))
             names = tuple(model.classify_face(centre, _outward_normal(abs(tag), centre, model)))
         atomic.setdefault(names, []).append(abs(tag))
     facet_groups: dict[str, list[int]] = {}
@@ -327,6 +327,30 @@ def _classify_boundary(model: BlockModel) -> dict[str, list[int]]:
         for name in names:
             facet_groups.setdefault(name, []).append(n)
     return facet_groups
+
+
+def _point_on_face(face: int, samples: int = 24) -> np.ndarray:
+    """A point on a plane face (m): its centre of mass if that lies on the face (always for the rectangles
+    of a plain block model), else the sample of a parametric grid nearest to it that does (a face with a
+    hole, or an L-shaped one, can have its centre of mass off the face, where tests of the material on
+    either side would look at the wrong place)."""
+    import gmsh
+
+    centre = np.array(gmsh.model.occ.getCenterOfMass(2, face))
+    uv = gmsh.model.getParametrization(2, face, list(centre))
+    if gmsh.model.isInside(2, face, list(uv)):
+        return centre
+    (u0, v0), (u1, v1) = gmsh.model.getParametrizationBounds(2, face)
+    best, best_d = centre, np.inf
+    for i in range(samples):
+        for j in range(samples):
+            p_uv = [u0 + (i + 0.5) * (u1 - u0) / samples, v0 + (j + 0.5) * (v1 - v0) / samples]
+            if gmsh.model.isInside(2, face, p_uv):
+                p = np.array(gmsh.model.getValue(2, face, p_uv))
+                d = float(np.linalg.norm(p - centre))
+                if d < best_d:
+                    best, best_d = p, d
+    return best
 
 
 def _bore_of_face(face: int, model: BlockModel) -> tuple[str, ...]:

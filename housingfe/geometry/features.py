@@ -87,10 +87,11 @@ def rim_parts(name: str, x: tuple[float, float], y: tuple[float, float], z: tupl
 
 
 def bore_through(name: str, x: float, z: float, diameter: float, y: tuple[float, float],
-                 groups: tuple[str, ...] = ()) -> Bore:
+                 groups: tuple[str, ...] = (), overshoot: tuple[float, float] = (1e-3, 1e-3)) -> Bore:
     """A bore along y (the shaft direction) with its axis at (x, z), through the material between y[0] and
-    y[1] (m); the cutting cylinder overshoots both faces by 1 mm."""
-    return Bore(name, (x, 0.5 * (y[0] + y[1]), z), 1, diameter / 2, (y[0] - 1e-3, y[1] + 1e-3), groups)
+    y[1] (m); the cutting cylinder overshoots the faces by `overshoot` (m; 0 where a cover closes it)."""
+    return Bore(name, (x, 0.5 * (y[0] + y[1]), z), 1, diameter / 2, (y[0] - overshoot[0], y[1] + overshoot[1]),
+                groups)
 
 
 def face_grid_points(lo: Vec, hi: Vec, n: int = 3) -> list[Vec]:

@@ -160,9 +160,12 @@ def gearbox_model(g) -> BlockModel:
     bores, points = [], {"bearing_centres": [], "response_points": []}
     for bore in g.bores:
         for side, y in (("front", (-W2 - proud, -W2 + t)), ("back", (W2 - t, W2 + proud))):
+            overshoot = ((0.0, 1e-3) if side == "front" else (1e-3, 0.0)) if g.covers else (1e-3, 1e-3)
             bores.append(bore_through(f"bore_{bore.name}_{side}", bore.x, zs, bore.diameter, y,
-                                      (f"bore_{bore.name}", "bores")))
+                                      (f"bore_{bore.name}", "bores"), overshoot))
             points["bearing_centres"].append((bore.x, (y[0] + y[1]) / 2, zs))
+    if g.covers is not None:
+        parts = cover_parts(g) + parts
     patches = []
     x_exc = sum(b.x for b in g.bores) / len(g.bores) if g.bores else 0.0
     exc = (x_exc, -W2 - proud, zs)
@@ -181,7 +184,23 @@ def gearbox_model(g) -> BlockModel:
                                  + face_grid_points((-L2, -W2, H), (L2, W2, H), 3)
                                  + face_grid_points((-L2, -W2, 0.0), (-L2, W2, H), 2))
     thin = [t, bp.thickness] + ([g.feet.thickness] if g.feet else []) + ([g.rim.width] if g.rim else [])
-    return assemble(parts, [cavity], patches, bores, thin=thin, points=points)
+    cavities = [cavity] + ([Part("bore", (b.centre[0] - b.radius, b.span[0], b.centre[2] - b.radius),
+                                 (b.centre[0] + b.radius, b.span[1], b.centre[2] + b.radius)) for b in bores]
+                           if g.covers is not None else [])
+    return assemble(parts, cavities, patches, bores, thin=thin, points=points)
+
+
+def cover_parts(g) -> list[Part]:
+    """Square bearing covers on the outside of the bearing plates (spec g.covers), one per bore and side."""
+    W2, zs, c = g.width / 2, g.split_height, g.covers
+    proud = g.bearing_plate.thickness - g.wall_thickness
+    out = []
+    for bore in g.bores:
+        half = bore.diameter / 2 + c.margin
+        x, z = (bore.x - half, bore.x + half), (zs - half, zs + half)
+        out += [box_part(f"cover_{bore.name}_front", x, (-W2 - proud - c.thickness, -W2 - proud), z),
+                box_part(f"cover_{bore.name}_back", x, (W2 + proud, W2 + proud + c.thickness), z)]
+    return out
 
 
 def foot_bolt_centres(g) -> list[tuple[float, float]]:

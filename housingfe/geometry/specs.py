@@ -4,6 +4,7 @@ Each geometry kind has a spec here and a block-model builder registered in housi
 """
 from __future__ import annotations
 
+import itertools
 from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, model_validator
@@ -132,6 +133,15 @@ class FeetSpec(_Strict):
     bolt_patch_size: PositiveFloat = 0.024
 
 
+class CoverSpec(_Strict):
+    """Bearing covers (m): a square plate of `thickness` on the outside of each bore, reaching `margin`
+    beyond the bore all round (square, not round: the block grid; a round cover of diameter + 2 margin has
+    pi/4 of its area and mass)."""
+
+    thickness: PositiveFloat
+    margin: PositiveFloat = 0.010
+
+
 class GearboxGeometry(_Strict):
     """A welded gearbox housing without bottom plate (Sec. 4.5 model, Ch. 5 test gearbox), lengths in m.
 
@@ -148,6 +158,7 @@ class GearboxGeometry(_Strict):
     bores: list[BoreSpec] = []
     rim: RimSpec | None = None
     feet: FeetSpec | None = None
+    covers: CoverSpec | None = None
     excitation_patch_size: PositiveFloat = 0.010
 
     @model_validator(mode="after")
@@ -175,6 +186,12 @@ class GearboxGeometry(_Strict):
             if gap < t:
                 raise ValueError(f"bores: bore {name!r} leaves a ligament of {gap * 1e3:.1f} mm to the bearing "
                                  f"plate edge or the next bore (less than wall_thickness)")
+        if self.covers is not None:
+            ordered = sorted(self.bores, key=lambda b: b.x)
+            for a, b in itertools.pairwise(ordered):
+                if b.x - a.x - (a.diameter + b.diameter) / 2 <= 2 * self.covers.margin:
+                    raise ValueError(f"covers: margin {self.covers.margin} m makes the covers of bores "
+                                     f"{a.name!r} and {b.name!r} overlap")
         if self.rim is not None and self.rim.height >= bp.below + bp.above:
             raise ValueError("rim.height: taller than the bearing plate")
         return self

@@ -203,3 +203,30 @@ def test_feet_on_a_base_do_not_radiate(comm):
     assert len(hm.facets("foot_bottom")) > 0 and not set(hm.facets("foot_bottom")) & outer
     assert _area(hm, "foot_bottom", comm) == pytest.approx(2 * g.length * g.feet.width, rel=1e-10)
     assert len(hm.facets("foot_bolts")) > 0 and set(hm.facets("foot_bolts")) <= set(hm.facets("foot_bottom"))
+
+
+def test_covers_close_the_bores(comm):
+    """Square covers: exact added volume, their outer faces radiate, the disc of each cover that closes a
+    bore looks into the housing (inner), no face between cover and plate is left unglued."""
+    from housingfe.geometry import build_mesh
+    from housingfe.geometry.mesh import block_model_for
+
+    g = load_scene("gearbox-model", "geometry.covers={thickness=0.008, margin=0.010}").geometry
+    g0 = load_scene("gearbox-model").geometry
+    side = g.bores[0].diameter + 2 * g.covers.margin
+    assert block_model_for(g).volume() - block_model_for(g0).volume() == pytest.approx(
+        4 * side**2 * g.covers.thickness, rel=1e-12)
+    hm = build_mesh(g, "tet", 0.03, 1, comm)
+    cover_outer = side**2 + 4 * side * g.covers.thickness
+    for name in ("pinion", "wheel"):
+        for s in ("front", "back"):
+            assert _area(hm, f"outer_cover_{name}_{s}", comm) == pytest.approx(cover_outer, rel=1e-10)
+    hm0 = build_mesh(g0, "tet", 0.03, 1, comm)
+    discs = sum(2 * math.pi * (b.diameter / 2) ** 2 for b in g.bores)
+    # the discs are inscribed polygons in a straight-sided tet mesh: a few per cent less than the circles
+    assert 0.95 * discs < _area(hm, "inner", comm) - _area(hm0, "inner", comm) <= discs * (1 + 1e-9)
+    # everything else of the housing radiates as before, plus the covers, less the bearing plate faces
+    # they cover (square minus disc each; the open model's holes are polygons, slightly smaller than discs)
+    covered = 4 * (side**2 - math.pi * (g.bores[0].diameter / 2) ** 2)
+    expected_outer = _area(hm0, "outer", comm) + 4 * cover_outer - covered
+    assert 0.0 <= expected_outer - _area(hm, "outer", comm) < 0.05 * discs
