@@ -340,7 +340,11 @@ def _first_error(exc: ValidationError) -> str:
     # a misspelt key also shows up as a missing one: name the unknown key, it is the cause
     errors = sorted(exc.errors(), key=lambda e: e["type"] != "extra_forbidden")
     err = errors[0]
-    loc = ".".join(str(p) for p in err["loc"] if not (isinstance(p, str) and p in ("box", "plate")))
+    # pydantic puts the discriminator value of a union (geometry.<kind>.key) into the location: drop it
+    loc_parts = list(err["loc"])
+    if len(loc_parts) > 1 and loc_parts[0] == "geometry":
+        del loc_parts[1]
+    loc = ".".join(str(p) for p in loc_parts)
     msg = err["msg"]
     if err["type"] == "extra_forbidden":
         msg = "unknown key"

@@ -103,21 +103,23 @@ def modal_superposition(K, M, modal_result, loads, frequencies, damping: Damping
 
     shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
     ksp = _factor(_shifted(K, M, shift), "residual_") if residual else None
-    blocks, kept = [], []
     every = np.arange(len(omega))
-    for load in loads:
+    shared = list(rigid) + list(elastic)
+    residuals = [_residual_vector(ksp, M, load.vector, rigid, elastic, lam_e, shift) for load in loads] if residual else []
+    reduced = reduce(shared + residuals)   # one reduction for all load cases: modes are shared
+    damp = (1.0 / (1 + 1j * eta) if xi is None else np.ones_like(omega))[None, :]
+    blocks, kept = [], []
+    for j, load in enumerate(loads):
         f = load.vector
         p_rigid = np.array([phi.dot(f) for phi in rigid])
         p_el = np.array([phi.dot(f) for phi in elastic])
-        c = [p_rigid[:, None] / (-omega[None, :] ** 2), p_el[:, None] / denominators]
-        basis = list(rigid) + list(elastic)
+        c = np.zeros((len(shared) + len(residuals), len(omega)), dtype=complex)
+        c[:len(rigid)] = p_rigid[:, None] / (-omega[None, :] ** 2)
+        c[len(rigid):len(shared)] = p_el[:, None] / denominators
         if residual:
-            r = _residual_vector(ksp, M, f, rigid, elastic, lam_e, shift)
-            basis.append(r)
-            damp = 1.0 / (1 + 1j * eta) if xi is None else np.ones_like(omega)
-            c.append(damp[None, :])
-        blocks.append([Block(reduce(basis), np.vstack(c), every)])
-        kept.append(basis)
+            c[len(shared) + j] = damp[0]
+        blocks.append([Block(reduced, c, every)])
+        kept.append(shared + residuals)
     if ksp is not None:
         ksp.destroy()
     return HarmonicResult(np.asarray(frequencies, float), blocks, "modal+residual" if residual else "modal",
