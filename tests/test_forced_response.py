@@ -1,6 +1,5 @@
 """Forced response: analytic limits, modal+residual against direct, reciprocity, load resultants,
 band sums, sample points against the exact integral, singular undamped lines."""
-import math
 
 import numpy as np
 import pytest

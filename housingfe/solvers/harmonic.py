@@ -227,15 +227,9 @@ def _shifted(K, M, shift: float) -> PETSc.Mat:
 
 
 def _factor(A: PETSc.Mat, prefix: str) -> PETSc.KSP:
-    ksp = PETSc.KSP().create(A.getComm())
-    ksp.setOptionsPrefix(prefix)
-    ksp.setOperators(A)
-    ksp.setType("preonly")
-    pc = ksp.getPC()
-    pc.setType("cholesky")
-    pc.setFactorSolverType("mumps")
-    ksp.setFromOptions()
-    return ksp
+    from housingfe.solvers.modal import mumps_cholesky
+
+    return mumps_cholesky(A, prefix)
 
 
 def _mult(A: PETSc.Mat, x: PETSc.Vec) -> PETSc.Vec:

@@ -57,17 +57,20 @@ class ModalResult:
         return len(self.eigenvalues) == self.expected_count
 
 
-def _mumps_ksp(A: PETSc.Mat, comm, prefix: str) -> PETSc.KSP:
-    ksp = PETSc.KSP().create(comm)
+def mumps_cholesky(A: PETSc.Mat, prefix: str, inertia: bool = False) -> PETSc.KSP:
+    """A direct solver for a symmetric A: MUMPS LDL^T (Cholesky when A is positive definite).  With
+    `inertia`, the factor can report its inertia (no ScaLAPACK root, null-pivot detection on)."""
+    ksp = PETSc.KSP().create(A.getComm())
     ksp.setOptionsPrefix(prefix)
     ksp.setOperators(A)
     ksp.setType("preonly")
     pc = ksp.getPC()
     pc.setType("cholesky")
     pc.setFactorSolverType("mumps")
-    opts = PETSc.Options()
-    opts[f"{prefix}mat_mumps_icntl_13"] = 1   # no ScaLAPACK root: required for the inertia in parallel
-    opts[f"{prefix}mat_mumps_icntl_24"] = 1   # null-pivot detection: MatGetInertia requires it
+    if inertia:
+        opts = PETSc.Options()
+        opts[f"{prefix}mat_mumps_icntl_13"] = 1   # no ScaLAPACK root: required for the inertia in parallel
+        opts[f"{prefix}mat_mumps_icntl_24"] = 1   # null-pivot detection: MatGetInertia requires it
     ksp.setFromOptions()
     return ksp
 
@@ -77,7 +80,7 @@ def count_eigenvalues_below(K: PETSc.Mat, M: PETSc.Mat, sigma: float) -> int:
     A = K.copy()
     A.axpy(-sigma, M, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-    ksp = _mumps_ksp(A, K.getComm(), "inertia_")
+    ksp = mumps_cholesky(A, "inertia_", inertia=True)
     ksp.setUp()
     nneg, nzero, npos = ksp.getPC().getFactorMatrix().getInertia()
     ksp.destroy()

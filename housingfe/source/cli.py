@@ -12,12 +12,11 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import tomllib
 from pathlib import Path
 
 from housingfe.errors import InputError
+from housingfe.scene import read_scene_dict
 
-SCENE_DIR = Path(__file__).resolve().parent.parent / "scenes"
 MODELS = {
     "roosmalen": "housingfe.source.roosmalen",
     "fukuma": "housingfe.source.fukuma",
@@ -25,30 +24,9 @@ MODELS = {
 }
 
 
-def scene_path(name_or_path: str) -> Path:
-    """Path of a built-in scene name or a TOML file; InputError when neither exists."""
-    path = Path(name_or_path)
-    if path.suffix == ".toml" or path.exists():
-        if not path.is_file():
-            raise InputError(f"{name_or_path}: scene file not found")
-        return path
-    builtin = SCENE_DIR / f"{name_or_path}.toml"
-    if builtin.is_file():
-        return builtin
-    names = sorted(p.stem for p in SCENE_DIR.glob("*.toml"))
-    raise InputError(f"{name_or_path}: no such scene (built-in: {', '.join(names)})")
-
-
 def load_scene(name_or_path: str) -> tuple[dict, Path]:
     """Parse and check the common part of a source scene: [scene] kind = "source", [source] model."""
-    path = scene_path(name_or_path)
-    try:
-        with open(path, "rb") as fh:
-            scene = tomllib.load(fh)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML: {exc}") from None
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
+    scene, path = read_scene_dict(name_or_path)   # the same name lookup and TOML errors as `housingfe run`
     info = scene.get("scene")
     if not isinstance(info, dict):
         raise InputError(f"{path}: scene: missing [scene] table")

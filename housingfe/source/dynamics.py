@@ -23,7 +23,7 @@ d = h^T q, so the (2H+1) x (2H+1) Toeplitz system for d is solved directly; no i
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
@@ -412,7 +412,6 @@ class BearingSpectra:
 def bearing_spectra(state: SteadyState, mats: Matrices, interior: Interior, geometry: ShaftGeometry,
                     pair: GearPair, speed_rpm: float, torque: float) -> BearingSpectra:
     """Bearing loads of both shafts from the steady state (see `BearingSpectra`)."""
-    H = (state.harmonics.size - 1) // 2
     pos = state.harmonics >= 1
     names, zs, loads, lumped = [], [], [], []
     for g, shaft, spans, kb in ((0, "pinion", geometry.pinion_spans, interior.pinion_bearings),

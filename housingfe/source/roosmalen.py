@@ -14,7 +14,6 @@ so, as in Appendix F):
 """
 from __future__ import annotations
 
-import math
 from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Literal, Optional

@@ -26,12 +26,12 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from housingfe.errors import InputError, SolverError
-from housingfe.source.gears import GearPair, involute, tooth_profile
+from housingfe.source.gears import GearPair, tooth_profile
 
 # Schmidt's plate factor alpha = 12 / (1 + 2 nu)^2 (eq. 2.11 as printed).
 def _plate_alpha(nu: float) -> float:

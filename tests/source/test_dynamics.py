@@ -2,7 +2,6 @@
 against time integration and exact frequency response, engagement shock, published trends."""
 import math
 import tomllib
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
