@@ -140,6 +140,7 @@ def gearbox_parts(g) -> list[Part]:
     for side, x in (("left", (-L2, -L2 + t)), ("right", (L2 - t, L2))):
         parts += [box_part(f"side_low_{side}", x, (-W2 + t, W2 - t), (0.0, zs)),
                   box_part(f"side_up_{side}", x, (-W2 + t, W2 - t), (zs, H - t))]
+    parts += [box_part(f"rib_{r.name}", r.x, r.y, r.z) for r in g.ribs]   # outside, so tagged outer_rib_<name>
     return parts
 
 

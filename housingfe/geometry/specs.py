@@ -142,6 +142,28 @@ class CoverSpec(_Strict):
     margin: PositiveFloat = 0.010
 
 
+class RibSpec(_Strict):
+    """A stiffening rib: an axis-aligned plate welded to the outside of the housing, given by its extent
+    (m) in x, y and z (housing coordinates).  It must touch the housing (share a face with a wall)."""
+
+    name: str
+    x: tuple[float, float]
+    y: tuple[float, float]
+    z: tuple[float, float]
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        for axis in ("x", "y", "z"):
+            lo, hi = getattr(self, axis)
+            if not hi > lo:
+                raise ValueError(f"{axis}: the rib's extent must increase (lo < hi)")
+        return self
+
+
+def _touches(lo: float, hi: float, planes) -> bool:
+    return any(abs(lo - p) < 1e-9 or abs(hi - p) < 1e-9 for p in planes)
+
+
 class GearboxGeometry(_Strict):
     """A welded gearbox housing without bottom plate (Sec. 4.5 model, Ch. 5 test gearbox), lengths in m.
 
@@ -159,6 +181,7 @@ class GearboxGeometry(_Strict):
     rim: RimSpec | None = None
     feet: FeetSpec | None = None
     covers: CoverSpec | None = None
+    ribs: list[RibSpec] = []
     excitation_patch_size: PositiveFloat = 0.010
 
     @model_validator(mode="after")
@@ -194,7 +217,20 @@ class GearboxGeometry(_Strict):
                                      f"{a.name!r} and {b.name!r} overlap")
         if self.rim is not None and self.rim.height >= bp.below + bp.above:
             raise ValueError("rim.height: taller than the bearing plate")
+        for r in self.ribs:
+            self._check_rib(r)
         return self
+
+    def _check_rib(self, r: RibSpec) -> None:
+        """A rib lies outside the housing's outer envelope and shares a plane with one of its walls."""
+        L2, W2, H = self.length / 2, self.width / 2, self.height
+        proud = self.bearing_plate.thickness - self.wall_thickness
+        inside = (r.x[0] < L2 and r.x[1] > -L2) and (r.y[0] < W2 and r.y[1] > -W2) and (r.z[0] < H and r.z[1] > 0)
+        touching = (_touches(*r.x, (-L2, L2)) or _touches(*r.y, (-W2, W2, -W2 - proud, W2 + proud))
+                    or _touches(*r.z, (H,)))
+        if inside or not touching:
+            raise ValueError(f"ribs: rib {r.name!r} must sit outside the walls and share a face with one "
+                             "(x = +-length/2, y = +-width/2 or the bearing plate face, z = height)")
 
     @property
     def min_thickness(self) -> float:

@@ -230,3 +230,23 @@ def test_covers_close_the_bores(comm):
     covered = 4 * (side**2 - math.pi * (g.bores[0].diameter / 2) ** 2)
     expected_outer = _area(hm0, "outer", comm) + 4 * cover_outer - covered
     assert 0.0 <= expected_outer - _area(hm, "outer", comm) < 0.05 * discs
+
+
+def test_rib_adds_its_volume_and_is_tagged(comm):
+    """A rib welded on top of the gearbox model adds exactly its volume and gets its own outer tag; a
+    floating rib is rejected with the key named."""
+    from housingfe.errors import InputError
+    from housingfe.geometry import block_model_for
+    from housingfe.scene import load_housing_scene
+
+    base, _ = load_housing_scene("gearbox-model")
+    rib = 'geometry.ribs=[{name="top", x=[-0.15, 0.15], y=[-0.004, 0.004], z=[0.301, 0.331]}]'
+    ribbed, _ = load_housing_scene("gearbox-model", [rib])
+    added = block_model_for(ribbed.geometry).volume() - block_model_for(base.geometry).volume()
+    assert added == pytest.approx(0.30 * 0.008 * 0.030, rel=1e-9)
+    from housingfe.geometry import build_mesh
+
+    hm = build_mesh(ribbed.geometry, "tet", 0.05, 1, comm)
+    assert "outer_rib_top" in hm.facet_groups
+    with pytest.raises(InputError, match="ribs"):
+        load_housing_scene("gearbox-model", ['geometry.ribs=[{name="x", x=[0, 0.1], y=[0, 0.01], z=[0.5, 0.6]}]'])
