@@ -207,8 +207,8 @@ def plot_mode_shapes(path: Path, model, result, count: int) -> None:
 # --------------------------------------------------------------------------------------- harmonic results
 def _band_rows(forced):
     """(load, band nominal, band centre, {solver: (Lv, TF)}, {N: TF_points}) for every band."""
-    from housingfe.response import band_levels, transfer_band_levels
     from housingfe import levels as lv
+    from housingfe.response import band_levels, transfer_band_levels
 
     spec = forced.spec
     rows = []

@@ -51,8 +51,8 @@ def test_reciprocity(plate_both):
 
 
 def test_sample_points_converge_to_area_integral(plate_both):
-    from housingfe.response import band_levels
     from housingfe import levels
+    from housingfe.response import band_levels
 
     _, forced = plate_both
     r = forced.responses["direct"][0]

@@ -2,4 +2,4 @@
 
 `build_mesh(geometry, mesh_settings, size, comm)` is the one entry point the rest of the chain uses.
 """
-from housingfe.geometry.mesh import HousingMesh, build_mesh, block_model_for  # noqa: F401
+from housingfe.geometry.mesh import HousingMesh, block_model_for, build_mesh  # noqa: F401

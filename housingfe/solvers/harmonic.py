@@ -158,6 +158,8 @@ def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | No
     blocks = [[] for _ in loads]
     t_factor = 0.0
     pair = np.array([[1.0], [1j]])
+    # the 2x2 block matrix is symmetric iff K, M and the damping matrices are: LDL^T then, LU otherwise
+    symmetric = all(_is_symmetric(A) for A in (K, M, damping.D, C) if A is not None)
     for k, (f_hz, eta_f) in enumerate(zip(frequencies, eta)):
         w = 2 * math.pi * f_hz
         if undamped:
@@ -176,9 +178,9 @@ def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | No
         nest = PETSc.Mat().createNest([[Kr, Ki], [Ki, mKr]], comm=K.getComm())
         row_is, _ = nest.getNestISs()
         A = nest.convert("aij", PETSc.Mat())   # petsc4py converts in place unless given an output
-        A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        A.setOption(PETSc.Mat.Option.SYMMETRIC, symmetric)
         t1 = time.perf_counter()
-        ksp = _factor(A, "direct_")
+        ksp = _factor(A, "direct_", lu=not symmetric)
         try:
             ksp.setUp()
         except PETSc.Error as exc:
@@ -226,10 +228,18 @@ def _shifted(K, M, shift: float) -> PETSc.Mat:
     return A
 
 
-def _factor(A: PETSc.Mat, prefix: str) -> PETSc.KSP:
+def _factor(A: PETSc.Mat, prefix: str, lu: bool = False) -> PETSc.KSP:
     from housingfe.solvers.modal import mumps_cholesky
 
-    return mumps_cholesky(A, prefix)
+    ksp = mumps_cholesky(A, prefix)
+    if lu:   # non-symmetric bearing stiffness or fluid-film damping
+        ksp.getPC().setType("lu")
+    return ksp
+
+
+def _is_symmetric(A: PETSc.Mat) -> bool:
+    """Numerically symmetric (relative 1e-12 of the matrix norm)?"""
+    return bool(A.isSymmetric(1e-12 * max(A.norm(), 1e-300)))
 
 
 def _mult(A: PETSc.Mat, x: PETSc.Vec) -> PETSc.Vec:

@@ -18,7 +18,6 @@ from slepc4py import SLEPc
 
 from housingfe.errors import SolverError
 
-
 # Rigid-body modes come out at ~1e-7 f_max in double precision; elastic modes of any sensible scene lie
 # far above 1e-4 f_max.
 RIGID_FREQUENCY_RATIO = 1e-4

@@ -382,4 +382,4 @@ def bearing_load_spectra(pair: FukumaPair, z: float, rpm: float, te_harmonics_m,
 
 
 # re-exported so the CLI finds them here
-from housingfe.source.fukuma_run import bench_rows, run_scene  # noqa: F401
+from housingfe.source.fukuma_run import bench_rows, run_scene  # noqa: E402,F401

@@ -37,16 +37,11 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from housingfe.errors import InputError
 from housingfe.report import format_table, write_csv, write_json
+from housingfe.scene import SceneInfo
 
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid")
-
-
-class _SceneHeader(_Strict):
-    name: str
-    kind: Literal["source"]
-    description: str = ""
 
 
 class _Source(_Strict):
@@ -108,7 +103,7 @@ class _Loads(_Strict):
 class FukumaScene(_Strict):
     """Validated Fukuma scene (see module docstring)."""
 
-    scene: _SceneHeader
+    scene: SceneInfo
     source: _Source
     shaft: _Shaft
     gear: _Gear

@@ -25,8 +25,14 @@ from housingfe.errors import InputError
 from housingfe.report import format_table, write_csv, write_json
 from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair, tooth_profile
-from housingfe.source.stiffness import (Corrections, MeshModel, ShaftBending, iso6336_stiffness,
-                                        normal_force_from_torque, stiffness_curve)
+from housingfe.source.stiffness import (
+    Corrections,
+    MeshModel,
+    ShaftBending,
+    iso6336_stiffness,
+    normal_force_from_torque,
+    stiffness_curve,
+)
 
 
 class _Strict(BaseModel):

@@ -33,6 +33,7 @@ import numpy as np
 from housingfe.errors import InputError, SolverError
 from housingfe.source.gears import GearPair, tooth_profile
 
+
 # Schmidt's plate factor alpha = 12 / (1 + 2 nu)^2 (eq. 2.11 as printed).
 def _plate_alpha(nu: float) -> float:
     return 12.0 / (1.0 + 2.0 * nu) ** 2
@@ -374,7 +375,6 @@ class MeshModel:
         """Linear part of the compliance matrix [m/N] between the contact points (no Hertz)."""
         pr, hx, wl = pts["pair"], pts["helix"], pts["w_local"]
         fl = self._flex_at(pts["s"])
-        same_pair = (pr[:, None] == pr[None, :]) & (hx[:, None] == hx[None, :])
         C = self.body_compliance(pts["w"])
         b = self.pair.contact_width
         for g in (0, 1):

@@ -16,7 +16,6 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-
 from housingfe.report import format_table, write_csv
 from housingfe.source.gears import GearPair
 from housingfe.source.stiffness import MeshModel, stiffness_curve

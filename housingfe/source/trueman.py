@@ -229,4 +229,4 @@ def thesis_style_transfer(model: DriveModel, omega: float) -> np.ndarray:
 
 
 # re-exported here so scenes and the benchmark only need this module
-from housingfe.source.trueman_run import bench_rows, run_scene
+from housingfe.source.trueman_run import bench_rows, run_scene  # noqa: E402,F401

@@ -39,6 +39,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from housingfe.errors import InputError
 from housingfe.report import format_table, write_csv, write_json
+from housingfe.scene import SceneInfo
 from housingfe.source import trueman_data as data
 
 if TYPE_CHECKING:
@@ -47,12 +48,6 @@ if TYPE_CHECKING:
 
 class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid")
-
-
-class _SceneHeader(_Strict):
-    name: str
-    kind: Literal["source"]
-    description: str = ""
 
 
 class _Source(_Strict):
@@ -110,7 +105,7 @@ class _Forced(_Strict):
 class TruemanScene(_Strict):
     """Validated Trueman scene (see module docstring)."""
 
-    scene: _SceneHeader
+    scene: SceneInfo
     source: _Source
     machine: _Machine = _Machine()
     configurations: list[_Configuration] = Field(min_length=1)

@@ -49,7 +49,7 @@ def test_mesh_tags_and_areas(coarse_box_model, comm, element):
 def test_outer_surface_excludes_foot_and_inner(coarse_box_model, comm):
     g = coarse_box_model.scene.geometry
     hm = coarse_box_model.housing
-    L, W, H, t, tf, b = g.length, g.width, g.height, g.wall_thickness, g.flange_thickness, g.flange_width
+    L, W, H, tf, b = g.length, g.width, g.height, g.flange_thickness, g.flange_width
     ds = ufl.Measure("ds", domain=hm.mesh, subdomain_data=hm.facet_tags)
     outer = comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ds(hm.facet_tag_values("outer")))))
     plates = L * W + 2 * (L + W) * (H - tf)

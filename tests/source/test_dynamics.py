@@ -12,7 +12,13 @@ import housingfe
 from housingfe.levels import OMEGA0
 from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair
-from housingfe.source.stiffness import Corrections, MeshModel, ShaftBending, normal_force_from_torque, stiffness_curve
+from housingfe.source.stiffness import (
+    Corrections,
+    MeshModel,
+    ShaftBending,
+    normal_force_from_torque,
+    stiffness_curve,
+)
 
 REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())["gears"]
 PAIR = GearPair.from_table(REF["single_helical"])

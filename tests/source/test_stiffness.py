@@ -12,9 +12,16 @@ from scipy.integrate import solve_bvp
 import housingfe
 from housingfe.errors import InputError
 from housingfe.source.gears import GearPair
-from housingfe.source.stiffness import (Corrections, MeshModel, ShaftBending, beam_influence,
-                                        iso6336_stiffness, normal_force_from_torque, plate_green,
-                                        stiffness_curve)
+from housingfe.source.stiffness import (
+    Corrections,
+    MeshModel,
+    ShaftBending,
+    beam_influence,
+    iso6336_stiffness,
+    normal_force_from_torque,
+    plate_green,
+    stiffness_curve,
+)
 
 REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())["gears"]
 SHAFTS = (ShaftBending(0.06, 0.06, 0.080), ShaftBending(0.06, 0.06, 0.095))
