@@ -338,10 +338,16 @@ def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) ->
     kind = data.get("scene", {}).get("kind") if isinstance(data.get("scene"), dict) else None
     if kind == "source":
         raise InputError(f"{path}: scene.kind: this is a source scene; run it with `housingfe source`")
+    return validate(HousingScene, data, path), path
+
+
+def validate(model_cls, data, path, prefix: str = ""):
+    """model_cls.model_validate(data), or InputError "<path>: <prefix><key>: <problem>" naming the first bad
+    key (an unknown key before the missing one it causes).  Shared by every kind of scene."""
     try:
-        return HousingScene.model_validate(data), path
+        return model_cls.model_validate(data)
     except ValidationError as exc:
-        raise InputError(f"{path}: {_first_error(exc)}") from None
+        raise InputError(f"{path}: {prefix}{_first_error(exc)}") from None
 
 
 def _first_error(exc: ValidationError) -> str:

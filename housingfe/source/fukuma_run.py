@@ -33,11 +33,10 @@ from pathlib import Path
 from typing import Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from housingfe.errors import InputError
 from housingfe.report import format_table, write_csv, write_json
-from housingfe.scene import SceneInfo
+from housingfe.scene import SceneInfo, validate
 
 
 class _Strict(BaseModel):
@@ -121,12 +120,7 @@ class FukumaScene(_Strict):
 
 def parse_scene(scene: dict, scene_path: str) -> FukumaScene:
     """Validate a scene dict; bad input -> InputError("<file>: <key>: <problem>")."""
-    try:
-        return FukumaScene.model_validate(scene)
-    except ValidationError as exc:
-        err = exc.errors()[0]
-        key = ".".join(str(p) for p in err["loc"]) or "scene"
-        raise InputError(f"{scene_path}: {key}: {err['msg'].removeprefix('Value error, ')}") from None
+    return validate(FukumaScene, scene, scene_path)
 
 
 def build_pair(sc: FukumaScene):

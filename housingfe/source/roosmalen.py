@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Literal, Optional
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt
 
 from housingfe.errors import InputError
 from housingfe.report import format_table, write_csv, write_json
@@ -118,12 +118,9 @@ class SourceTable(_Strict):
 
 def parse(scene: dict, scene_path: str) -> SourceTable:
     """Validate the [source] table; InputError naming the file and the first bad key."""
-    try:
-        return SourceTable.model_validate(scene.get("source", {}))
-    except ValidationError as exc:
-        err = exc.errors()[0]
-        where = ".".join(str(p) for p in ("source", *err["loc"]))
-        raise InputError(f"{scene_path}: {where}: {err['msg']}") from None
+    from housingfe.scene import validate
+
+    return validate(SourceTable, scene.get("source", {}), scene_path, prefix="source.")
 
 
 def build(table: SourceTable, scene_path: str = "scene"):

@@ -35,11 +35,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from housingfe.errors import InputError
 from housingfe.report import format_table, write_csv, write_json
-from housingfe.scene import SceneInfo
+from housingfe.scene import SceneInfo, validate
 from housingfe.source import trueman_data as data
 
 if TYPE_CHECKING:
@@ -124,13 +123,7 @@ class TruemanScene(_Strict):
 
 def parse_scene(scene: dict, scene_path: str) -> TruemanScene:
     """Validate a scene dict; bad input -> InputError("<file>: <key>: <problem>")."""
-    try:
-        return TruemanScene.model_validate(scene)
-    except ValidationError as exc:
-        err = exc.errors()[0]
-        key = ".".join(str(p) for p in err["loc"]) or "scene"
-        msg = err["msg"].removeprefix("Value error, ")
-        raise InputError(f"{scene_path}: {key}: {msg}") from None
+    return validate(TruemanScene, scene, scene_path)
 
 
 def drive_config(sc: TruemanScene, conf) -> DriveConfig:
