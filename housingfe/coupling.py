@@ -23,7 +23,7 @@ with MPC/penalty diagonals in eigenproblems) and the modal (SLEPc, inertia-count
 work on (K_c, M_c) unchanged.  K_c and M_c share one sparsity pattern (the solvers add them with
 SAME_NONZERO_PATTERN).
 
-Serial only: the FE matrices are gathered into scipy (a one-rank PETSc AIJ is read directly), the triple
+Serial only (for now): the FE matrices are gathered into scipy (a one-rank PETSc AIJ is read directly), the triple
 product is done there and the result is handed back as PETSc AIJ.
 """
 from __future__ import annotations
@@ -34,7 +34,6 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 from petsc4py import PETSc
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
 
 from housingfe.errors import InputError
 
@@ -499,130 +498,8 @@ def _petsc(pattern: sp.csr_matrix, values: np.ndarray) -> PETSc.Mat:
     return A
 
 
-# ------------------------------------------------------------------------------------------ scene section
-# A `[coupling]` section for housing scenes (validated like the rest of a scene: unknown keys are errors).
-# housingfe.scene does not include it yet: HousingScene needs `coupling: CouplingSpec | None = None`
-# and the run needs `couple_from_spec(model, scene.coupling)` before its solvers.
-Vector3 = tuple[float, float, float]
-
-
-class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
-
-
-class BoreSpec(_Strict):
-    """A bore master: surface of the housing, centre (m; default: centre of the surface's bounding box),
-    axis, kind (rbe2 | rbe3 | star) and rod_stiffness (N/m per rod, star only)."""
-
-    name: str
-    surface: str
-    centre: Vector3 | None = None
-    axis: Vector3 = (0.0, 0.0, 1.0)
-    kind: str = Field("rbe2", pattern="^(rbe2|rbe3|star)$")
-    rod_stiffness: PositiveFloat | None = None
-
-
-class DiscSpec(_Strict):
-    """A gear as a rigid cylinder (m) on shaft node `node`."""
-
-    node: int = Field(ge=0)
-    outer_diameter: PositiveFloat
-    width: PositiveFloat
-    inner_diameter: float = Field(0.0, ge=0.0)
-
-
-class ShaftSpec(_Strict):
-    """A stepped Timoshenko shaft: segments [[length, outer_d(, inner_d)], ...] (m) from origin along axis."""
-
-    name: str = Field(pattern=r"^[A-Za-z0-9_]+$")
-    origin: Vector3
-    axis: Vector3
-    segments: list[list[float]]
-    elements_per_segment: PositiveInt = 4
-    discs: list[DiscSpec] = []
-
-
-class BearingSpec(_Strict):
-    """A bearing from shaft node (e.g. "pinion:0") to a bore master (None: ground): a catalogue designation
-    with its mean load (Fx, Fy, Fz, Mx, My) (N, N m) in the bearing frame, or a diagonal stiffness (6 values,
-    N/m and N m/rad, bearing frame)."""
-
-    shaft_node: str
-    bore: str | None = None
-    axis: Vector3 = (0.0, 0.0, 1.0)
-    designation: str | None = None
-    load: tuple[float, float, float, float, float] | None = None
-    stiffness: tuple[float, float, float, float, float, float] | None = None
-
-    @model_validator(mode="after")
-    def _one(self):
-        if (self.designation is None) == (self.stiffness is None):
-            raise ValueError("give either designation (+ load) or stiffness")
-        if self.designation is not None and self.load is None:
-            raise ValueError("load: required with a designation (N, N m)")
-        return self
-
-
-class GearMeshSpec(_Strict):
-    """Mesh stiffness (N/m) along the line of action `direction` through the contact `point` (m)."""
-
-    a: str
-    b: str
-    stiffness: PositiveFloat
-    point: Vector3
-    direction: Vector3
-    damping: float = Field(0.0, ge=0.0)
-
-
-class TieRodSpec(_Strict):
-    """A solid round beam (m) between two nodes."""
-
-    a: str
-    b: str
-    diameter: PositiveFloat
-
-
-class CouplingSpec(_Strict):
-    bores: list[BoreSpec] = []
-    shafts: list[ShaftSpec] = []
-    bearings: list[BearingSpec] = []
-    gear_meshes: list[GearMeshSpec] = []
-    tie_rods: list[TieRodSpec] = []
-
-
 def surface_centre(model, surface: str) -> np.ndarray:
     """Centre (m) of the bounding box of a surface's nodes (a bore: on the axis, mid-plate)."""
     nodes, _ = surface_nodes(model, surface)
     x = model.V.tabulate_dof_coordinates()[nodes]
     return (x.min(axis=0) + x.max(axis=0)) / 2
-
-
-def couple_from_spec(model, spec: CouplingSpec | dict) -> CoupledSystem:
-    """couple() from a scene's [coupling] section (a CouplingSpec or the raw dict)."""
-    from housingfe.bearings import bearing_stiffness
-    from housingfe.shafts import CircularSection, RigidDisc, Shaft
-
-    if isinstance(spec, dict):
-        from pydantic import ValidationError
-
-        try:
-            spec = CouplingSpec.model_validate(spec)
-        except ValidationError as exc:
-            err = exc.errors()[0]
-            raise InputError(f"coupling.{'.'.join(str(p) for p in err['loc'])}: {err['msg']}") from None
-    connections = [BoreConnection(b.name, b.surface, tuple(b.centre if b.centre is not None
-                                                           else surface_centre(model, b.surface)),
-                                  b.axis, b.kind, b.rod_stiffness) for b in spec.bores]
-    shafts, elements = {}, []
-    for s in spec.shafts:
-        shaft = Shaft.stepped([tuple(seg) for seg in s.segments], origin=s.origin, axis=s.axis,
-                              elements_per_segment=s.elements_per_segment)
-        for d in s.discs:
-            shaft.add_disc(d.node, RigidDisc.cylinder(d.outer_diameter, d.width, d.inner_diameter))
-        shafts[s.name] = shaft
-    for b in spec.bearings:
-        k = (bearing_stiffness(b.designation, b.load).K if b.designation is not None else np.diag(b.stiffness))
-        elements.append(bearing(b.shaft_node, b.bore, k, b.axis))
-    meshes = [GearMesh(g.a, g.b, g.stiffness, g.point, g.direction, g.damping) for g in spec.gear_meshes]
-    rods = [TieRod(t.a, t.b, CircularSection(t.diameter)) for t in spec.tie_rods]
-    return couple(model, connections, elements, shafts, meshes, rods)

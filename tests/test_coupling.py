@@ -10,6 +10,7 @@ import scipy.linalg as sl
 from scipy.optimize import brentq
 
 from housingfe import coupling as cp
+from housingfe import interior
 from housingfe.errors import InputError
 from housingfe.model import build_model
 from housingfe.shafts import CircularSection, RigidDisc, Shaft
@@ -328,7 +329,7 @@ def test_scene_section(stiff_block):
 
     spec = tomllib.loads(SPEC)
     only_block = {"bores": spec["bores"], "bearings": spec["bearings"][:1]}
-    system = cp.couple_from_spec(stiff_block, only_block)
+    system = interior.couple_from_spec(stiff_block, only_block)
     assert np.allclose(system.nodes["bore"][0], BOTTOM_CENTRE)
     res = modal.solve_modes(system.K, system.M, 200.0)
     f = res.frequencies_hz
@@ -336,8 +337,8 @@ def test_scene_section(stiff_block):
     k6[5, 5] = 0.0
     exact = rigid_block_frequencies(k6 + 1e-9 * np.eye(6), BOTTOM_CENTRE)
     assert res.rigid_count == 1 and np.max(np.abs(f[1:] / exact[1:] - 1)) < 1e-5
-    full = cp.couple_from_spec(stiff_block, spec)
+    full = interior.couple_from_spec(stiff_block, spec)
     assert {"s:0", "s:4"} <= set(full.nodes) and full.size == system.size + 30
     bad = dict(spec, bores=[dict(spec["bores"][0], kindd="rbe2")])
     with pytest.raises(InputError, match="kindd"):
-        cp.couple_from_spec(stiff_block, bad)
+        interior.couple_from_spec(stiff_block, bad)
