@@ -23,6 +23,8 @@ class ForcedResult:
     timings: dict = field(default_factory=dict)
     facts: dict = field(default_factory=dict)
     sound_power: list | None = None
+    to_fe: object = None          # q -> housing vector (coupled models), for deflection shapes
+    angular_velocity_node: str | None = None
 
 
 def damping_model(scene, model) -> harmonic.Damping:
@@ -63,58 +65,100 @@ def _max():
     return MPI.MAX
 
 
-def choose_solver(spec, damping: harmonic.Damping) -> list[str]:
+def choose_solver(spec, damping: harmonic.Damping, interior=None) -> list[str]:
     """Solvers to run: 'auto' is modal for proportional damping, direct when a non-proportional damping
-    matrix is present."""
-    if damping.modal_ratios and spec.solver in ("direct", "both"):
-        from housingfe.errors import InputError
+    matrix (material loss factors, bearing damping) or a non-symmetric stiffness (fluid films) is present."""
+    from housingfe.errors import InputError
 
+    if damping.modal_ratios and spec.solver in ("direct", "both"):
         raise InputError("damping.modal_damping_ratios: per-mode damping exists only in the modal solver; "
                          "use solver = \"modal\" or a loss factor")
+    non_modal = interior is not None and (interior.C is not None or not interior.system.symmetric)
+    if non_modal and spec.solver in ("modal", "both"):
+        raise InputError("analysis.harmonic.solver: the interior has bearing damping or a non-symmetric "
+                         "stiffness, which only the direct solver takes; use solver = \"direct\" or \"auto\"")
     if spec.solver == "both":
         return ["modal", "direct"]
     if spec.solver == "auto":
-        return ["direct"] if damping.D is not None else ["modal"]
+        return ["direct"] if damping.D is not None or non_modal else ["modal"]
     return [spec.solver]
 
 
-def run(model, spec) -> ForcedResult:
-    """Assemble the loads, run the chosen solver(s) on spec.frequencies and evaluate the responses."""
+def assemble_loads(model, interior=None) -> list:
+    """The scene's load cases in the solver's DOFs: housing loads (FE vectors, mapped to the coupled DOFs when
+    there is an interior) and loads on interior nodes."""
+    from housingfe.loads import LoadCase
+
+    out = []
+    for i, load in enumerate(model.scene.loads):
+        if load.node is not None:
+            vec = interior.node_load(load.node, load.kind, load.direction, f"loads.{i}.node")
+            out.append(LoadCase(load.name, load.kind, vec, load, 0.0, interior.system.nodes[load.node][0]))
+            continue
+        lc = assemble_load(load, model.housing, model.V, model.bcs)
+        if interior is not None:
+            lc.vector = interior.system.load(fe_load=lc.vector)
+        out.append(lc)
+    return out
+
+
+def run(model, spec, interior=None) -> ForcedResult:
+    """Assemble the loads, run the chosen solver(s) on spec.frequencies and evaluate the responses.
+    interior: the coupled interior (housingfe.interior.Interior) or None for the housing alone."""
+    from housingfe.response import CoupledObserver
+
     scene = model.scene
     t0 = time.perf_counter()
-    loads = [assemble_load(load, model.housing, model.V, model.bcs) for load in scene.loads]
+    loads = assemble_loads(model, interior)
     extra, plate_ids = {}, None
     if scene.radiation is not None and scene.radiation.model == "numerical":
         from housingfe.radiation.housing import RADIATION_POINTS, radiation_points
 
         extra[RADIATION_POINTS], plate_ids = radiation_points(model, scene.radiation)
-    observer = SurfaceObserver(model, spec.surface, spec.sample_points, loads, extra)
+    if interior is None:
+        observer = SurfaceObserver(model, spec.surface, spec.sample_points, loads, extra)
+        K, M, C = model.K, model.M, None
+    else:
+        nodes = [spec.angular_velocity_node] if spec.angular_velocity_node else []
+        for node in nodes:
+            interior.shaft_axis(node)     # a clear error for a node that is not on a shaft
+        observer = CoupledObserver(interior, spec.surface, spec.sample_points, loads, extra, nodes)
+        K, M, C = interior.K, interior.M, interior.C
     damping = damping_model(scene, model)
+    if interior is not None and damping.D is not None:
+        from housingfe.errors import InputError
+
+        raise InputError("damping: per-material loss factors are not mapped to the coupled model yet; give "
+                         "damping.loss_factor or damping.modal_damping_ratio")
     freqs = spec.frequencies
     timings = {"loads_and_observer_s": time.perf_counter() - t0}
     facts = {"frequencies": len(freqs), "df_hz": spec.df, "surface_area_m2": observer.area}
     results, resp = {}, {}
-    for solver in choose_solver(spec, damping):
+    for solver in choose_solver(spec, damping, interior):
         t1 = time.perf_counter()
         if solver == "modal":
             f_basis = spec.modal_basis_factor * spec.f_max
-            modes = modal.solve_modes(model.K, model.M, f_basis)
+            modes = modal.solve_modes(K, M, f_basis)
             timings["modal_eigensolve_s"] = time.perf_counter() - t1
             facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
                          rigid_modes=modes.rigid_count, basis_f_max_hz=f_basis)
-            result = harmonic.modal_superposition(model.K, model.M, modes, loads, freqs, damping,
+            result = harmonic.modal_superposition(K, M, modes, loads, freqs, damping,
                                                   observer.reduce, residual=spec.residual)
             if spec.solver == "both" and spec.residual:
-                plain = harmonic.modal_superposition(model.K, model.M, modes, loads, freqs, damping,
+                plain = harmonic.modal_superposition(K, M, modes, loads, freqs, damping,
                                                      observer.reduce, residual=False)
                 results["modal"], resp["modal"] = plain, responses(plain, observer, loads)
             name = result.solver
         else:
-            result = harmonic.direct(model.K, model.M, loads, freqs, damping, observer.reduce)
+            result = harmonic.direct(K, M, loads, freqs, damping, observer.reduce, C=C)
             name = "direct"
         timings[f"{name}_s"] = time.perf_counter() - t1
         results[name], resp[name] = result, responses(result, observer, loads)
-    forced = ForcedResult(spec, loads, resp, observer, results, timings, facts)
+    forced = ForcedResult(spec, loads, resp, observer, results, timings, facts,
+                          to_fe=None if interior is None else interior.fe_vector,
+                          angular_velocity_node=spec.angular_velocity_node)
+    if spec.angular_velocity_node:
+        add_angular_velocity_transfer(forced, interior)
     if scene.radiation is not None:
         from housingfe.radiation.housing import sound_power
 
@@ -122,6 +166,24 @@ def run(model, spec) -> ForcedResult:
         forced.sound_power = sound_power(forced, model, plate_ids)
         timings["radiation_s"] = time.perf_counter() - t1
     return forced
+
+
+def add_angular_velocity_transfer(forced: ForcedResult, interior) -> None:
+    """TF_omega = L_v - L_omega (dB, v0 = omega0 = 5e-8, thesis eq. 5.5) per load response, with omega the
+    angular velocity of `angular_velocity_node` about its shaft axis; stored in response.extras as
+    "L_omega_dB" (per unit load) and "TF_omega_dB"."""
+    from housingfe import levels
+    from housingfe.response import node_key
+
+    node = forced.angular_velocity_node
+    axis = interior.shaft_axis(node)
+    for resps in forced.responses.values():
+        for r in resps:
+            theta = axis @ r.extras["point_values"][node_key(node)][3:6]
+            omega2 = (2 * np.pi * r.frequencies) ** 2 * np.abs(theta) ** 2
+            r.extras["omega_mean_square"] = omega2
+            r.extras["L_omega_dB"] = levels.level(omega2, levels.OMEGA0)
+            r.extras["TF_omega_dB"] = r.transfer_db - r.extras["L_omega_dB"]
 
 
 def deflection_shape(result: ForcedResult, load_index: int, frequency: float):
@@ -139,6 +201,8 @@ def deflection_shape(result: ForcedResult, load_index: int, frequency: float):
     for vec, ck in zip(basis, c):
         ur.axpy(ck.real, vec)
         ui.axpy(ck.imag, vec)
+    if result.to_fe is not None:
+        ur, ui = result.to_fe(ur), result.to_fe(ui)
     return res.frequencies[k], ur, ui
 
 

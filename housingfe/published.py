@@ -62,3 +62,33 @@ def modal_comparison(scene, summary: dict) -> list[dict]:
                     rows.append(row(name, f"elastic modes below {f_lim:g} Hz (thesis EMA found)",
                                     int(np.sum(freqs < f_lim)), value, "-", src))
     return rows
+
+
+def interior_comparison(scene, interior: dict) -> list[dict]:
+    """Rows for a housing coupled with its interior (thesis Sec. 4.6): the interior on rigid bores and the
+    coupled model, next to the published values of the scene's reference section (when it has them)."""
+    ref = scene.reference
+    data = thesis().get(ref.section, {}) if ref is not None and ref.section else {}
+    if "interior_on_rigid_bores_first_Hz" not in data:
+        return []
+    name, src = scene.scene.name, f"{THESIS} [{ref.section}]"
+    f_rigid = np.asarray(interior["rigid_bores_frequencies_hz"])
+    energy = np.asarray(interior["rigid_bores_bearing_energy"])
+    nan = float("nan")
+    whole = f_rigid[energy > 0.5]
+    f_max = scene.analysis.f_max
+    rows = [row(name, "interior on rigid bores: first mode", float(f_rigid[0]) if len(f_rigid) else nan,
+                data["interior_on_rigid_bores_first_Hz"], "Hz", src),
+            row(name, "interior on rigid bores: first mode moving as a whole on the bearings (bearing energy > 50 %)",
+                float(whole[0]) if len(whole) else nan, data["interior_on_rigid_bores_whole_body_Hz"], "Hz", src)]
+    if f_max >= 4000.0:
+        rows.append(row(name, "interior on rigid bores: modes below 4000 Hz", int(np.sum(f_rigid < 4000.0)),
+                        data["interior_on_rigid_bores_modes_below_4000Hz"], "-", src))
+    coupled = list(interior["coupled_interior_modes_hz"])
+    for i, f_pub in enumerate(data.get("coupled_interior_modes_Hz", [])):
+        rows.append(row(name, f"coupled: interior-dominated mode {i + 1} (interior kinetic energy > 50 %)",
+                        float(coupled[i]) if i < len(coupled) else nan, f_pub, "Hz", src))
+    if "coupled_housing_modes_below_4000Hz" in data and f_max >= 4000.0:
+        rows.append(row(name, "coupled: housing-dominated modes below 4000 Hz", interior["coupled_housing_modes"],
+                        data["coupled_housing_modes_below_4000Hz"], "-", src))
+    return rows

@@ -93,6 +93,17 @@ def modal_summary_text(summary: dict) -> str:
         lines.append("elastic eigenfrequencies (Hz):")
         for i in range(0, len(f), 8):
             lines.append("  " + "  ".join(f"{v:8.2f}" for v in f[i:i + 8]))
+    inner = summary.get("interior")
+    if inner:
+        lines.append(f"interior on rigid bores ({inner['rigid_bores_dofs']} DOFs, {inner['rigid_bores_mechanisms']} "
+                     "mechanisms), Hz [share of strain energy in the bearings]:")
+        lines.append("  " + "  ".join(f"{f:.1f} [{e:.2f}]" for f, e in
+                                      zip(inner["rigid_bores_frequencies_hz"], inner["rigid_bores_bearing_energy"])))
+        lines.append(f"coupled ({inner['coupled_dofs']} DOFs): {len(inner['coupled_interior_modes_hz'])} "
+                     f"interior-dominated modes (interior kinetic energy > 50 %), {inner['coupled_housing_modes']} "
+                     "housing-dominated; interior-dominated (mode number: Hz):")
+        lines.append("  " + "  ".join(f"{n}: {f:.1f}" for n, f in zip(inner["coupled_interior_mode_numbers"],
+                                                                     inner["coupled_interior_modes_hz"])))
     if summary.get("published"):
         lines.append("compared with published values:")
         lines.append(format_table(
@@ -280,6 +291,11 @@ def harmonic_summary_text(forced) -> str:
     table = [[r[0], f"{r[1]:g}"] + [round(float(r[3][s][1]), 2) for s in solvers] for r in rows]
     lines.append(f"1/3-octave TF (dB re {main}):")
     lines.append(format_table(header, table))
+    if forced.angular_velocity_node:
+        lines.append(f"TF_omega = L_v - L_omega, omega about the shaft axis at {forced.angular_velocity_node} "
+                     "(eq. 5.5), 1/3-octave bands:")
+        lines.append(format_table(["load", "solver", "band Hz", "TF_omega dB"],
+                                  [[r[0], r[1], f"{r[2]:g}", round(float(r[4]), 2)] for r in tf_omega_band_rows(forced)]))
     return "\n".join(lines)
 
 
@@ -322,10 +338,38 @@ def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
         "load_cases": [{"name": lc.name, "kind": lc.kind, "patch_area_m2": lc.patch_area, "centre_m": lc.centre}
                        for lc in forced.loads]})
     (folder / "summary_forced.txt").write_text(harmonic_summary_text(forced) + "\n")
+    if forced.angular_velocity_node:
+        write_csv(folder / "tf_omega.csv", ["load_case", "solver", "frequency_hz", "L_omega_dB", "TF_omega_dB"],
+                  tf_omega_rows(forced))
+        write_csv(folder / "tf_omega_bands.csv", ["load_case", "solver", "band_nominal_hz", "band_center_hz",
+                                                  "TF_omega_dB"], tf_omega_band_rows(forced))
     if model.scene.output.pictures:
         plot_transfer_functions(folder / "tf_bands.png", forced, rows, solvers)
     if forced.sound_power:
         write_sound_power(folder, forced, model.scene.output.pictures)
+
+
+def tf_omega_rows(forced) -> list:
+    """Narrow-band TF_omega = L_v - L_omega (eq. 5.5) of every load case and solver."""
+    return [[r.name, solver, f, r.extras["L_omega_dB"][k], r.extras["TF_omega_dB"][k]]
+            for solver, resps in forced.responses.items() for r in resps for k, f in enumerate(r.frequencies)]
+
+
+def tf_omega_band_rows(forced) -> list:
+    """1/3-octave TF_omega: band L_v minus band L_omega (energy sums of the lines in each band)."""
+    from housingfe import levels
+    from housingfe.response import band_levels
+
+    out = []
+    for solver, resps in forced.responses.items():
+        for r in resps:
+            f = r.frequencies
+            f_lo = max(f[0], 10.0)
+            bands, lv = band_levels(f, r.mean_square_velocity, f_lo, f[-1], levels.V0)
+            _, lw = band_levels(f, r.extras["omega_mean_square"], f_lo, f[-1], levels.OMEGA0)
+            out += [[r.name, solver, n, c, v - w] for n, c, v, w in zip(bands.nominal, bands.center, lv, lw)
+                    if np.isfinite(v - w)]
+    return out
 
 
 def _db(ms):

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from types import SimpleNamespace
 
 import numpy as np
 import ufl
@@ -203,8 +204,11 @@ class SurfaceObserver:
         self.evaluators = {N: PointEvaluator(V, s) for N, s in {**self.samples, **self.extra_samples}.items()}
         self.load_vectors = [lc.vector for lc in load_cases]
 
-    def reduce(self, vectors) -> Reduced:
-        """Project a list of PETSc vectors (see Reduced)."""
+    def reduce(self, vectors, housing_vectors=None) -> Reduced:
+        """Project a list of PETSc vectors (see Reduced).  housing_vectors: the same vectors on the housing's
+        FE space when `vectors` live in other DOFs (a coupled model); the load projections use `vectors`."""
+        loads = np.array([[f.dot(x) for x in vectors] for f in self.load_vectors])
+        vectors = vectors if housing_vectors is None else housing_vectors
         Wv = []
         for x in vectors:
             y = self.W.createVecLeft()
@@ -212,8 +216,33 @@ class SurfaceObserver:
             Wv.append(y)
         gram = np.array([[a.dot(b) for b in Wv] for a in vectors])
         points = {N: np.array([ev.normal_values(x) for x in vectors]).T for N, ev in self.evaluators.items()}
-        loads = np.array([[f.dot(x) for x in vectors] for f in self.load_vectors])
         return Reduced(gram, points, loads)
+
+
+class CoupledObserver(SurfaceObserver):
+    """The observer of a housing coupled with its interior (housingfe.interior.Interior): solution vectors are
+    in the coupled DOFs q; the surface quantities come from their housing part, the load projections from q,
+    and `nodes` (interior node names) keep their six displacement components (m, rad) per unit load as
+    extra point sets named "node <name>"."""
+
+    def __init__(self, interior, surface: str, sample_counts, load_cases, extra_points: dict | None = None,
+                 nodes=()):
+        super().__init__(interior.model, surface, sample_counts, load_cases, extra_points)
+        self.interior = interior
+        self.nodes = {node_key(n): n for n in nodes}
+        for key in self.nodes:
+            self.extra_samples[key] = SimpleNamespace(weights=np.ones(6))
+
+    def reduce(self, vectors) -> Reduced:
+        red = super().reduce(vectors, [self.interior.fe_vector(q) for q in vectors])
+        for key, name in self.nodes.items():
+            red.points[key] = np.array([self.interior.system.node_displacement(q, name) for q in vectors]).T
+        return red
+
+
+def node_key(name: str) -> str:
+    """The point-set name under which a CoupledObserver keeps an interior node's values."""
+    return f"node {name}"
 
 
 # ----------------------------------------------------------------------------------- responses

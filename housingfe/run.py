@@ -24,19 +24,29 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     from housingfe.solvers import modal
 
     model = build_model(scene, comm)
+    interior = None
+    if scene.coupling is not None:
+        from housingfe.interior import build_interior
+
+        interior = build_interior(model, scene.coupling, scene.analysis.f_max)
+    K, M = (model.K, model.M) if interior is None else (interior.K, interior.M)
     modal_spec, harmonic_spec = scene.analysis.modal, scene.analysis.harmonic
     modes = None
     if modal_spec is not None:
-        modes = modal.solve_modes(model.K, model.M, modal_spec.f_max, tol=modal_spec.tolerance)
-        summary = modal_summary(model, modes, modal_checks(model, modes), time.perf_counter() - t_start)
+        modes = modal.solve_modes(K, M, modal_spec.f_max, tol=modal_spec.tolerance)
+        summary = modal_summary(model, modes, modal_checks(model, modes, interior), time.perf_counter() - t_start)
+        if interior is not None:
+            summary["interior"] = interior_summary(interior, modes)
+            summary["published"] += published.interior_comparison(scene, summary["interior"])
     forced = None
     if harmonic_spec is not None:
         from housingfe import forced_response
 
-        forced = forced_response.run(model, harmonic_spec)
+        forced = forced_response.run(model, harmonic_spec, interior)
     with report.atomic_output_dir(out, comm) as tmp:
         if modes is not None:
-            report.write_modal_outputs(tmp, model, modes, summary, comm)
+            housing_modes = modes if interior is None else interior.fe_modes(modes)
+            report.write_modal_outputs(tmp, model, housing_modes, summary, comm)
         if forced is not None:
             report.write_harmonic_outputs(tmp, model, forced, comm)
     if comm.rank == 0:
@@ -48,20 +58,25 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     return out
 
 
-def modal_checks(model, result) -> dict:
-    """Rigid-body count and the mass / centre of gravity that the rigid modes carry (free structures)."""
+def modal_checks(model, result, interior=None) -> dict:
+    """Rigid-body count and the mass / centre of gravity that the rigid modes carry (free structures).  With an
+    interior the expected zero modes are the housing's plus the interior's mechanisms on fixed bores (counted
+    independently on the small interior matrices), and the mass includes shafts and gears."""
     from housingfe.solvers import elasticity, modal
 
     freqs = result.frequencies_hz
     n_rigid = result.rigid_count
-    checks: dict = {"rigid_modes_expected": model.rigid_modes_expected}
-    if model.rigid_modes_expected and n_rigid != model.rigid_modes_expected:
-        raise SolverError(f"a free structure must have {model.rigid_modes_expected} rigid-body modes, found "
-                          f"{n_rigid}: lowest frequencies {np.round(freqs[:7], 4).tolist()} Hz")
-    if n_rigid == 6:
-        props = modal.rigid_body_mass_properties(model.M, result.vectors[:n_rigid],
-                                                 elasticity.rigid_body_vectors(model.V))
-        checks.update(props)
+    expected = model.rigid_modes_expected if interior is None else interior.expected_mechanisms()
+    checks: dict = {"rigid_modes_expected": expected}
+    if (expected or interior is not None) and n_rigid != expected:
+        raise SolverError(f"the model must have {expected} rigid-body / mechanism modes, found "
+                          f"{n_rigid}: lowest frequencies {np.round(freqs[:expected + 1], 4).tolist()} Hz")
+    if model.rigid_modes_expected == 6 and n_rigid >= 6 and (interior is None or hasattr(interior.system, "rigid_body_vectors")):
+        if interior is None:
+            M, fields = model.M, elasticity.rigid_body_vectors(model.V)
+        else:
+            M, fields = interior.M, interior.system.rigid_body_vectors(model.V)
+        checks.update(modal.rigid_body_mass_properties(M, result.vectors[:n_rigid], fields))
     checks["geometry_mass_kg"] = model.material.density * model.housing.volume
     checks["geometry_centre_of_gravity_m"] = model.housing.centroid
     return checks
@@ -97,3 +112,24 @@ def modal_summary(model, result, checks: dict, wall_time_s: float) -> dict:
     }
     summary["published"] = published.modal_comparison(scene, summary)
     return summary
+
+
+def interior_summary(interior, result) -> dict:
+    """The interior's share of the coupled modes and its modes on rigid bores (Sec. 4.6's two models)."""
+    n_rigid = result.rigid_count
+    share = interior.interior_fraction(result.vectors[n_rigid:])
+    freqs = result.frequencies_hz[n_rigid:]
+    rigid = interior.rigid
+    el = rigid.frequencies_hz[rigid.mechanisms:]
+    return {
+        "rigid_bores_frequencies_hz": el,
+        "rigid_bores_bearing_energy": rigid.bearing_energy[rigid.mechanisms:],
+        "rigid_bores_mechanisms": rigid.mechanisms,
+        "rigid_bores_dofs": rigid.dofs,
+        "coupled_interior_energy_share": share,
+        "coupled_interior_modes_hz": freqs[share > 0.5],
+        "coupled_interior_mode_numbers": (np.flatnonzero(share > 0.5) + 1).tolist(),
+        "coupled_housing_modes": int(np.sum(share <= 0.5)),
+        "coupled_dofs": interior.system.size,
+        "coupling_s": interior.model.timings.get("coupling_s"),
+    }

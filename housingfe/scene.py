@@ -22,6 +22,7 @@ from pydantic import (
 
 from housingfe.errors import InputError
 from housingfe.geometry.specs import Geometry
+from housingfe.interior import CouplingSpec
 from housingfe.materials import LIBRARY, Material
 
 SCENE_DIR = Path(__file__).parent / "scenes"
@@ -102,12 +103,15 @@ class LoadSpec(_Strict):
     """One load case.  force: `amplitude` N along `direction`, spread uniformly over the facets of
     `surface` within `radius` of `point` (a true point load is singular in solids).  moment: a couple of
     `amplitude` N m about `direction`, as a linear traction field over the same kind of patch.  pressure:
-    uniform `amplitude` Pa on the whole surface, pushing along -n.  Amplitudes are rms; `spectrum` scales
-    them per frequency (flat when absent)."""
+    uniform `amplitude` Pa on the whole surface, pushing along -n.  With `node` instead of a surface, a force
+    or moment acts on a node of the [coupling] interior (a shaft node "<shaft>:<index>" or a bore master), e.g.
+    the thesis' 1 N m torque at the wheel centre (Sec. 5.4).  Amplitudes are rms; `spectrum` scales them per
+    frequency (flat when absent)."""
 
     name: str
     kind: Literal["force", "moment", "pressure"]
-    surface: str
+    surface: Optional[str] = None
+    node: Optional[str] = None
     point: Optional[list[float]] = Field(None, min_length=3, max_length=3)
     direction: Optional[list[float]] = Field(None, min_length=3, max_length=3)
     radius: PositiveFloat = 0.005
@@ -116,11 +120,17 @@ class LoadSpec(_Strict):
 
     @model_validator(mode="after")
     def _check(self):
-        if self.kind != "pressure":
-            if self.point is None:
-                raise ValueError("point: required for a force or moment load (m)")
-            if self.direction is None or sum(c * c for c in self.direction) == 0:
-                raise ValueError("direction: required and non-zero for a force or moment load")
+        if (self.surface is None) == (self.node is None):
+            raise ValueError("surface: give either surface (a load on the housing) or node (on the interior)")
+        if self.kind != "pressure" and (self.direction is None or sum(c * c for c in self.direction) == 0):
+            raise ValueError("direction: required and non-zero for a force or moment load")
+        if self.node is not None:
+            if self.kind == "pressure":
+                raise ValueError("kind: a node load is a force or a moment")
+            if self.point is not None:
+                raise ValueError("point: not used with node (the node is the point)")
+        elif self.kind != "pressure" and self.point is None:
+            raise ValueError("point: required for a force or moment load (m)")
         return self
 
 
@@ -162,6 +172,9 @@ class HarmonicSpec(_Strict):
     surface: str = "outer"
     sample_points: list[PositiveInt] = [18, 36, 48, 94]
     deflection_shapes_hz: list[PositiveFloat] = []
+    # a shaft node of the [coupling] interior: TF_omega = L_v - L_omega with omega its angular velocity about
+    # the shaft axis (thesis eq. 5.5)
+    angular_velocity_node: Optional[str] = None
 
     @model_validator(mode="after")
     def _check(self):
@@ -260,6 +273,8 @@ class HousingScene(_Strict):
     radiation: Optional[RadiationSpec] = None
     output: OutputSpec = OutputSpec()
     reference: Optional[ReferenceSpec] = None
+    # the gearbox interior: bore masters, shafts, gears, bearings, gear meshes, tie rods (housingfe.interior)
+    coupling: Optional[CouplingSpec] = None
 
     @model_validator(mode="after")
     def _needs_analysis(self):
@@ -270,6 +285,11 @@ class HousingScene(_Strict):
             raise ValueError("radiation: sound power needs a forced response ([analysis.harmonic])")
         if self.analysis.harmonic is not None and not self.loads:
             raise ValueError("loads: a harmonic analysis needs at least one [[loads]] entry")
+        if self.coupling is None:
+            if any(load.node is not None for load in self.loads):
+                raise ValueError("loads: a node load needs a [coupling] interior")
+            if self.analysis.harmonic is not None and self.analysis.harmonic.angular_velocity_node is not None:
+                raise ValueError("analysis.harmonic.angular_velocity_node: needs a [coupling] interior")
         names = [load.name for load in self.loads]
         if len(set(names)) != len(names):
             raise ValueError("loads: load case names must be unique")
