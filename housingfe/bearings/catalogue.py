@@ -17,6 +17,15 @@ Estimation rules (stated before any result was computed, not tuned to any publis
   cylindrical rollers D_w = 0.26 (D - d), effective length 0.6 B, Z = round(0.80 pi d_m / D_w).
   spherical rollers   two rows, D_w = 0.22 (D - d), length per row 0.4 B, Z per row = round(0.80 pi d_m / D_w),
                       contact angle 9 deg (from a typical SKF calculation factor e = 1.5 tan(alpha) ~ 0.24).
+  tapered rollers     (SKF 30316 J2, 30219 J2: not named by the thesis, which only says "taper roller bearings",
+                      Sec. 5.8; chosen as the single-row series with the same d, D and cone width B as the
+                      6316 / 6219 and 7316 B / 7219 B they replace, see _TAPERED.)  Cup contact angle from the
+                      catalogue calculation factor e = 1.5 tan(alpha); mean roller diameter D_w = 0.22 (D - d)
+                      (the spherical-roller ratio: the raceways are inclined and the cone carries a large rib),
+                      effective length 0.6 B and Z = round(0.80 pi d_m / D_w) as for cylindrical rollers;
+                      one contact angle for both raceways (the rollers taken as cylinders, thesis Sec. 3.3.2);
+                      radial clearance 0 (adjusted against the ball bearing at the other end of the shaft, like
+                      the angular contact bearings).
   material            bearing steel E = 208 GPa, nu = 0.3.
 """
 from __future__ import annotations
@@ -46,6 +55,19 @@ _BOUNDARY = {
     "22219CC": ("spherical_roller", 95, 170, 43, None, None, (65, 90)),
     "NJ316": ("cylindrical_roller", 80, 170, 39, 0.0, None, (40, 70)),
     "NU2219": ("cylindrical_roller", 95, 170, 43, 0.0, None, (45, 75)),
+    "30316J2": ("tapered_roller", 80, 170, 39, None, None, None),
+    "30219J2": ("tapered_roller", 95, 170, 32, None, None, None),
+}
+
+# single-row tapered roller bearings: total width T, cup width C [mm], calculation factors e, Y (SKF catalogue
+# values as recalled, NOT checked against the catalogue: the search found SKF tables of the same series for
+# small bores only, e.g. 30204 J2: e = 0.35, Y = 1.7).  d, D, B are in _BOUNDARY; alpha = atan(e / 1.5).
+# Why not the steep 31316 J2 (e = 0.83, Y = 0.72): at the test gearbox load (Fr = 21.2 kN per bearing,
+# Fa = 8272 N) a single bearing needs Fa >= 0.5 Fr / Y, i.e. 6.2 kN (30316 J2), 7.6 kN (30219 J2) but 14.7 kN
+# (31316 J2): the steep bearing cannot run alone at the locating position.
+_TAPERED = {
+    "30316J2": {"T": 42.5, "C": 33.0, "e": 0.35, "Y": 1.7},
+    "30219J2": {"T": 34.5, "C": 27.0, "e": 0.43, "Y": 1.4},
 }
 
 _SPHERICAL_CONTACT_ANGLE_DEG = 9.0
@@ -75,6 +97,8 @@ def lookup(designation: str) -> RollingBearing:
         raise InputError(f"bearing designation {designation!r}: not in the catalogue "
                          f"(known: {', '.join(_BOUNDARY)})")
     kind, d, outer, width, alpha_deg, published, clearance = _BOUNDARY[key]
+    if kind == "tapered_roller":
+        return _tapered(key, d, outer, width)
     d, outer, width = d * _MM, outer * _MM, width * _MM
     pitch = (d + outer) / 2.0
     est = {"pitch_diameter": "(d + D) / 2", "E": "bearing steel 208 GPa", "nu": "0.3"}
@@ -115,3 +139,34 @@ def lookup(designation: str) -> RollingBearing:
                           element_diameter=dw, pitch_diameter=pitch,
                           contact_angle=math.radians(_SPHERICAL_CONTACT_ANGLE_DEG),
                           radial_clearance=radial_clearance, roller_length=0.4 * width, rows=2, estimated=est)
+
+
+def _tapered(key: str, d: float, outer: float, width: float) -> RollingBearing:
+    from housingfe.bearings.rolling import RollingBearing
+
+    data = _TAPERED[key]
+    d, outer, width = d * _MM, outer * _MM, width * _MM
+    pitch = (d + outer) / 2.0
+    dw = 0.22 * (outer - d)
+    z = round(0.80 * math.pi * pitch / dw)
+    alpha = math.atan(data["e"] / 1.5)
+    est = {"pitch_diameter": "(d + D) / 2", "E": "bearing steel 208 GPa", "nu": "0.3",
+           "element_diameter": "0.22 (D - d) (mean roller diameter)", "roller_length": "0.6 B",
+           "n_elements": "round(0.80 pi d_m / D_w)",
+           "contact_angle": f"atan(e / 1.5) with e = {data['e']} (SKF value recalled, not checked); one angle "
+                            "for both raceways (rollers as cylinders, thesis Sec. 3.3.2)",
+           "radial_clearance": "0 (adjusted against the ball bearing at the other end of the shaft)"}
+    return RollingBearing(designation=f"SKF {key[:-2]} {key[-2:]}", kind="tapered_roller", bore=d,
+                          outer_diameter=outer, width=width, n_elements=z, element_diameter=dw,
+                          pitch_diameter=pitch, contact_angle=alpha, radial_clearance=0.0,
+                          roller_length=0.6 * width, estimated=est)
+
+
+def tapered_data(designation: str) -> dict:
+    """Total width T and cup width C [mm] and the calculation factors e, Y of a catalogue tapered roller
+    bearing (the values the entry's contact angle comes from)."""
+    key = normalise(designation)
+    if key not in _TAPERED:
+        raise InputError(f"bearing designation {designation!r}: not a tapered roller bearing of the catalogue "
+                         f"(known: {', '.join(_TAPERED)})")
+    return dict(_TAPERED[key])
