@@ -287,7 +287,7 @@ def evaluate(name: str, loads, speeds_rpm=None, *, hold_tilt: bool = True, axial
             if choice.kind == "rolling":
                 res = _rolling_result(choice, f, hold_tilt)
             else:
-                res = _fluid_film_result(choice, f, speeds_rpm, fluid_film_model, label)
+                res = _fluid_film_result(choice, f, speeds_rpm, fluid_film_model)
         except InputError as err:
             raise InputError(f"{label}: {err}") from None
         if config.gear_set == "double_helical" and position in AXIAL_LOCATION[axial_location]:
@@ -323,7 +323,7 @@ def _rolling_result(choice: BearingChoice, f: np.ndarray, hold_tilt: bool) -> Po
                           displacement=tt * res.displacement, mirrored=bool(mirrored), detail=res)
 
 
-def _fluid_film_result(choice: BearingChoice, f: np.ndarray, speeds_rpm, model: str, label: str) -> PositionResult:
+def _fluid_film_result(choice: BearingChoice, f: np.ndarray, speeds_rpm, model: str) -> PositionResult:
     from housingfe.bearings.fluid_film import journal_bearing_coefficients, short_bearing_coefficients
 
     shaft = SHAFT[choice.position]
@@ -356,9 +356,8 @@ def _fluid_film_result(choice: BearingChoice, f: np.ndarray, speeds_rpm, model: 
     c = t[:, None] * c * t[None, :]
     load = np.zeros(6)
     load[:2] = f[:2]
-    out = PositionResult(position=choice.position, choice=choice, K=k, C=c, load=load,
-                         displacement=t * res.displacement, mirrored=reverse, detail=res)
-    return out
+    return PositionResult(position=choice.position, choice=choice, K=k, C=c, load=load,
+                          displacement=t * res.displacement, mirrored=reverse, detail=res)
 
 
 def _axial_stand_in(position: str, f: np.ndarray, label: str) -> float:
@@ -387,3 +386,14 @@ def diagonal_table(results: dict[str, dict[str, PositionResult]]) -> str:
                 bearing += " (mirrored)"
             lines.append(f"| {name} | {p} | {bearing} | " + " | ".join(f"{v:.3g}" for v in d[:5]) + " |")
     return "\n".join(lines)
+
+
+def main() -> None:
+    """Print the diagonal table of every configuration at the representative load (docs/bearings.md)."""
+    results = {name: evaluate(name, representative_loads(c.gear_set), REPRESENTATIVE_SPEEDS_RPM)
+               for name, c in configurations().items()}
+    print(diagonal_table(results))
+
+
+if __name__ == "__main__":
+    main()
