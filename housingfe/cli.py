@@ -17,6 +17,7 @@ _EXTENSIONS = (
     "housingfe.bearings",
     "housingfe.radiation",
     "housingfe.source.cli",
+    "housingfe.bearing_variants",
 )
 
 

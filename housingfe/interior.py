@@ -72,7 +72,7 @@ class BearingSpec(_Strict):
     axis: Vector3 = (0.0, 0.0, 1.0)
     designation: str | None = None
     load: tuple[float, float, float, float, float] | None = None
-    model: str | None = Field(None, pattern="^(lim-ball|lim-roller|sliced-roller|self-aligning)$")
+    model: str | None = Field(None, pattern="^(lim-ball|lim-roller|sliced-roller|sliced-roller-thesis|self-aligning)$")
     # tilt (rad) held by the shaft instead of zero moments (a shaft on two bearings sets the tilt; see
     # housingfe.bearings.validation)
     fixed_tilt: tuple[float, float] | None = None
