@@ -28,7 +28,8 @@ import numpy as np
 from housingfe.errors import InputError
 
 GEAR_SCENES = {"single_helical": "gearset-B", "double_helical": "gearset-double-helical"}
-SPEEDS_RPM = {"pinion": 1500.0, "wheel": 500.0}       # Sec. 3.5: the fluid-film operating points
+# Sec. 3.5: the fluid-film operating points; signed about the common +y shaft axis (the wheel turns the other way)
+SPEEDS_RPM = {"pinion": 1500.0, "wheel": -500.0}
 TORQUE_NM = 2000.0                                    # pinion torque, Sec. 5.8 (T = 2000 N m)
 SPEED_RANGE_HZ = (320.0, 600.0)                       # tooth frequency at 800-1500 rev/min (0.4 Hz per rpm)
 POSITIONS = ("pinion_front", "pinion_back", "wheel_front", "wheel_back")
@@ -127,7 +128,9 @@ def configuration_spec(base, config: str, torque: float = TORQUE_NM):
                                      pos[back.shaft_node], axis)
         loads[f"{shaft}_front"] = to_bearing_frame(lf, front.axis)
         loads[f"{shaft}_back"] = to_bearing_frame(lb, back.axis)
-    matrices = bearing_matrices(config, loads, SPEEDS_RPM)
+    # both front bearings locate axially (a double helical wheel is otherwise axially free: its mesh has no
+    # axial component)
+    matrices = bearing_matrices(config, loads, SPEEDS_RPM, axial_location="both")
     new_bearings = []
     for b in base.bearings:
         K, C = matrices[b.name]
