@@ -1,7 +1,14 @@
 """FE coupling (housingfe.coupling) against analytic answers: a stiff block on a 6x6 spring (rigid-body
 spring-mass eigenproblem), RBE3 adds no stiffness, star rods -> RBE2, a pinned-pinned Timoshenko shaft on
-bearings, two gears on a mesh spring, and the direct harmonic solver with non-symmetric bearing matrices."""
+bearings, two gears on a mesh spring, the direct harmonic solver with non-symmetric bearing matrices, the
+total mass from the rigid-body vectors, and 1 against 2 MPI ranks."""
+import json
 import math
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -14,7 +21,7 @@ from housingfe import interior
 from housingfe.errors import InputError
 from housingfe.model import build_model
 from housingfe.shafts import CircularSection, RigidDisc, Shaft
-from housingfe.solvers import harmonic, modal
+from housingfe.solvers import elasticity, harmonic, modal
 from tests.conftest import load_scene
 
 A, B, H, RHO = 0.2, 0.1, 0.05, 7850.0            # block (m, kg/m^3)
@@ -342,3 +349,122 @@ def test_scene_section(stiff_block):
     bad = dict(spec, bores=[dict(spec["bores"][0], kindd="rbe2")])
     with pytest.raises(InputError, match="kindd"):
         interior.couple_from_spec(stiff_block, bad)
+
+
+def test_rigid_body_vectors_give_total_mass_and_centre(coarse_box_model, bare_box):
+    """rigid_body_vectors + the coupled rigid modes (the free box's six and the shaft's spin): the mass is the box's
+    plus the shaft's and the disc's, the centre of gravity their weighted mean; expand/restrict round trip."""
+    m = coarse_box_model
+    top = cp.surface_centre(m, "outer_top")
+    L, d = 0.2, 0.03
+    shaft = Shaft.stepped([(L, d)], origin=top, axis=(0, 0, 1), elements_per_segment=4)
+    disc = RigidDisc.cylinder(0.1, 0.02)
+    shaft.add_disc(4, disc)
+    system = cp.couple(m, [cp.BoreConnection("top", "outer_top", tuple(top), (0, 0, 1), "rbe2")],
+                       [cp.bearing("s:0", "top", np.diag([1e9, 1e9, 1e9, 1e6, 1e6, 0.0]), (0, 0, 1))],
+                       shafts={"s": shaft})
+    res = modal.solve_modes(system.K, system.M, 50.0)        # below the first elastic mode: the rigid ones
+    assert res.rigid_count == 7 and len(res.eigenvalues) == 7
+    rigid = system.rigid_body_vectors(m.V)
+    props = modal.rigid_body_mass_properties(system.M, res.vectors, rigid)
+    box = modal.rigid_body_mass_properties(m.M, bare_box.vectors[:6], elasticity.rigid_body_vectors(m.V))
+    m_shaft = shaft.material.rho * CircularSection(d).area * L
+    total = box["mass_kg"] + m_shaft + disc.mass
+    centre = (box["mass_kg"] * box["centre_of_gravity_m"] + m_shaft * (top + [0, 0, L / 2])
+              + disc.mass * shaft.nodes[4]) / total
+    assert abs(props["mass_kg"] / total - 1) < 1e-8
+    assert np.allclose(props["centre_of_gravity_m"], centre, rtol=0, atol=1e-8)
+    assert props["projection_defect"] < 1e-6
+    # the rigid fields satisfy the constraints: expand then restrict gives them back; the master moves rigidly
+    for i, q in enumerate(rigid):
+        back = system.restrict(system.expand(q))
+        back.axpy(-1.0, q)
+        assert back.norm() == 0.0
+        expected = np.eye(6)[i] if i < 3 else np.r_[np.cross(np.eye(3)[i - 3], top), np.eye(3)[i - 3]]
+        assert np.allclose(system.node_displacement(q, "top"), expected, rtol=0, atol=1e-12)
+
+
+def mpi_case(model) -> dict:
+    """What the 1-against-2-rank test compares, on the steel block (a condition number ~100x below the stiff
+    block's, so round-off stays far below 1e-8): the block on its spring through rbe2 and rbe3, and through star
+    rods with a shaft (disc, bearing to the master, a soft spin spring); for the last, a static solve of an FE
+    load plus node loads, mapped back with expand, fe_vector, node_displacement, and the mass of its rigid-body
+    vectors."""
+    from petsc4py import PETSc
+
+    comm = model.V.mesh.comm
+    out = {"ranks": comm.size, "bore_nodes": comm.allgather(len(cp.surface_nodes(model, "bottom")[0]))}
+    for kind in ("rbe2", "rbe3"):
+        out[kind] = coupled_frequencies(model, kind).tolist()
+    shaft = Shaft.stepped([(0.1, 0.03)], origin=(A / 2, B / 2, -0.15), axis=(0, 0, 1), elements_per_segment=2)
+    shaft.add_disc(0, RigidDisc.cylinder(0.08, 0.02))
+    con = cp.BoreConnection("bore", "bottom", BOTTOM_CENTRE, (0, 0, 1), "star", rod_stiffness=1e10)
+    elements = [cp.spring("bore", None, K_SPRING),
+                cp.bearing("s:2", "bore", np.diag([1e7, 1e7, 1e7, 1e4, 1e4, 0.0]), (0, 0, 1)),
+                cp.spring("s:0", None, np.diag([0.0, 0.0, 0.0, 0.0, 0.0, 1e3]))]
+    system = cp.couple(model, [con], elements, shafts={"s": shaft})
+    out["star"] = modal.solve_modes(system.K, system.M, 600.0).frequencies_hz.tolist()
+
+    f = system.load(elasticity.rigid_body_vectors(model.V)[2],             # 1 N along z on every FE node
+                    {"s:0": [0.0, 100.0, 0.0, 0.0, 0.0, 5.0], "bore": [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]})
+    ksp = PETSc.KSP().create(system.K.getComm())
+    ksp.setOperators(system.K)
+    ksp.setType("preonly")
+    ksp.getPC().setType("lu")
+    ksp.getPC().setFactorSolverType("mumps")
+    q = system.K.createVecRight()
+    ksp.solve(f, q)
+    u = system.expand(q)
+    back = system.restrict(u)
+    back.axpy(-1.0, q)
+    out["restrict_error"] = back.norm(PETSc.NormType.INFINITY) / q.norm(PETSc.NormType.INFINITY)
+    out["compliance"] = f.dot(q)
+    out["u_norm"] = u.norm()
+    out["fe_norm"] = system.fe_vector(q, model.V).norm()
+    for name in ("bore", "s:0"):
+        value = system.node_displacement(q, name)
+        out["same_on_all_ranks_" + name] = all(np.array_equal(v, value) for v in comm.allgather(value))
+        out[name] = value.tolist()
+    tx = system.rigid_body_vectors(model.V)[0]
+    Mt = system.M.createVecLeft()
+    system.M.mult(tx, Mt)
+    out["mass"] = tx.dot(Mt)
+    out["size"] = system.size
+    return out
+
+
+@pytest.mark.mpi
+def test_two_ranks_give_the_serial_answer(steel_block):
+    """rbe2, rbe3, star rods + shaft: frequencies, a static solve mapped back, node displacements (the same on every
+    rank) and the coupled mass agree between 1 rank (here) and 2 ranks (mpirun, below)."""
+    one = mpi_case(steel_block)
+    mass = RHO * A * B * H + Shaft.stepped([(0.1, 0.03)]).material.rho * CircularSection(0.03).area * 0.1 \
+        + RigidDisc.cylinder(0.08, 0.02).mass
+    assert abs(one["mass"] / mass - 1) < 1e-10 and one["restrict_error"] < 1e-14
+    if not shutil.which("mpirun"):
+        pytest.skip("mpirun not installed")
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    proc = subprocess.run([shutil.which("mpirun"), "-n", "2", sys.executable, "-m", "tests.test_coupling"],
+                          capture_output=True, text=True, env=env, timeout=300, cwd=Path(__file__).parents[1])
+    assert proc.returncode == 0, proc.stderr
+    two = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert two["ranks"] == 2 and min(two["bore_nodes"]) > 0        # the bore is split between the ranks
+    assert sum(two["bore_nodes"]) == one["bore_nodes"][0] and two["size"] == one["size"]
+    for kind in ("rbe2", "rbe3", "star"):
+        assert len(two[kind]) == len(one[kind])
+        assert np.max(np.abs(np.divide(two[kind], one[kind]) - 1)) < 1e-8, kind
+    for key in ("compliance", "u_norm", "fe_norm", "mass"):
+        assert abs(two[key] / one[key] - 1) < 1e-8, key
+    for name in ("bore", "s:0"):
+        assert two["same_on_all_ranks_" + name]
+        assert np.linalg.norm(np.subtract(two[name], one[name])) < 1e-8 * np.linalg.norm(one[name]), name
+    assert two["restrict_error"] < 1e-14
+
+
+if __name__ == "__main__":       # mpirun -n 2 python -m tests.test_coupling: the 2-rank half of the test above
+    from mpi4py import MPI
+
+    result = mpi_case(build_model(block_scene(2.1e11), MPI.COMM_WORLD))
+    if MPI.COMM_WORLD.rank == 0:
+        print(json.dumps(result))
