@@ -185,8 +185,10 @@ class CoupledSystem:
     given), C (PETSc AIJ or None, viscous damping from the springs, N s/m).  P: PETSc AIJ, u_full = P q
     (rows: the full layout [FE DOFs, 6 DOFs per extra node], columns: q; see the module docstring for the
     parallel layouts).  n_fe: global number of FE DOFs.  nodes: extra node name -> (position (m), global offset
-    in the full vector).  size: global number of q DOFs.  All methods are collective (call them on every rank)
-    and give the same answer on any number of ranks.
+    in the full vector).  size: global number of q DOFs.  independent: this rank's full-layout rows that are its
+    q entries, in order.  timings (s): extra_assembly_s (lumped parts, bore nodes, star rods), to_petsc_s
+    (K_full, M_full, C_full), transform_s (P, the triple products, the pattern check), couple_s (all).  All
+    methods are collective (call them on every rank) and give the same answer on any number of ranks.
     """
 
     K: PETSc.Mat
@@ -364,10 +366,12 @@ class _Layout:
         self.n_x = n_x
         self.fe_start, self.fe_end = model.K.getOwnershipRange()
         self.last = self.comm.rank == self.comm.size - 1
-        starts = self.comm.allgather(self.fe_start)
-        if self.last and self.fe_end != self.n_fe:
-            raise SolverError("coupling: the FE matrix rows are not numbered rank by rank")
-        self.starts = np.array(starts + [self.n_fe + n_x])      # row ownership of the full layout
+        index_map, bs = model.V.dofmap.index_map, model.V.dofmap.index_map_bs
+        wrong = ((self.fe_start, self.fe_end) != tuple(bs * r for r in index_map.local_range)
+                 or (self.last and self.fe_end != self.n_fe))
+        if self.comm.allreduce(wrong):
+            raise SolverError("coupling: the rows of model.K are not dolfinx's rank-by-rank numbering of model.V")
+        self.starts = np.array(self.comm.allgather(self.fe_start) + [self.n_fe + n_x])   # full-layout row owners
         self.n_fe_local = self.fe_end - self.fe_start
         self.n_local = self.n_fe_local + (n_x if self.last else 0)
         self.n_full = self.n_fe + n_x
