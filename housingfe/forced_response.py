@@ -74,13 +74,15 @@ def choose_solver(spec, damping: harmonic.Damping, interior=None) -> list[str]:
         raise InputError("damping.modal_damping_ratios: per-mode damping exists only in the modal solver; "
                          "use solver = \"modal\" or a loss factor")
     non_modal = interior is not None and (interior.C is not None or not interior.system.symmetric)
-    if non_modal and spec.solver in ("modal", "both"):
+    if non_modal and spec.solver == "modal":
         raise InputError("analysis.harmonic.solver: the interior has bearing damping or a non-symmetric "
-                         "stiffness, which only the direct solver takes; use solver = \"direct\" or \"auto\"")
+                         "stiffness, which the modal solver cannot take; use \"projected\", \"direct\" or \"auto\"")
+    if spec.solver == "projected" and damping.D is not None:
+        raise InputError("analysis.harmonic.solver: per-material loss factors need solver = \"direct\" or \"auto\"")
     if spec.solver == "both":
-        return ["modal", "direct"]
+        return ["projected" if non_modal else "modal", "direct"]
     if spec.solver == "auto":
-        return ["direct"] if damping.D is not None or non_modal else ["modal"]
+        return ["direct"] if damping.D is not None else ["projected"] if non_modal else ["modal"]
     return [spec.solver]
 
 
@@ -149,6 +151,15 @@ def run(model, spec, interior=None) -> ForcedResult:
                                                      observer.reduce, residual=False)
                 results["modal"], resp["modal"] = plain, responses(plain, observer, loads)
             name = result.solver
+        elif solver == "projected":
+            f_basis = spec.modal_basis_factor * spec.f_max
+            K_sym = K if interior is None or interior.system.symmetric else interior.basis_stiffness()
+            modes = modal.solve_modes(K_sym, M, f_basis)
+            timings["modal_eigensolve_s"] = time.perf_counter() - t1
+            facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
+                         rigid_modes=modes.rigid_count, basis_f_max_hz=f_basis)
+            result = harmonic.projected(K, M, modes, loads, freqs, damping, observer.reduce, C=C, K_sym=K_sym)
+            name = "projected"
         else:
             result = harmonic.direct(K, M, loads, freqs, damping, observer.reduce, C=C)
             name = "direct"

@@ -358,6 +358,21 @@ class Interior:
     def C(self):
         return self.system.C
 
+    def basis_stiffness(self):
+        """A symmetric positive semi-definite stand-in for K, for the modal basis of the projected solver: every
+        bearing matrix replaced by the nearest PSD matrix to its symmetric part (fluid films have a non-symmetric
+        K whose symmetric part can be indefinite).  Same DOFs as K, built once."""
+        if getattr(self, "_basis_K", None) is None:
+            from housingfe import coupling as cp
+
+            bearings = [b.model_copy(update={"designation": None, "load": None, "model": None, "fixed_tilt": None,
+                                             "stiffness": None, "damping_matrix": None,
+                                             "stiffness_matrix": nearest_psd(b.matrices()[0]).tolist()})
+                        for b in self.spec.bearings]
+            p = parts(self.spec.model_copy(update={"bearings": bearings}), self.centres)
+            self._basis_K = cp.couple(self.model, p.connections, p.elements, p.shafts, p.gear_meshes).K
+        return self._basis_K
+
     def expected_mechanisms(self) -> int:
         """Zero modes the coupled model must have: the housing's six rigid-body motions if it is free, plus the
         interior's own mechanisms on fixed bores (each counted independently, by a dense rank count)."""
@@ -401,6 +416,13 @@ class Interior:
         value = np.zeros(6)
         value[(0 if kind == "force" else 3):(3 if kind == "force" else 6)] = d
         return self.system.load(node_loads={node: value})
+
+
+def nearest_psd(K: np.ndarray) -> np.ndarray:
+    """The symmetric positive semi-definite matrix nearest (Frobenius) to K: clip the negative eigenvalues of its
+    symmetric part."""
+    lam, vec = np.linalg.eigh((K + K.T) / 2)
+    return (vec * np.clip(lam, 0.0, None)) @ vec.T
 
 
 def _mult(A, x):

@@ -158,7 +158,9 @@ class HarmonicSpec(_Strict):
     """Forced harmonic response on lines f_min, f_min + df, ... <= f_max (Hz).
 
     solver: "modal" (superposition with residual flexibility), "direct" (one factorisation per line),
-    "both" (modal, checked against direct), or "auto" (modal unless non-proportional terms are present).
+    "projected" (the full K, C, M on the modal basis + residual vectors: for bearing damping and non-symmetric
+    fluid films), "both" (modal or projected, checked against direct), or "auto" (modal, or projected when the
+    interior has bearing damping or a non-symmetric stiffness, direct for per-material loss factors).
     modal_basis_factor: modes up to this multiple of f_max are kept dynamically; the rest enter through
     the residual (static) flexibility when `residual` is true.
     """
@@ -166,7 +168,7 @@ class HarmonicSpec(_Strict):
     f_min: PositiveFloat = 4.88
     f_max: PositiveFloat
     df: PositiveFloat = 4.88
-    solver: Literal["auto", "modal", "direct", "both"] = "auto"
+    solver: Literal["auto", "modal", "direct", "projected", "both"] = "auto"
     residual: bool = True
     modal_basis_factor: float = Field(1.5, ge=1.0, le=4.0)
     surface: str = "outer"

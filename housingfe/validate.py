@@ -33,7 +33,11 @@ from housingfe.scene import builtin_scenes, load_housing_scene
 RESULTS = Path("results")
 PACKAGE = Path(__file__).parent
 # the sources a modal result depends on: a result older than any of them is recomputed
-MODAL_SOURCES = ("geometry", "solvers", "model.py", "scene.py", "run.py", "materials.py", "published.py", "data")
+MODAL_SOURCES = ("geometry", "solvers", "model.py", "scene.py", "run.py", "materials.py", "published.py", "data",
+                 "interior.py", "coupling.py", "shafts.py", "bearings")
+# the bearing-variant study (thesis Sec. 5.8, Fig. 5.18) and what its result depends on
+VARIANT_SCENE = "test-gearbox-interior"
+VARIANT_SOURCES = MODAL_SOURCES + ("forced_response.py", "response.py", "loads.py", "bearing_variants.py", "source")
 # modules whose published_rows() join the table when they exist
 ROW_PROVIDERS = ("housingfe.bearings.validation", "housingfe.radiation.validation", "housingfe.source.validation",
                  "housingfe.radiation", "housingfe.source", "housingfe.response", "housingfe.coupling")
@@ -58,6 +62,7 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     rows += geometry_rows(names if scenes else list(APPENDIX_E))
     rows += joint_rows(modal)
     if not scenes:
+        rows += bearing_variant_rows()
         rows += provider_rows()
     write_outputs(rows, Path(out_dir), json_path)
     print(format_rows(rows))
@@ -91,13 +96,14 @@ def modal_results(name: str) -> dict:
         return json.load(fh)
 
 
-def is_up_to_date(folder: Path, scene_path: Path) -> bool:
-    """True if folder/modes.json is newer than the scene file and every source in MODAL_SOURCES."""
-    result = folder / "modes.json"
+def is_up_to_date(folder: Path, scene_path: Path, result_name: str = "modes.json",
+                  depends_on: tuple = MODAL_SOURCES) -> bool:
+    """True if folder/result_name is newer than the scene file and every source in depends_on."""
+    result = folder / result_name
     if not result.is_file():
         return False
     sources = [scene_path]
-    for name in MODAL_SOURCES:
+    for name in depends_on:
         p = PACKAGE / name
         sources += [f for f in p.rglob("*") if f.is_file()] if p.is_dir() else [p]
     newest = max(f.stat().st_mtime for f in sources if f.suffix in (".py", ".toml"))
@@ -110,7 +116,7 @@ def is_up_to_date(folder: Path, scene_path: Path) -> bool:
 def scene_rows(scene: str, summary: dict) -> list[dict]:
     """Rows beyond modes.json's automatic ones."""
     freqs = np.asarray(summary["frequencies_hz"], dtype=float)
-    if scene.startswith("gearbox-model"):
+    if scene.startswith("gearbox-model") and "interior" not in scene:
         return gearbox_model_rows(scene, freqs)
     if scene.startswith("box-supported"):
         return close_pair_rows(scene, freqs)
@@ -145,6 +151,37 @@ def close_pair_rows(scene: str, freqs: np.ndarray) -> list[dict]:
     i = int(np.argmin(spacing))
     return [row(scene, f"closest mode pair: relative spacing (ours {freqs[i]:.0f}/{freqs[i + 1]:.0f} Hz)",
                 float(spacing[i]), (f_hi - f_lo) / f_lo, "-", src)]
+
+
+def bearing_variant_rows() -> list[dict]:
+    """Sec. 5.8 / Fig. 5.18: TF_omega of ball minus self-aligning bearings in the test gearbox (thesis FEM 7.3 dB
+    mean, s.d. 4.5 dB).  Reuses results/bearing-variants-<scene>/variants.json when up to date, else runs
+    `housingfe bearing-variants --configs ball self_aligning` first (about a minute)."""
+    scene, path = load_housing_scene(VARIANT_SCENE)
+    folder = RESULTS / f"bearing-variants-{scene.scene.name}"
+    fresh = is_up_to_date(folder, path, "variants.json", VARIANT_SOURCES)
+    if fresh:
+        with open(folder / "variants.json") as fh:
+            data = json.load(fh)
+        fresh = "self_aligning" in data["configurations"]
+    if not fresh:
+        print(f"validate: running the bearing-variant study ({folder}/variants.json is missing or stale)", flush=True)
+        subprocess.run([sys.executable, "-m", "housingfe", "bearing-variants", "--scene", str(path), "--configs",
+                        "ball", "self_aligning", "--out", str(folder)], check=True, stdout=subprocess.DEVNULL)
+        with open(folder / "variants.json") as fh:
+            data = json.load(fh)
+    ref = thesis()["test_gearbox"]["bearings"]
+    src = f"{THESIS} [test_gearbox.bearings], Fig. 5.18"
+    out = []
+    for r in data["differences"]:
+        if r["configuration"] != "self_aligning" or r["average"] not in ("surface", "8 points"):
+            continue
+        label = "surface average" if r["average"] == "surface" else "8 points"
+        out.append(row(scene.scene.name, f"TF_omega ball - self-aligning, mean over 320-600 Hz ({label})",
+                       r["mean_dB_320_600Hz"], ref["fem_TF_ball_minus_self_aligning_mean_dB"], "dB", src))
+        out.append(row(scene.scene.name, f"TF_omega ball - self-aligning, s.d. over 320-600 Hz ({label})",
+                       r["sd_dB_320_600Hz"], ref["fem_TF_ball_minus_self_aligning_sd_dB"], "dB", src))
+    return out
 
 
 def joint_rows(modal: dict[str, dict]) -> list[dict]:

@@ -140,30 +140,72 @@ def test_wheel_torque_turns_the_free_gear_train(gearbox_low):
     assert np.allclose(omega, expected, rtol=5e-3)
 
 
-def test_coupled_modal_matches_direct(comm, tmp_path):
-    """The same coupled scene through modal superposition (+ residual) and the direct solver, hysteretic
-    damping: surface TF and TF_omega agree on lines around the first housing modes."""
+def _variant_scene(tmp_path, comm, **harmonic):
+    """test-gearbox-interior with hysteretic damping (eta = 0.08, the same in every solver) and the given
+    harmonic settings: (scene, model)."""
     import tomllib
 
-    from housingfe import forced_response
-    from housingfe.interior import build_interior
     from housingfe.model import build_model
     from housingfe.scene import SCENE_DIR, load_housing_scene
 
     with open(SCENE_DIR / "test-gearbox-interior.toml", "rb") as fh:
         data = tomllib.load(fh)
     data["damping"] = {"loss_factor": 0.08}
-    data["analysis"]["harmonic"].update(f_min=300.0, f_max=600.0, df=100.0, solver="both", modal_basis_factor=3.0)
-    text = _toml(data)
+    data["analysis"]["harmonic"].update(harmonic)
     path = tmp_path / "scene.toml"
-    path.write_text(text)
+    path.write_text(_toml(data))
     scene, _ = load_housing_scene(str(path))
-    model = build_model(scene, comm)
+    return scene, build_model(scene, comm)
+
+
+def test_coupled_modal_matches_direct(comm, tmp_path):
+    """The ball-bearing gearbox through modal superposition (+ residual) and the direct solver: surface TF and
+    TF_omega agree on lines around the first housing modes."""
+    from housingfe import forced_response
+    from housingfe.interior import build_interior
+
+    scene, model = _variant_scene(tmp_path, comm, f_min=300.0, f_max=600.0, df=100.0, solver="both",
+                                  modal_basis_factor=3.0)
     interior = build_interior(model, scene.coupling, 1800.0)
     forced = forced_response.run(model, scene.analysis.harmonic, interior)
     m, d = forced.responses["modal+residual"][0], forced.responses["direct"][0]
     assert np.max(np.abs(m.transfer_db - d.transfer_db)) < 0.05
     assert np.max(np.abs(m.extras["TF_omega_dB"] - d.extras["TF_omega_dB"])) < 0.05
+
+
+def test_projected_solver_with_a_journal_bearing_matches_a_dense_solve(comm):
+    """A stiff block on a journal bearing (Ocvirk: non-symmetric K, cross-coupled C) plus a 6x6 spring: the
+    projected solver (modes of the nearest PSD stand-in + residual vector, full K and C projected) against a
+    dense complex solve of (K + i w C - w^2 M) q = f, at lines between and near the spring-mass modes."""
+    from types import SimpleNamespace
+
+    from housingfe import coupling as cp
+    from housingfe.bearings import JournalBearing, short_bearing_coefficients
+    from housingfe.interior import nearest_psd
+    from housingfe.model import build_model
+    from housingfe.solvers import harmonic, modal
+    from tests.test_coupling import BOTTOM_CENTRE, K_SPRING, block_scene
+
+    block = build_model(block_scene(2.1e13), comm)
+    film = short_bearing_coefficients(JournalBearing(0.05, 0.025, 50e-6, 0.02), 300.0, (0.0, -1000.0))
+    con = cp.BoreConnection("bore", "bottom", BOTTOM_CENTRE, (0, 0, 1), "rbe3")
+    system = cp.couple(block, [con], [cp.bearing("bore", None, K_SPRING + film.K, (0, 0, 1), film.C)])
+    stand_in = cp.couple(block, [con], [cp.bearing("bore", None, nearest_psd(K_SPRING + film.K), (0, 0, 1))])
+    modes = modal.solve_modes(stand_in.K, stand_in.M, 2000.0)
+    f = system.load(node_loads={"bore": [0.0, 0.3, 1.0, 0.0, 0.0, 0.0]})
+    freqs = np.array([40.0, 75.0, 120.0, 300.0])
+    res = harmonic.projected(system.K, system.M, modes, [SimpleNamespace(vector=f)], freqs,
+                             harmonic.Damping(eta=lambda x: np.full(np.shape(x), 0.02)),
+                             lambda vecs: np.array([v.getArray().copy() for v in vecs]), C=system.C,
+                             K_sym=stand_in.K)
+    n = system.size
+    K, M, C = (A.getValues(range(n), range(n)) for A in (system.K, system.M, system.C))
+    blk = res.blocks[0][0]
+    u = blk.reduced.T @ blk.coeffs
+    for k, fr in enumerate(freqs):
+        w = 2 * math.pi * fr
+        ref = np.linalg.solve(K * (1 + 0.02j) + 1j * w * C - w * w * M, f.getArray())
+        assert np.linalg.norm(u[:, k] - ref) < 1e-4 * np.linalg.norm(ref), fr
 
 
 def _toml(data, prefix=""):

@@ -149,6 +149,84 @@ def _check_not_singular(denominators: np.ndarray, lam_e: np.ndarray, frequencies
                           f"mode {n + 1}): the response is infinite; add damping or move the line")
 
 
+# -------------------------------------------------------------------------------------- projected
+def symmetric_part(K: PETSc.Mat) -> PETSc.Mat:
+    """(K + K^T) / 2 (same pattern as K when K's pattern is symmetric, as assembled FE + bearing blocks are)."""
+    Kt = K.copy()
+    Kt.transpose()
+    S = K.copy()
+    S.axpy(1.0, Kt, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    S.scale(0.5)
+    S.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    Kt.destroy()
+    return S
+
+
+def projected(K, M, modal_result, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None, *,
+              K_sym: PETSc.Mat | None = None, shift: float | None = None) -> HarmonicResult:
+    """Non-proportional damping and non-symmetric stiffness (fluid films) on a reduced basis.
+
+    Basis: the undamped modes of (K_sym, M) (modal_result, K_sym = the symmetric part of K) plus, per load, the
+    static residual vector of the modes left out (as in modal superposition), M-orthonormalised.  The full K,
+    C and M are projected on it (Galerkin, dense, non-symmetric) and the small system
+    (Kr (1 + i eta) + i omega (Cr + D_xi) - omega^2 Mr) c = Fr is solved per line; D_xi = 2 xi omega_n on the
+    modes for modal damping ratios.  Exact for the loads' static response and the kept modes' dynamics; the
+    error is what the rest of the spectrum does beyond its static part (check: tests against `direct`)."""
+    t0 = time.perf_counter()
+    K_sym = K_sym if K_sym is not None else K
+    omega = 2 * math.pi * np.asarray(frequencies, dtype=float)
+    lam = modal_result.eigenvalues
+    n_rigid = modal_result.rigid_count
+    phis = list(modal_result.vectors)
+    lam_e = lam[n_rigid:]
+    shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
+    ksp = _factor(_shifted(K_sym, M, shift), "projected_")
+    basis = list(phis)
+    for load in loads:
+        r = _residual_vector(ksp, M, load.vector, phis[:n_rigid], phis[n_rigid:], lam_e, shift)
+        for b in basis:                         # M-orthogonal to the basis (twice: round-off)
+            r.axpy(-b.dot(_mult(M, r)), b)
+        for b in basis:
+            r.axpy(-b.dot(_mult(M, r)), b)
+        norm = math.sqrt(max(r.dot(_mult(M, r)), 0.0))
+        if norm > 1e-12 * math.sqrt(max(load.vector.norm(), 1e-300)):
+            r.scale(1.0 / norm)
+            basis.append(r)
+    ksp.destroy()
+    t1 = time.perf_counter()
+    KB = [_mult(K, b) for b in basis]
+    MB = [_mult(M, b) for b in basis]
+    Kr = np.array([[a.dot(kb) for kb in KB] for a in basis])
+    Mr = np.array([[a.dot(mb) for mb in MB] for a in basis])
+    Cr = np.zeros_like(Kr)
+    if C is not None:
+        CB = [_mult(C, b) for b in basis]
+        Cr = np.array([[a.dot(cb) for cb in CB] for a in basis])
+    Fr = np.array([[b.dot(load.vector) for load in loads] for b in basis])
+    n_modes = len(phis)
+    xi = damping.ratios(len(lam_e))
+    D = np.zeros_like(Kr)
+    if xi is not None:
+        idx = np.arange(n_rigid, n_modes)
+        D[idx, idx] = 2 * xi * np.sqrt(np.clip(lam_e, 0.0, None))
+    eta = np.zeros(len(omega)) if xi is not None else damping.hysteretic(frequencies)
+    coeffs = np.zeros((len(loads), len(basis), len(omega)), dtype=complex)
+    for k, (w, e) in enumerate(zip(omega, eta)):
+        A = Kr * (1 + 1j * e) + 1j * w * (Cr + D) - w * w * Mr
+        try:
+            coeffs[:, :, k] = np.linalg.solve(A, Fr).T
+        except np.linalg.LinAlgError as exc:
+            raise SolverError(f"projected solver: singular reduced system at {frequencies[k]:.6g} Hz") from exc
+    t2 = time.perf_counter()
+    reduced = reduce(basis)
+    every = np.arange(len(omega))
+    blocks = [[Block(reduced, coeffs[j], every)] for j in range(len(loads))]
+    return HarmonicResult(np.asarray(frequencies, float), blocks, "projected",
+                          {"projected_s": time.perf_counter() - t0, "projected_basis_s": t1 - t0,
+                           "projected_lines_s": t2 - t1, "projected_basis_size": len(basis)},
+                          modal_vectors=[basis] * len(loads))
+
+
 # ----------------------------------------------------------------------------------------- direct
 def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None) -> HarmonicResult:
     """Direct solution per frequency in the real 2x2 block form (MUMPS LDL^T), all load cases per factor."""
@@ -160,12 +238,15 @@ def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | No
     pair = np.array([[1.0], [1j]])
     # the 2x2 block matrix is symmetric iff K, M and the damping matrices are: LDL^T then, LU otherwise
     symmetric = all(_is_symmetric(A) for A in (K, M, damping.D, C) if A is not None)
+    from housingfe.solvers.modal import axpy_structure
+
+    structure = axpy_structure(K, M)
     for k, (f_hz, eta_f) in enumerate(zip(frequencies, eta)):
         w = 2 * math.pi * f_hz
         if undamped:
             _check_undamped_line(K, M, w * w, f_hz)
         Kr = K.copy()
-        Kr.axpy(-w * w, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        Kr.axpy(-w * w, M, structure=structure)
         if damping.D is not None and damping.modal_ratio is None:
             Ki = damping.D.copy()
         else:
@@ -223,7 +304,9 @@ def _check_undamped_line(K, M, w2: float, f_hz: float, tol: float = 1e-9) -> Non
 # ---------------------------------------------------------------------------------------- helpers
 def _shifted(K, M, shift: float) -> PETSc.Mat:
     A = K.copy()
-    A.axpy(-shift, M, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+    from housingfe.solvers.modal import axpy_structure
+
+    A.axpy(-shift, M, structure=axpy_structure(A, M))
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     return A
 

@@ -74,10 +74,27 @@ def mumps_cholesky(A: PETSc.Mat, prefix: str, inertia: bool = False) -> PETSc.KS
     return ksp
 
 
+def axpy_structure(Y: PETSc.Mat, X: PETSc.Mat):
+    """PETSc's fast SAME_NONZERO_PATTERN when Y and X share their sparsity pattern on every rank (FE K and M,
+    a coupled K_c and M_c), DIFFERENT_NONZERO_PATTERN otherwise (e.g. a stand-in stiffness built separately):
+    SAME on different patterns would silently give a wrong matrix."""
+    ia, ja, _ = Y.getValuesCSR()
+    ib, jb, _ = X.getValuesCSR()
+    same = int(np.array_equal(ia, ib) and np.array_equal(ja, jb))
+    same = Y.getComm().tompi4py().allreduce(same, op=_mpi_min())
+    return PETSc.Mat.Structure.SAME_NONZERO_PATTERN if same else PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+
+
+def _mpi_min():
+    from mpi4py import MPI
+
+    return MPI.MIN
+
+
 def count_eigenvalues_below(K: PETSc.Mat, M: PETSc.Mat, sigma: float) -> int:
     """Number of eigenvalues of K x = lambda M x below sigma (rad^2/s^2), by the inertia of K - sigma M."""
     A = K.copy()
-    A.axpy(-sigma, M, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+    A.axpy(-sigma, M, structure=axpy_structure(A, M))
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     ksp = mumps_cholesky(A, "inertia_", inertia=True)
     ksp.setUp()
