@@ -14,7 +14,9 @@ couples them with the housing and computes TF_omega = L_v - L_omega (eq. 5.5) on
 Results: TF_omega per configuration (surface average and the scene's sample-point sets), the differences
 ball - configuration with mean and standard deviation over the measured speed range (800-1500 rev/min, tooth
 frequency 320-600 Hz) and over all lines, CSV + PNG, next to the thesis' 7.3 dB (s.d. 4.5) for ball minus
-self-aligning.
+self-aligning.  The thesis' FEM had no self-aligning bearing model: it used the ball bearing matrices with the
+moment terms zeroed; that comparison is the configuration `ball_zero_moment`, next to our spherical roller
+model `self_aligning` (whose radial stiffness is several times the ball bearing's).
 """
 from __future__ import annotations
 
@@ -33,6 +35,12 @@ SPEEDS_RPM = {"pinion": 1500.0, "wheel": -500.0}
 TORQUE_NM = 2000.0                                    # pinion torque, Sec. 5.8 (T = 2000 N m)
 SPEED_RANGE_HZ = (320.0, 600.0)                       # tooth frequency at 800-1500 rev/min (0.4 Hz per rpm)
 POSITIONS = ("pinion_front", "pinion_back", "wheel_front", "wheel_back")
+# the thesis' FEM stand-in for self-aligning bearings (Sec. 5.8): the ball bearing matrices with their moment
+# rows and columns zeroed ("the stiffness matrix of the ball bearings was used with zero moment stiffness")
+THESIS_SELF_ALIGNING = "ball_zero_moment"
+# a diagnostic: the ball matrices with the moment stiffness of the thesis' own interior model (Appendix C:
+# 3.4-5.2e6 N m/rad, some 25x what Lim's theory gives for these bearings here)
+APPENDIX_C_MOMENTS = "ball_appendix_c_moments"
 
 
 # ------------------------------------------------------------------------------------------- gear forces
@@ -107,6 +115,29 @@ def configuration_spec(base, config: str, torque: float = TORQUE_NM):
     from housingfe.bearings.variants import bearing_matrices, configurations
 
     configs = configurations()
+    if config == THESIS_SELF_ALIGNING:
+        spec, loads, forces = configuration_spec(base, "ball", torque)
+        bearings = []
+        for b in spec.bearings:
+            k = np.array(b.stiffness_matrix)
+            k[3:5, :] = 0.0
+            k[:, 3:5] = 0.0
+            bearings.append(b.model_copy(update={"stiffness_matrix": k.tolist()}))
+        return spec.model_copy(update={"bearings": bearings}), loads, forces
+    if config == APPENDIX_C_MOMENTS:
+        spec, loads, forces = configuration_spec(base, "ball", torque)
+        from housingfe.published import thesis
+
+        diag = thesis()["gears"]["interior_model"]["bearing_stiffness_diag"]
+        moments = {"pinion": (diag["thx1"], diag["thy1"]), "wheel": (diag["thx2"], diag["thy2"])}
+        bearings = []
+        for b in spec.bearings:
+            k = np.array(b.stiffness_matrix)
+            k[3:5, :] = 0.0
+            k[:, 3:5] = 0.0
+            k[3, 3], k[4, 4] = moments[b.name.split("_")[0]]
+            bearings.append(b.model_copy(update={"stiffness_matrix": k.tolist()}))
+        return spec.model_copy(update={"bearings": bearings}), loads, forces
     if config not in configs:
         raise InputError(f"bearing configuration {config!r}: unknown (known: {', '.join(configs)})")
     if len(base.gear_meshes) != 1:
@@ -184,7 +215,7 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
     if scene.coupling is None or scene.analysis.harmonic is None or not scene.analysis.harmonic.angular_velocity_node:
         raise InputError(f"{scene_name}: bearing-variants needs a scene with [coupling], [analysis.harmonic] and "
                          "analysis.harmonic.angular_velocity_node")
-    configs = list(configs or configurations())
+    configs = list(configs or [*configurations(), THESIS_SELF_ALIGNING, APPENDIX_C_MOMENTS])
     comm = MPI.COMM_WORLD
     model = build_model(scene, comm)
     t_model = time.perf_counter() - t_start
@@ -204,7 +235,7 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
                                       forces.stiffness, {"total_s": time.perf_counter() - t0, **forced.timings})
         if comm.rank == 0:
             print(f"{name:20s} {solver:15s} {time.perf_counter() - t0:6.1f} s", flush=True)
-    summary = differences(results)
+    summary = differences(results, "ball" if "ball" in results else configs[0])
     out = Path(out_dir or f"results/bearing-variants-{scene.scene.name}")
     with report.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
@@ -230,7 +261,7 @@ def differences(results: dict, reference: str = "ball", band=SPEED_RANGE_HZ) -> 
         for label, a, b in [("surface", ref.tf_omega_db, r.tf_omega_db)] + [
                 (f"{N} points", ref.tf_omega_points_db[N], r.tf_omega_points_db[N]) for N in ref.tf_omega_points_db]:
             d = np.asarray(a) - np.asarray(b)
-            rows.append({"configuration": name, "average": label,
+            rows.append({"configuration": name, "reference": reference, "average": label,
                          "mean_dB_320_600Hz": float(d[in_band].mean()), "sd_dB_320_600Hz": float(d[in_band].std()),
                          "mean_dB_all": float(d.mean()), "sd_dB_all": float(d.std()),
                          "min_dB_all": float(d.min()), "max_dB_all": float(d.max())})
@@ -242,7 +273,8 @@ def summary_text(rows: list[dict], model, t_model: float) -> str:
     from housingfe.report import format_table
 
     data = published.thesis()["test_gearbox"]["bearings"]
-    lines = [f"housing model {model.dofs} DOFs built in {t_model:.1f} s; TF_omega differences ball - configuration "
+    reference = rows[0]["reference"] if rows else "ball"
+    lines = [f"housing model {model.dofs} DOFs built in {t_model:.1f} s; TF_omega differences {reference} - configuration "
              f"(dB; positive = the configuration transmits less); thesis FEM ball - self-aligning: "
              f"{data['fem_TF_ball_minus_self_aligning_mean_dB']} dB mean, s.d. "
              f"{data['fem_TF_ball_minus_self_aligning_sd_dB']} dB"]
@@ -283,11 +315,12 @@ def plot(path: Path, results: dict) -> None:
         ax1.plot(r.frequencies, r.tf_omega_db, label=n)
     ax1.set_ylabel("TF_omega = L_v - L_omega [dB]")
     ax1.legend(fontsize=8)
-    ref = results.get("ball")
-    if ref is not None:
+    name = "ball" if "ball" in results else next(iter(results))
+    ref = results[name]
+    if len(results) > 1:
         for n, r in results.items():
-            if n != "ball":
-                ax2.plot(r.frequencies, ref.tf_omega_db - r.tf_omega_db, label=f"ball - {n}")
+            if n != name:
+                ax2.plot(r.frequencies, ref.tf_omega_db - r.tf_omega_db, label=f"{name} - {n}")
         ax2.axvspan(*SPEED_RANGE_HZ, color="0.9", label="800-1500 rev/min")
         ax2.axhline(7.3, color="k", ls="--", lw=0.8, label="thesis FEM mean, ball - self-aligning")
     ax2.set_xlabel("frequency [Hz]")
@@ -304,7 +337,8 @@ def register_cli(subparsers) -> None:
                               help="TF_omega of the test gearbox with each bearing configuration (Sec. 5.8/5.9)")
     p.add_argument("--scene", default="test-gearbox-interior", help="housing scene with an interior")
     p.add_argument("--configs", nargs="+", default=None,
-                   help="configurations (default: all of housingfe.bearings.variants; 'ball' is the reference)")
+                   help="configurations (default: all of housingfe.bearings.variants and ball_zero_moment, the "
+                        "thesis' FEM stand-in for self-aligning bearings; 'ball' is the reference)")
     p.add_argument("--torque", type=float, default=TORQUE_NM, help="pinion torque [N m]")
     p.add_argument("--out", default=None, help="result folder")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value")
