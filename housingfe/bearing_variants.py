@@ -116,28 +116,13 @@ def configuration_spec(base, config: str, torque: float = TORQUE_NM):
 
     configs = configurations()
     if config == THESIS_SELF_ALIGNING:
-        spec, loads, forces = configuration_spec(base, "ball", torque)
-        bearings = []
-        for b in spec.bearings:
-            k = np.array(b.stiffness_matrix)
-            k[3:5, :] = 0.0
-            k[:, 3:5] = 0.0
-            bearings.append(b.model_copy(update={"stiffness_matrix": k.tolist()}))
-        return spec.model_copy(update={"bearings": bearings}), loads, forces
+        return _ball_with_moment_stiffness(base, torque, {"pinion": (0.0, 0.0), "wheel": (0.0, 0.0)})
     if config == APPENDIX_C_MOMENTS:
-        spec, loads, forces = configuration_spec(base, "ball", torque)
         from housingfe.published import thesis
 
         diag = thesis()["gears"]["interior_model"]["bearing_stiffness_diag"]
-        moments = {"pinion": (diag["thx1"], diag["thy1"]), "wheel": (diag["thx2"], diag["thy2"])}
-        bearings = []
-        for b in spec.bearings:
-            k = np.array(b.stiffness_matrix)
-            k[3:5, :] = 0.0
-            k[:, 3:5] = 0.0
-            k[3, 3], k[4, 4] = moments[b.name.split("_")[0]]
-            bearings.append(b.model_copy(update={"stiffness_matrix": k.tolist()}))
-        return spec.model_copy(update={"bearings": bearings}), loads, forces
+        return _ball_with_moment_stiffness(base, torque, {"pinion": (diag["thx1"], diag["thy1"]),
+                                                          "wheel": (diag["thx2"], diag["thy2"])})
     if config not in configs:
         raise InputError(f"bearing configuration {config!r}: unknown (known: {', '.join(configs)})")
     if len(base.gear_meshes) != 1:
@@ -172,6 +157,20 @@ def configuration_spec(base, config: str, torque: float = TORQUE_NM):
     new_mesh = mesh.model_copy(update={"stiffness": forces.stiffness, "direction": tuple(forces.direction)})
     spec = base.model_copy(update={"bearings": new_bearings, "gear_meshes": [new_mesh]})
     return spec, loads, forces
+
+
+def _ball_with_moment_stiffness(base, torque: float, moments: dict):
+    """The ball configuration with the moment rows and columns of every bearing replaced by the diagonal
+    (k_theta_x, k_theta_y) of `moments` {"pinion"|"wheel": (N m/rad, N m/rad)}."""
+    spec, loads, forces = configuration_spec(base, "ball", torque)
+    bearings = []
+    for b in spec.bearings:
+        k = np.array(b.stiffness_matrix)
+        k[3:5, :] = 0.0
+        k[:, 3:5] = 0.0
+        k[3, 3], k[4, 4] = moments[b.name.split("_")[0]]
+        bearings.append(b.model_copy(update={"stiffness_matrix": k.tolist()}))
+    return spec.model_copy(update={"bearings": bearings}), loads, forces
 
 
 def _node_positions(spec) -> dict:

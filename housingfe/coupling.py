@@ -545,12 +545,17 @@ def _star_rods(trip, dofs, moff, r, k) -> None:
 
 
 def _gear_element(g: GearMesh, nodes) -> Element:
+    return gear_mesh_element(g, _node(nodes, g.a)[0], _node(nodes, g.b)[0])
+
+
+def gear_mesh_element(g: GearMesh, position_a, position_b) -> Element:
+    """The 12x12 Element of a gear mesh between nodes at position_a and position_b (m): stiffness (and damping)
+    on the relative flank displacement along the contact normal (see GearMesh)."""
     n = np.asarray(g.direction, float)
     n /= np.linalg.norm(n)
     x = np.asarray(g.point, float)
-    ga = n @ rigid_arm(x - _node(nodes, g.a)[0])
-    gb = n @ rigid_arm(x - _node(nodes, g.b)[0])
-    gvec = np.concatenate([ga, -gb])
+    gvec = np.concatenate([n @ rigid_arm(x - np.asarray(position_a, float)),
+                           -(n @ rigid_arm(x - np.asarray(position_b, float)))])
     K = g.stiffness * np.outer(gvec, gvec)
     C = g.damping * np.outer(gvec, gvec) if g.damping else None
     return Element((g.a, g.b), K, None, C)

@@ -6,7 +6,7 @@ N/m, N m/rad, rev/min only where the key says so.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Annotated
 
 import numpy as np
@@ -158,6 +158,7 @@ class Parts:
     bearings: list
     gear_meshes: list
     tie_rods: list          # Elements (beam K, M between the two nodes, rigid ends included)
+    positions: dict         # node name (bores, shaft nodes) -> position (m)
 
     @property
     def elements(self) -> list:
@@ -215,7 +216,7 @@ def parts(spec: CouplingSpec, bore_centres: dict) -> Parts:
                 **{f"{n}:{i}": x for n, sh in shafts.items() for i, x in enumerate(sh.nodes)}}
     rods = [tie_rod_element(t, position[t.a], position[t.b], f"coupling.tie_rods.{i}")
             for i, t in enumerate(spec.tie_rods)]
-    return Parts(connections, shafts, bearings, meshes, rods)
+    return Parts(connections, shafts, bearings, meshes, rods, position)
 
 
 def tie_rod_element(t: TieRodSpec, pa: np.ndarray, pb: np.ndarray, key: str):
@@ -283,8 +284,6 @@ def interior_matrices(spec: CouplingSpec, centres: dict):
     p = parts(spec, centres)
     names = [f"{n}:{i}" for n, sh in p.shafts.items() for i in range(len(sh.nodes))]
     index = {n: 6 * i for i, n in enumerate(names)}
-    position = {**{n: np.asarray(x) for n, x in centres.items()},
-                **{f"{n}:{i}": x for n, sh in p.shafts.items() for i, x in enumerate(sh.nodes)}}
     size = 6 * len(names)
     K, M, Kb = np.zeros((size, size)), np.zeros((size, size)), np.zeros((size, size))
 
@@ -304,11 +303,7 @@ def interior_matrices(spec: CouplingSpec, centres: dict):
         add(K, list(e.nodes), e.K)
         add(Kb, list(e.nodes), e.K)
     for g in p.gear_meshes:
-        n = np.asarray(g.direction, float) / np.linalg.norm(g.direction)
-        ga = n @ cp.rigid_arm(np.asarray(g.point) - position[g.a])
-        gb = n @ cp.rigid_arm(np.asarray(g.point) - position[g.b])
-        gvec = np.concatenate([ga, -gb])
-        add(K, [g.a, g.b], g.stiffness * np.outer(gvec, gvec))
+        add(K, [g.a, g.b], cp.gear_mesh_element(g, p.positions[g.a], p.positions[g.b]).K)
     for e in p.tie_rods:
         add(K, list(e.nodes), e.K)
         add(M, list(e.nodes), e.M)
@@ -345,6 +340,7 @@ class Interior:
     system: object
     rigid: RigidBoreModes
     centres: dict
+    _basis_K: object = field(default=None, repr=False)   # built on first use (projected solver only)
 
     @property
     def K(self):
@@ -362,7 +358,7 @@ class Interior:
         """A symmetric positive semi-definite stand-in for K, for the modal basis of the projected solver: every
         bearing matrix replaced by the nearest PSD matrix to its symmetric part (fluid films have a non-symmetric
         K whose symmetric part can be indefinite).  Same DOFs as K, built once."""
-        if getattr(self, "_basis_K", None) is None:
+        if self._basis_K is None:
             from housingfe import coupling as cp
 
             bearings = [b.model_copy(update={"designation": None, "load": None, "model": None, "fixed_tilt": None,

@@ -150,23 +150,11 @@ def _check_not_singular(denominators: np.ndarray, lam_e: np.ndarray, frequencies
 
 
 # -------------------------------------------------------------------------------------- projected
-def symmetric_part(K: PETSc.Mat) -> PETSc.Mat:
-    """(K + K^T) / 2 (same pattern as K when K's pattern is symmetric, as assembled FE + bearing blocks are)."""
-    Kt = K.copy()
-    Kt.transpose()
-    S = K.copy()
-    S.axpy(1.0, Kt, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    S.scale(0.5)
-    S.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-    Kt.destroy()
-    return S
-
-
 def projected(K, M, modal_result, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None, *,
               K_sym: PETSc.Mat | None = None, shift: float | None = None) -> HarmonicResult:
     """Non-proportional damping and non-symmetric stiffness (fluid films) on a reduced basis.
 
-    Basis: the undamped modes of (K_sym, M) (modal_result, K_sym = the symmetric part of K) plus, per load, the
+    Basis: the undamped modes of (K_sym, M) (modal_result; K_sym a symmetric PSD stand-in for K) plus, per load, the
     static residual vector of the modes left out (as in modal superposition), M-orthonormalised.  The full K,
     C and M are projected on it (Galerkin, dense, non-symmetric) and the small system
     (Kr (1 + i eta) + i omega (Cr + D_xi) - omega^2 Mr) c = Fr is solved per line; D_xi = 2 xi omega_n on the
