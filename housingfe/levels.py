@@ -1,7 +1,8 @@
 """Levels in dB, frequency bands and weighting, shared by every stage of the chain.
 
 References as in van Roosmalen (1994): v0 = 5e-8 m/s (eq. 4.1, 5.4), omega0 = 5e-8 rad/s (eq. 2.61),
-F0 = 1 N, P0 = 1 pW (eq. 4.16), S0 = 1 m^2, l0 = 1 m (eq. 4.5).
+F0 = 1 N, P0 = 1 pW (eq. 4.16), S0 = 1 m^2, l0 = 1 m (eq. 4.5).  Levels are of rms quantities
+(`level(mean_square, ref)` takes the mean square, i.e. rms^2).  Air: c = 344 m/s, rho = 1.2 kg/m^3.
 
 Bands follow IEC 61260-1 (base-10: G = 10^(3/10), exact mid-band f_m = 1000 * G^(x/b)).
 A-weighting follows IEC 61672-1 (analytic pole form, normalised to 0 dB at 1 kHz).
@@ -18,6 +19,16 @@ F0 = 1.0         # N, force level reference
 P0 = 1e-12       # W, sound power reference
 S0 = 1.0         # m^2, area level reference
 L0 = 1.0         # m, moment-to-force reference length
+
+# Air: the one place for c and rho; every default in the package is taken from here (a test greps for others).
+# Source: the thesis' list of symbols (housingfe/data/roosmalen1994.toml [references] c_air_m_per_s,
+# rho_air_kg_per_m3); c = 344 m/s is also the value behind Appendix E's printed 1.13*U*fc/c.
+SPEED_OF_SOUND = 344.0  # m/s
+AIR_DENSITY = 1.2       # kg/m^3
+
+# Amplitude convention (docs/radiation.md, "Conventions"): loads, responses and velocities are rms unless a
+# parameter name says peak; a harmonic quantity of peak amplitude x_hat has rms x_hat / sqrt(2).
+RMS_PER_PEAK = 2.0 ** -0.5
 
 _G = 10.0 ** 0.3  # octave frequency ratio, base 10
 

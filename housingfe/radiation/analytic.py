@@ -1,7 +1,11 @@
 """Analytic radiators and quick estimates (van Roosmalen 1994, Sec. 4.7).
 
-Conventions used throughout `housingfe.radiation`:
-- SI units; frequencies in Hz; velocities in m/s.
+Conventions used throughout `housingfe.radiation` (the table in docs/radiation.md):
+- SI units; frequencies in Hz; velocities in m/s.  Air: c and rho from `housingfe.levels` (344 m/s,
+  1.2 kg/m^3, the thesis' symbols list); `SPEED_OF_SOUND` and `AIR_DENSITY` here are those constants.
+- Amplitudes: a scalar velocity amplitude is named by its convention (`velocity_rms_m_s` or
+  `velocity_peak_m_s`); velocity *fields* given to the numerical radiators are complex peak phasors unless
+  `velocity_is_rms=True` (the housing's forced response passes rms phasors).  Mean squares are rms^2.
 - Radiation efficiency sigma = P / (rho c S <v~^2>) (eq. 4.8), with <v~^2> the surface-averaged
   *mean-square* (rms^2) normal velocity.  A harmonic velocity of peak amplitude v_hat has
   v~^2 = |v_hat|^2 / 2.
@@ -13,9 +17,9 @@ import numpy as np
 from scipy.special import eval_legendre, j1, spherical_jn, spherical_yn
 
 from housingfe.errors import InputError
+from housingfe.levels import AIR_DENSITY, SPEED_OF_SOUND
 
-SPEED_OF_SOUND = 344.0  # m/s, the value behind the printed numbers of Appendix E (1.13*U*fc/c)
-AIR_DENSITY = 1.21      # kg/m^3, air at about 20 degC and 1 atm
+__all__ = ["AIR_DENSITY", "SPEED_OF_SOUND"]  # re-exported: the package's one c and rho (housingfe.levels)
 
 
 def _positive(name: str, value) -> np.ndarray:
@@ -49,15 +53,22 @@ def sphere_sigma(ka) -> np.ndarray:
     return x2 / (1.0 + x2)
 
 
-def sphere_power(radius_m: float, velocity_amplitude_m_s, frequency_hz,
+def sphere_power(radius_m: float, frequency_hz, *, velocity_rms_m_s=None, velocity_peak_m_s=None,
                  rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND) -> np.ndarray:
     """Time-averaged sound power of a pulsating sphere in W (eq. 4.6):
-    P = 2 pi rho c R^2 v_R^2 (f/f_s)^2 / (1 + (f/f_s)^2), with v_R the radial velocity *amplitude*
-    (peak, m/s) and R in m."""
+    P = 2 pi rho c R^2 v_R^2 (f/f_s)^2 / (1 + (f/f_s)^2) with v_R the radial velocity *peak* amplitude,
+    i.e. P = 4 pi rho c R^2 v_rms^2 sigma.  Give exactly one of `velocity_rms_m_s` (the package's convention,
+    as the scenes' loads and responses) or `velocity_peak_m_s` (as printed in eq. 4.6), in m/s; R in m,
+    f in Hz.  Keyword-only, so that a value can never be read in the other convention by position."""
+    if (velocity_rms_m_s is None) == (velocity_peak_m_s is None):
+        raise InputError("velocity_rms_m_s: give exactly one of velocity_rms_m_s and velocity_peak_m_s")
     R = _positive("radius_m", radius_m)
-    vR = _non_negative("velocity_amplitude_m_s", velocity_amplitude_m_s)
+    if velocity_rms_m_s is not None:
+        v_rms = _non_negative("velocity_rms_m_s", velocity_rms_m_s)
+    else:
+        v_rms = _non_negative("velocity_peak_m_s", velocity_peak_m_s) / np.sqrt(2.0)
     ka = wavenumber(frequency_hz, c) * R
-    return 2.0 * np.pi * _positive("rho", rho) * c * R**2 * vR**2 * sphere_sigma(ka)
+    return 4.0 * np.pi * _positive("rho", rho) * c * R**2 * v_rms**2 * sphere_sigma(ka)
 
 
 def sphere_modal_resistance(n: int, ka) -> np.ndarray:

@@ -12,8 +12,10 @@ Lagrange elements of `degree` on second-order (curved) tetrahedra, closed by
   at kR < 1, where the near field dominates; kept for comparison).
 A plane z = 0 outside the body is a rigid baffle when the mesh is a half-space (baffled piston).
 
-Velocity convention as in `housingfe.radiation.numerical`: complex peak normal velocity (m/s),
-P = 1/2 Re int p v_n* dS, sigma = P / (rho c S <v~^2>), <v~^2> = int |v_n|^2 / 2 dS / S.
+Velocity convention as in `housingfe.radiation.numerical` (docs/radiation.md, "Conventions"): the velocity
+field is a complex *peak* phasor (m/s), P = 1/2 Re int p v_n* dS, sigma = P / (rho c S <v~^2>),
+<v~^2> = int |v_n|^2 / 2 dS / S; rms phasors (the housing's forced response, the scenes' loads) are accepted
+explicitly with `velocity_is_rms=True`.  rho and c default to `housingfe.levels` (1.2 kg/m^3, 344 m/s).
 """
 from __future__ import annotations
 
@@ -137,13 +139,14 @@ def complex_env() -> dict:
 
 def helmholtz_fem_radiation(geometry: FemGeometry, frequencies_hz, velocity=1.0, truncation: str = "bgt2",
                             degree: int = 2, rho: float = AIR_DENSITY, c: float = SPEED_OF_SOUND,
-                            save_msh: str | None = None, timeout_s: float = 3600.0,
+                            save_msh: str | None = None, timeout_s: float = 3600.0, *,
                             velocity_is_rms: bool = False) -> FemSweep:
     """Radiated power (W) and radiation efficiency per frequency (Hz) from an exterior Helmholtz FE model.
 
-    velocity: a complex peak normal velocity (m/s) uniform over the vibrating surface, or a pair
+    velocity: a complex *peak* normal velocity phasor (m/s) uniform over the vibrating surface, or a pair
     (points (n,3) m, values (n,) complex m/s) sampled on it (nearest sample per surface DOF).
-    With velocity_is_rms the values are rms phasors (scaled by sqrt(2) to peak).
+    velocity_is_rms=True (keyword only): the values are rms phasors (scaled by sqrt(2) to peak); the power
+    is then twice that of the same numbers read as peak, sigma is the same.
     One mesh and one form compilation serve the whole sweep; each frequency is one sparse LU (MUMPS)."""
     scale = np.sqrt(2.0) if velocity_is_rms else 1.0
     f = np.atleast_1d(np.asarray(frequencies_hz, dtype=float))

@@ -27,9 +27,19 @@ def test_pulsating_sphere_within_half_db():
     err = _db_error(sweep.results, analytic.sphere_sigma(KA))
     assert np.all(abs(err) < 0.5), err
     assert np.all(abs(err) < 0.05), err  # measured: < 0.01 dB on this mesh
-    # power in W against eq. 4.6 (amplitude 1 m/s), not only the ratio
+    # power in W against eq. 4.6 (the FE's default velocity 1 m/s is a peak phasor), not only the ratio
     p = np.array([r.power_w for r in sweep.results])
-    assert p == pytest.approx(analytic.sphere_power(A, 1.0, _frequencies(KA)), rel=0.01)
+    assert p == pytest.approx(analytic.sphere_power(A, _frequencies(KA), velocity_peak_m_s=1.0), rel=0.01)
+
+
+def test_rms_velocity_is_accepted_explicitly():
+    # velocity_is_rms: 1 m/s rms carries the power of sqrt(2) m/s peak (eq. 4.6 with v_rms)
+    f = _frequencies(np.array([1.0]))
+    sweep = fem.helmholtz_fem_radiation(fem.sphere_geometry(A, h_m=0.03, h_surface_m=0.025), f, 1.0,
+                                        velocity_is_rms=True)
+    assert sweep.results[0].power_w == pytest.approx(analytic.sphere_power(A, f, velocity_rms_m_s=1.0)[0],
+                                                     rel=0.01)
+    assert sweep.results[0].mean_square_velocity == pytest.approx(1.0, rel=1e-6)
 
 
 def _fibonacci_sphere(n, radius):
