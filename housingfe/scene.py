@@ -154,6 +154,26 @@ class DampingSpec(_Strict):
         return self
 
 
+class ResponsePointSpec(_Strict):
+    """A named response point for point FRFs (points.csv): `point` (m) is snapped to the nearest point of
+    `surface` (default: every tagged surface of the housing); farther than `tolerance` (m, default one element
+    size) is an error.  direction: a vector (the response along it), "normal" (the outward surface normal at
+    the snapped point), or absent (the x, y and z components)."""
+
+    name: str = Field(min_length=1)
+    point: list[float] = Field(min_length=3, max_length=3)
+    direction: Optional[list[float] | Literal["normal"]] = None
+    surface: Optional[str] = None
+    tolerance: Optional[PositiveFloat] = None
+
+    @model_validator(mode="after")
+    def _check(self):
+        if isinstance(self.direction, list) and (len(self.direction) != 3 or
+                                                 sum(c * c for c in self.direction) == 0):
+            raise ValueError("direction: a non-zero vector of 3 components, \"normal\", or absent (x, y, z)")
+        return self
+
+
 class HarmonicSpec(_Strict):
     """Forced harmonic response on lines f_min, f_min + df, ... <= f_max (Hz).
 
@@ -174,6 +194,8 @@ class HarmonicSpec(_Strict):
     surface: str = "outer"
     sample_points: list[PositiveInt] = [18, 36, 48, 94]
     deflection_shapes_hz: list[PositiveFloat] = []
+    # named response points: point FRFs (receptance, mobility, accelerance) in points.csv
+    points: list[ResponsePointSpec] = []
     # a shaft node of the [coupling] interior: TF_omega = L_v - L_omega with omega its angular velocity about
     # the shaft axis (thesis eq. 5.5)
     angular_velocity_node: Optional[str] = None
@@ -182,6 +204,9 @@ class HarmonicSpec(_Strict):
     def _check(self):
         if self.f_min > self.f_max:
             raise ValueError("f_min: must not exceed f_max")
+        names = [p.name for p in self.points]
+        if len(set(names)) != len(names):
+            raise ValueError("points: response point names must be unique")
         return self
 
     @property
