@@ -39,7 +39,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
 def _cmd_validate(args: argparse.Namespace) -> int:
     from housingfe import validate
 
-    validate.main(out_dir=args.out, json_path=args.json, scenes=args.scenes)
+    validate.main(out_dir=args.out, json_path=args.json, scenes=args.scenes, quick=args.quick,
+                  results_dir=args.results)
     return 0
 
 
@@ -85,6 +86,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("scenes", nargs="*", help="restrict to these scenes")
     p.add_argument("--out", default="results/validate", help="folder for validate.csv / validate.md")
     p.add_argument("--json", default=None, metavar="FILE", help="also write the rows as JSON")
+    p.add_argument("--quick", action="store_true",
+                   help="the CI subset: small FE scenes and every row that needs no FE (docs/verification.md)")
+    p.add_argument("--results", default=None, metavar="DIR",
+                   help="folder of the cached FE results (default results/)")
     p.set_defaults(func=_cmd_validate)
 
     p = sub.add_parser("bench", help="speed-against-error benchmarks (tables, CSV, PNG)")

@@ -19,11 +19,14 @@ def thesis() -> dict:
         return tomllib.load(fh)
 
 
-def row(scene: str, quantity: str, ours, published, unit: str, source: str) -> dict:
-    """One comparison row; `difference` is ours - published (and relative where meaningful)."""
+def row(scene: str, quantity: str, ours, published, unit: str, source: str, note: str = "") -> dict:
+    """One comparison row; `difference` is ours - published (and relative where meaningful).  `ours` is None
+    for a published number the package does not reproduce (say why in `note`); `source` names the publication
+    and its table/section/equation, `note` any assumption the comparison rests on."""
     out = {"scene": scene, "quantity": quantity, "ours": ours, "published": published, "unit": unit,
-           "source": source}
-    if isinstance(ours, (int, float)) and isinstance(published, (int, float)) and not math.isnan(published):
+           "source": source, "note": note}
+    if isinstance(ours, (int, float)) and isinstance(published, (int, float)) and not math.isnan(published) \
+            and not math.isnan(ours):
         out["difference"] = ours - published
         if published:
             out["relative_difference"] = (ours - published) / published

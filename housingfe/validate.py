@@ -1,21 +1,27 @@
 """`housingfe validate`: our numbers next to the published ones, for every scene and module that has them.
 
 Rows come from three places:
-1. housing scenes with a [reference] (modal results): the rows `housingfe run` already put into
+1. housing scenes with a [reference] and a modal analysis: the rows `housingfe run` already put into
    modes.json, plus scene-specific rows made here (first three modes and empty 1/3-octave bands of the
    Sec. 4.5 gearbox model, the closest mode pair of Sec. 4.3, the gasket's effect on the eigenfrequencies
-   of Sec. 4.4);
+   of Sec. 4.4) and the Sec. 5.8 bearing-variant study;
 2. geometry reconstructions that can be checked without FE (Appendix E plate areas and perimeters);
-3. other modules' `published_rows()` (bearings, and radiation/source once they provide one).
+3. the `published_rows()` of the modules listed in ROW_PROVIDERS (bearings, radiation, source).
 
-FE results are reused from `results/<scene>/modes.json` when that folder is newer than the scene file and
-every source the modal result depends on (geometry/, solvers/, model.py, scene.py, run.py, materials.py,
-published.py, data/); otherwise the scene is run (`housingfe run <scene> --out results/<scene>`,
-in a subprocess) first.  A full validate on 2 cores takes a few minutes the first time, seconds afterwards.
+FE results are cached in `<results>/<scene>/` (default `results/`).  A cached result is reused only when its
+stamp `.validate-key` holds the same key: a sha256 of the resolved scene (after defaults and overrides) and
+of the content of every housingfe source file the computation imported plus `housingfe/data/` (the list is
+recorded by the run itself).  File modification times play no part, so a fresh clone, a `git checkout` or
+touching an unrelated file reuses what is still valid, and any edit of a file the result depends on reruns it.
+
+Every computation runs in a subprocess; a failure is reported as one line (the log of that run is kept in
+`<results>/.validate-logs/`), the remaining rows are still collected and written, and the command exits
+non-zero.  `--quick` is a subset for CI (see QUICK_SCENES and docs/verification.md).
 """
 from __future__ import annotations
 
 import csv
+import hashlib
 import importlib
 import json
 import math
@@ -26,88 +32,189 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.errors import InputError
+from housingfe.errors import InputError, SolverError
 from housingfe.published import THESIS, row, thesis
 from housingfe.scene import builtin_scenes, load_housing_scene
 
 RESULTS = Path("results")
-PACKAGE = Path(__file__).parent
-# the sources a modal result depends on: a result older than any of them is recomputed
-MODAL_SOURCES = ("geometry", "solvers", "model.py", "scene.py", "run.py", "materials.py", "published.py", "data",
-                 "interior.py", "coupling.py", "shafts.py", "bearings")
-# the bearing-variant study (thesis Sec. 5.8, Fig. 5.18) and what its result depends on
+PACKAGE = Path(__file__).resolve().parent
+STAMP = ".validate-key"
+# the bearing-variant study (thesis Sec. 5.8, Fig. 5.18) and the configurations it needs
 VARIANT_SCENE = "test-gearbox-interior"
-VARIANT_SOURCES = MODAL_SOURCES + ("forced_response.py", "response.py", "loads.py", "bearing_variants.py", "source")
-# modules whose published_rows() join the table when they exist
-ROW_PROVIDERS = ("housingfe.bearings.validation", "housingfe.radiation.validation", "housingfe.source.validation",
-                 "housingfe.radiation", "housingfe.source", "housingfe.response", "housingfe.coupling")
+VARIANT_CONFIGS = ("ball", "self_aligning", "ball_zero_moment")
+# modules whose published_rows() join the table: every name must import and define published_rows()
+# (tests/test_validate.py checks it), so a renamed module fails loudly instead of silently dropping rows
+ROW_PROVIDERS = ("housingfe.bearings.validation", "housingfe.radiation.validation", "housingfe.source.validation")
 # Appendix E tables that a gearbox scene's reconstruction is checked against
 APPENDIX_E = {"gearbox-model": "scale_model", "test-gearbox": "test_gearbox"}
+# `housingfe validate --quick` (CI): the small FE scenes and every row that needs no FE (providers, Appendix E
+# geometry); the full run adds the other housing scenes and the bearing-variant study (docs/verification.md)
+QUICK_SCENES = ("nafems-fv12", "box-free")
+
+
+class ComputationFailed(Exception):
+    """A subprocess of validate failed; the message is one line."""
 
 
 def main(out_dir: str | Path = "results/validate", json_path: str | Path | None = None,
-         scenes: list[str] | None = None) -> list[dict]:
+         scenes: list[str] | None = None, quick: bool = False, results_dir: str | Path | None = None) -> list[dict]:
     """Collect the rows, print them, write validate.csv and validate.md to out_dir (and the JSON list of
-    rows to json_path if given).  scenes: names or paths; default every built-in housing scene with a
-    reference plus the other modules' rows."""
+    rows to json_path if given).  scenes: names or paths (only their rows); default every built-in housing
+    scene with a reference and a modal analysis plus the other modules' rows; quick: the CI subset.
+    results_dir: where FE results are cached (default results/).  Raises SolverError (one line) after
+    writing the table when a computation failed."""
     t0 = time.perf_counter()
-    names = scenes or default_scenes()
+    results = Path(results_dir) if results_dir is not None else RESULTS
+    names = scenes or default_scenes(quick)
     rows: list[dict] = []
+    failures: list[str] = []
     modal: dict[str, dict] = {}
     for name in names:
-        summary = modal_results(name)
+        try:
+            summary = modal_results(name, results)
+        except ComputationFailed as exc:
+            failures.append(str(exc))
+            continue
+        if summary is None:
+            continue
         modal[summary["scene"]] = summary
         rows += summary.get("published", [])
         rows += scene_rows(summary["scene"], summary)
     rows += geometry_rows(names if scenes else list(APPENDIX_E))
     rows += joint_rows(modal)
     if not scenes:
-        rows += bearing_variant_rows()
-        rows += provider_rows()
+        if not quick:
+            try:
+                rows += bearing_variant_rows(results)
+            except ComputationFailed as exc:
+                failures.append(str(exc))
+        rows += provider_rows(failures)
     write_outputs(rows, Path(out_dir), json_path)
     print(format_rows(rows))
     print(f"{len(rows)} rows in {time.perf_counter() - t0:.0f} s; written to {out_dir}/validate.csv, validate.md"
           + (f" and {json_path}" if json_path else ""))
+    if failures:
+        raise SolverError(f"validate: {len(failures)} computation(s) failed, their rows are missing: "
+                          + "; ".join(failures))
     return rows
 
 
-def default_scenes() -> list[str]:
-    """Built-in housing scenes that name published data."""
+def default_scenes(quick: bool = False) -> list[str]:
+    """Built-in housing scenes that name published data and have a modal analysis (harmonic-only scenes write
+    no modes.json); with quick, only QUICK_SCENES."""
+    if quick:
+        return list(QUICK_SCENES)
     out = []
     for name in builtin_scenes():
         try:
             scene, _ = load_housing_scene(name)
         except InputError:  # source scenes
             continue
-        if scene.reference is not None:
+        if scene.reference is not None and scene.analysis.modal is not None:
             out.append(name)
     return out
 
 
-def modal_results(name: str) -> dict:
-    """modes.json of a scene: reused from results/<scene> when up to date, else computed first."""
+# ------------------------------------------------------------------------------------- cached computations
+
+# Runs one computation in a fresh interpreter and records which housingfe files it imported: the cache key
+# depends on exactly those.  Kept out of this module so that editing validate.py invalidates nothing.
+_WORKER = r"""
+import json, logging, sys
+from pathlib import Path
+job = json.loads(sys.argv[1])
+logging.disable(logging.INFO)
+from housingfe.errors import InputError, SolverError
+try:
+    if job["kind"] == "run":
+        from housingfe.run import run_scene
+        run_scene(job["scene"], out_dir=job["out"], overrides=job["overrides"])
+    else:
+        from housingfe.bearing_variants import run_study
+        run_study(job["scene"], job["configs"], job["out"], job["overrides"])
+except InputError as exc:
+    print(f"input error: {exc}", file=sys.stderr); sys.exit(2)
+except SolverError as exc:
+    print(f"solver error: {exc}", file=sys.stderr); sys.exit(3)
+package = Path(sys.modules["housingfe"].__file__).resolve().parent
+files = {str(Path(m.__file__).resolve().relative_to(package)) for m in list(sys.modules.values())
+         if getattr(m, "__file__", None) and Path(m.__file__).resolve().is_relative_to(package)}
+Path(job["deps"]).write_text(json.dumps(sorted(files)))
+"""
+
+
+def dependency_files(recorded: list[str]) -> list[str]:
+    """The files a result depends on: those its run imported (relative to the package) and housingfe/data/
+    (published numbers, read as files)."""
+    data = [str(p.relative_to(PACKAGE)) for p in sorted((PACKAGE / "data").rglob("*")) if p.is_file()]
+    return sorted(set(recorded) | set(data))
+
+
+def cache_key(scene, files: list[str], extra=None) -> str | None:
+    """sha256 of the resolved scene (pydantic model after defaults and overrides), `extra` (JSON-able job
+    options) and the content of `files` (relative to the package); None when one of them no longer exists."""
+    h = hashlib.sha256()
+    h.update(json.dumps(scene.model_dump(mode="json"), sort_keys=True).encode())
+    h.update(json.dumps(extra, sort_keys=True).encode())
+    for name in sorted(files):
+        path = PACKAGE / name
+        if not path.is_file():
+            return None
+        h.update(name.encode() + b"\0" + hashlib.sha256(path.read_bytes()).digest())
+    return h.hexdigest()
+
+
+def is_up_to_date(folder: Path, scene, result_name: str, extra=None) -> bool:
+    """True if folder/result_name exists and folder/.validate-key matches the current key."""
+    stamp = folder / STAMP
+    if not (folder / result_name).is_file() or not stamp.is_file():
+        return False
+    try:
+        stored = json.loads(stamp.read_text())
+        files = stored["files"]
+        return stored["key"] == cache_key(scene, files, extra)
+    except (ValueError, KeyError, TypeError):
+        return False
+
+
+def compute(job: dict, scene, folder: Path, results: Path, label: str, extra=None) -> None:
+    """Run `job` in a subprocess (the worker), then stamp the folder with the key of what it imported.
+    Any failure -> ComputationFailed with one line; the full output is kept in <results>/.validate-logs/."""
+    logs = results / ".validate-logs"
+    logs.mkdir(parents=True, exist_ok=True)
+    log = logs / f"{folder.name}.log"
+    deps = logs / f"{folder.name}.deps.json"
+    deps.unlink(missing_ok=True)
+    job = {**job, "out": str(folder), "deps": str(deps)}
+    print(f"validate: computing {label} -> {folder}/", flush=True)
+    t0 = time.perf_counter()
+    with open(log, "w") as fh:
+        proc = subprocess.run([sys.executable, "-c", _WORKER, json.dumps(job)], stdout=fh,
+                              stderr=subprocess.PIPE, text=True)
+        fh.write(proc.stderr)
+    if proc.returncode != 0 or not deps.is_file():
+        lines = [line.strip() for line in proc.stderr.splitlines() if line.strip()]
+        last = lines[-1] if lines else "no error message"
+        raise ComputationFailed(f"{label}: exit {proc.returncode}: {last} (log: {log})")
+    files = dependency_files(json.loads(deps.read_text()))
+    (folder / STAMP).write_text(json.dumps({"key": cache_key(scene, files, extra), "files": files}, indent=0))
+    print(f"validate: {label} done in {time.perf_counter() - t0:.0f} s", flush=True)
+
+
+def modal_results(name: str, results: Path | None = None) -> dict | None:
+    """modes.json of a scene, reused from <results>/<scene> when its key matches, else computed first;
+    None (with a note) for a scene without a modal analysis."""
+    results = RESULTS if results is None else results
     scene, path = load_housing_scene(name)
-    folder = RESULTS / scene.scene.name
-    if not is_up_to_date(folder, path):
-        print(f"validate: running {scene.scene.name} (no up-to-date {folder}/modes.json)", flush=True)
-        subprocess.run([sys.executable, "-m", "housingfe", "run", str(path), "--out", str(folder)], check=True,
-                       stdout=subprocess.DEVNULL)
+    if scene.analysis.modal is None:
+        print(f"validate: {scene.scene.name} has no modal analysis (harmonic only): no modal rows", flush=True)
+        return None
+    folder = results / scene.scene.name
+    if not is_up_to_date(folder, scene, "modes.json"):
+        compute({"kind": "run", "scene": str(path), "overrides": []}, scene, folder, results,
+                f"housingfe run {scene.scene.name}")
     with open(folder / "modes.json") as fh:
         return json.load(fh)
-
-
-def is_up_to_date(folder: Path, scene_path: Path, result_name: str = "modes.json",
-                  depends_on: tuple = MODAL_SOURCES) -> bool:
-    """True if folder/result_name is newer than the scene file and every source in depends_on."""
-    result = folder / result_name
-    if not result.is_file():
-        return False
-    sources = [scene_path]
-    for name in depends_on:
-        p = PACKAGE / name
-        sources += [f for f in p.rglob("*") if f.is_file()] if p.is_dir() else [p]
-    newest = max(f.stat().st_mtime for f in sources if f.suffix in (".py", ".toml"))
-    return result.stat().st_mtime >= newest
 
 
 # ------------------------------------------------------------------------------------- scene-specific rows
@@ -153,23 +260,19 @@ def close_pair_rows(scene: str, freqs: np.ndarray) -> list[dict]:
                 float(spacing[i]), (f_hi - f_lo) / f_lo, "-", src)]
 
 
-def bearing_variant_rows() -> list[dict]:
+def bearing_variant_rows(results: Path | None = None) -> list[dict]:
     """Sec. 5.8 / Fig. 5.18: TF_omega of ball minus self-aligning bearings in the test gearbox (thesis FEM 7.3 dB
-    mean, s.d. 4.5 dB).  Reuses results/bearing-variants-<scene>/variants.json when up to date, else runs
-    `housingfe bearing-variants --configs ball self_aligning` first (about a minute)."""
+    mean, s.d. 4.5 dB).  Reuses <results>/bearing-variants-<scene>/variants.json when its key matches, else runs
+    the study for VARIANT_CONFIGS first (a few minutes)."""
+    results = RESULTS if results is None else results
     scene, path = load_housing_scene(VARIANT_SCENE)
-    folder = RESULTS / f"bearing-variants-{scene.scene.name}"
-    fresh = is_up_to_date(folder, path, "variants.json", VARIANT_SOURCES)
-    if fresh:
-        with open(folder / "variants.json") as fh:
-            data = json.load(fh)
-        fresh = {"self_aligning", "ball_zero_moment"} <= set(data["configurations"])
-    if not fresh:
-        print(f"validate: running the bearing-variant study ({folder}/variants.json is missing or stale)", flush=True)
-        subprocess.run([sys.executable, "-m", "housingfe", "bearing-variants", "--scene", str(path), "--configs",
-                        "ball", "self_aligning", "ball_zero_moment", "--out", str(folder)], check=True, stdout=subprocess.DEVNULL)
-        with open(folder / "variants.json") as fh:
-            data = json.load(fh)
+    folder = results / f"bearing-variants-{scene.scene.name}"
+    extra = {"configs": list(VARIANT_CONFIGS)}
+    if not is_up_to_date(folder, scene, "variants.json", extra):
+        compute({"kind": "bearing-variants", "scene": str(path), "configs": list(VARIANT_CONFIGS), "overrides": []},
+                scene, folder, results, f"housingfe bearing-variants --scene {scene.scene.name}", extra)
+    with open(folder / "variants.json") as fh:
+        data = json.load(fh)
     ref = thesis()["test_gearbox"]["bearings"]
     src = f"{THESIS} [test_gearbox.bearings], Fig. 5.18"
     out = []
@@ -231,67 +334,81 @@ def geometry_rows(names: list[str]) -> list[dict]:
     return out
 
 
-def provider_rows() -> list[dict]:
-    """published_rows() of the modules that have one."""
+def provider_rows(failures: list[str] | None = None) -> list[dict]:
+    """published_rows() of every module in ROW_PROVIDERS.  A provider that fails is reported on one line
+    (appended to `failures`, or raised as SolverError when no list is given); the others still count."""
     out = []
     for module_name in ROW_PROVIDERS:
         try:
-            module = importlib.import_module(module_name)
-        except ModuleNotFoundError as exc:
-            if exc.name and module_name.startswith(exc.name):
-                continue
-            raise
-        if hasattr(module, "published_rows"):
-            out += module.published_rows()
+            t0 = time.perf_counter()
+            rows = importlib.import_module(module_name).published_rows()
+            print(f"validate: {module_name}: {len(rows)} rows in {time.perf_counter() - t0:.1f} s", flush=True)
+            out += rows
+        except Exception as exc:  # noqa: BLE001 - reported on one line, the exit code says it failed
+            message = f"{module_name}.published_rows(): {type(exc).__name__}: {exc}".replace("\n", " ")
+            if failures is None:
+                raise SolverError(message) from exc
+            print(f"validate: failed: {message}", file=sys.stderr, flush=True)
+            failures.append(message)
     return out
 
 
 # ----------------------------------------------------------------------------------------------- output
 
-COLUMNS = ("scene", "quantity", "ours", "published", "difference", "unit", "source")
+COLUMNS = ("scene", "quantity", "ours", "published", "difference", "unit", "source", "note")
 
 
 def _fmt(value) -> str:
+    if value is None:
+        return "-"          # a published number we do not reproduce (the note says why)
     if isinstance(value, float):
         return "nan" if math.isnan(value) else f"{value:.4g}"
     return str(value)
 
 
 def _difference(r: dict) -> str:
-    if "relative_difference" in r and r["unit"] != "-":
+    if "relative_difference" in r and r["unit"] not in ("-", "dB", "dB(A)"):   # % of a level means nothing
         return f"{r['difference']:+.4g} ({100 * r['relative_difference']:+.1f} %)"
     if "difference" in r:
         return f"{r['difference']:+.4g}"
     return ""
 
 
+def _cells(r: dict) -> list[str]:
+    return [r["scene"], r["quantity"], _fmt(r["ours"]), _fmt(r["published"]), _difference(r), r["unit"], r["source"],
+            r.get("note", "")]
+
+
 def format_rows(rows: list[dict]) -> str:
     """A plain-text table of the rows."""
     from housingfe.report import format_table
 
-    return format_table(COLUMNS, [[r["scene"], r["quantity"], _fmt(r["ours"]), _fmt(r["published"]),
-                                   _difference(r), r["unit"], r["source"]] for r in rows])
+    return format_table(COLUMNS, [_cells(r) for r in rows])
 
 
 def write_outputs(rows: list[dict], out_dir: Path, json_path) -> None:
-    """validate.csv and validate.md in out_dir; the list of rows as JSON in json_path."""
+    """validate.csv and validate.md in out_dir; the list of rows as JSON in json_path.  In the CSV an empty
+    `ours` is a published number we do not reproduce (see `note`)."""
     out_dir.mkdir(parents=True, exist_ok=True)
     with open(out_dir / "validate.csv", "w", newline="") as fh:
         writer = csv.writer(fh)
         writer.writerow(COLUMNS)
         for r in rows:
-            writer.writerow([r["scene"], r["quantity"], r["ours"], r["published"], r.get("difference", ""),
-                             r["unit"], r["source"]])
+            writer.writerow([r["scene"], r["quantity"], _csv(r["ours"]), _csv(r["published"]), r.get("difference", ""),
+                             r["unit"], r["source"], r.get("note", "")])
     lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     for r in rows:
-        lines.append("| " + " | ".join([r["scene"], r["quantity"], _fmt(r["ours"]), _fmt(r["published"]),
-                                        _difference(r), r["unit"], r["source"]]) + " |")
+        lines.append("| " + " | ".join(c.replace("|", "/") for c in _cells(r)) + " |")
     (out_dir / "validate.md").write_text("\n".join(lines) + "\n")
     if json_path:
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
-        keys = ("scene", "quantity", "ours", "published", "unit", "source")
+        keys = ("scene", "quantity", "ours", "published", "unit", "source", "note")
         with open(json_path, "w") as fh:
-            json.dump([{k: _jsonable(r[k]) for k in keys} for r in rows], fh, indent=1)
+            json.dump([{k: _jsonable(r.get(k, "")) for k in keys} for r in rows], fh, indent=1)
+
+
+def _csv(v):
+    return "" if v is None or (isinstance(v, float) and math.isnan(v)) else v
 
 
 def _jsonable(v):
