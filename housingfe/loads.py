@@ -59,7 +59,9 @@ def assemble_load(spec, housing, V, bcs) -> LoadCase:
         area, first, _ = _moments(x, ds, mesh.comm)
         centre = first / area
     else:
-        patch = _patch(mesh, facets, np.asarray(spec.point, dtype=float), spec.radius)
+        point = np.asarray(spec.point, dtype=float)
+        _check_point_on_surface(mesh, facets, point, spec)
+        patch = _patch(mesh, facets, point, spec.radius)
         ds = ufl.Measure("ds", domain=mesh, subdomain_data=patch)(1)
         area, first, second = _moments(x, ds, mesh.comm)
         centre = first / area
@@ -79,6 +81,46 @@ def assemble_load(spec, housing, V, bcs) -> LoadCase:
     vec.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     set_bc(vec, bcs)
     return LoadCase(spec.name, spec.kind, vec, spec, area, centre)
+
+
+# Floor of the on-surface tolerance (m): scene coordinates are usually given to the millimetre.
+POINT_TOLERANCE_FLOOR = 1e-3
+
+
+def point_tolerance(spec) -> float:
+    """How far (m) a force's or moment's point may lie from its surface: the load's own `radius`, at least
+    1 mm.  The patch is by definition the surface within `radius` of the point, so a point farther away than
+    that has no patch of its own; the fallback to the nearest facets in `_patch` is for coarse meshes only
+    (a facet's midpoint can lie beyond `radius` though the surface passes through the point)."""
+    return max(float(spec.radius), POINT_TOLERANCE_FLOOR)
+
+
+def surface_distance_bound(mesh, facets: np.ndarray, point: np.ndarray) -> float:
+    """A lower bound of the distance (m) from `point` to the union of `facets` (all ranks): the minimum over
+    the facets of |point - midpoint| minus the facet's largest midpoint-to-node distance.  It is <= 0 for a
+    point on the surface however coarse the mesh, and within a facet size of the true distance otherwise."""
+    fdim = mesh.topology.dim - 1
+    bound = np.inf
+    if len(facets):
+        from dolfinx.cpp.mesh import entities_to_geometry
+
+        mids = dmesh.compute_midpoints(mesh, fdim, facets)
+        cpp_mesh = getattr(mesh, "_mesh", mesh)  # dolfinx 0.5.2's Python Mesh wraps the C++ one
+        nodes = entities_to_geometry(cpp_mesh, fdim, np.ascontiguousarray(facets, dtype=np.int32), False)
+        reach = np.linalg.norm(mesh.geometry.x[nodes] - mids[:, None, :], axis=2).max(axis=1)
+        bound = float(np.min(np.linalg.norm(mids - point, axis=1) - reach))
+    return mesh.comm.allreduce(bound, op=MPI.MIN)
+
+
+def _check_point_on_surface(mesh, facets, point, spec) -> None:
+    """InputError naming loads.<name>.point when the point lies farther than `point_tolerance` from the
+    load's surface (before, the load silently moved to the nearest facets, metres away)."""
+    distance = surface_distance_bound(mesh, facets, point)
+    tol = point_tolerance(spec)
+    if distance > tol:
+        raise InputError(f"loads.{spec.name}.point: {list(spec.point)} lies at least {distance * 1e3:.0f} mm "
+                         f"from surface {spec.surface!r} (allowed: the load radius, {tol * 1e3:.0f} mm); "
+                         "put the point on the surface")
 
 
 def _integrate(expr, comm) -> float:
