@@ -6,6 +6,7 @@ names the file and the key, never a silently ignored setting.
 """
 from __future__ import annotations
 
+import math
 import tomllib
 from pathlib import Path
 from typing import Annotated, Literal, Optional
@@ -354,6 +355,8 @@ def read_scene_dict(name_or_path: str) -> tuple[dict, Path]:
             return tomllib.load(fh), path
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{path}: malformed TOML: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not a UTF-8 text file (byte {exc.start}); a scene is TOML text") from None
     except OSError as exc:
         raise InputError(f"{path}: cannot read: {exc.strerror}") from None
 
@@ -364,6 +367,8 @@ def apply_overrides(data: dict, overrides: list[str], source: str = "--set") -> 
         if "=" not in item:
             raise InputError(f"{source}: {item!r} is not KEY=VALUE")
         key, raw = item.split("=", 1)
+        if not all(part.strip() for part in key.split(".")):
+            raise InputError(f"{source}: {item!r}: empty key (give a dotted key such as mesh.size)")
         try:
             value = tomllib.loads(f"v = {raw}")["v"]
         except tomllib.TOMLDecodeError:
@@ -391,10 +396,26 @@ def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) ->
 def validate(model_cls, data, path, prefix: str = ""):
     """model_cls.model_validate(data), or InputError "<path>: <prefix><key>: <problem>" naming the first bad
     key (an unknown key before the missing one it causes).  Shared by every kind of scene."""
+    bad = _first_non_finite(data)
+    if bad is not None:     # TOML allows inf and nan; pydantic would pass inf as a positive length
+        raise InputError(f"{path}: {prefix}{bad[0]}: {bad[1]} is not a finite number")
     try:
         return model_cls.model_validate(data)
     except ValidationError as exc:
         raise InputError(f"{path}: {prefix}{_first_error(exc)}") from None
+
+
+def _first_non_finite(data, key: str = ""):
+    """(dotted key, value) of the first inf or nan in a parsed scene, or None."""
+    items = data.items() if isinstance(data, dict) else enumerate(data) if isinstance(data, list) else ()
+    for k, v in items:
+        sub = f"{key}.{k}" if key else str(k)
+        if isinstance(v, float) and not math.isfinite(v):
+            return sub, v
+        found = _first_non_finite(v, sub)
+        if found is not None:
+            return found
+    return None
 
 
 def _first_error(exc: ValidationError) -> str:
