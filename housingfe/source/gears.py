@@ -13,13 +13,21 @@ helix angle, addendum reduction k*m, transverse/overlap/total contact ratios, pa
 reference table with millimetre and degree keys.  `tooth_profile(pair, gear)` gives the transverse
 tooth outline (involute + trochoid fillet) as points.
 
-Definitions used (Appendix F's printed values follow from exactly these):
+Definitions used (DIN 3960 / ISO 21771; Appendix F's printed values follow from exactly these):
   d = m z / cos(beta), alpha_t = atan(tan(alpha_n)/cos(beta)), d_b = d cos(alpha_t),
-  cos(alpha_wt) = a0 cos(alpha_t) / a with a0 = (d1 + d2)/2,
-  k m = (a - a0) - (x1 + x2) m   (addendum reduction, negative = tips shortened),
-  d_a = d + 2 m (h_a + x) + 2 k m,  d_f = d - 2 m (h_f - x),
+  zero-backlash centre distance a_w: inv(alpha_wt0) = inv(alpha_t) + 2 (x1 + x2) tan(alpha_n) / (z1 + z2),
+      a_w = a0 cos(alpha_t) / cos(alpha_wt0) with a0 = (d1 + d2)/2,
+  operating centre distance a (default a_w; a < a_w is an error, a > a_w means backlash):
+      cos(alpha_wt) = a0 cos(alpha_t) / a,
+  circumferential backlash on the operating pitch circles j_wt = 2 a (inv(alpha_wt) - inv(alpha_wt0)),
+      normal backlash j_bn = j_wt cos(alpha_wt) cos(beta_b),
+  k m = (a_w - a0) - (x1 + x2) m   (DIN 3960 addendum reduction, <= 0: a property of the blanks, never of
+      the mounting distance),
+  tip diameters belong to the gear blanks: d_a = d + 2 m (h_aP + x) by default, + 2 k m only with
+      tip_shortening=True, or the given blank_tip_diameter;  d_f = d - 2 m (h_fP - x),
   eps_alpha = (sqrt(r_a1^2 - r_b1^2) + sqrt(r_a2^2 - r_b2^2) - a sin(alpha_wt)) / p_bt,
   eps_beta = b sin(beta) / (pi m) with b the smaller (per helix) face width.
+The basic rack (h_aP*, h_fP*, rho_fP*) may differ per gear: give a pair instead of a number.
 """
 from __future__ import annotations
 
@@ -38,6 +46,32 @@ def involute(angle):
     return np.tan(angle) - angle
 
 
+def inverse_involute(value: float) -> float:
+    """The angle a in [0, pi/2) [rad] with inv(a) = value (>= 0), by Newton's method from Cheng's start."""
+    if not value >= 0:
+        raise InputError(f"inverse involute: need a value >= 0, got {value}")
+    if value == 0:
+        return 0.0
+    a = min((3.0 * value) ** (1.0 / 3.0), 1.5)        # inv(a) ~ a^3/3 for small a
+    for _ in range(60):
+        step = (math.tan(a) - a - value) / math.tan(a) ** 2     # d inv / da = tan^2(a)
+        a = min(max(a - step, 0.5 * a), 0.5 * (a + math.pi / 2))
+        if abs(step) < 1e-15:
+            break
+    return a
+
+
+def _pair(value, key: str, where: str) -> tuple[float, float]:
+    """A number or a (pinion, wheel) pair -> (float, float)."""
+    if isinstance(value, (int, float)):
+        return (float(value), float(value))
+    try:
+        first, second = value
+        return (float(first), float(second))
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: {key}: need a number or a pair (pinion, wheel), got {value!r}") from None
+
+
 @dataclass(frozen=True)
 class GearPair:
     """An external involute gear pair.
@@ -49,13 +83,20 @@ class GearPair:
       helix_angle: helix angle beta at the pitch circle [rad] (0 for spur)
       profile_shift: addendum modification factors (x1, x2) [-]
       face_width: (b1, b2) [m]; for double helical gears the width of ONE helix
-      centre_distance: operating centre distance a [m]
-      addendum_coefficient: h_a [-] (Appendix F: 1.0)
-      dedendum_coefficient: h_f [-] (Appendix F: 1.4)
-      rack_tip_radius_factor: rho_f / m of the cutter tip [-] (Appendix F: 0.4)
+      centre_distance: operating centre distance a [m]; None (default): the zero-backlash centre distance
+          a_w of the profile shifts.  a < a_w is an InputError (the teeth would interfere); a > a_w gives
+          backlash (`normal_backlash`) and never changes the tips.
+      addendum_coefficient: h_aP* of the basic rack [-] (Appendix F: 1.0), a number or (pinion, wheel)
+      dedendum_coefficient: h_fP* of the basic rack [-] (Appendix F: 1.4), a number or (pinion, wheel)
+      rack_tip_radius_factor: rho_fP* = rho_fP / m of the cutter tip [-] (Appendix F: 0.4), number or pair
       kind: "spur", "single_helical" or "double_helical"
       helix_gap: gap between the two helices of a double helical gear [m]
       youngs_modulus, poisson_ratio, density: material (steel default) [Pa, -, kg/m^3]
+      blank_tip_diameter: (d_a1, d_a2) of the gear blanks as made [m]; None: from the basic rack
+      tip_shortening: True applies the DIN 3960 tip shortening k m (computed at a_w) to the rack tips; an
+          explicit choice (Appendix F's tips include it); never derived from the mounting distance
+    The per-gear values are stored as (pinion, wheel) tuples; the resolved centre distance in
+    `centre_distance`.
     """
 
     module: float
@@ -64,16 +105,18 @@ class GearPair:
     helix_angle: float
     profile_shift: tuple[float, float]
     face_width: tuple[float, float]
-    centre_distance: float
-    addendum_coefficient: float = 1.0
-    dedendum_coefficient: float = 1.25
-    rack_tip_radius_factor: float = 0.38
+    centre_distance: float | None = None
+    addendum_coefficient: float | tuple[float, float] = 1.0
+    dedendum_coefficient: float | tuple[float, float] = 1.25
+    rack_tip_radius_factor: float | tuple[float, float] = 0.38
     kind: str = "single_helical"
     helix_gap: float = 0.0
     youngs_modulus: float = 2.06e11
     poisson_ratio: float = 0.3
     density: float = 7850.0
     name: str = field(default="", compare=False)
+    blank_tip_diameter: tuple[float, float] | None = None
+    tip_shortening: bool = False
 
     def __post_init__(self):
         where = self.name or "gear pair"
@@ -93,19 +136,61 @@ class GearPair:
             raise InputError(f"{where}: helix_angle: a {self.kind} gear needs a helix angle > 0")
         if min(self.face_width) <= 0:
             raise InputError(f"{where}: face_width: must be > 0")
-        a_min = 0.5 * self.module * sum(self.teeth) / math.cos(self.helix_angle) * 0.8
-        if not self.centre_distance > a_min:
-            raise InputError(f"{where}: centre_distance: {self.centre_distance} m is far too small")
+        # frozen dataclass: normalise the per-gear rack values and resolve the default centre distance
+        for key in ("addendum_coefficient", "dedendum_coefficient", "rack_tip_radius_factor"):
+            object.__setattr__(self, key, _pair(getattr(self, key), key, where))
+        if min(self.addendum_coefficient) <= 0 or min(self.dedendum_coefficient) <= 0:
+            raise InputError(f"{where}: addendum_coefficient/dedendum_coefficient: must be > 0")
+        if not all(0 <= r < 0.6 for r in self.rack_tip_radius_factor):
+            raise InputError(f"{where}: rack_tip_radius_factor: must lie in [0, 0.6)")
+        a_w = self.zero_backlash_centre_distance
+        if self.centre_distance is None:
+            object.__setattr__(self, "centre_distance", a_w)
+        elif not (isinstance(self.centre_distance, (int, float)) and math.isfinite(self.centre_distance)):
+            raise InputError(f"{where}: centre_distance: need a number in m, got {self.centre_distance!r}")
+        elif self.centre_distance < a_w - 1e-6 * self.module:     # round-off of printed shifts: < 1 um/mm
+            raise InputError(
+                f"{where}: centre_distance: {self.centre_distance * 1e3:.4f} mm is smaller than the zero-backlash "
+                f"centre distance a_w = {a_w * 1e3:.4f} mm of these profile shifts: the teeth would interfere "
+                "(increase it, lower the profile shifts, or leave it out for a_w)")
+        if self.blank_tip_diameter is not None:
+            if self.tip_shortening:
+                raise InputError(f"{where}: tip_shortening: give either blank tip diameters or tip_shortening")
+            tips = _pair(self.blank_tip_diameter, "blank_tip_diameter", where)
+            object.__setattr__(self, "blank_tip_diameter", tips)
+            for g in (0, 1):
+                if not tips[g] > max(self.root_diameter[g], self.base_diameter[g]):
+                    raise InputError(f"{where}: blank_tip_diameter: {tips[g] * 1e3:.4f} mm of gear {g + 1} "
+                                     "must exceed its root and base diameters")
+        s_a = self.tip_thickness
+        for g in (0, 1):
+            if not s_a[g] > 0:
+                raise InputError(f"{where}: tip diameter {self.tip_diameter[g] * 1e3:.4f} mm of gear {g + 1}: "
+                                 "the teeth come to a point below it (lower the tip diameter or the profile shift)")
+        clearance = self.tip_clearance
+        for g in (0, 1):
+            if clearance[g] < -1e-6 * self.module:      # round-off of an exact tip shortening
+                raise InputError(
+                    f"{where}: the tip of gear {g + 1} reaches {-clearance[g] * 1e3:.4f} mm into the root of its "
+                    "mate at this centre distance: set tip_shortening, give smaller blank tip diameters, or a "
+                    "larger dedendum")
         if self.contact_length_tip_limited() <= 0:
-            raise InputError(f"{where}: geometry gives no path of contact (check profile shifts)")
+            raise InputError(
+                f"{where}: no path of contact: at centre distance {self.centre_distance * 1e3:.4f} mm "
+                f"({self.radial_play * 1e3:.4f} mm beyond the zero-backlash a_w = {a_w * 1e3:.4f} mm) the tips "
+                f"(d_a = {self.tip_diameter[0] * 1e3:.4f}, {self.tip_diameter[1] * 1e3:.4f} mm) do not reach each "
+                "other's flanks (check the centre distance and the profile shifts)")
 
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_table(cls, t: dict, where: str = "gears") -> "GearPair":
         """Build from a table with Appendix F style keys in mm / degrees:
         module_mm, teeth, pressure_angle_deg, helix_angle_deg, addendum_modification, face_width_mm
-        (a pair, or for double helical pairs of [b, b]), centre_distance_mm, addendum_coefficient,
-        dedendum_coefficient, rack_tip_radius_factor, kind (optional), helix_gap_mm (optional)."""
+        (a pair, or for double helical pairs of [b, b]), centre_distance_mm (optional: default the
+        zero-backlash a_w), addendum_coefficient, dedendum_coefficient, rack_tip_radius_factor (each a
+        number or a [pinion, wheel] pair), kind (optional), helix_gap_mm (optional), tip_diameter_mm
+        (optional: the blanks' tip diameters, e.g. Appendix F's printed ones), tip_shortening (optional bool).
+        Other keys (derived values of a reference table) are ignored."""
         try:
             widths = t["face_width_mm"]
             double = isinstance(widths[0], (list, tuple))
@@ -120,13 +205,18 @@ class GearPair:
                 helix_angle=math.radians(float(t.get("helix_angle_deg", 0.0))),
                 profile_shift=(float(t["addendum_modification"][0]), float(t["addendum_modification"][1])),
                 face_width=(float(widths[0]) * 1e-3, float(widths[1]) * 1e-3),
-                centre_distance=float(t["centre_distance_mm"]) * 1e-3,
-                addendum_coefficient=float(t.get("addendum_coefficient", 1.0)),
-                dedendum_coefficient=float(t.get("dedendum_coefficient", 1.25)),
-                rack_tip_radius_factor=float(t.get("rack_tip_radius_factor", 0.38)),
+                centre_distance=(None if t.get("centre_distance_mm") is None
+                                 else float(t["centre_distance_mm"]) * 1e-3),
+                addendum_coefficient=_pair(t.get("addendum_coefficient", 1.0), "addendum_coefficient", where),
+                dedendum_coefficient=_pair(t.get("dedendum_coefficient", 1.25), "dedendum_coefficient", where),
+                rack_tip_radius_factor=_pair(t.get("rack_tip_radius_factor", 0.38), "rack_tip_radius_factor",
+                                             where),
                 kind=kind,
                 helix_gap=float(t.get("helix_gap_mm", 0.0)) * 1e-3,
                 name=where,
+                blank_tip_diameter=(None if t.get("tip_diameter_mm") is None
+                                    else tuple(float(v) * 1e-3 for v in t["tip_diameter_mm"])),
+                tip_shortening=bool(t.get("tip_shortening", False)),
             )
         except KeyError as exc:
             raise InputError(f"{where}: missing key {exc.args[0]}") from None
@@ -176,31 +266,82 @@ class GearPair:
                          / self.centre_distance)
 
     @property
-    def zero_backlash_centre_distance(self) -> float:
-        """Centre distance [m] at which the profile shifts mesh without backlash (DIN 3960)."""
-        from scipy.optimize import brentq
+    def zero_backlash_pressure_angle(self) -> float:
+        """alpha_wt0 [rad]: inv(alpha_wt0) = inv(alpha_t) + 2 (x1 + x2) tan(alpha_n) / (z1 + z2) (DIN 3960)."""
+        target = float(involute(self.transverse_pressure_angle)) \
+            + 2 * math.tan(self.pressure_angle) * sum(self.profile_shift) / sum(self.teeth)
+        if target <= 0:
+            where = self.name or "gear pair"
+            raise InputError(f"{where}: addendum_modification: the sum {sum(self.profile_shift)} is so negative "
+                             "that no centre distance gives a backlash-free mesh")
+        return inverse_involute(target)
 
-        at = self.transverse_pressure_angle
-        target = involute(at) + 2 * math.tan(self.pressure_angle) * sum(self.profile_shift) / sum(self.teeth)
-        awt = brentq(lambda t: involute(t) - target, 1e-3, 1.4)
-        return self.reference_centre_distance * math.cos(at) / math.cos(awt)
+    @property
+    def zero_backlash_centre_distance(self) -> float:
+        """a_w = a0 cos(alpha_t) / cos(alpha_wt0) [m]: the profile shifts mesh without backlash (DIN 3960)."""
+        return self.reference_centre_distance * math.cos(self.transverse_pressure_angle) \
+            / math.cos(self.zero_backlash_pressure_angle)
+
+    @property
+    def radial_play(self) -> float:
+        """a - a_w [m] (>= 0)."""
+        return self.centre_distance - self.zero_backlash_centre_distance
+
+    @property
+    def circumferential_backlash(self) -> float:
+        """j_wt = 2 a (inv(alpha_wt) - inv(alpha_wt0)) [m] on the operating pitch circles (tooth thicknesses as
+        generated by the profile shifts, no thickness tolerances)."""
+        j = 2 * self.centre_distance * float(involute(self.operating_pressure_angle)
+                                             - involute(self.zero_backlash_pressure_angle))
+        return max(j, 0.0)      # a within round-off below a_w counts as zero backlash
+
+    @property
+    def normal_backlash(self) -> float:
+        """j_bn = j_wt cos(alpha_wt) cos(beta_b) [m], normal to the flanks (= 2 m_n sin(alpha_n) times the
+        profile-shift sum missing for zero backlash at a)."""
+        return self.circumferential_backlash * math.cos(self.operating_pressure_angle) * math.cos(self.base_helix_angle)
 
     @property
     def addendum_reduction(self) -> float:
-        """k m = (a - a0) - (x1 + x2) m [m]; negative: the tips are shortened to keep tip clearance."""
-        return (self.centre_distance - self.reference_centre_distance) - sum(self.profile_shift) * self.module
+        """DIN 3960 k m = (a_w - a0) - (x1 + x2) m [m] (<= 0) of the blanks: what tip shortening would take off
+        each tip radius to keep the rack's tip clearance at the zero-backlash centre distance.  Applied to the
+        tips only with tip_shortening=True."""
+        return (self.zero_backlash_centre_distance - self.reference_centre_distance) \
+            - sum(self.profile_shift) * self.module
 
     @property
     def tip_diameter(self) -> np.ndarray:
-        """(d_a1, d_a2) = d + 2 m (h_a + x) + 2 k m [m]."""
+        """(d_a1, d_a2) [m]: the blanks' given tip diameters, else d + 2 m (h_aP* + x) (+ 2 k m with
+        tip_shortening).  Independent of the centre distance."""
+        if self.blank_tip_diameter is not None:
+            return np.array(self.blank_tip_diameter, dtype=float)
         x = np.array(self.profile_shift)
-        return self.pitch_diameter + 2 * self.module * (self.addendum_coefficient + x) + 2 * self.addendum_reduction
+        shortening = 2 * self.addendum_reduction if self.tip_shortening else 0.0
+        return self.pitch_diameter + 2 * self.module * (np.array(self.addendum_coefficient) + x) + shortening
 
     @property
     def root_diameter(self) -> np.ndarray:
-        """(d_f1, d_f2) = d - 2 m (h_f - x) [m]."""
+        """(d_f1, d_f2) = d - 2 m (h_fP* - x) [m]."""
         x = np.array(self.profile_shift)
-        return self.pitch_diameter - 2 * self.module * (self.dedendum_coefficient - x)
+        return self.pitch_diameter - 2 * self.module * (np.array(self.dedendum_coefficient) - x)
+
+    @property
+    def tip_clearance(self) -> np.ndarray:
+        """(c1, c2) = a - d_a1/2 - d_f2/2, a - d_a2/2 - d_f1/2 [m]: radial room between each tip and the mate's
+        root circle at the operating centre distance."""
+        da, df = self.tip_diameter, self.root_diameter
+        return self.centre_distance - 0.5 * (da + df[::-1])
+
+    @property
+    def tip_thickness(self) -> np.ndarray:
+        """Transverse tooth thickness on the tip circle (s_at1, s_at2) [m] (generated thickness, no backlash
+        allowance); <= 0 means pointed teeth."""
+        at = self.transverse_pressure_angle
+        da, db = self.tip_diameter, self.base_diameter
+        x = np.array(self.profile_shift)
+        alpha_a = np.arccos(np.minimum(db / da, 1.0))
+        half = (math.pi / 2 + 2 * x * math.tan(self.pressure_angle)) / np.array(self.teeth, float)
+        return da * (half + float(involute(at)) - involute(alpha_a))
 
     @property
     def transverse_base_pitch(self) -> float:
@@ -287,6 +428,11 @@ class GearPair:
             "root_diameter_mm": (self.root_diameter * 1e3).tolist(),
             "base_diameter_mm": (self.base_diameter * 1e3).tolist(),
             "addendum_reduction_mm": self.addendum_reduction * 1e3,
+            "tip_shortening_applied": bool(self.tip_shortening),
+            "tip_diameter_from": ("blank" if self.blank_tip_diameter is not None else
+                                  "basic rack + tip shortening" if self.tip_shortening else "basic rack"),
+            "centre_distance_mm": self.centre_distance * 1e3,
+            "normal_backlash_mm": self.normal_backlash * 1e3,
             "transverse_contact_ratio": self.transverse_contact_ratio,
             ("overlap_ratio_per_helix" if self.kind == "double_helical" else "overlap_ratio"): self.overlap_ratio,
             "total_contact_ratio": self.total_contact_ratio,
@@ -310,14 +456,17 @@ class GearPair:
 
 
 # ---------------------------------------------------------------------- tooth profile (Appendix B)
-def _rack_boundary(pair: GearPair, x: float, n: int = 200) -> np.ndarray:
+def _rack_boundary(pair: GearPair, gear: int, n: int = 200) -> np.ndarray:
     """Transverse outline of the cutting rack tooth to the right of the gap that forms a gear tooth
     centred on u = 0: flank, tip rounding (radius rho m), tip line.  Coordinates (u, v) in m, u along
     the pitch line, v radial from the gear's pitch circle (v < 0 towards the gear centre)."""
     m, mt, at = pair.module, pair.transverse_module, pair.transverse_pressure_angle
-    rho = pair.rack_tip_radius_factor * m
-    v_tip = (x - pair.dedendum_coefficient) * m
-    v_top = (x + pair.addendum_coefficient + 0.5) * m
+    x = pair.profile_shift[gear]
+    rho = pair.rack_tip_radius_factor[gear] * m
+    v_tip = (x - pair.dedendum_coefficient[gear]) * m
+    # above the rack's own addendum so that a blank tip larger than the rack tip is still cut
+    v_top = (x + max(pair.addendum_coefficient[gear], (pair.tip_diameter[gear] - pair.pitch_diameter[gear])
+                     / (2 * m) - x) + 0.5) * m
 
     def flank_u(v):
         return math.pi * mt / 4 - (v - x * m) * math.tan(at)   # gap widens towards the gear centre
@@ -351,8 +500,8 @@ def tooth_profile(pair: GearPair, gear: int, n_radii: int = 120) -> dict[str, np
     r = float(pair.pitch_diameter[gear]) / 2
     ra = float(pair.tip_diameter[gear]) / 2
     rf = float(pair.root_diameter[gear]) / 2
-    rack = _rack_boundary(pair, x, n=400)
-    phi_max = 2.5 * (pair.dedendum_coefficient + pair.addendum_coefficient + 1) * pair.module / r + 0.3
+    rack = _rack_boundary(pair, gear, n=400)
+    phi_max = 2.5 * (pair.dedendum_coefficient[gear] + pair.addendum_coefficient[gear] + 1) * pair.module / r + 0.3
     phis = np.linspace(-phi_max, phi_max, 3000)
     # Rack translated by r*phi, gear frame rotated back by phi (pure rolling on the pitch circle).
     X = rack[None, :, 0] + r * phis[:, None]

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, replace
 from pathlib import Path
-from typing import Literal, Optional
+from typing import Annotated, Literal, Optional, Union
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt
@@ -46,10 +46,15 @@ class GearsTable(_Strict):
     helix_angle_deg: float = 0.0
     addendum_modification: tuple[float, float] = (0.0, 0.0)
     face_width_mm: list = Field(min_length=2, max_length=2)
-    centre_distance_mm: PositiveFloat
-    addendum_coefficient: PositiveFloat = 1.0
-    dedendum_coefficient: PositiveFloat = 1.25
-    rack_tip_radius_factor: float = Field(0.38, ge=0.0, lt=0.6)
+    centre_distance_mm: Optional[PositiveFloat] = None     # None: the zero-backlash centre distance
+    # basic rack h_aP*, h_fP*, rho_fP*: one value for both gears or [pinion, wheel]
+    addendum_coefficient: Union[PositiveFloat, tuple[PositiveFloat, PositiveFloat]] = 1.0
+    dedendum_coefficient: Union[PositiveFloat, tuple[PositiveFloat, PositiveFloat]] = 1.25
+    rack_tip_radius_factor: Union[Annotated[float, Field(ge=0.0, lt=0.6)],
+                                  tuple[Annotated[float, Field(ge=0.0, lt=0.6)],
+                                        Annotated[float, Field(ge=0.0, lt=0.6)]]] = 0.38
+    tip_diameter_mm: Optional[tuple[PositiveFloat, PositiveFloat]] = None   # the blanks; None: from the rack
+    tip_shortening: bool = False           # apply DIN 3960 k m to the rack tips (Appendix F does)
     kind: Optional[Literal["spur", "single_helical", "double_helical"]] = None
     helix_gap_mm: float = Field(0.0, ge=0.0)
     power_kW: PositiveFloat = 300.0
@@ -181,7 +186,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     geo.update({"kind": pair.kind, "module_mm": g.module_mm, "teeth": list(pair.teeth),
                 "pressure_angle_deg": g.pressure_angle_deg, "helix_angle_deg": g.helix_angle_deg,
                 "addendum_modification": list(pair.profile_shift), "face_width_mm": g.face_width_mm,
-                "centre_distance_mm": g.centre_distance_mm})
+                "centre_distance_mm": pair.centre_distance * 1e3})
     write_json(out_dir / "gear_geometry.json", geo)
     fig, axes = plt.subplots(1, 2, figsize=(9, 4.5))
     for ax, gear, label in zip(axes, (0, 1), ("pinion", "wheel")):
@@ -213,8 +218,8 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.plot(np.append(c.position, 1.0) * 100, np.append(c.per_width, c.per_width[0]) / 1e9, "o-", ms=3,
             label="analytic (Sec. 2.2-2.3)")
-    ax.axhline(iso["c_gamma_alpha"] / 1e9, color="r", ls="--", label="ISO 6336-1 c_gamma_alpha")
-    ax.axhline(iso["c_prime"] / 1e9, color="g", ls=":", label="ISO 6336-1 c'")
+    ax.axhline(iso["c_gamma_alpha_N_per_mm_um"], color="r", ls="--", label="ISO 6336-1 c_gamma_alpha")
+    ax.axhline(iso["c_prime_N_per_mm_um"], color="g", ls=":", label="ISO 6336-1 c'")
     ax.set_xlabel("mesh position [% of base pitch]")
     ax.set_ylabel("s [N/(mm um)]")
     ax.set_title(f"{name}: tooth stiffness per unit width at T1 = {table.torque_Nm:g} N m")
@@ -317,10 +322,16 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
         f"scene {name} ({scene_path})",
         "",
         format_table(["quantity", "value"], [
+            ["centre distance / zero-backlash a_w [mm]",
+             f"{pair.centre_distance * 1e3:.4f} / {pair.zero_backlash_centre_distance * 1e3:.4f}"],
+            ["normal backlash j_bn [mm]", f"{pair.normal_backlash * 1e3:.4f}"],
+            ["tip diameters [mm]", f"{pair.tip_diameter[0] * 1e3:.3f}, {pair.tip_diameter[1] * 1e3:.3f} "
+             f"({geo['tip_diameter_from']})"],
             ["transverse contact ratio", f"{pair.transverse_contact_ratio:.3f}"],
             ["overlap ratio", f"{pair.overlap_ratio:.3f}"],
             ["mean s [N/(mm um)]", f"{c.per_width.mean() / 1e9:.2f}"],
-            ["ISO 6336-1 c' / c_gamma_alpha [N/(mm um)]", f"{iso['c_prime'] / 1e9:.2f} / {iso['c_gamma_alpha'] / 1e9:.2f}"],
+            ["ISO 6336-1 c' / c_gamma_alpha [N/(mm um)]",
+             f"{iso['c_prime_N_per_mm_um']:.2f} / {iso['c_gamma_alpha_N_per_mm_um']:.2f}"],
             ["mean deflection [um]", f"{c.deflection.mean() * 1e6:.1f}"],
             ["stiffness peak-to-peak / mean", f"{np.ptp(c.stiffness) / c.mean:.4f}"],
         ]),

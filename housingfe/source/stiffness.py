@@ -119,17 +119,19 @@ class _ToothFlex:
 
 def _virtual_spur(pair: GearPair) -> GearPair:
     """The virtual spur gear pair of the normal section: z_n = z / (cos^2(beta_b) cos(beta)), same
-    normal module, pressure angle, profile shifts, addendum reduction and rack."""
+    normal module, pressure angle, profile shifts and racks; tip diameters d_an = d_n + d_a - d (ISO 6336-3),
+    so the virtual teeth have the real ones' addendum whatever set the real tips."""
     bb, b = pair.base_helix_angle, pair.helix_angle
     zn = tuple(z / (math.cos(bb) ** 2 * math.cos(b)) for z in pair.teeth)
-    a0 = 0.5 * pair.module * (zn[0] + zn[1])
+    dn = pair.module * np.array(zn)
+    tips = dn + pair.tip_diameter - pair.pitch_diameter
     return GearPair(module=pair.module, teeth=zn, pressure_angle=pair.pressure_angle, helix_angle=0.0,
                     profile_shift=pair.profile_shift, face_width=pair.face_width,
-                    centre_distance=a0 + sum(pair.profile_shift) * pair.module + pair.addendum_reduction,
                     addendum_coefficient=pair.addendum_coefficient,
                     dedendum_coefficient=pair.dedendum_coefficient,
                     rack_tip_radius_factor=pair.rack_tip_radius_factor, kind="spur",
-                    youngs_modulus=pair.youngs_modulus, poisson_ratio=pair.poisson_ratio)
+                    youngs_modulus=pair.youngs_modulus, poisson_ratio=pair.poisson_ratio,
+                    blank_tip_diameter=(float(tips[0]), float(tips[1])))
 
 
 @functools.lru_cache(maxsize=32)   # GearPair is frozen (hashable); the profile generation takes ~0.5 s
@@ -503,23 +505,56 @@ def normal_force_from_torque(pair: GearPair, pinion_torque: float) -> float:
 
 
 # ----------------------------------------------------------------------------- ISO 6336-1
-def iso6336_stiffness(pair: GearPair, load_per_width: float | None = None) -> dict[str, float]:
-    """Single stiffness c' and mesh stiffness c_gamma_alpha after ISO 6336-1:2006 method B
-    (eq. for q', C_M = 0.8, C_R = 1 for solid blanks, C_B from the basic rack, cos(beta)).
-    load_per_width: F_t K_A / b [N/m]; below 100 N/mm c' is reduced proportionally.
-    Returns values in N/(m m) (divide by 1e9 for N/(mm um))."""
+def iso6336_blank_factor(web_thickness: float | None, face_width: float, rim_thickness: float | None,
+                         module: float) -> float:
+    """Gear blank factor C_R of ISO 6336-1 (method B) [-].
+
+    web_thickness b_s [m] (None: solid disc, C_R = 1), face_width b [m], rim_thickness s_R [m], normal
+    module m_n [m].  C_R = 1 + ln(b_s / b) / (5 exp(s_R / (5 m_n))), with b_s/b limited to [0.2, 1.2] and
+    s_R/m_n to >= 1 as the standard prescribes.  For a pair whose two blanks differ, pass the C_R of the more
+    flexible (webbed) blank."""
+    if web_thickness is None:
+        return 1.0
+    if not (face_width > 0 and module > 0 and web_thickness > 0 and rim_thickness is not None
+            and rim_thickness > 0):
+        raise InputError("iso6336_blank_factor: web_thickness, face_width, rim_thickness and module must be > 0 m")
+    bs_b = min(max(web_thickness / face_width, 0.2), 1.2)
+    sr_m = max(rim_thickness / module, 1.0)
+    return 1.0 + math.log(bs_b) / (5.0 * math.exp(sr_m / 5.0))
+
+
+def iso6336_stiffness(pair: GearPair, load_per_width: float | None = None, blank_factor: float = 1.0,
+                      correction_factor: float = 0.8) -> dict[str, float]:
+    """Single stiffness c' and mesh stiffness c_gamma of ISO 6336-1 method B, in the standard's units
+    N/(mm um) (= 1e9 N/m per m of face width).
+
+    c'_th = 1 / q' with q' from the standard's polynomial in z_n1, z_n2, x1, x2 [mm um / N];
+    c' = c'_th C_M C_R C_B cos(beta), C_M = correction_factor (0.8 for solid discs), C_R = blank_factor
+    (1 for solid discs; see `iso6336_blank_factor`), C_B = (C_B1 + C_B2) / 2 with
+    C_Bi = [1 + 0.5 (1.2 - h_fP,i / m_n)] [1 - 0.02 (20 deg - alpha_n)] from each gear's basic rack
+    (pair.dedendum_coefficient); load_per_width = F_t K_A / b [N/m]: below 100 N/mm c' is multiplied by
+    (F_t K_A / b / 100 N/mm)^0.25.  c_gamma_alpha = c' (0.75 eps_alpha + 0.25), c_gamma_beta = 0.85
+    c_gamma_alpha.
+
+    Keys: c_th_N_per_mm_um, c_prime_N_per_mm_um, c_gamma_alpha_N_per_mm_um, c_gamma_beta_N_per_mm_um, the SI
+    twins *_N_per_m2 (N/m per m of face width), the factors C_M, C_R, C_B, and q_prime_mm_um_per_N."""
+    if not blank_factor > 0 or not correction_factor > 0:
+        raise InputError("iso6336_stiffness: blank_factor and correction_factor must be > 0")
     bb, b = pair.base_helix_angle, pair.helix_angle
     zn1, zn2 = (z / (math.cos(bb) ** 2 * math.cos(b)) for z in pair.teeth)
     x1, x2 = pair.profile_shift
     q = (0.04723 + 0.15551 / zn1 + 0.25791 / zn2 - 0.00635 * x1 - 0.11654 * x1 / zn1
          - 0.00193 * x2 - 0.24188 * x2 / zn2 + 0.00529 * x1**2 + 0.00182 * x2**2)   # mm um / N
     c_th = 1.0 / q                                                                   # N/(mm um)
-    c_m, c_r = 0.8, 1.0
-    c_b = (1 + 0.5 * (1.2 - pair.dedendum_coefficient)) * (1 - 0.02 * (20 - math.degrees(pair.pressure_angle)))
-    c_prime = c_th * c_m * c_r * c_b * math.cos(b)
+    alpha_term = 1 - 0.02 * (20 - math.degrees(pair.pressure_angle))
+    c_b = 0.5 * sum((1 + 0.5 * (1.2 - h_f)) * alpha_term for h_f in pair.dedendum_coefficient)
+    c_prime = c_th * correction_factor * blank_factor * c_b * math.cos(b)
     if load_per_width is not None and load_per_width < 100e3:
         c_prime *= (load_per_width / 1e3) ** 0.25 / 100 ** 0.25
     eps_a = pair.transverse_contact_ratio
     c_gamma_alpha = c_prime * (0.75 * eps_a + 0.25)
-    return {"c_th": c_th * 1e9, "c_prime": c_prime * 1e9, "c_gamma_alpha": c_gamma_alpha * 1e9,
-            "c_gamma_beta": 0.85 * c_gamma_alpha * 1e9, "q_prime_mm_um_per_N": q}
+    out = {"c_th_N_per_mm_um": c_th, "c_prime_N_per_mm_um": c_prime,
+           "c_gamma_alpha_N_per_mm_um": c_gamma_alpha, "c_gamma_beta_N_per_mm_um": 0.85 * c_gamma_alpha}
+    out.update({k.replace("_N_per_mm_um", "_N_per_m2"): v * 1e9 for k, v in list(out.items())})
+    out.update({"C_M": correction_factor, "C_R": blank_factor, "C_B": c_b, "q_prime_mm_um_per_N": q})
+    return out

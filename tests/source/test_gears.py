@@ -5,6 +5,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.optimize import brentq
 
 import housingfe
 from housingfe.errors import InputError
@@ -28,10 +29,17 @@ def double():
     return GearPair.from_table(REF["double_helical"])
 
 
+def _without_printed_tips(which: str) -> dict:
+    """The Appendix F input data with the printed tips dropped and DIN 3960 tip shortening asked for: the tips
+    must then follow from the rack and the profile shifts alone."""
+    table = {k: v for k, v in REF[which].items() if k != "tip_diameter_mm"}
+    return {**table, "tip_shortening": True}
+
+
 @pytest.mark.parametrize("key", ["pitch_diameter_mm", "tip_diameter_mm", "root_diameter_mm", "base_diameter_mm"])
 @pytest.mark.parametrize("which", ["single_helical", "double_helical"])
 def test_diameters_match_appendix_f(key, which):
-    table = GearPair.from_table(REF[which]).appendix_f_table()
+    table = GearPair.from_table(_without_printed_tips(which)).appendix_f_table()
     for ours, printed in zip(table[key], REF[which][key]):
         assert ours == pytest.approx(printed, abs=_printed_tolerance(printed)), (which, key)
 
@@ -111,3 +119,92 @@ def test_bad_input_is_an_input_error():
         GearPair.from_table({**REF["single_helical"], "module_mm": -4})
     with pytest.raises(InputError, match="teeth"):
         GearPair.from_table({k: v for k, v in REF["single_helical"].items() if k != "teeth"})
+
+
+# ---------------------------------------------------------------- centre distance, backlash and tips (issue 12)
+KHK = dict(module=3e-3, teeth=(12, 24), pressure_angle=math.radians(20), helix_angle=0.0,
+           profile_shift=(0.6, 0.36), face_width=(0.02, 0.02), kind="spur")
+
+
+def test_zero_backlash_default_matches_khk_profile_shifted_example():
+    # KHK gear technical reference, profile shifted spur gears (also bolsover.com): m = 3, z = 12/24,
+    # x = 0.6/0.36 -> a = 56.4999 mm, alpha_w = 26.0886 deg, d_a = 44.840/79.400 (tips shortened to keep
+    # c = 0.25 m), d_f = 32.100/66.660, eps_alpha = 1.202
+    pair = GearPair(**KHK, tip_shortening=True)
+    assert pair.centre_distance == pytest.approx(56.4999e-3, abs=0.06e-6)
+    assert math.degrees(pair.operating_pressure_angle) == pytest.approx(26.0886, abs=1e-4)
+    assert pair.tip_diameter * 1e3 == pytest.approx([44.840, 79.400], abs=5e-4)
+    assert pair.root_diameter * 1e3 == pytest.approx([32.100, 66.660], abs=5e-4)
+    assert pair.transverse_contact_ratio == pytest.approx(1.202, abs=5e-4)
+    assert pair.normal_backlash == pytest.approx(0.0, abs=1e-12)
+
+
+def test_tips_belong_to_the_blanks_not_to_the_centre_distance():
+    plain = GearPair(**KHK)                                   # rack tips: d + 2 m (1 + x)
+    assert plain.tip_diameter * 1e3 == pytest.approx([45.6, 80.16], abs=1e-9)
+    wider = GearPair(**KHK, centre_distance=plain.centre_distance + 0.3e-3)
+    assert np.array_equal(wider.tip_diameter, plain.tip_diameter)
+    assert wider.transverse_contact_ratio < plain.transverse_contact_ratio
+    given = GearPair(**KHK, blank_tip_diameter=(45.0e-3, 79.9e-3))
+    assert given.tip_diameter.tolist() == [45.0e-3, 79.9e-3]
+    with pytest.raises(InputError, match="either blank tip diameters or tip_shortening"):
+        GearPair(**KHK, blank_tip_diameter=(45.0e-3, 79.9e-3), tip_shortening=True)
+
+
+def test_issue_12_case_keeps_the_pinion_tip():
+    # z = 17/103, m = 8, x = 0.175/0.16875: a = 500 mm used to grow the pinion tip to 189.3 mm (eps_alpha 2.54)
+    kw = dict(module=8e-3, teeth=(17, 103), pressure_angle=math.radians(20), helix_angle=0.0,
+              profile_shift=(0.175, 0.16875), face_width=(0.08, 0.08), kind="spur")
+    pair = GearPair(**kw)
+    alpha = math.radians(20)
+    target = math.tan(alpha) - alpha + 2 * (0.175 + 0.16875) * math.tan(alpha) / 120
+    alpha_w = brentq(lambda t: math.tan(t) - t - target, 0.1, 1.0, xtol=1e-15)
+    a_w = 0.5 * 8e-3 * 120 * math.cos(alpha) / math.cos(alpha_w)
+    assert pair.centre_distance == pytest.approx(a_w, rel=1e-12)
+    assert pair.tip_diameter[0] * 1e3 == pytest.approx(154.8, abs=1e-9)
+    backlash = GearPair(**kw, centre_distance=pair.centre_distance + 0.5e-3)
+    assert backlash.tip_diameter[0] * 1e3 == pytest.approx(154.8, abs=1e-9)
+    assert backlash.normal_backlash > 0
+    with pytest.raises(InputError, match=r"no path of contact.*a_w = 482\.694"):
+        GearPair(**kw, centre_distance=0.5)
+    with pytest.raises(InputError, match="smaller than the zero-backlash centre distance"):
+        GearPair(**kw, centre_distance=0.48)
+
+
+def test_backlash_of_iso21771_example():
+    # ISO 21771 worked example (z = 31/30, m_n = 3.5, beta = 21 deg, a = 116.5 mm): zero backlash needs
+    # x1 + x2 = 0.6518771; cutting x1 + x2 = 0.6401022 instead leaves a normal backlash of 0.03 mm measured
+    # as tooth thickness at the reference circle, i.e. j_bn = 0.03 cos(alpha_n) normal to the flanks
+    kw = dict(module=3.5e-3, teeth=(31, 30), pressure_angle=math.radians(20), helix_angle=math.radians(21),
+              face_width=(0.03, 0.03))
+    exact = GearPair(**kw, profile_shift=(0.291, 0.6518771312 - 0.291))
+    assert exact.zero_backlash_centre_distance == pytest.approx(0.1165, abs=1e-9)
+    thinner = GearPair(**kw, profile_shift=(0.291, 0.6401022280 - 0.291), centre_distance=0.1165)
+    assert thinner.normal_backlash == pytest.approx(0.03e-3 * math.cos(math.radians(20)), rel=1e-6)
+    assert thinner.radial_play > 0
+
+
+def test_tip_interference_needs_an_explicit_choice():
+    # with h_fP* = h_aP* = 1 there is no rack tip clearance: a positive profile-shift sum makes the rack tips
+    # reach into the mate's root (k m < 0); DIN 3960 tip shortening exactly restores c = 0
+    with pytest.raises(InputError, match="tip_shortening"):
+        GearPair(**KHK, dedendum_coefficient=1.0)
+    short = GearPair(**KHK, dedendum_coefficient=1.0, tip_shortening=True)
+    assert short.tip_clearance == pytest.approx([0.0, 0.0], abs=1e-12)
+
+
+def test_basic_rack_per_gear():
+    pair = GearPair(**KHK, addendum_coefficient=(1.0, 0.9), dedendum_coefficient=(1.25, 1.4),
+                    rack_tip_radius_factor=(0.38, 0.25))
+    d = np.array([36e-3, 72e-3])
+    assert pair.tip_diameter == pytest.approx(d + 2 * 3e-3 * (np.array([1.0, 0.9]) + [0.6, 0.36]), rel=1e-12)
+    assert pair.root_diameter == pytest.approx(d - 2 * 3e-3 * (np.array([1.25, 1.4]) - [0.6, 0.36]), rel=1e-12)
+    for gear in (0, 1):   # the generated outline reaches each gear's own root circle
+        assert tooth_profile(pair, gear)["radius"][0] == pytest.approx(pair.root_diameter[gear] / 2)
+    with pytest.raises(InputError, match="dedendum_coefficient"):
+        GearPair(**KHK, dedendum_coefficient=(1.25, -1.0))
+
+
+def test_from_table_without_centre_distance_is_zero_backlash():
+    table = {k: v for k, v in REF["single_helical"].items() if k != "centre_distance_mm"}
+    assert GearPair.from_table(table).centre_distance == pytest.approx(0.200, abs=1e-7)

@@ -2,7 +2,6 @@
 thesis' published statements."""
 import math
 import tomllib
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +16,7 @@ from housingfe.source.stiffness import (
     MeshModel,
     ShaftBending,
     beam_influence,
+    iso6336_blank_factor,
     iso6336_stiffness,
     normal_force_from_torque,
     plate_green,
@@ -94,15 +94,35 @@ def test_mean_stiffness_near_iso6336_mesh_stiffness(test_gear):
     iso = iso6336_stiffness(pair)
     # ISO's c_gamma_alpha contains the empirical C_M = 0.8 and C_B factors; the analytic model is a
     # theoretical stiffness: agreement within 25 % is what the two methods can promise
-    assert 0.75 < curve.per_width.mean() / iso["c_gamma_alpha"] < 1.25
-    assert curve.per_width.mean() > iso["c_prime"]          # a mesh of ~1.4 pairs is stiffer than one pair
+    assert 0.75 < curve.per_width.mean() / iso["c_gamma_alpha_N_per_m2"] < 1.25
+    assert curve.per_width.mean() > iso["c_prime_N_per_m2"]     # a mesh of ~1.4 pairs is stiffer than one pair
 
 
 def test_iso6336_single_stiffness_textbook_value():
     # ISO 6336-1 q' for x = 0, z -> infinity equals C1 = 0.04723: c'_th = 21.17 N/(mm um)
-    pair = GearPair(4e-3, (2000, 2000), math.radians(20), 0.0, (0.0, 0.0), (0.05, 0.05), 16.0, kind="spur")
-    assert iso6336_stiffness(pair)["c_th"] / 1e9 == pytest.approx(1 / (0.04723 + 0.15551 / 2000 + 0.25791 / 2000),
-                                                                   rel=1e-9)
+    pair = GearPair(4e-3, (2000, 2000), math.radians(20), 0.0, (0.0, 0.0), (0.05, 0.05), kind="spur")
+    iso = iso6336_stiffness(pair)
+    assert iso["c_th_N_per_mm_um"] == pytest.approx(1 / (0.04723 + 0.15551 / 2000 + 0.25791 / 2000), rel=1e-9)
+    assert 20 < iso["c_th_N_per_mm_um"] < 22                  # the standard's units, not N/m^2
+    # solid blanks, standard rack h_fP* = 1.25, alpha_n = 20 deg: c' = c'_th * 0.8 * 1 * 0.975
+    assert iso["C_B"] == pytest.approx(0.975, rel=1e-12)
+    assert iso["c_prime_N_per_mm_um"] == pytest.approx(iso["c_th_N_per_mm_um"] * 0.8 * 0.975, rel=1e-12)
+    assert iso["c_prime_N_per_m2"] == pytest.approx(iso["c_prime_N_per_mm_um"] * 1e9, rel=1e-15)
+
+
+def test_iso6336_basic_rack_per_gear_and_blank_factor():
+    table = REF["single_helical"]
+    same = iso6336_stiffness(GearPair.from_table(table))                      # h_fP* = 1.4 both
+    mixed = iso6336_stiffness(GearPair.from_table({**table, "dedendum_coefficient": [1.4, 1.25]}))
+    assert same["C_B"] == pytest.approx(0.9, rel=1e-12)                       # 1 + 0.5 (1.2 - 1.4)
+    assert mixed["C_B"] == pytest.approx(0.5 * (0.9 + 0.975), rel=1e-12)      # mean of the two racks
+    # C_R = 1 + ln(b_s/b) / (5 exp(s_R / (5 m_n))): b_s/b = 0.2, s_R = m_n -> 1 + ln(0.2) / (5 e^0.2)
+    c_r = iso6336_blank_factor(0.01, 0.05, 0.004, 0.004)
+    assert c_r == pytest.approx(1 + math.log(0.2) / (5 * math.exp(0.2)), rel=1e-12)
+    assert iso6336_blank_factor(0.001, 0.05, 0.001, 0.004) == pytest.approx(c_r, rel=1e-12)   # limits 0.2, 1
+    assert iso6336_blank_factor(None, 0.05, None, 0.004) == 1.0                                 # solid disc
+    webbed = iso6336_stiffness(GearPair.from_table(table), blank_factor=c_r)
+    assert webbed["c_prime_N_per_mm_um"] == pytest.approx(c_r * same["c_prime_N_per_mm_um"], rel=1e-12)
 
 
 def test_stiffness_is_periodic_in_the_base_pitch(test_gear):
@@ -123,9 +143,8 @@ def test_load_distribution_balances_and_has_equal_approach(test_gear):
 
 def test_spur_stiffness_is_a_block_function():
     # Fig. 2.8: two levels; the double-contact share of the period equals eps_alpha - 1
-    pair = GearPair(2.25e-3, (18, 90), math.radians(20), 0.0, (0.472, -0.110), (0.04, 0.04), 0.13,
-                    1.0, 1.25, 0.38, kind="spur")
-    pair = replace(pair, centre_distance=pair.zero_backlash_centre_distance)
+    pair = GearPair(2.25e-3, (18, 90), math.radians(20), 0.0, (0.472, -0.110), (0.04, 0.04), None,
+                    1.0, 1.25, 0.38, kind="spur", tip_shortening=True)
     curve = stiffness_curve(MeshModel(pair, n_slices=8), 50e3 * 0.04, n_positions=60)
     k = curve.stiffness
     high = k > 0.5 * (k.max() + k.min())
@@ -138,9 +157,8 @@ def test_spur_stiffness_is_a_block_function():
 def _overlap_study_pair(width):
     # Sec. 2.4: z = 18/90, m = 2.25, alpha = 20, h_a = 1, h_f = 1.25, x = 0.472/-0.110; the helix angle is
     # not printed: beta = asin(pi/18) = 10.05 deg makes B = 20.25 ... 81 mm give eps_beta = 0.5 ... 2.0
-    pair = GearPair(2.25e-3, (18, 90), math.radians(20), math.asin(math.pi / 18), (0.472, -0.110),
-                    (width, width), 0.13, 1.0, 1.25, 0.38)
-    return replace(pair, centre_distance=pair.zero_backlash_centre_distance)
+    return GearPair(2.25e-3, (18, 90), math.radians(20), math.asin(math.pi / 18), (0.472, -0.110),
+                    (width, width), None, 1.0, 1.25, 0.38, tip_shortening=True)
 
 
 def test_overlap_ratio_study_trends():
