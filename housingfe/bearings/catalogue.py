@@ -26,7 +26,7 @@ Estimation rules (stated before any result was computed, not tuned to any publis
                       one contact angle for both raceways (the rollers taken as cylinders, thesis Sec. 3.3.2);
                       radial clearance 0 (adjusted against the ball bearing at the other end of the shaft, like
                       the angular contact bearings).
-  material            bearing steel E = 208 GPa, nu = 0.3.
+  material            bearing steel youngs_modulus = 208 GPa, poisson_ratio = 0.3 (rolling.BEARING_STEEL_*).
 """
 from __future__ import annotations
 
@@ -101,7 +101,7 @@ def lookup(designation: str) -> RollingBearing:
         return _tapered(key, d, outer, width)
     d, outer, width = d * _MM, outer * _MM, width * _MM
     pitch = (d + outer) / 2.0
-    est = {"pitch_diameter": "(d + D) / 2", "E": "bearing steel 208 GPa", "nu": "0.3"}
+    est = {"pitch_diameter": "(d + D) / 2", "youngs_modulus": "bearing steel 208 GPa", "poisson_ratio": "0.3"}
     name = f"SKF {key}"
     radial_clearance = 0.0 if clearance is None else 0.25 * (clearance[0] + clearance[1]) * _UM
     if clearance is not None:
@@ -150,7 +150,7 @@ def _tapered(key: str, d: float, outer: float, width: float) -> RollingBearing:
     dw = 0.22 * (outer - d)
     z = round(0.80 * math.pi * pitch / dw)
     alpha = math.atan(data["e"] / 1.5)
-    est = {"pitch_diameter": "(d + D) / 2", "E": "bearing steel 208 GPa", "nu": "0.3",
+    est = {"pitch_diameter": "(d + D) / 2", "youngs_modulus": "bearing steel 208 GPa", "poisson_ratio": "0.3",
            "element_diameter": "0.22 (D - d) (mean roller diameter)", "roller_length": "0.6 B",
            "n_elements": "round(0.80 pi d_m / D_w)",
            "contact_angle": f"atan(e / 1.5) with e = {data['e']} (SKF value recalled, not checked); one angle "

@@ -37,33 +37,45 @@ from housingfe.errors import InputError
 DOF_NAMES = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
 
 
+# Bearing steel (through-hardened 100Cr6 / AISI 52100): E = 208 GPa, nu = 0.3.  Handbook values for this steel
+# lie between about 200 and 210 GPa; a ball contact's stiffness goes with E^(2/3), so that spread moves K by
+# under 3 %.  The same names as the scenes' [material] tables.
+BEARING_STEEL_YOUNGS_MODULUS = 208e9
+BEARING_STEEL_POISSON_RATIO = 0.3
+
+
 @dataclass(frozen=True)
 class RollingBearing:
     """Geometry of a rolling-element bearing (SI units: m, rad, Pa).
 
     kind: "ball", "cylindrical_roller", "tapered_roller" or "spherical_roller" (double-row self-aligning).
-    contact_angle: unloaded contact angle alpha0 (ball: 0 for deep groove; the clearance is radial_clearance).
-    radial_clearance: Lim's r_L, the radial play of the unloaded, centred rings (half the diametral one).
-    groove_inner/groove_outer: groove radius / ball diameter (balls only).
-    roller_length: effective contact length of one roller (rollers only).
+    n_elements: Z per row; element_diameter: D_w [m]; pitch_diameter: d_pw [m] (required, although they
+    follow bore, outer_diameter and width positionally for backwards compatibility).
+    bore, outer_diameter, width [m]: boundary dimensions, optional (no model uses them; when given they are
+    checked against the internal geometry).
+    contact_angle: unloaded contact angle alpha0 [rad] (ball: 0 for deep groove; the clearance is radial_clearance).
+    radial_clearance: Lim's r_L [m], the radial play of the unloaded, centred rings (half the diametral one).
+    groove_inner/groove_outer: groove conformities f_i = r_i / D_w, f_o = r_o / D_w [-], > 0.5 (balls only).
+    roller_length: effective contact length of one roller [m] (rollers only).
+    youngs_modulus [Pa], poisson_ratio [-]: rings and elements (default bearing steel, 208 GPa, 0.3).
     estimated: {field name: estimation rule} for every value that is not public catalogue data.
     """
     designation: str
     kind: str
-    bore: float
-    outer_diameter: float
-    width: float
-    n_elements: int
-    element_diameter: float
-    pitch_diameter: float
+    bore: float | None = None
+    outer_diameter: float | None = None
+    width: float | None = None
+    n_elements: int | None = None
+    element_diameter: float | None = None
+    pitch_diameter: float | None = None
     contact_angle: float = 0.0
     radial_clearance: float = 0.0
     groove_inner: float = 0.52
     groove_outer: float = 0.53
     roller_length: float = 0.0
     rows: int = 1
-    E: float = 208e9
-    nu: float = 0.3
+    youngs_modulus: float = BEARING_STEEL_YOUNGS_MODULUS
+    poisson_ratio: float = BEARING_STEEL_POISSON_RATIO
     estimated: dict = field(default_factory=dict, compare=False, hash=False)
 
     def __post_init__(self):
@@ -71,29 +83,45 @@ class RollingBearing:
         if self.kind not in ("ball", "cylindrical_roller", "tapered_roller", "spherical_roller"):
             raise InputError(f"{name}: kind={self.kind!r}: must be ball, cylindrical_roller, "
                              "tapered_roller or spherical_roller")
-        positive = {"bore": self.bore, "outer_diameter": self.outer_diameter, "width": self.width,
-                    "element_diameter": self.element_diameter, "pitch_diameter": self.pitch_diameter}
+        for key in ("n_elements", "element_diameter", "pitch_diameter"):
+            if getattr(self, key) is None:
+                raise InputError(f"{name}: {key}: missing (the internal geometry Z, D_w, d_pw is required)")
+        positive = {"element_diameter": self.element_diameter, "pitch_diameter": self.pitch_diameter}
+        positive.update({k: getattr(self, k) for k in ("bore", "outer_diameter", "width")
+                         if getattr(self, k) is not None})
         for key, value in positive.items():
-            if not (value > 0 and math.isfinite(value)):
+            if not (isinstance(value, (int, float)) and value > 0 and math.isfinite(value)):
                 raise InputError(f"{name}: {key}={value}: must be a positive length in m")
-        if self.n_elements < 3:
-            raise InputError(f"{name}: n_elements={self.n_elements}: need at least 3 rolling elements")
-        if not (self.bore < self.pitch_diameter < self.outer_diameter):
-            raise InputError(f"{name}: pitch_diameter={self.pitch_diameter} m: must lie between bore and "
-                             "outside diameter")
-        if self.element_diameter >= (self.outer_diameter - self.bore) / 2:
-            raise InputError(f"{name}: element_diameter={self.element_diameter} m: larger than the ring section")
+        if isinstance(self.n_elements, bool) or not isinstance(self.n_elements, int) or self.n_elements < 3:
+            raise InputError(f"{name}: n_elements={self.n_elements}: need a whole number >= 3 of rolling elements")
+        if self.element_diameter >= self.pitch_diameter:
+            raise InputError(f"{name}: element_diameter={self.element_diameter} m: must be smaller than the pitch "
+                             f"diameter {self.pitch_diameter} m")
+        if self.bore is not None and self.outer_diameter is not None:
+            if not (self.bore < self.pitch_diameter < self.outer_diameter):
+                raise InputError(f"{name}: pitch_diameter={self.pitch_diameter} m: must lie between bore and "
+                                 "outside diameter")
+            if self.element_diameter >= (self.outer_diameter - self.bore) / 2:
+                raise InputError(f"{name}: element_diameter={self.element_diameter} m: larger than the ring "
+                                 "section")
         if not (0.0 <= self.contact_angle < math.pi / 2):
             raise InputError(f"{name}: contact_angle={self.contact_angle} rad: must be in [0, pi/2)")
-        if self.radial_clearance < -0.01 * self.element_diameter:
+        if not math.isfinite(self.radial_clearance) or self.radial_clearance < -0.01 * self.element_diameter:
             raise InputError(f"{name}: radial_clearance={self.radial_clearance} m: non-physical interference")
-        if self.kind != "ball" and self.roller_length <= 0:
+        if self.kind != "ball" and not self.roller_length > 0:
             raise InputError(f"{name}: roller_length={self.roller_length} m: rollers need a positive length")
-        if self.kind == "ball" and (self.groove_inner <= 0.5 or self.groove_outer <= 0.5):
-            raise InputError(f"{name}: groove curvature factors must be > 0.5 "
+        if self.kind == "ball" and not (self.groove_inner > 0.5 and self.groove_outer > 0.5):
+            raise InputError(f"{name}: groove conformities f_i, f_o must be > 0.5 "
                              f"(got {self.groove_inner}, {self.groove_outer})")
+        if self.kind == "ball" and max(self.groove_inner, self.groove_outer) >= 1.0:
+            raise InputError(f"{name}: groove conformities f_i, f_o must be < 1 (got {self.groove_inner}, "
+                             f"{self.groove_outer}): a groove radius of a whole ball diameter or more")
         if self.rows not in (1, 2):
             raise InputError(f"{name}: rows={self.rows}: must be 1 or 2")
+        if not (self.youngs_modulus > 0 and math.isfinite(self.youngs_modulus)):
+            raise InputError(f"{name}: youngs_modulus={self.youngs_modulus} Pa: must be > 0")
+        if not (0.0 <= self.poisson_ratio < 0.5):
+            raise InputError(f"{name}: poisson_ratio={self.poisson_ratio}: must be in [0, 0.5)")
 
 
 @dataclass
@@ -114,14 +142,109 @@ class BearingResult:
     iterations: int
     residual: float
 
+    def secant_stiffness(self) -> list[float | None]:
+        """Secant stiffness F_i / delta_i per DOF (x, y, z, theta_x, theta_y) [N/m, N m/rad]: the load divided by
+        the deflection it causes (from the equilibrium solve).  None where the DOF carries no load or does not
+        move.  Not a matrix, and not K: the tangent K = dF/d(delta) is larger (1.5 F/delta for a pure Hertz ball
+        contact), so delta = F/K underestimates the deflection under the load."""
+        out = []
+        for i in range(5):
+            f, d = float(self.load[i]), float(self.displacement[i])
+            out.append(f / d if f != 0.0 and d != 0.0 and f / d > 0 else None)
+        return out
+
     def as_dict(self) -> dict:
-        """JSON-ready dict: K, displacement, element_loads (SI units) and the operating point."""
+        """JSON-ready dict: K, displacement, element_loads (SI units) and the operating point.
+        "displacement" is the deflection under the load (equilibrium solve) [m, rad]; "K" the tangent stiffness
+        dF/d(delta) at that point; "secant_stiffness" the per-DOF F_i / delta_i (None where undefined)."""
         return {"designation": self.designation, "model": self.model, "load": self.load.tolist(),
-                "K": self.K.tolist(), "displacement": self.displacement.tolist(),
+                "K": self.K.tolist(), "K_is": "tangent stiffness dF/d(delta) at the operating point",
+                "displacement": self.displacement.tolist(),
+                "displacement_is": "deflection under the load, from the equilibrium solve [m, rad]",
+                "secant_stiffness": self.secant_stiffness(),
+                "secant_stiffness_is": "F_i / delta_i per DOF x, y, z, theta_x, theta_y [N/m, N m/rad]",
                 "element_loads": self.element_loads.tolist(),
                 "element_angles_deg": np.degrees(self.element_angles).tolist(),
                 "contact_angles_deg": np.degrees(self.contact_angles).tolist(),
                 "iterations": self.iterations}
+
+
+# ----------------------------------------------------------------------------------------------- user geometry
+GEOMETRY_KEYS = {
+    # TOML key: (RollingBearing field, help) -- all SI (m, Pa) except the angle in degrees
+    "designation": ("designation", "a name for the reports"),
+    "kind": ("kind", "ball (default), cylindrical_roller, tapered_roller or spherical_roller"),
+    "elements": ("n_elements", "number of rolling elements Z per row"),
+    "element_diameter": ("element_diameter", "ball (roller) diameter D_w [m]"),
+    "pitch_diameter": ("pitch_diameter", "pitch diameter d_pw [m]"),
+    "conformity_inner": ("groove_inner", "inner groove conformity f_i = r_i / D_w [-], > 0.5 (default 0.52)"),
+    "conformity_outer": ("groove_outer", "outer groove conformity f_o = r_o / D_w [-], > 0.5 (default 0.53)"),
+    "radial_clearance": ("radial_clearance", "radial play of the centred rings = half the diametral clearance "
+                                             "[m] (default 0)"),
+    "contact_angle_deg": ("contact_angle", "unloaded contact angle [deg] (default 0)"),
+    "roller_length": ("roller_length", "effective roller length [m] (rollers only)"),
+    "rows": ("rows", "1 or 2"),
+    "bore": ("bore", "bore d [m], optional"),
+    "outer_diameter": ("outer_diameter", "outside diameter D [m], optional"),
+    "width": ("width", "width B [m], optional"),
+    "youngs_modulus": ("youngs_modulus", "[Pa] (default 208e9, bearing steel)"),
+    "poisson_ratio": ("poisson_ratio", "[-] (default 0.3)"),
+}
+
+
+def bearing_from_table(table: dict, where: str = "bearing") -> RollingBearing:
+    """RollingBearing from a table of internal geometry (the [bearing] table of `housingfe bearing --geometry`).
+
+    Keys (SI, angle in degrees): see GEOMETRY_KEYS; elements, element_diameter and pitch_diameter are
+    required.  Unknown keys, wrong types and non-physical values raise InputError("<where>: <key>: ...").
+    Defaults that stand in for unknown data are listed in the result's `estimated`."""
+    if not isinstance(table, dict):
+        raise InputError(f"{where}: need a table of bearing geometry")
+    for key in table:
+        if key not in GEOMETRY_KEYS:
+            raise InputError(f"{where}: {key}: unknown key (known: {', '.join(GEOMETRY_KEYS)})")
+    for key in ("elements", "element_diameter", "pitch_diameter"):
+        if key not in table:
+            raise InputError(f"{where}: {key}: missing ({GEOMETRY_KEYS[key][1]})")
+    kwargs: dict = {"designation": "user bearing", "kind": "ball"}
+    for key, value in table.items():
+        name = GEOMETRY_KEYS[key][0]
+        if key in ("designation", "kind"):
+            if not isinstance(value, str):
+                raise InputError(f"{where}: {key}: need a string, got {value!r}")
+        elif key in ("elements", "rows"):
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise InputError(f"{where}: {key}: need a whole number, got {value!r}")
+        elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            raise InputError(f"{where}: {key}: need a number, got {value!r}")
+        if key == "contact_angle_deg":
+            if not 0.0 <= value < 90.0:
+                raise InputError(f"{where}: {key}: {value} deg must lie in [0, 90)")
+            value = math.radians(value)
+        elif key in ("element_diameter", "pitch_diameter", "bore", "outer_diameter", "width") and not value > 0:
+            raise InputError(f"{where}: {key}: {value} m must be > 0")
+        elif key in ("conformity_inner", "conformity_outer") and not value > 0.5:
+            raise InputError(f"{where}: {key}: {value} must be > 0.5 (groove radius larger than the ball's)")
+        elif key == "roller_length" and not value > 0:
+            raise InputError(f"{where}: {key}: {value} m must be > 0")
+        kwargs[name] = float(value) if isinstance(value, (int, float)) and key not in ("elements", "rows") \
+            else value
+    estimated = {}
+    if kwargs["kind"] == "ball":
+        for key, rule in (("conformity_inner", "0.52 (Harris typical)"), ("conformity_outer", "0.53 (Harris typical)")):
+            if key not in table:
+                estimated[GEOMETRY_KEYS[key][0]] = f"default {rule}"
+    if "youngs_modulus" not in table:
+        estimated["youngs_modulus"] = "default 208 GPa (bearing steel)"
+    try:
+        bearing = RollingBearing(**kwargs, estimated=estimated)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+    # (RollingBearing itself allows overfull rings: analytic studies use them, e.g. Stribeck's limit Z -> inf)
+    z, dw, dpw = bearing.n_elements, bearing.element_diameter, bearing.pitch_diameter
+    if z * dw >= math.pi * dpw:
+        raise InputError(f"{where}: elements: {z} elements of {dw} m do not fit on the pitch circle ({dpw} m)")
+    return bearing
 
 
 # ----------------------------------------------------------------------------------------------- models
@@ -176,7 +299,7 @@ class LimBall(_Model):
         super().__init__(bearing)
         b = bearing
         self.k_n = hertz.ball_effective_stiffness(b.element_diameter, b.pitch_diameter, b.contact_angle,
-                                                  b.groove_inner, b.groove_outer, b.E, b.nu)
+                                                  b.groove_inner, b.groove_outer, b.youngs_modulus, b.poisson_ratio)
         self.a0 = (b.groove_inner + b.groove_outer - 1.0) * b.element_diameter       # Eq. (3.2), A_0
         # r_j: radius of the inner raceway groove curvature centre (Eq. (3.5))
         self.r_j = b.pitch_diameter / 2.0 + (b.groove_inner - 0.5) * b.element_diameter * math.cos(b.contact_angle)
@@ -215,7 +338,7 @@ class LimRoller(_Model):
     def __init__(self, bearing: RollingBearing):
         super().__init__(bearing)
         b = bearing
-        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.E, b.nu)
+        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.youngs_modulus, b.poisson_ratio)
         self.r_j = b.pitch_diameter / 2.0
         a = b.contact_angle
         self.g = math.cos(a) * self.radial_direction() + math.sin(a) * self.axial_direction(self.r_j)
@@ -240,7 +363,7 @@ class SelfAligningRoller(LimRoller):
     def __init__(self, bearing: RollingBearing):
         _Model.__init__(self, bearing)
         b = bearing
-        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.E, b.nu)
+        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.youngs_modulus, b.poisson_ratio)
         self.r_j = b.pitch_diameter / 2.0
         a = b.contact_angle
         rad = self.radial_direction()
@@ -269,7 +392,7 @@ class SlicedRoller(_Model):
         super().__init__(bearing)
         b = bearing
         self.slices = slices
-        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.E, b.nu)   # only for scaling
+        self.k_n = hertz.roller_effective_stiffness(b.roller_length, b.youngs_modulus, b.poisson_ratio)   # only for scaling
         self.r_j = b.pitch_diameter / 2.0
         dl = b.roller_length / slices
         self.a = (np.arange(slices) + 0.5) * dl - b.roller_length / 2.0
@@ -283,7 +406,7 @@ class SlicedRoller(_Model):
         self.gap = b.radial_clearance * math.cos(alpha)
         inner_race = b.pitch_diameter / 2.0 - b.element_diameter / 2.0
         outer_race = b.pitch_diameter / 2.0 + b.element_diameter / 2.0
-        self.law = hertz.LineContactSlices(b.element_diameter, inner_race, outer_race, dl, b.E, b.nu)
+        self.law = hertz.LineContactSlices(b.element_diameter, inner_race, outer_race, dl, b.youngs_modulus, b.poisson_ratio)
 
     def _evaluate(self, q):
         approach = self.g @ q - self.gap

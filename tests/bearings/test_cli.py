@@ -32,3 +32,80 @@ def test_preload_axial_adds_to_fz(capsys):
     ref = bearing_stiffness("6215", [0, -5000, 3000, 0, 0])
     assert np.allclose(data["K"], ref.K, rtol=1e-12, atol=0)
     assert data["load"][2] == 3000.0
+
+
+# ---------------------------------------------------------------- internal geometry on the command line (issue 12)
+GEOMETRY = ["--balls", "12", "--ball-diameter", "0.025", "--pitch-diameter", "0.125", "--conformity-inner", "0.52",
+            "--conformity-outer", "0.53", "--contact-angle-deg", "40", "--radial-clearance", "0"]
+
+
+def test_geometry_from_flags_and_from_toml_equal_the_api(capsys, tmp_path):
+    import math
+
+    from housingfe.bearings import RollingBearing
+
+    load = ["0", "0", "8000", "0", "0"]
+    assert main(["bearing", *GEOMETRY, "--load", *load, "--json"]) == 0
+    flags = json.loads(capsys.readouterr().out)
+    toml = tmp_path / "ac.toml"
+    toml.write_text("[bearing]\ndesignation = 'AC 40 deg'\nelements = 12\nelement_diameter = 0.025\n"
+                    "pitch_diameter = 0.125\nconformity_inner = 0.52\nconformity_outer = 0.53\n"
+                    "contact_angle_deg = 40.0\nradial_clearance = 0.0\n")
+    assert main(["bearing", "--geometry", str(toml), "--load", *load, "--json"]) == 0
+    from_file = json.loads(capsys.readouterr().out)
+    ref = bearing_stiffness(RollingBearing("api", "ball", n_elements=12, element_diameter=0.025,
+                                           pitch_diameter=0.125, contact_angle=math.radians(40)),
+                            [0, 0, 8000.0, 0, 0])
+    for data in (flags, from_file):
+        assert np.allclose(data["K"], ref.K, rtol=1e-12, atol=0)
+        assert np.allclose(data["displacement"], ref.displacement, rtol=1e-12, atol=1e-30)
+        assert data["secant_stiffness"][2] == 8000.0 / ref.displacement[2]
+        assert "equilibrium" in data["displacement_is"] and "tangent" in data["K_is"]
+
+
+def test_text_output_labels_deflection_tangent_and_secant(capsys):
+    assert main(["bearing", *GEOMETRY, "--load", "0", "0", "8000", "0", "0"]) == 0
+    out = capsys.readouterr().out
+    assert "deflection under the load" in out and "equilibrium solve" in out
+    assert "tangent stiffness K = dF/d(deflection)" in out and "secant stiffness F/deflection" in out
+
+
+def test_flags_override_a_catalogue_entry(capsys):
+    assert main(["bearing", "6312", "--radial-clearance", "0", "--load", "0", "-10000", "0", "0", "0", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    import dataclasses
+
+    from housingfe.bearings import lookup
+    ref = bearing_stiffness(dataclasses.replace(lookup("6312"), radial_clearance=0.0), [0, -10000, 0, 0, 0])
+    assert np.allclose(data["K"], ref.K, rtol=1e-12, atol=0)
+    assert "radial_clearance" not in data["estimated"]
+
+
+def _one_line_exit_2(capsys, argv, match):
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    err = captured.err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert match in err, err
+    assert captured.out == ""
+
+
+def test_bad_geometry_exit_2_one_line(capsys, tmp_path):
+    load = ["--load", "0", "0", "8000", "0", "0"]
+    bad = {"--ball-diameter": ("-0.025", "element_diameter"), "--conformity-inner": ("0.5", "conformity_inner"),
+           "--conformity-outer": ("0.45", "conformity_outer"), "--contact-angle-deg": ("90", "contact_angle_deg")}
+    for flag, (value, key) in bad.items():
+        argv = list(GEOMETRY)
+        argv[argv.index(flag) + 1] = value
+        _one_line_exit_2(capsys, ["bearing", *argv, *load], key)
+    _one_line_exit_2(capsys, ["bearing", "--balls", "12", "--pitch-diameter", "0.125", *load], "element_diameter")
+    _one_line_exit_2(capsys, ["bearing", *load], "designation")
+    toml = tmp_path / "bad.toml"
+    toml.write_text("[bearing]\nelements = 12\nelement_diameter = 0.025\npitch_diameter = 0.125\nballs = 3\n")
+    _one_line_exit_2(capsys, ["bearing", "--geometry", str(toml), *load], "balls: unknown key")
+    toml.write_text("[bearing\n")
+    _one_line_exit_2(capsys, ["bearing", "--geometry", str(toml), *load], "not valid TOML")
+    _one_line_exit_2(capsys, ["bearing", "--geometry", str(tmp_path / "none.toml"), *load], "no such file")
+    _one_line_exit_2(capsys, ["bearing", "6312", "--geometry", str(toml), *load], "not both")
+    # an angular contact bearing loaded axially the wrong way cannot carry it
+    _one_line_exit_2(capsys, ["bearing", *GEOMETRY, "--load", "0", "-1000", "-8000", "0", "0"], "cannot carry")

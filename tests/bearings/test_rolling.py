@@ -221,3 +221,86 @@ def test_thesis_half_tilt_variant_has_quarter_slicing_tilt_stiffness():
     half = make_model(b, "sliced-roller-thesis").evaluate(q)[2]
     assert half[3, 3] == pytest.approx(full[3, 3] / 4, rel=1e-12)
     assert half[1, 1] == pytest.approx(full[1, 1], rel=1e-12)
+
+
+# ---------------------------------------------------------------- internal geometry without a catalogue (issue 12)
+def test_ball_model_needs_no_boundary_dimensions_and_axial_load_matches_closed_form():
+    # angular contact ball bearing from its internal geometry only (Z, D_w, d_pw, f_i, f_o, alpha0): pure axial
+    # load, zero clearance.  Closed form: every ball moves by the axial displacement d_a, its groove centres move
+    # apart to A = hypot(A0 cos a0, A0 sin a0 + d_a), delta_n = A - A0, Q = K_n delta_n^1.5 and
+    # F_a = Z Q sin(alpha) with sin(alpha) = (A0 sin a0 + d_a) / A: one equation in d_a.
+    from scipy.optimize import brentq
+
+    from housingfe.bearings import hertz
+
+    z, dw, dpw, fi, fo, a0 = 12, 0.025, 0.125, 0.52, 0.53, math.radians(40.0)
+    b = RollingBearing("angular contact, internal geometry", "ball", n_elements=z, element_diameter=dw,
+                       pitch_diameter=dpw, groove_inner=fi, groove_outer=fo, contact_angle=a0)
+    assert b.bore is None and b.outer_diameter is None and b.width is None
+    fa = 8000.0
+    res = bearing_stiffness(b, [0, 0, fa, 0, 0])
+    kn = hertz.ball_effective_stiffness(dw, dpw, a0, fi, fo, 208e9, 0.3)
+    big_a0 = (fi + fo - 1) * dw
+
+    def axial_force(da):
+        a = math.hypot(big_a0 * math.cos(a0), big_a0 * math.sin(a0) + da)
+        return z * kn * (a - big_a0) ** 1.5 * (big_a0 * math.sin(a0) + da) / a - fa
+
+    da = brentq(axial_force, 1e-12, 1e-3, xtol=1e-18, rtol=1e-14)
+    assert res.displacement[2] == pytest.approx(da, rel=1e-8)
+    a = math.hypot(big_a0 * math.cos(a0), big_a0 * math.sin(a0) + da)
+    assert res.element_loads == pytest.approx(np.full(z, kn * (a - big_a0) ** 1.5), rel=1e-8)
+    assert res.secant_stiffness()[2] == pytest.approx(fa / da, rel=1e-8)
+    assert res.secant_stiffness()[0] is None                # no radial load, no radial secant
+
+
+def test_tangent_is_1_5_times_secant_for_the_hertz_power_law():
+    # deep groove, zero clearance, pure radial: F = K_n delta^1.5 sum cos^2.5 exactly, so the tangent K is 1.5 x the
+    # secant F/delta, and delta = F/K (tangent taken as secant) comes out 1/3 low
+    b = RollingBearing("deep groove, internal geometry", "ball", n_elements=9, element_diameter=0.02,
+                       pitch_diameter=0.1)
+    f = 12000.0
+    res = bearing_stiffness(b, [f, 0, 0, 0, 0])          # along x: the ball pattern is symmetric about x
+    c = np.cos(2 * np.pi * np.arange(9) / 9)
+    kn = make_model(b).k_n
+    delta = (f / (kn * np.sum(c[c > 0] ** 2.5))) ** (2 / 3)
+    assert res.displacement[0] == pytest.approx(delta, rel=1e-9)
+    assert res.K[0, 0] / res.secant_stiffness()[0] == pytest.approx(1.5, rel=1e-9)
+    assert (f / res.K[0, 0]) / res.displacement[0] == pytest.approx(2 / 3, rel=1e-9)
+
+
+def test_material_keys_as_in_the_scenes():
+    from housingfe.bearings.rolling import BEARING_STEEL_POISSON_RATIO, BEARING_STEEL_YOUNGS_MODULUS
+
+    b = RollingBearing("x", "ball", n_elements=9, element_diameter=0.02, pitch_diameter=0.1)
+    assert (b.youngs_modulus, b.poisson_ratio) == (BEARING_STEEL_YOUNGS_MODULUS, BEARING_STEEL_POISSON_RATIO)
+    assert BEARING_STEEL_YOUNGS_MODULUS == 208e9
+    stiff = dataclasses.replace(b, youngs_modulus=2 * b.youngs_modulus)
+    load = [12000.0, 0, 0, 0, 0]
+    # Hertz: K_n ~ E, delta ~ K_n^(-2/3) at a given load, tangent K = 1.5 F / delta ~ E^(2/3)
+    ratio = bearing_stiffness(stiff, load).K[0, 0] / bearing_stiffness(b, load).K[0, 0]
+    assert ratio == pytest.approx(2 ** (2 / 3), rel=1e-9)
+    with pytest.raises(InputError, match="poisson_ratio"):
+        dataclasses.replace(b, poisson_ratio=0.5)
+
+
+@pytest.mark.parametrize("change,match", [
+    ({"element_diameter": -0.02}, "element_diameter"),
+    ({"conformity_inner": 0.5}, "conformity_inner"),
+    ({"conformity_outer": 0.49}, "conformity_outer"),
+    ({"contact_angle_deg": 95.0}, "contact_angle_deg"),
+    ({"elements": 2.5}, "elements"),
+    ({"elements": 30}, "do not fit"),
+    ({"pitch_diameter": 0.015}, "smaller than the pitch"),
+    ({"ball_diameter": 0.02}, "ball_diameter: unknown key"),
+    ({"bore": 0.12, "outer_diameter": 0.2}, "pitch_diameter"),
+])
+def test_geometry_table_errors_name_the_key(change, match):
+    from housingfe.bearings.rolling import bearing_from_table
+
+    table = {"elements": 9, "element_diameter": 0.02, "pitch_diameter": 0.1}
+    assert bearing_from_table(table).n_elements == 9
+    with pytest.raises(InputError, match=match):
+        bearing_from_table({**table, **change}, "geometry.toml: bearing")
+    with pytest.raises(InputError, match="pitch_diameter: missing"):
+        bearing_from_table({"elements": 9, "element_diameter": 0.02})
