@@ -94,3 +94,46 @@ def _mult(M, x):
     y = M.createVecLeft()
     M.mult(x, y)
     return y
+
+
+SIMPLY_SUPPORTED = ('geometry.edges={x0="simply_supported",x1="simply_supported",'
+                    'y0="simply_supported",y1="simply_supported"}')
+
+
+@pytest.mark.parametrize("f_max", [3.7, 8.0])
+def test_rigid_count_does_not_depend_on_f_max(comm, f_max):
+    """Issue 12 item 4: FV12's plate simply supported (w = 0 on the edges) keeps its three in-plane rigid
+    motions, counted as three whatever f_max; its first elastic mode is Kirchhoff's f_11 = 2.377 Hz."""
+    scene = load_scene("nafems-fv12", SIMPLY_SUPPORTED)
+    model = build_model(scene, comm)
+    result = modal.solve_modes(model.K, model.M, f_max)
+    assert result.rigid_count == 3
+    m = model.material
+    D = m.youngs_modulus * 0.05**3 / (12 * (1 - m.poisson_ratio**2))
+    f11 = math.pi / 2 * (2 / 10.0**2) * math.sqrt(D / (m.density * 0.05))
+    assert result.frequencies_hz[3] == pytest.approx(f11, rel=0.01)
+
+
+def test_free_plate_has_six_rigid_modes_below_a_low_f_max(comm):
+    """The free FV12 plate solved only to 3 Hz (f_max close to its 1.622 Hz first mode) still has six."""
+    scene = load_scene("nafems-fv12")
+    model = build_model(scene, comm)
+    result = modal.solve_modes(model.K, model.M, 3.0)
+    assert result.rigid_count == 6
+    assert result.frequencies_hz[6] == pytest.approx(1.622, rel=0.015)
+
+
+def test_simply_supported_plate_harmonic_basis_counts_rigid_modes(comm):
+    """harmonic.json's facts for the issue's plate: a basis to 3.7 Hz = three rigid modes, one elastic mode."""
+    from housingfe import forced_response
+
+    scene = load_scene("nafems-fv12", SIMPLY_SUPPORTED,
+                       "analysis.harmonic={f_min=0.5, f_max=2.4666667, df=0.5, surface=\"top\", "
+                       "modal_basis_factor=1.5}",
+                       "loads=[{name=\"top\", kind=\"force\", surface=\"top\", point=[3.1, 2.7, 0.05], "
+                       "direction=[0.0, 0.0, -1.0], radius=0.2}]",
+                       "damping={loss_factor=0.01}")
+    forced = forced_response.run(build_model(scene, comm), scene.analysis.harmonic, None)
+    assert forced.facts["basis_f_max_hz"] == pytest.approx(3.7)
+    assert forced.facts["rigid_modes"] == 3
+    assert forced.facts["modes_in_basis"] == 1
