@@ -68,13 +68,15 @@ class MaterialSpec(_Strict):
 
 class MeshSpec(_Strict):
     """Discretisation.  The element size follows from the highest frequency of interest unless `size` is
-    given: size = bending wavelength of the thinnest wall at f_max / elements_per_wavelength."""
+    given: size = bending wavelength of the thinnest wall at f_max / elements_per_wavelength.  A model whose
+    estimated memory exceeds the machine's available memory stops before meshing unless allow_large."""
 
     element: Literal["hex", "tet"] = "hex"
     degree: Literal[1, 2, 3] = 2
     elements_per_wavelength: PositiveFloat = 6.0
     layers: PositiveInt = 1
     size: Optional[PositiveFloat] = None
+    allow_large: bool = False   # run even when the estimated memory exceeds what the machine has available
 
 
 class ModalSpec(_Strict):
