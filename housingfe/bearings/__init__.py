@@ -13,7 +13,8 @@ Public API (axis convention: z = shaft axis, DOF order x, y, z, theta_x, theta_y
 
     transform_stiffness(K, R) -> K in global axes (R: columns = the bearing's x, y, z in global coordinates).
 
-`housingfe bearing DESIGNATION --load FX FY FZ MX MY [--json]` prints the same (see bearings.cli).
+`housingfe bearing DESIGNATION|--geometry FILE.toml|--balls Z --ball-diameter M ... --load FX FY FZ MX MY [--json]`
+prints the same: the deflection under the load, the secant F/delta and the tangent K (see bearings.cli).
 """
 from __future__ import annotations
 
@@ -28,11 +29,11 @@ _LAZY = {
     "journal_bearing_coefficients": "fluid_film", "short_bearing_coefficients": "fluid_film",
     "DOF_NAMES": "rolling", "BearingResult": "rolling", "RollingBearing": "rolling",
     "finite_difference_stiffness": "rolling", "make_model": "rolling", "rolling_bearing_stiffness": "rolling",
-    "stiffness_at": "rolling", "transform_stiffness": "rolling",
+    "stiffness_at": "rolling", "transform_stiffness": "rolling", "bearing_from_table": "rolling",
 }
 
 __all__ = ["DOF_NAMES", "BearingResult", "FluidFilmResult", "JournalBearing", "RollingBearing",
-           "bearing_stiffness", "designations", "finite_difference_stiffness", "journal_bearing_coefficients",
+           "bearing_from_table", "bearing_stiffness", "designations", "finite_difference_stiffness", "journal_bearing_coefficients",
            "lookup", "make_model", "register_cli", "short_bearing_coefficients", "stiffness_at",
            "transform_stiffness"]
 
