@@ -38,9 +38,16 @@ fi
 
 # Reinstall only when the project's metadata changed since the last successful install.
 stamp="$venv/.housingfe-installed"
+# Offline install (container builds, air-gapped machines, proxies that break TLS): when a wheelhouse exists
+# (docker/build.sh fills ./wheelhouse), PyPI packages come only from it. Without one, from the index as before.
+wheelhouse="${HOUSINGFE_WHEELHOUSE:-$here/wheelhouse}"
+pip_source=()
+[ ! -d "$wheelhouse" ] || pip_source=(--no-index --find-links "$wheelhouse")
 if [ ! -f "$stamp" ] || [ "$here/pyproject.toml" -nt "$stamp" ] || [ "$here/scripts/constraints.txt" -nt "$stamp" ]; then
-  echo "bootstrap: installing housingfe[$extras] into $venv" >&2
-  "$venv/bin/python" -m pip install -q --disable-pip-version-check \
-      -c "$here/scripts/constraints.txt" -e "$here[$extras]" >&2
+  echo "bootstrap: installing housingfe[$extras] into $venv${pip_source:+ from $wheelhouse}" >&2
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check "${pip_source[@]}" \
+      -c "$here/scripts/constraints.txt" -e "$here[$extras]" >&2 \
+    || { [ ${#pip_source[@]} -eq 0 ] || echo "bootstrap: $wheelhouse lacks a package: refresh it" \
+           "(bash docker/build.sh does) or remove it to install from PyPI" >&2; exit 1; }
   touch "$stamp"
 fi
