@@ -150,34 +150,63 @@ def dependency_files(recorded: list[str]) -> list[str]:
     return sorted(set(recorded) | set(data))
 
 
-def cache_key(scene, files: list[str], extra=None) -> str | None:
-    """sha256 of the resolved scene (pydantic model after defaults and overrides), `extra` (JSON-able job
-    options) and the content of `files` (relative to the package); None when one of them no longer exists."""
-    h = hashlib.sha256()
-    h.update(json.dumps(scene.model_dump(mode="json"), sort_keys=True).encode())
-    h.update(json.dumps(extra, sort_keys=True).encode())
-    for name in sorted(files):
-        path = PACKAGE / name
-        if not path.is_file():
+def _sha(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def file_hashes(files) -> dict[str, str | None]:
+    """sha256 of the content of each file (relative to the package); None for a file that no longer exists."""
+    return {name: _sha((PACKAGE / name).read_bytes()) if (PACKAGE / name).is_file() else None
+            for name in sorted(files)}
+
+
+def scene_hash(scene, extra=None) -> str:
+    """sha256 of the resolved scene (the pydantic model after defaults and overrides) and `extra` (JSON-able
+    job options)."""
+    return _sha(json.dumps([scene.model_dump(mode="json"), extra], sort_keys=True).encode())
+
+
+def cache_key(scene, files, extra=None) -> str | None:
+    """sha256 of the resolved scene, `extra` and the content of `files` (relative to the package); None when
+    one of the files no longer exists."""
+    hashes = file_hashes(files)
+    if None in hashes.values():
+        return None
+    return _sha(json.dumps([scene_hash(scene, extra), hashes], sort_keys=True).encode())
+
+
+def stale_reason(folder: Path, scene, result_name: str, extra=None) -> str | None:
+    """None if folder/result_name can be reused (its stamp holds the current key), else why not."""
+    stamp = folder / STAMP
+    if not (folder / result_name).is_file():
+        return f"no {result_name}"
+    if not stamp.is_file():
+        return f"no {STAMP} (computed outside validate)"
+    try:
+        stored = json.loads(stamp.read_text())
+        if stored["key"] == cache_key(scene, stored["files"], extra):
             return None
-        h.update(name.encode() + b"\0" + hashlib.sha256(path.read_bytes()).digest())
-    return h.hexdigest()
+        if stored.get("scene") != scene_hash(scene, extra):
+            return "the scene changed"
+        now = file_hashes(stored["files"])
+        changed = [n for n, h in now.items() if h != stored["files"][n]]
+        return "changed: " + ", ".join(changed[:5]) + (f" and {len(changed) - 5} more" if len(changed) > 5 else "")
+    except (ValueError, KeyError, TypeError, AttributeError):
+        return f"unreadable {STAMP}"
 
 
 def is_up_to_date(folder: Path, scene, result_name: str, extra=None) -> bool:
     """True if folder/result_name exists and folder/.validate-key matches the current key."""
-    stamp = folder / STAMP
-    if not (folder / result_name).is_file() or not stamp.is_file():
-        return False
-    try:
-        stored = json.loads(stamp.read_text())
-        files = stored["files"]
-        return stored["key"] == cache_key(scene, files, extra)
-    except (ValueError, KeyError, TypeError):
-        return False
+    return stale_reason(folder, scene, result_name, extra) is None
 
 
-def compute(job: dict, scene, folder: Path, results: Path, label: str, extra=None) -> None:
+def write_stamp(folder: Path, scene, files, extra=None) -> None:
+    """Record the key of a fresh result (and the parts it is made of, to say later what changed)."""
+    stamp = {"key": cache_key(scene, files, extra), "scene": scene_hash(scene, extra), "files": file_hashes(files)}
+    (folder / STAMP).write_text(json.dumps(stamp, indent=0))
+
+
+def compute(job: dict, scene, folder: Path, results: Path, label: str, extra=None, reason: str = "") -> None:
     """Run `job` in a subprocess (the worker), then stamp the folder with the key of what it imported.
     Any failure -> ComputationFailed with one line; the full output is kept in <results>/.validate-logs/."""
     logs = results / ".validate-logs"
@@ -186,7 +215,7 @@ def compute(job: dict, scene, folder: Path, results: Path, label: str, extra=Non
     deps = logs / f"{folder.name}.deps.json"
     deps.unlink(missing_ok=True)
     job = {**job, "out": str(folder), "deps": str(deps)}
-    print(f"validate: computing {label} -> {folder}/", flush=True)
+    print(f"validate: computing {label} -> {folder}/" + (f" ({reason})" if reason else ""), flush=True)
     t0 = time.perf_counter()
     with open(log, "w") as fh:
         proc = subprocess.run([sys.executable, "-c", _WORKER, json.dumps(job)], stdout=fh,
@@ -197,7 +226,7 @@ def compute(job: dict, scene, folder: Path, results: Path, label: str, extra=Non
         last = lines[-1] if lines else "no error message"
         raise ComputationFailed(f"{label}: exit {proc.returncode}: {last} (log: {log})")
     files = dependency_files(json.loads(deps.read_text()))
-    (folder / STAMP).write_text(json.dumps({"key": cache_key(scene, files, extra), "files": files}, indent=0))
+    write_stamp(folder, scene, files, extra)
     print(f"validate: {label} done in {time.perf_counter() - t0:.0f} s", flush=True)
 
 
@@ -210,9 +239,10 @@ def modal_results(name: str, results: Path | None = None) -> dict | None:
         print(f"validate: {scene.scene.name} has no modal analysis (harmonic only): no modal rows", flush=True)
         return None
     folder = results / scene.scene.name
-    if not is_up_to_date(folder, scene, "modes.json"):
+    reason = stale_reason(folder, scene, "modes.json")
+    if reason:
         compute({"kind": "run", "scene": str(path), "overrides": []}, scene, folder, results,
-                f"housingfe run {scene.scene.name}")
+                f"housingfe run {scene.scene.name}", reason=reason)
     with open(folder / "modes.json") as fh:
         return json.load(fh)
 
@@ -268,9 +298,10 @@ def bearing_variant_rows(results: Path | None = None) -> list[dict]:
     scene, path = load_housing_scene(VARIANT_SCENE)
     folder = results / f"bearing-variants-{scene.scene.name}"
     extra = {"configs": list(VARIANT_CONFIGS)}
-    if not is_up_to_date(folder, scene, "variants.json", extra):
+    reason = stale_reason(folder, scene, "variants.json", extra)
+    if reason:
         compute({"kind": "bearing-variants", "scene": str(path), "configs": list(VARIANT_CONFIGS), "overrides": []},
-                scene, folder, results, f"housingfe bearing-variants --scene {scene.scene.name}", extra)
+                scene, folder, results, f"housingfe bearing-variants --scene {scene.scene.name}", extra, reason)
     with open(folder / "variants.json") as fh:
         data = json.load(fh)
     ref = thesis()["test_gearbox"]["bearings"]

@@ -88,13 +88,14 @@ def test_result_reused_only_with_a_matching_stamp(fake_package, tmp_path):
     folder.mkdir(parents=True)
     (folder / "modes.json").write_text("{}")
     assert not validate.is_up_to_date(folder, scene, "modes.json")          # no stamp: computed elsewhere
-    (folder / validate.STAMP).write_text(json.dumps({"key": validate.cache_key(scene, ["used.py"]),
-                                                     "files": ["used.py"]}))
+    validate.write_stamp(folder, scene, ["used.py"])
     assert validate.is_up_to_date(folder, scene, "modes.json")
     changed, _ = load_housing_scene("box-free", ["geometry.wall_thickness=0.009"])
-    assert not validate.is_up_to_date(folder, changed, "modes.json")
+    assert validate.stale_reason(folder, changed, "modes.json") == "the scene changed"
+    (fake_package / "unrelated.py").write_text("y = 3\n")
+    assert validate.is_up_to_date(folder, scene, "modes.json")
     (fake_package / "used.py").write_text("x = 3\n")
-    assert not validate.is_up_to_date(folder, scene, "modes.json")
+    assert validate.stale_reason(folder, scene, "modes.json") == "changed: used.py"
     (folder / validate.STAMP).write_text("not json")
     assert not validate.is_up_to_date(folder, scene, "modes.json")
 
@@ -217,8 +218,7 @@ def test_main_writes_csv_markdown_and_json(tmp_path, monkeypatch):
                               "ours": 4, "published": 42, "unit": "-", "source": "x", "difference": -38}]}
     (folder / "modes.json").write_text(json.dumps(summary))
     scene, _ = load_housing_scene("gearbox-model")
-    (folder / validate.STAMP).write_text(json.dumps({"key": validate.cache_key(scene, ["run.py"]),
-                                                     "files": ["run.py"]}))
+    validate.write_stamp(folder, scene, ["run.py"])
     monkeypatch.setattr(validate, "compute", lambda *a, **k: pytest.fail("must reuse the stored result"))
     out = tmp_path / "validate"
     rows = validate.main(out_dir=out, json_path=tmp_path / "rows.json", scenes=["gearbox-model"],
