@@ -16,6 +16,13 @@ from housingfe.scene import HousingScene
 # Elements that fail this quality are rejected before any solve (hex: scaled Jacobian, tet: shape ratio).
 MIN_ELEMENT_QUALITY = 0.05
 
+# Peak memory of a run ~ base + per DOF (mesh, K and M, the MUMPS LDL^T factors of the inertia count and the
+# shift-invert, the Krylov basis).  Upper end of what was measured on this stack: 39 k DOFs 0.5 GB, 136 k
+# 1.2-1.7 GB, 317 k 2.8-4.0 GB (STACK-NOTES); `housingfe run` peak RSS: box-free 39 k DOFs 0.83 GB, gearbox-model
+# 62 k DOFs 0.84 GB (estimates 0.81 and 1.1 GB).
+MEMORY_BASE_BYTES = 0.3e9
+MEMORY_PER_DOF_BYTES = 13e3
+
 
 @dataclass
 class HousingModel:
@@ -55,6 +62,7 @@ def build_model(scene: HousingScene, comm) -> HousingModel:
 
     material = scene.material.resolve()
     size = element_size(scene, material)
+    check_model_size(scene, size, comm)
     housing = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, comm)
     if housing.quality["min"] < MIN_ELEMENT_QUALITY:
         raise InputError(f"mesh: element quality {housing.quality['min']:.3f} < {MIN_ELEMENT_QUALITY} "
@@ -67,6 +75,44 @@ def build_model(scene: HousingScene, comm) -> HousingModel:
     timings = {"mesh_s": housing.mesh_time_s, "assembly_s": time.perf_counter() - t0}
     free = not bcs and not any(s.kind == "elastic" for s in scene.supports)
     return HousingModel(scene, housing, material, V, bcs, K, M, 6 if free else 0, timings, materials)
+
+
+def available_memory_bytes() -> tuple[int, int]:
+    """(MemAvailable, MemTotal) of this machine in bytes, from /proc/meminfo (0, 0 where it cannot be read)."""
+    info = {}
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                key, value = line.split(":", 1)
+                info[key] = int(value.split()[0]) * 1024
+    except (OSError, ValueError):
+        return 0, 0
+    return info.get("MemAvailable", info.get("MemFree", 0)), info.get("MemTotal", 0)
+
+
+def check_model_size(scene: HousingScene, size: float, comm) -> dict:
+    """Estimate DOFs and peak memory before meshing (housingfe.geometry.mesh.estimate_dofs, MEMORY_*) and raise
+    InputError in one line when the estimate exceeds the memory available on this machine (MemAvailable of
+    /proc/meminfo; all ranks of a run share the machine), unless mesh.allow_large is set.  The message names
+    the element size, its key, and the geometry's largest dimension.  Returns the estimate."""
+    from housingfe.geometry.mesh import estimate_dofs
+
+    mesh = scene.mesh
+    dofs = estimate_dofs(scene.geometry, mesh.element, mesh.degree, size, mesh.layers)
+    need = MEMORY_BASE_BYTES * comm.size + MEMORY_PER_DOF_BYTES * dofs
+    available, total = comm.bcast(available_memory_bytes() if comm.rank == 0 else None, root=0)
+    estimate = {"dofs": dofs, "memory_bytes": need, "available_bytes": available, "total_bytes": total}
+    if available and need > available and not mesh.allow_large:
+        size_key = "mesh.size" if mesh.size is not None else "mesh.elements_per_wavelength"
+        lengths = {k: v for k, v in scene.geometry.model_dump().items()
+                   if isinstance(v, float) and not isinstance(v, bool)}
+        largest = max(lengths, key=lengths.get) if lengths else None
+        dims = f" (largest dimension: geometry.{largest} = {lengths[largest]:g} m)" if largest else ""
+        raise InputError(f"mesh: model too large: ~{dofs:,} DOFs at {size * 1e3:.3g} mm elements need "
+                         f"~{need / 1e9:.1f} GB, this machine has {available / 1e9:.1f} GB available "
+                         f"(MemAvailable, {total / 1e9:.1f} GB total); check {size_key}{dims} or set "
+                         f"mesh.allow_large = true to run anyway")
+    return estimate
 
 
 def material_field(scene: HousingScene, housing: HousingMesh, default: Material):

@@ -34,6 +34,14 @@ class BoxGeometry(_Strict):
             raise ValueError("height: must exceed flange_thickness + wall_thickness")
         if self.bolt_patch_size >= self.flange_width:
             raise ValueError("bolt_patch_size: must be smaller than flange_width")
+        # a flange wider than the box itself is a unit typo (5.0 for 0.05 m), not a housing: it would mesh
+        # metres of flange at millimetre elements
+        if self.flange_width > max(self.length, self.width):
+            raise ValueError(f"flange_width: {self.flange_width:g} m is wider than the box itself "
+                             f"({self.length:g} x {self.width:g} m); lengths are in m")
+        if self.flange_thickness > self.height:
+            raise ValueError(f"flange_thickness: {self.flange_thickness:g} m exceeds the box height "
+                             f"{self.height:g} m; lengths are in m")
         return self
 
     @property
@@ -60,6 +68,13 @@ class PlateGeometry(_Strict):
     b: PositiveFloat
     h: PositiveFloat
     edges: PlateEdges = PlateEdges()
+
+    @model_validator(mode="after")
+    def _thin(self):
+        if self.h > min(self.a, self.b):
+            raise ValueError(f"h: a plate {self.h:g} m thick and {min(self.a, self.b):g} m wide is not a plate; "
+                             f"lengths are in m")
+        return self
 
     @property
     def min_thickness(self) -> float:
