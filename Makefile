@@ -4,7 +4,7 @@ export OMPI_ALLOW_RUN_AS_ROOT = 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM = 1
 export OPENBLAS_NUM_THREADS = 1
 
-.PHONY: bootstrap demo test bench clean
+.PHONY: bootstrap demo test bench container clean
 
 bootstrap:
 	@bash scripts/bootstrap.sh
@@ -17,6 +17,10 @@ test: bootstrap
 
 bench: bootstrap
 	$(VENV)/bin/housingfe bench modal --out results/bench-modal
+
+# Builds docker/Dockerfile (docker, else podman; offline-capable) and checks box-free in it against this machine.
+container: bootstrap
+	bash docker/build.sh --check
 
 clean:
 	rm -rf results .pytest_cache
