@@ -12,6 +12,20 @@ THESIS = "van Roosmalen 1994"
 _DATA = Path(__file__).parent / "data" / "roosmalen1994.toml"
 
 
+# where in the thesis each table of roosmalen1994.toml comes from (the TOML's comments, which tomllib drops)
+SECTIONS = {"box_free": "Sec. 4.2", "box_supported": "Sec. 4.3", "box_halves": "Sec. 4.4",
+            "gearbox_model_empty": "Sec. 4.5", "gearbox_model_interior": "Sec. 4.6", "radiation": "Sec. 4.7, Appendix E",
+            "fluid_film_bearings": "Sec. 3.5", "shaft_bearing_rig": "Sec. 3.4", "gears": "Ch. 2, Appendix F",
+            "test_gearbox": "Ch. 5", "test_gearbox.bearings": "Sec. 5.8", "test_gearbox.profile_corrections": "Sec. 5.7",
+            "test_gearbox.double_helical": "Sec. 5.9"}
+
+
+def thesis_source(section: str, detail: str = "") -> str:
+    """Provenance of a thesis number: 'van Roosmalen 1994, Sec. 4.2[, detail] [box_free]' from the table name."""
+    where = SECTIONS.get(section) or SECTIONS.get(section.split(".")[0], "")
+    return ", ".join(x for x in (THESIS, where, detail) if x) + f" [{section}]"
+
+
 @functools.lru_cache(maxsize=1)
 def thesis() -> dict:
     """The thesis' published numbers (housingfe/data/roosmalen1994.toml) as a dict."""
@@ -47,7 +61,7 @@ def modal_comparison(scene, summary: dict) -> list[dict]:
             rows.append(row(name, f"elastic mode {i + 1}", ours, f_ref, "Hz", ref.source))
     if ref.section:
         data = thesis()[ref.section]
-        src = f"{THESIS} [{ref.section}]"
+        src = thesis_source(ref.section)
         if "mass_kg" in data:
             rows.append(row(name, "mass", summary["mass_kg"], data["mass_kg"], "kg", src))
         if "fem_first_elastic_Hz" in data:
@@ -74,7 +88,7 @@ def interior_comparison(scene, interior: dict) -> list[dict]:
     data = thesis().get(ref.section, {}) if ref is not None and ref.section else {}
     if "interior_on_rigid_bores_first_Hz" not in data:
         return []
-    name, src = scene.scene.name, f"{THESIS} [{ref.section}]"
+    name, src = scene.scene.name, thesis_source(ref.section)
     f_rigid = np.asarray(interior["rigid_bores_frequencies_hz"])
     energy = np.asarray(interior["rigid_bores_bearing_energy"])
     nan = float("nan")

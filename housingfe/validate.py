@@ -33,7 +33,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.errors import InputError, SolverError
-from housingfe.published import THESIS, row, thesis
+from housingfe.published import THESIS, row, thesis, thesis_source
 from housingfe.scene import builtin_scenes, load_housing_scene
 
 RESULTS = Path("results")
@@ -265,7 +265,7 @@ def gearbox_model_rows(scene: str, freqs: np.ndarray) -> list[dict]:
     from housingfe.levels import third_octave_bands
 
     data = thesis()["gearbox_model_empty"]
-    src = f"{THESIS} [gearbox_model_empty]"
+    src = thesis_source("gearbox_model_empty")
     out = [row(scene, f"elastic mode {i + 1} (thesis FEM)", float(freqs[i]), f, "Hz", src)
            for i, f in enumerate(data["fem_first_three_elastic_Hz"]) if i < len(freqs)]
     bands = third_octave_bands(300, 1300)
@@ -281,7 +281,7 @@ def gearbox_model_rows(scene: str, freqs: np.ndarray) -> list[dict]:
 def close_pair_rows(scene: str, freqs: np.ndarray) -> list[dict]:
     """Sec. 4.3 mentions two modes almost coinciding at 1167/1176 Hz: our closest pair below 4 kHz."""
     f_lo, f_hi = thesis()["box_supported"]["fem_close_pair_Hz"]
-    src = f"{THESIS} [box_supported]"
+    src = thesis_source("box_supported")
     if len(freqs) < 2:
         return []
     spacing = np.diff(freqs) / freqs[:-1]
@@ -305,7 +305,7 @@ def bearing_variant_rows(results: Path | None = None) -> list[dict]:
     with open(folder / "variants.json") as fh:
         data = json.load(fh)
     ref = thesis()["test_gearbox"]["bearings"]
-    src = f"{THESIS} [test_gearbox.bearings], Fig. 5.18"
+    src = thesis_source("test_gearbox.bearings", "Fig. 5.18")
     out = []
     names = {"ball_zero_moment": "ball - ball with zero moment stiffness (the thesis' FEM)",
              "self_aligning": "ball - spherical roller (our self-aligning model)"}
@@ -330,7 +330,7 @@ def joint_rows(modal: dict[str, dict]) -> list[dict]:
     n = min(len(a), len(b))
     change = np.abs(b[:n] - a[:n]) / a[:n]
     data = thesis()["box_halves"]
-    src = f"{THESIS} [box_halves] (EMA with/without gasket)"
+    src = thesis_source("box_halves", "EMA with/without gasket")
     return [row("box-halves-gasket", "gasket: max relative eigenfrequency change", float(change.max()),
                 data["gasket_eigenfrequency_change_max"], "-", src),
             row("box-halves-gasket", "gasket: mean relative eigenfrequency change", float(change.mean()),
