@@ -25,6 +25,21 @@ class ForcedResult:
     sound_power: list | None = None
     to_fe: object = None          # q -> housing vector (coupled models), for deflection shapes
     angular_velocity_node: str | None = None
+    response_points: list = field(default_factory=list)      # housingfe.response.ResponsePoint
+    deflection_shapes: list = field(default_factory=list)    # DeflectionShape, scaled by the load amplitude
+
+
+@dataclass
+class DeflectionShape:
+    """Operating deflection shape of load case `load` at the line `frequency` (Hz): the rms displacement
+    phasor u = real + i imag (m, housing FE vectors) for the load's amplitude and spectrum at that line,
+    time dependence e^{i omega t}; `solver` says which solver produced it."""
+
+    load: str
+    frequency: float
+    real: object
+    imag: object
+    solver: str
 
 
 def damping_model(scene, model) -> harmonic.Damping:
@@ -117,6 +132,13 @@ def run(model, spec, interior=None) -> ForcedResult:
         from housingfe.radiation.housing import RADIATION_POINTS, radiation_points
 
         extra[RADIATION_POINTS], plate_ids = radiation_points(model, scene.radiation)
+    if spec.points:
+        from housingfe.response import RESPONSE_POINTS, locate_response_points, response_point_samples
+
+        points = locate_response_points(model.housing, spec.points)
+        extra[RESPONSE_POINTS] = response_point_samples(points)
+    else:
+        points = []
     if interior is None:
         observer = SurfaceObserver(model, spec.surface, spec.sample_points, loads, extra)
         K, M, C = model.K, model.M, None
@@ -167,7 +189,11 @@ def run(model, spec, interior=None) -> ForcedResult:
         results[name], resp[name] = result, responses(result, observer, loads)
     forced = ForcedResult(spec, loads, resp, observer, results, timings, facts,
                           to_fe=None if interior is None else interior.fe_vector,
-                          angular_velocity_node=spec.angular_velocity_node)
+                          angular_velocity_node=spec.angular_velocity_node, response_points=points)
+    if spec.deflection_shapes_hz:
+        t1 = time.perf_counter()
+        forced.deflection_shapes = deflection_shapes(forced, K, M, damping, C)
+        timings["deflection_shapes_s"] = time.perf_counter() - t1
     if spec.angular_velocity_node:
         add_angular_velocity_transfer(forced, interior)
     if scene.radiation is not None:
@@ -197,23 +223,74 @@ def add_angular_velocity_transfer(forced: ForcedResult, interior) -> None:
             r.extras["TF_omega_dB"] = r.transfer_db - r.extras["L_omega_dB"]
 
 
-def deflection_shape(result: ForcedResult, load_index: int, frequency: float):
-    """Complex displacement field (real, imaginary PETSc Vecs) of a load case at the grid line nearest
-    `frequency` (modal solver), for ParaView."""
-    res = next((r for r in result.results.values() if r.modal_vectors is not None), None)
-    if res is None:
-        return None
-    k = int(np.argmin(abs(res.frequencies - frequency)))
-    basis = res.modal_vectors[load_index]
-    c = res.blocks[load_index][0].coeffs[:, k]
-    ur, ui = basis[0].duplicate(), basis[0].duplicate()
-    ur.set(0.0)
-    ui.set(0.0)
-    for vec, ck in zip(basis, c):
-        ur.axpy(ck.real, vec)
-        ui.axpy(ck.imag, vec)
-    if result.to_fe is not None:
-        ur, ui = result.to_fe(ur), result.to_fe(ui)
-    return res.frequencies[k], ur, ui
+def deflection_shapes(forced: ForcedResult, K, M, damping, C=None) -> list[DeflectionShape]:
+    """Operating deflection shapes of every load case at the grid lines nearest `spec.deflection_shapes_hz`,
+    scaled by the load amplitude (rms phasors, m).  From the direct solver when it ran (re-solved at those
+    lines, since the sweep keeps no vectors), else from the modal basis of the modal / projected solver."""
+    spec = forced.spec
+    freqs = spec.frequencies
+    lines = sorted({int(np.argmin(abs(freqs - f))) for f in spec.deflection_shapes_hz})
+    f_lines = freqs[lines]
+    if "direct" in forced.results:
+        res = harmonic.direct(K, M, forced.loads, f_lines, damping, lambda vecs: [v.copy() for v in vecs], C=C)
+        solver, index = "direct", list(range(len(lines)))
+    else:
+        # the last modal-type result: "modal+residual" or "projected" rather than the plain "modal" of "both"
+        solver, res = [(n, r) for n, r in forced.results.items() if r.modal_vectors is not None][-1]
+        index = lines
+    out = []
+    for j, lc in enumerate(forced.loads):
+        amplitude = lc.amplitude(f_lines)
+        for m, k in enumerate(index):
+            if res.modal_vectors is not None:
+                basis, c = res.modal_vectors[j], res.blocks[j][0].coeffs[:, k]
+            else:
+                block = res.blocks[j][k]
+                basis, c = block.reduced, block.coeffs[:, 0]
+            ur, ui = basis[0].duplicate(), basis[0].duplicate()
+            ur.set(0.0)
+            ui.set(0.0)
+            for vec, ck in zip(basis, c * amplitude[m]):
+                ur.axpy(ck.real, vec)
+                ui.axpy(ck.imag, vec)
+            if forced.to_fe is not None:
+                ur, ui = forced.to_fe(ur), forced.to_fe(ui)
+            out.append(DeflectionShape(lc.name, float(f_lines[m]), ur, ui, solver))
+    return out
 
 
+def point_rows(forced: ForcedResult) -> list:
+    """Rows of points.csv: per solver, load case, response point, direction and line, the receptance H (m per
+    unit load: m/N, m/(N m) or m/Pa), mobility i omega H and accelerance -omega^2 H (re, im, magnitude,
+    phase in degrees, time dependence e^{i omega t}), then the load's rms amplitude and the rms displacement,
+    velocity and acceleration it causes there."""
+    from housingfe.response import RESPONSE_POINTS
+
+    if not forced.response_points:
+        return []
+    unit = {"force": "N", "moment": "N m", "pressure": "Pa"}
+    rows = []
+    for solver, resps in forced.responses.items():
+        for r in resps:
+            values = r.extras["point_values"][RESPONSE_POINTS]
+            omega = 2 * np.pi * r.frequencies
+            row = 0
+            for rp in forced.response_points:
+                for d, label in zip(rp.directions, rp.labels):
+                    H = values[row]
+                    row += 1
+                    frfs = (H, 1j * omega * H, -omega**2 * H)
+                    for k, f in enumerate(r.frequencies):
+                        cells = []
+                        for h in frfs:
+                            cells += [h[k].real, h[k].imag, abs(h[k]), float(np.degrees(np.angle(h[k])))]
+                        a = r.amplitude[k]
+                        rows.append([r.name, solver, rp.name, label, d[0], d[1], d[2], f, unit.get(r.kind, r.kind)]
+                                    + cells + [a, abs(frfs[0][k]) * a, abs(frfs[1][k]) * a, abs(frfs[2][k]) * a])
+    return rows
+
+
+POINT_COLUMNS = (["load_case", "solver", "point", "direction", "dx", "dy", "dz", "frequency_hz", "load_unit"]
+                 + [f"{q}_{p}" for q in ("receptance", "mobility", "accelerance")
+                    for p in ("re", "im", "abs", "phase_deg")]
+                 + ["load_rms", "displacement_rms_m", "velocity_rms_m_s", "acceleration_rms_m_s2"])

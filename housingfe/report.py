@@ -217,9 +217,10 @@ def plot_mode_shapes(path: Path, model, result, count: int) -> None:
 
 # --------------------------------------------------------------------------------------- harmonic results
 def _band_rows(forced):
-    """(load, band nominal, band centre, {solver: (Lv, TF)}, {N: TF_points}) for every band."""
+    """(load, band nominal, band centre, {solver: (Lv, TF)}, {N: TF_points}, lines) for every band that holds
+    at least one line (a band without lines has no level and is left out: see band_note)."""
     from housingfe import levels as lv
-    from housingfe.response import band_levels, transfer_band_levels
+    from housingfe.response import band_levels, band_line_counts, transfer_band_levels
 
     spec = forced.spec
     rows = []
@@ -237,10 +238,39 @@ def _band_rows(forced):
         for N, ms in r.point_mean_square_velocity.items():
             _, Lp = band_levels(r.frequencies, ms * r.amplitude**2, max(spec.f_min, 10.0), spec.f_max, lv.V0)
             points[N] = Lp - per_solver[main][0] + per_solver[main][1]
-        for b in range(len(bands.center)):
+        counts = band_line_counts(r.frequencies, bands)
+        for b in np.flatnonzero(counts > 0):
             rows.append((lc.name, bands.nominal[b], bands.center[b], {s: (v[0][b], v[1][b]) for s, v in per_solver.items()},
-                         {N: p[b] for N, p in points.items()}))
+                         {N: p[b] for N, p in points.items()}, int(counts[b])))
     return rows, solvers
+
+
+def band_note(forced) -> str | None:
+    """Why a 1/3-octave band or a line is missing from bands.csv (None when nothing is): bands narrower than
+    df that hold no line, lines below the lowest band (10 Hz) or beyond the highest."""
+    from housingfe import levels as lv
+    from housingfe.response import band_line_counts
+
+    spec = forced.spec
+    f = spec.frequencies
+    bands = lv.third_octave_bands(max(spec.f_min, 10.0), spec.f_max)
+    counts = band_line_counts(f, bands)
+    notes = []
+    empty = bands.nominal[counts == 0]
+    if len(empty):
+        notes.append(f"1/3-octave band(s) {', '.join(f'{v:g}' for v in empty)} Hz hold no line (df = {spec.df:g} Hz "
+                     "is wider than the band there): left out of bands.csv")
+    lo = bands.lower[0] if len(bands.center) else np.inf
+    hi = bands.upper[-1] if len(bands.center) else -np.inf
+    below, above = f[f < lo], f[f >= hi]
+    if len(below):
+        notes.append(f"{len(below)} line(s) ({', '.join(f'{v:g}' for v in below[:5])}{' ...' if len(below) > 5 else ''}"
+                     f" Hz) lie below the lowest band ({'none' if not len(bands.center) else f'{bands.nominal[0]:g} Hz'}"
+                     f", lower edge {lo:.3g} Hz; bands start at 10 Hz): in frf.csv, in no band")
+    if len(above):
+        notes.append(f"{len(above)} line(s) above {hi:.4g} Hz (upper edge of the highest band whose centre is "
+                     f"<= f_max) are in no band")
+    return "; ".join(notes) or None
 
 
 def octave_rows(forced, solver: str) -> list:
@@ -257,8 +287,9 @@ def octave_rows(forced, solver: str) -> list:
         with np.errstate(divide="ignore", invalid="ignore"):
             Lv = lv.level(ms, lv.V0)
             tf = Lv - lv.level(load, 1.0)
-        rows += [[r.name, bands.nominal[b], bands.center[b], Lv[b], tf[b], solver] for b in range(len(bands.center))
-                 if load[b] > 0]
+        lines = lv.band_sum(f, np.ones_like(f), bands).astype(int)
+        rows += [[r.name, bands.nominal[b], bands.center[b], Lv[b], tf[b], solver, lines[b]]
+                 for b in range(len(bands.center)) if lines[b] > 0 and load[b] > 0]
     return rows
 
 
@@ -291,6 +322,15 @@ def harmonic_summary_text(forced) -> str:
     table = [[r[0], f"{r[1]:g}"] + [round(float(r[3][s][1]), 2) for s in solvers] for r in rows]
     lines.append(f"1/3-octave TF (dB re {main}):")
     lines.append(format_table(header, table))
+    note = band_note(forced)
+    if note:
+        lines.append("note: " + note)
+    for rp in forced.response_points:
+        lines.append(f"response point {rp.name}: {np.round(rp.point, 4).tolist()} m on surface {rp.surface} "
+                     f"(snapped {rp.distance * 1e3:.2f} mm), directions {', '.join(rp.labels)}: points.csv")
+    for ds in forced.deflection_shapes[:1]:
+        lines.append(f"operating deflection shapes ({ds.solver}) at "
+                     f"{', '.join(sorted({f'{d.frequency:g}' for d in forced.deflection_shapes}))} Hz: ods_<load>.xdmf")
     if forced.angular_velocity_node:
         lines.append(f"TF_omega = L_v - L_omega, omega about the shaft axis at {forced.angular_velocity_node} "
                      "(eq. 5.5), 1/3-octave bands:")
@@ -300,9 +340,9 @@ def harmonic_summary_text(forced) -> str:
 
 
 def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
-    """frf.csv, bands.csv, receptance.csv, harmonic.json, TF plots, deflection shapes (XDMF)."""
-    if forced.spec.deflection_shapes_hz:
-        write_deflection_shapes(folder / "deflection_shapes.xdmf", model, forced, comm)
+    """frf.csv, bands.csv, receptance.csv, points.csv, harmonic.json, TF plots, operating deflection shapes
+    (ods_<load>.xdmf)."""
+    ods_files = write_deflection_shapes(folder, model, forced, comm) if forced.deflection_shapes else {}
     if comm.rank != 0:
         return
     counts = sorted(forced.observer.samples)
@@ -315,13 +355,17 @@ def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
     write_csv(folder / "frf.csv", ["load_case", "solver", "frequency_hz", "Lv_dB", "TF_dB"]
               + [f"TF_points{N}_dB" for N in counts], frf)
     rows, solvers = _band_rows(forced)
-    header = ["load_case", "band_nominal_hz", "band_center_hz", "Lv_dB", "TF_dB", "solver"]
+    header = ["load_case", "band_nominal_hz", "band_center_hz", "lines", "Lv_dB", "TF_dB", "solver"]
     header += [f"TF_{s}_dB" for s in solvers[1:]] + [f"TF_points{N}_dB" for N in counts]
     write_csv(folder / "bands.csv", header,
-              [[r[0], r[1], r[2], r[3][solvers[0]][0], r[3][solvers[0]][1], solvers[0]]
+              [[r[0], r[1], r[2], r[5], r[3][solvers[0]][0], r[3][solvers[0]][1], solvers[0]]
                + [r[3][s][1] for s in solvers[1:]] + [r[4][N] for N in counts] for r in rows])
     write_csv(folder / "octave_bands.csv", ["load_case", "band_nominal_hz", "band_center_hz", "Lv_dB", "TF_dB",
-                                            "solver"], octave_rows(forced, solvers[0]))
+                                            "solver", "lines"], octave_rows(forced, solvers[0]))
+    if forced.response_points:
+        from housingfe.forced_response import POINT_COLUMNS, point_rows
+
+        write_csv(folder / "points.csv", POINT_COLUMNS, point_rows(forced))
     main = forced.responses[solvers[0]]
     rec = []
     for i, ri in enumerate(main):
@@ -336,7 +380,17 @@ def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
         "sample_points": {N: {"points_m": s.points, "weights_m2": s.weights}
                           for N, s in forced.observer.samples.items()},
         "load_cases": [{"name": lc.name, "kind": lc.kind, "patch_area_m2": lc.patch_area, "centre_m": lc.centre}
-                       for lc in forced.loads]})
+                       for lc in forced.loads],
+        "band_note": band_note(forced),
+        "response_points": [{"name": rp.name, "requested_m": rp.requested, "snapped_m": rp.point,
+                             "snap_distance_m": rp.distance, "surface": rp.surface, "outward_normal": rp.normal,
+                             "directions": dict(zip(rp.labels, rp.directions.tolist()))}
+                            for rp in forced.response_points],
+        "deflection_shapes": {
+            "files": ods_files, "solver": forced.deflection_shapes[0].solver if forced.deflection_shapes else None,
+            "frequencies_hz": sorted({d.frequency for d in forced.deflection_shapes}),
+            "fields": "displacement_re, displacement_im (m, rms phasor for the load's amplitude, e^{i omega t}), "
+                      "displacement_abs (m, |u|); time = frequency (Hz)"}})
     (folder / "summary_forced.txt").write_text(harmonic_summary_text(forced) + "\n")
     if forced.angular_velocity_node:
         write_csv(folder / "tf_omega.csv", ["load_case", "solver", "frequency_hz", "L_omega_dB", "TF_omega_dB"],
@@ -415,39 +469,48 @@ def plot_transfer_functions(path: Path, forced, rows, solvers) -> None:
     plt.close(fig)
 
 
-def write_deflection_shapes(path: Path, model, forced, comm) -> None:
-    """Operating deflection shapes (real and imaginary part) at the requested frequencies (modal solver)."""
-    from dolfinx import fem, io
+def write_deflection_shapes(folder: Path, model, forced, comm) -> dict:
+    """Operating deflection shapes, one XDMF file per load case (ods_<load>.xdmf), one time step per line with
+    time = frequency (Hz): displacement_re and displacement_im (vertex values, m, rms phasor for the load's
+    amplitude and spectrum, u(t) = Re((re + i im) e^{i omega t}) sqrt 2) and displacement_abs = |u| (m).
+    Returns {load: file name} (collective)."""
+    import re
 
-    from housingfe.forced_response import deflection_shape
+    import ufl
+    from dolfinx import fem, io
 
     mesh = model.V.mesh
     V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
+    S1 = fem.FunctionSpace(mesh, ("Lagrange", 1))
     uh = fem.Function(model.V)
-    re, im = fem.Function(V1, name="real"), fem.Function(V1, name="imag")
-    step = 0
-    with io.XDMFFile(comm, str(path), "w") as xdmf:
-        xdmf.write_mesh(mesh)
-        for j in range(len(forced.loads)):
-            for f in forced.spec.deflection_shapes_hz:
-                shape = deflection_shape(forced, j, f)
-                if shape is None:
-                    return
-                _, ur, ui = shape
-                for vec, out in ((ur, re), (ui, im)):
+    ure, uim = fem.Function(V1, name="displacement_re"), fem.Function(V1, name="displacement_im")
+    uabs = fem.Function(S1, name="displacement_abs")
+    magnitude = fem.Expression(ufl.sqrt(ufl.inner(ure, ure) + ufl.inner(uim, uim)),
+                               S1.element.interpolation_points())
+    files = {}
+    for lc in forced.loads:
+        name = re.sub(r"[^A-Za-z0-9_.-]+", "_", lc.name)
+        while f"ods_{name}.xdmf" in files.values():
+            name += "_"
+        files[lc.name] = f"ods_{name}.xdmf"
+        with io.XDMFFile(comm, str(folder / files[lc.name]), "w") as xdmf:
+            xdmf.write_mesh(mesh)
+            for ds in (d for d in forced.deflection_shapes if d.load == lc.name):
+                for vec, out in ((ds.real, ure), (ds.imag, uim)):
                     vec.copy(uh.vector)
                     uh.x.scatter_forward()
                     out.interpolate(uh)
-                step += 1
-                xdmf.write_function(re, float(step))
-                xdmf.write_function(im, float(step))
+                uabs.interpolate(magnitude)
+                for fn in (ure, uim, uabs):
+                    xdmf.write_function(fn, ds.frequency)
+    return files
 
 
 # ------------------------------------------------------------------------------------------ sound power
 def sound_power_rows(forced) -> list:
     """Rows of sound_power.csv: per load case, every line and every 1/3-octave band (and the totals)."""
     from housingfe import levels
-    from housingfe.response import band_levels
+    from housingfe.response import band_levels, band_line_counts
 
     rows = []
     solver = next(iter(forced.responses))
@@ -459,7 +522,8 @@ def sound_power_rows(forced) -> list:
                          s.L_W_db[k], s.L_W_db[k] + float(levels.a_weighting_db(f))])
         _, Lv_band = band_levels(resp.frequencies, resp.mean_square_velocity * resp.amplitude**2,
                                  s.bands.nominal.min(), s.bands.nominal.max(), levels.V0)
-        for b, fc in enumerate(s.bands.center):
+        lines = band_line_counts(resp.frequencies, s.bands)
+        for b in np.flatnonzero(lines > 0):    # a band without lines has no level (band_note says which)
             rows.append([sp.load_case, sp.model, "band", s.bands.nominal[b], Lv_band[b],
                          s.band_L_W_db[b] - Lv_band[b] - LS, s.band_L_W_db[b], s.band_L_WA_db[b]])
         rows.append([sp.load_case, sp.model, "total", "", "", "", s.total_L_W_db, s.total_L_WA_db])

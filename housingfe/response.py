@@ -63,7 +63,12 @@ def _surface_facet_data(housing, surface: str):
     data = [np.concatenate(a) if a else np.zeros((0, 3) if k < 2 else 0) for k, a in
             enumerate((mids, normals, areas, groups))]
     gathered = mesh.comm.allgather(data)
-    return [np.concatenate([g[k] for g in gathered]) for k in range(4)]
+    out = [np.concatenate([g[k] for g in gathered]) for k in range(4)]
+    # the gathered order depends on the partition: sort by position so that sample points (k-means from a
+    # seeded random start) are the same on any number of ranks
+    key = np.round(out[0], 9)
+    order = np.lexsort((key[:, 2], key[:, 1], key[:, 0]))
+    return [a[order] for a in out]
 
 
 def facet_points(housing, surface: str) -> tuple[SamplePoints, np.ndarray]:
@@ -101,6 +106,9 @@ def sample_points(housing, surface: str, count: int, seed: int = 0) -> SamplePoi
     gives clusters; each point is the facet midpoint nearest its cluster centre and carries the cluster's
     area.  Deterministic (fixed seed) and identical on every rank."""
     mids, normals, areas, groups = _surface_facet_data(housing, surface)
+    if count > len(areas):
+        raise InputError(f"analysis.harmonic.sample_points: {count} points asked for, but surface {surface!r} has "
+                         f"only {len(areas)} facets (one point per facet at most)")
     total = areas.sum()
     tags = np.unique(groups)
     share = np.array([areas[groups == t].sum() for t in tags]) / total * count
@@ -153,10 +161,14 @@ class PointEvaluator:
             cells = [c for c in colliding.links(i) if c < n_owned]
             if cells:
                 mine[i] = cells[0]
-        owner = np.where(mine >= 0, rank, mesh.comm.size)
-        owner = mesh.comm.allreduce(owner, op=MPI.MIN)
+        # each point evaluated once, by the lowest rank that owns a cell containing it (buffer Allreduce: the
+        # pickled allreduce cannot take MPI.MIN of arrays)
+        mine_rank = np.where(mine >= 0, rank, mesh.comm.size).astype(np.int64)
+        owner = np.empty_like(mine_rank)
+        mesh.comm.Allreduce(mine_rank, owner, op=MPI.MIN)
         if np.any(owner == mesh.comm.size):
-            raise InputError("sample points: a point lies outside the mesh")
+            bad = samples.points[np.flatnonzero(owner == mesh.comm.size)[0]]
+            raise InputError(f"analysis.harmonic: point {np.round(bad, 6).tolist()} lies outside the mesh")
         self.local = np.flatnonzero(owner == rank)
         self.cells = mine[self.local]
         self.u = fem.Function(V)
@@ -167,9 +179,141 @@ class PointEvaluator:
         self.u.x.scatter_forward()
         out = np.zeros(len(self.samples.points))
         if len(self.local):
-            vals = self.u.eval(self.samples.points[self.local], self.cells)
+            # dolfinx 0.5.2 returns shape (3,) instead of (1, 3) for a single point: reshape
+            vals = self.u.eval(self.samples.points[self.local], self.cells).reshape(len(self.local), -1)
             out[self.local] = np.einsum("ij,ij->i", vals, self.samples.normals[self.local])
-        return self.V.mesh.comm.allreduce(out, op=MPI.SUM)
+        total = np.empty_like(out)
+        self.V.mesh.comm.Allreduce(out, total, op=MPI.SUM)
+        return total
+
+
+# ------------------------------------------------------------------------------ response points
+RESPONSE_POINTS = "response points"
+
+
+@dataclass
+class ResponsePoint:
+    """A named response point snapped to the surface: requested and snapped position (m), snapping distance
+    (m), outward unit normal there, and the unit directions (rows) with their labels ("x", "y", "z", "normal",
+    or "given")."""
+
+    name: str
+    requested: np.ndarray
+    point: np.ndarray
+    distance: float
+    normal: np.ndarray
+    surface: str
+    directions: np.ndarray
+    labels: list
+
+
+def _surface_triangles(housing, names) -> tuple[np.ndarray, np.ndarray]:
+    """The facets of the named surfaces as straight triangles (T, 3, 3) with outward unit normals (T, 3),
+    gathered on every rank (owned facets only, so each once)."""
+    mesh = housing.mesh
+    tdim = mesh.topology.dim
+    fdim = tdim - 1
+    n_owned = mesh.topology.index_map(fdim).size_local
+    mesh.topology.create_connectivity(fdim, tdim)
+    f2c = mesh.topology.connectivity(fdim, tdim)
+    values = sorted({v for name in names for v in housing.facet_tag_values(name)})
+    quads = mesh.topology.cell_type == dmesh.CellType.hexahedron
+    tris, normals = [], []
+    for value in values:
+        facets = housing.facet_tags.find(value)
+        facets = facets[facets < n_owned]
+        if not len(facets):
+            continue
+        x = mesh.geometry.x[_cpp_mesh.entities_to_geometry(mesh._mesh, fdim, facets, False)]
+        # the first 3 (4) geometry nodes are the corners; tensor-product quad 0-1-3-2 -> two triangles
+        parts = [x[:, [0, 1, 3]], x[:, [0, 3, 2]]] if quads else [x[:, :3]]
+        mid = dmesh.compute_midpoints(mesh, fdim, facets)
+        cells = np.array([f2c.links(f)[0] for f in facets])
+        inward = dmesh.compute_midpoints(mesh, tdim, cells) - mid
+        for t in parts:
+            n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+            n /= np.linalg.norm(n, axis=1)[:, None]
+            n *= -np.sign(np.einsum("ij,ij->i", n, inward))[:, None]
+            tris.append(t), normals.append(n)
+    local = (np.concatenate(tris) if tris else np.zeros((0, 3, 3)),
+             np.concatenate(normals) if normals else np.zeros((0, 3)))
+    gathered = mesh.comm.allgather(local)
+    return np.concatenate([g[0] for g in gathered]), np.concatenate([g[1] for g in gathered])
+
+
+def closest_point_on_triangles(p: np.ndarray, tris: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Closest point (m) of each triangle (T, 3, 3) to the point p (3,) and its distance (m) (Ericson,
+    Real-Time Collision Detection, 5.1.5: Voronoi regions of vertices, edges and face)."""
+    a, b, c = tris[:, 0], tris[:, 1], tris[:, 2]
+    ab, ac, ap = b - a, c - a, p - a
+    d1, d2 = np.einsum("ij,ij->i", ab, ap), np.einsum("ij,ij->i", ac, ap)
+    bp, cp = p - b, p - c
+    d3, d4 = np.einsum("ij,ij->i", ab, bp), np.einsum("ij,ij->i", ac, bp)
+    d5, d6 = np.einsum("ij,ij->i", ab, cp), np.einsum("ij,ij->i", ac, cp)
+    va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        denom = va + vb + vc
+        v, w = vb / denom, vc / denom
+        out = a + ab * v[:, None] + ac * w[:, None]                      # inside the face
+        t_ab = d1 / (d1 - d3)
+        t_ac = d2 / (d2 - d6)
+        t_bc = (d4 - d3) / ((d4 - d3) + (d5 - d6))
+    # Ericson tests a, b, ab, c, ac, bc with early returns: applied here in reverse, so the earlier test wins
+    cases = [
+        ((va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), b + (c - b) * t_bc[:, None]),   # edge bc
+        ((vb <= 0) & (d2 >= 0) & (d6 <= 0), a + ac * t_ac[:, None]),     # edge ac
+        ((d6 >= 0) & (d5 <= d6), c),                                     # vertex c
+        ((vc <= 0) & (d1 >= 0) & (d3 <= 0), a + ab * t_ab[:, None]),     # edge ab
+        ((d3 >= 0) & (d4 <= d3), b),                                     # vertex b
+        ((d1 <= 0) & (d2 <= 0), a),                                      # vertex a
+    ]
+    for mask, q in cases:
+        out = np.where(mask[:, None], q, out)
+    return out, np.linalg.norm(out - p, axis=1)
+
+
+def locate_response_points(housing, specs) -> list[ResponsePoint]:
+    """Snap every ResponsePointSpec to its surface (see the spec); InputError naming the point when it lies
+    farther than its tolerance from the surface or names an unknown surface.  Identical on every rank."""
+    out = []
+    for i, spec in enumerate(specs):
+        key = f"analysis.harmonic.points.{i} ({spec.name})"
+        names = [spec.surface] if spec.surface is not None else sorted(housing.facet_groups)
+        for name in names:
+            if name not in housing.facet_groups:
+                raise InputError(f"{key}.surface: no surface {name!r} (known: {', '.join(sorted(housing.facet_groups))})")
+        tris, normals = _surface_triangles(housing, names)
+        p = np.asarray(spec.point, float)
+        q, dist = closest_point_on_triangles(p, tris)
+        k = int(np.argmin(dist))
+        tol = spec.tolerance if spec.tolerance is not None else housing.element_size
+        if dist[k] > tol:
+            where = f"surface {spec.surface!r}" if spec.surface else "the housing's surface"
+            raise InputError(f"{key}.point: {list(spec.point)} lies {dist[k]:.4g} m from {where} (more than the "
+                             f"tolerance {tol:.4g} m, one element size unless given; set tolerance to accept it)")
+        # the outward normal at the snapped point: mean of the triangles touching it (an edge or corner of the
+        # housing has several)
+        touching = dist <= dist[k] + 1e-9 * max(housing.element_size, 1e-12)
+        normal = normals[touching].mean(axis=0)
+        normal /= max(np.linalg.norm(normal), 1e-300)
+        if spec.direction is None:
+            dirs, labels = np.eye(3), ["x", "y", "z"]
+        elif spec.direction == "normal":
+            dirs, labels = normal[None, :], ["normal"]
+        else:
+            d = np.asarray(spec.direction, float)
+            dirs, labels = (d / np.linalg.norm(d))[None, :], ["given"]
+        out.append(ResponsePoint(spec.name, p, q[k], float(dist[k]), normal,
+                                 spec.surface or "any", dirs, labels))
+    return out
+
+
+def response_point_samples(points: list[ResponsePoint]) -> SamplePoints:
+    """One evaluation row per (point, direction), as a point set of the observer: `normals` holds the
+    directions, so the kept values are the displacement along each direction (m per unit load)."""
+    rows = [(rp.point, d) for rp in points for d in rp.directions]
+    return SamplePoints(np.array([r[0] for r in rows]).reshape(-1, 3), np.array([r[1] for r in rows]).reshape(-1, 3),
+                        np.ones(len(rows)))
 
 
 # ----------------------------------------------------------------------------------- observers
@@ -297,9 +441,16 @@ def responses(result, observer: SurfaceObserver, load_cases) -> list[LoadRespons
     return out
 
 
+def band_line_counts(freqs: np.ndarray, bands) -> np.ndarray:
+    """Number of lines in each band (lower <= f < upper).  A band with none has no level: the writers leave
+    it out (a grid with df wider than the band, or lines below the lowest band)."""
+    return levels.band_sum(freqs, np.ones_like(np.asarray(freqs, float)), bands).astype(int)
+
+
 def band_levels(freqs: np.ndarray, mean_square: np.ndarray, f_lo: float, f_hi: float, reference: float):
     """1/3-octave band levels (dB) of a narrow-band mean-square spectrum: energy sum of the lines in each
-    band (IEC 61260 base-10 edges).  Returns (bands, levels); bands with no line get nan."""
+    band (IEC 61260 base-10 edges).  Returns (bands, levels); bands with no line get nan here (one index per
+    band for the callers) and are left out of every table written (see band_line_counts)."""
     bands = levels.third_octave_bands(f_lo, f_hi)
     sums = levels.band_sum(freqs, mean_square, bands)
     counts = levels.band_sum(freqs, np.ones_like(freqs), bands)
