@@ -66,8 +66,16 @@ def _register_extension(name: str, sub) -> None:
         print(f"housingfe: warning: commands of {name} unavailable: {exc}", file=sys.stderr)
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """argparse prints its usage block before an error; the project's rule is one line naming the problem
+    (and the sub-command's --help for the usage), exit 2."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _OneLineParser(
         prog="housingfe", description="Gearbox noise: gear source, bearings, FE housing, radiation."
     )
     sub = parser.add_subparsers(dest="command", required=True)

@@ -489,9 +489,8 @@ def test_bad_bearing_command_is_rejected(argv, needles, tmp_path, capsys):
     code, err = _run_cli(argv, capsys)
     assert code == 2, (code, err)
     assert "Traceback" not in err, err
-    # argparse prints its usage before the one error line; our own errors are the one line
-    errors = [line for line in err.strip().splitlines() if "error" in line]
-    assert len(errors) == 1, err
+    errors = err.strip().splitlines()      # one line, argparse's own errors included (cli._OneLineParser)
+    assert len(errors) == 1 and "error" in errors[0], err
     for needle in needles:
         assert needle in errors[0], (needle, errors[0])
 
