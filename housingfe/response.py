@@ -351,15 +351,17 @@ class SurfaceObserver:
     def reduce(self, vectors, housing_vectors=None) -> Reduced:
         """Project a list of PETSc vectors (see Reduced).  housing_vectors: the same vectors on the housing's
         FE space when `vectors` live in other DOFs (a coupled model); the load projections use `vectors`."""
-        loads = np.array([[f.dot(x) for x in vectors] for f in self.load_vectors])
+        n = len(vectors)     # may be 0: a modal basis without modes below its limit and without residual
+        loads = np.array([[f.dot(x) for x in vectors] for f in self.load_vectors]).reshape(len(self.load_vectors), n)
         vectors = vectors if housing_vectors is None else housing_vectors
         Wv = []
         for x in vectors:
             y = self.W.createVecLeft()
             self.W.mult(x, y)
             Wv.append(y)
-        gram = np.array([[a.dot(b) for b in Wv] for a in vectors])
-        points = {N: np.array([ev.normal_values(x) for x in vectors]).T for N, ev in self.evaluators.items()}
+        gram = np.array([[a.dot(b) for b in Wv] for a in vectors]).reshape(n, n)
+        points = {N: np.array([ev.normal_values(x) for x in vectors]).reshape(n, len(ev.samples.points)).T
+                  for N, ev in self.evaluators.items()}
         return Reduced(gram, points, loads)
 
 
@@ -380,7 +382,7 @@ class CoupledObserver(SurfaceObserver):
     def reduce(self, vectors) -> Reduced:
         red = super().reduce(vectors, [self.interior.fe_vector(q) for q in vectors])
         for key, name in self.nodes.items():
-            red.points[key] = np.array([self.interior.system.node_displacement(q, name) for q in vectors]).T
+            red.points[key] = np.array([self.interior.system.node_displacement(q, name) for q in vectors]).reshape(len(vectors), 6).T
         return red
 
 
