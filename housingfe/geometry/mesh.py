@@ -131,7 +131,8 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm) -> Housin
     return HousingMesh(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=groups["cells"],
                        facet_groups=groups["facets"], volume=model.volume(), centroid=model.centroid(),
                        element_size=size, element=element, points=model.points,
-                       mesh_time_s=time.perf_counter() - t0, quality=element_quality(mesh))
+                       mesh_time_s=time.perf_counter() - t0,
+                       quality={**element_quality(mesh), "mesher": groups.get("mesher")})
 
 
 def element_quality(mesh) -> dict:

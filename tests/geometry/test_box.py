@@ -42,7 +42,7 @@ def test_mesh_tags_and_areas(coarse_box_model, comm, element):
     assert {"top", "front", "back", "left", "right", "flange"} <= set(hm.cell_groups)
     from housingfe.model import MIN_ELEMENT_QUALITY
 
-    # structured hexes are perfect boxes; HXT tetrahedra must pass the threshold the model enforces
+    # structured hexes are perfect boxes; Delaunay tetrahedra must pass the threshold the model enforces
     assert hm.quality["min"] > (0.999 if element == "hex" else MIN_ELEMENT_QUALITY)
 
 
