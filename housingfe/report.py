@@ -255,18 +255,20 @@ def band_note(forced) -> str | None:
     f = spec.frequencies
     bands = lv.third_octave_bands(max(spec.f_min, 10.0), spec.f_max)
     counts = band_line_counts(f, bands)
+    if not len(bands.center):
+        return (f"no 1/3-octave band: bands start at 10 Hz (lower edge 8.91 Hz) and the lines end at {f[-1]:g} Hz; "
+                "bands.csv and octave_bands.csv are empty, frf.csv and points.csv hold the lines")
     notes = []
     empty = bands.nominal[counts == 0]
     if len(empty):
         notes.append(f"1/3-octave band(s) {', '.join(f'{v:g}' for v in empty)} Hz hold no line (df = {spec.df:g} Hz "
                      "is wider than the band there): left out of bands.csv")
-    lo = bands.lower[0] if len(bands.center) else np.inf
-    hi = bands.upper[-1] if len(bands.center) else -np.inf
+    lo, hi = bands.lower[0], bands.upper[-1]
     below, above = f[f < lo], f[f >= hi]
     if len(below):
         notes.append(f"{len(below)} line(s) ({', '.join(f'{v:g}' for v in below[:5])}{' ...' if len(below) > 5 else ''}"
-                     f" Hz) lie below the lowest band ({'none' if not len(bands.center) else f'{bands.nominal[0]:g} Hz'}"
-                     f", lower edge {lo:.3g} Hz; bands start at 10 Hz): in frf.csv, in no band")
+                     f" Hz) lie below the lowest band ({bands.nominal[0]:g} Hz, lower edge {lo:.3g} Hz; bands start "
+                     "at 10 Hz): in frf.csv, in no band")
     if len(above):
         notes.append(f"{len(above)} line(s) above {hi:.4g} Hz (upper edge of the highest band whose centre is "
                      f"<= f_max) are in no band")
@@ -303,6 +305,8 @@ def band_comparison(forced, reference: str = "direct") -> dict:
         if s == reference:
             continue
         diffs = [r[3][s][1] - r[3][reference][1] for r in rows if np.isfinite(r[3][reference][1])]
+        if not diffs:     # no band holds a line
+            continue
         out[s] = {"max_abs_dB": float(np.max(np.abs(diffs))), "mean_dB": float(np.mean(diffs))}
     return out
 
@@ -453,8 +457,10 @@ def plot_transfer_functions(path: Path, forced, rows, solvers) -> None:
         ax.set_ylabel("TF (dB)")
         ax.set_title(f"{lc.name}: 1/3-octave TF")
         ax.legend(fontsize=7)
-        lo = np.nanmin([r[3][s][1] for r in sel for s in solvers])
-        ax.set_ylim(lo - 10, None)
+        if sel:
+            ax.set_ylim(np.nanmin([r[3][s][1] for r in sel for s in solvers]) - 10, None)
+        else:      # no band holds a line (all lines below 10 Hz): say so instead of an empty frame
+            ax.text(0.5, 0.5, "no 1/3-octave band holds a line", ha="center", transform=ax.transAxes)
         ax = axes[j, 1]
         for s in solvers:
             r = forced.responses[s][j]

@@ -320,3 +320,16 @@ def test_cli_far_point_exits_2_with_one_line(tmp_path):
     assert bad.returncode == 2
     assert len(bad.stderr.strip().splitlines()) == 1 and "analysis.harmonic.points.0 (far).point" in bad.stderr
     assert not (tmp_path / "bad").exists()
+
+
+def test_cli_lines_below_10_hz_say_why_the_band_tables_are_empty(tmp_path):
+    """All lines below the 10 Hz band: bands.csv has its header only and the summary says why; the run with
+    both solvers and a deflection shape still completes (it crashed on the empty band plot)."""
+    args = [a if a != "analysis.harmonic.f_max=300.0" else "analysis.harmonic.f_max=8.0" for a in CLI]
+    res = _housingfe("run", *args, "--set", "analysis.harmonic.f_min=2.0", "--set", "analysis.harmonic.df=2.0",
+                     "--set", 'analysis.harmonic.solver="both"', "--set", "output.pictures=true",
+                     "--set", "analysis.harmonic.deflection_shapes_hz=[4.0]", "--out", str(tmp_path / "low"))
+    assert res.returncode == 0, res.stderr
+    assert len(_table(tmp_path / "low" / "bands.csv")) == 1
+    assert "no 1/3-octave band: bands start at 10 Hz" in res.stdout
+    assert len(_table(tmp_path / "low" / "points.csv")) == 1 + 3 * 2 * 4     # solvers x loads x lines, 1 direction
