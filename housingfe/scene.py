@@ -195,6 +195,7 @@ class HarmonicSpec(_Strict):
     residual: bool = True
     modal_basis_factor: float = Field(1.5, ge=1.0, le=4.0)
     surface: str = "outer"
+    # sizes of area-weighted sample-point sets (counts, eq. 5.4), each at most the surface's facet count
     sample_points: list[PositiveInt] = [18, 36, 48, 94]
     deflection_shapes_hz: list[PositiveFloat] = []
     # named response points: point FRFs (receptance, mobility, accelerance) in points.csv
