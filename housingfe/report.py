@@ -330,7 +330,7 @@ def harmonic_summary_text(forced) -> str:
     if note:
         lines.append("note: " + note)
     for rp in forced.response_points:
-        lines.append(f"response point {rp.name}: {np.round(rp.point, 4).tolist()} m on surface {rp.surface} "
+        lines.append(f"response point {rp.name}: {(np.round(rp.point, 4) + 0.0).tolist()} m on surface {rp.surface} "
                      f"(snapped {rp.distance * 1e3:.2f} mm), directions {', '.join(rp.labels)}: points.csv")
     for ds in forced.deflection_shapes[:1]:
         lines.append(f"operating deflection shapes ({ds.solver}) at "
