@@ -261,20 +261,14 @@ SCENE_CASES = [
     ("top-level-unknown", _set("solver", {"kind": "mumps"}), ["solver", "unknown key"]),
 ]
 
-# Cases that the other helpers of issue 12 fix in files this test does not own; strict=False so that their
-# fixes turn these into passes without touching this file.
-KNOWN_ELSEWHERE = {
-    "sample-points-index-1": "issue 12 item 3: sample_points = [1] passes the scene check and crashes later",
-    "flange-5m": "issue 12 item 12: no model-size / plausibility guard for geometry.flange_width = 5.0",
-}
-
 # Cases that need the mesh (the check is in housingfe.loads); the box mesh at 40 mm linear hexes takes seconds.
 MESH_CASES = [
     ("force-5m-off-surface", _set("loads.0.point", [0.06, 0.04, 5.125]), ["loads.top.point"]),
     ("moment-off-surface", _all(_set("loads.0.kind", "moment"), _set("loads.0.point", [0.06, 0.04, 0.2])),
      ["loads.top.point"]),
     ("force-on-unknown-surface", _set("loads.0.surface", "outer_roof"), ["loads.top.surface"]),
-    ("sample-points-index-1", _set("analysis.harmonic.sample_points", [1]), ["analysis.harmonic.sample_points"]),
+    # sample_points are counts (item 3: [1] is valid and now runs); more points than the surface has facets is not
+    ("sample-points-too-many", _set("analysis.harmonic.sample_points", [100000]), ["analysis.harmonic.sample_points"]),
 ]
 
 
@@ -321,13 +315,7 @@ def test_bad_scene_is_rejected_before_meshing(change, needles, tmp_path, capsys,
 
 
 def _mesh_params():
-    out = []
-    for case_id, change, needles in MESH_CASES:
-        marks = ()
-        if case_id in KNOWN_ELSEWHERE:
-            marks = pytest.mark.xfail(reason=KNOWN_ELSEWHERE[case_id], strict=False)
-        out.append(pytest.param(change, needles, id=case_id, marks=marks))
-    return out
+    return [pytest.param(change, needles, id=case_id) for case_id, change, needles in MESH_CASES]
 
 
 @pytest.mark.timeout(300)
@@ -338,7 +326,6 @@ def test_bad_scene_found_on_the_mesh(change, needles, tmp_path, capsys):
     _expect_one_line_error(code, err, needles, tmp_path, out)
 
 
-@pytest.mark.xfail(reason=KNOWN_ELSEWHERE["flange-5m"], strict=False)
 def test_five_metre_flange_is_stopped_before_meshing(tmp_path, capsys, monkeypatch):
     # issue 12's typo (0.05 -> 5.0): it must stop before gmsh; meshing it here would take gigabytes, so any
     # call of the mesher counts as the failure
