@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe import published, report
-from housingfe.errors import SolverError
+from housingfe.errors import InputError, SolverError
 from housingfe.scene import load_housing_scene
 
 
@@ -19,7 +19,16 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     scene, path = load_housing_scene(name_or_path, overrides)
     comm = MPI.COMM_WORLD
     out = Path(out_dir or f"results/{scene.scene.name}")
+    try:
+        return _run(scene, out, comm, t_start)
+    except InputError as exc:
+        # problems found on the mesh (a load point off its surface, a response point too far) name the key;
+        # the file they are in is known only here
+        message = str(exc)
+        raise InputError(message if message.startswith(str(path)) else f"{path}: {message}") from None
 
+
+def _run(scene, out: Path, comm, t_start: float) -> Path:
     from housingfe.model import build_model
     from housingfe.solvers import modal
 
