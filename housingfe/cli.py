@@ -14,17 +14,17 @@ from housingfe.errors import InputError, SolverError
 
 # Modules that contribute sub-commands (each defines register_cli(subparsers)).
 _EXTENSIONS = (
-    "housingfe.bearings",
+    "housingfe.bearings.cli",
     "housingfe.radiation",
     "housingfe.source.cli",
-    "housingfe.bearing_variants",
+    "housingfe.studies.bearing_variants",
 )
 
 
 def _cmd_scenes(args: argparse.Namespace) -> int:
-    from housingfe import scene
+    from housingfe import scenefile
 
-    for name, description in scene.builtin_scenes().items():
+    for name, description in scenefile.builtin_scenes().items():
         print(f"{name:24s} {description}")
     return 0
 
@@ -37,7 +37,7 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_validate(args: argparse.Namespace) -> int:
-    from housingfe import validate
+    from housingfe.verification import validate
 
     validate.main(out_dir=args.out, json_path=args.json, scenes=args.scenes, quick=args.quick,
                   results_dir=args.results)
@@ -45,7 +45,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from housingfe import bench
+    from housingfe.benchmarks import _dispatch as bench
 
     bench.main(args.which, out_dir=args.out, quick=args.quick)
     return 0

@@ -3,6 +3,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from housingfe.errors import InputError
+
 
 @dataclass(frozen=True)
 class Material:
@@ -14,6 +16,16 @@ class Material:
     poisson_ratio: float
     density: float
     loss_factor: float = 0.0
+
+    def __post_init__(self):
+        if not (self.youngs_modulus > 0 and self.density > 0 and -1.0 < self.poisson_ratio < 0.5):
+            raise InputError(f"material {self.name!r}: youngs_modulus = {self.youngs_modulus} Pa, poisson_ratio = "
+                             f"{self.poisson_ratio}, density = {self.density} kg/m^3: non-physical")
+
+    @property
+    def shear_modulus(self) -> float:
+        """G = E / (2 (1 + nu)) in Pa."""
+        return self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
 
     @property
     def lame(self) -> tuple[float, float]:

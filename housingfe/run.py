@@ -6,9 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe import published, report
+from housingfe import outputs, report
 from housingfe.errors import InputError, SolverError
 from housingfe.scene import load_housing_scene
+from housingfe.verification import published
 
 
 def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
@@ -29,13 +30,13 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
 
 
 def _run(scene, out: Path, comm, t_start: float) -> Path:
-    from housingfe.model import build_model
+    from housingfe.fe.model import build_model
     from housingfe.solvers import modal
 
     model = build_model(scene, comm)
     interior = None
     if scene.coupling is not None:
-        from housingfe.interior import build_interior
+        from housingfe.drivetrain.interior import build_interior
 
         interior = build_interior(model, scene.coupling, scene.analysis.f_max)
     K, M = (model.K, model.M) if interior is None else (interior.K, interior.M)
@@ -49,10 +50,10 @@ def _run(scene, out: Path, comm, t_start: float) -> Path:
             summary["published"] += published.interior_comparison(scene, summary["interior"])
     forced = None
     if harmonic_spec is not None:
-        from housingfe import forced_response
+        from housingfe.response import forced as forced_response
 
         forced = forced_response.run(model, harmonic_spec, interior)
-    with report.atomic_output_dir(out, comm) as tmp:
+    with outputs.atomic_output_dir(out, comm) as tmp:
         if modes is not None:
             housing_modes = modes if interior is None else interior.fe_modes(modes)
             report.write_modal_outputs(tmp, model, housing_modes, summary, comm)

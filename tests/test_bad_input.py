@@ -20,7 +20,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from housingfe import cli
-from housingfe.scene import SCENE_DIR
+from housingfe.scenefile import SCENE_DIR
 
 # A valid, cheap housing scene: every section present, so each case changes exactly one thing.
 BASE = {
@@ -261,7 +261,7 @@ SCENE_CASES = [
     ("top-level-unknown", _set("solver", {"kind": "mumps"}), ["solver", "unknown key"]),
 ]
 
-# Cases that need the mesh (the check is in housingfe.loads); the box mesh at 40 mm linear hexes takes seconds.
+# Cases that need the mesh (the check is in housingfe.fe.loads); the box mesh at 40 mm linear hexes takes seconds.
 MESH_CASES = [
     ("force-5m-off-surface", _set("loads.0.point", [0.06, 0.04, 5.125]), ["loads.top.point"]),
     ("moment-off-surface", _all(_set("loads.0.kind", "moment"), _set("loads.0.point", [0.06, 0.04, 0.2])),
@@ -303,12 +303,12 @@ def _scene_case(change, tmp_path) -> tuple[Path, Path]:
 @pytest.mark.parametrize("change, needles", [c[1:] for c in SCENE_CASES], ids=[c[0] for c in SCENE_CASES])
 def test_bad_scene_is_rejected_before_meshing(change, needles, tmp_path, capsys, monkeypatch):
     # any attempt to build the model means the scene check let the case through: fail fast instead of meshing
-    import housingfe.model
+    import housingfe.fe.model
 
     def no_meshing(*args, **kwargs):
         raise AssertionError("the scene check accepted a bad scene (build_model was called)")
 
-    monkeypatch.setattr(housingfe.model, "build_model", no_meshing)
+    monkeypatch.setattr(housingfe.fe.model, "build_model", no_meshing)
     path, out = _scene_case(change, tmp_path)
     code, err = _run_cli(["run", str(path), "--out", str(out)], capsys)
     _expect_one_line_error(code, err, needles, tmp_path, out)
@@ -329,12 +329,12 @@ def test_bad_scene_found_on_the_mesh(change, needles, tmp_path, capsys):
 def test_five_metre_flange_is_stopped_before_meshing(tmp_path, capsys, monkeypatch):
     # issue 12's typo (0.05 -> 5.0): it must stop before gmsh; meshing it here would take gigabytes, so any
     # call of the mesher counts as the failure
-    import housingfe.model
+    import housingfe.fe.model
 
     def no_meshing(*args, **kwargs):
         raise AssertionError("a 5 m flange reached the mesher")
 
-    monkeypatch.setattr(housingfe.model, "build_mesh", no_meshing)
+    monkeypatch.setattr(housingfe.fe.model, "build_mesh", no_meshing)
     path, out = _scene_case(_set("geometry.flange_width", 5.0), tmp_path)
     code, err = _run_cli(["run", str(path), "--out", str(out)], capsys)
     _expect_one_line_error(code, err, ["geometry.flange_width"], tmp_path, out)
@@ -355,9 +355,9 @@ SET_CASES = [
 
 @pytest.mark.parametrize("item, needles", [c[1:] for c in SET_CASES], ids=[c[0] for c in SET_CASES])
 def test_bad_set_is_rejected(item, needles, tmp_path, capsys, monkeypatch):
-    import housingfe.model
+    import housingfe.fe.model
 
-    monkeypatch.setattr(housingfe.model, "build_model", lambda *a, **k: pytest.fail("scene accepted"))
+    monkeypatch.setattr(housingfe.fe.model, "build_model", lambda *a, **k: pytest.fail("scene accepted"))
     path, out = _scene_case(lambda d: None, tmp_path)
     code, err = _run_cli(["run", str(path), "--out", str(out), "--set", item], capsys)
     _expect_one_line_error(code, err, needles, tmp_path, out)

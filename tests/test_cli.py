@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from housingfe.scene import SCENE_DIR
+from housingfe.scenefile import SCENE_DIR
 
 BOX = (SCENE_DIR / "box-free.toml").read_text()
 FAST = ["--set", "mesh.size=0.04", "--set", "analysis.modal.f_max=2500.0", "--set", "output.pictures=false"]

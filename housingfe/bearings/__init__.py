@@ -34,7 +34,7 @@ _LAZY = {
 
 __all__ = ["DOF_NAMES", "BearingResult", "FluidFilmResult", "JournalBearing", "RollingBearing",
            "bearing_from_table", "bearing_stiffness", "designations", "finite_difference_stiffness", "journal_bearing_coefficients",
-           "lookup", "make_model", "register_cli", "short_bearing_coefficients", "stiffness_at",
+           "lookup", "make_model", "short_bearing_coefficients", "stiffness_at",
            "transform_stiffness"]
 
 if TYPE_CHECKING:
@@ -66,9 +66,3 @@ def bearing_stiffness(bearing: str | RollingBearing, load, *, model: str | None 
     return rolling_bearing_stiffness(geometry, load, model=model, preload_axial=preload_axial,
                                      fixed_tilt=fixed_tilt)
 
-
-def register_cli(subparsers) -> None:
-    """Add `housingfe bearing ...` to the top-level CLI."""
-    from housingfe.bearings.cli import register
-
-    register(subparsers)

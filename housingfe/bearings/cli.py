@@ -85,7 +85,7 @@ def bearing_from_arguments(args: argparse.Namespace):
     """The RollingBearing a command line describes: designation, --geometry file and/or flags."""
     import dataclasses
 
-    from housingfe.bearings import lookup
+    from housingfe.bearings.catalogue import lookup
     from housingfe.bearings.rolling import GEOMETRY_KEYS, bearing_from_table
 
     flags = {key: getattr(args, flag[2:].replace("-", "_")) for flag, (key, *_) in _FLAGS.items()}
@@ -164,3 +164,8 @@ def format_result(result, estimated: dict) -> str:
     if estimated:
         lines.append("estimated inputs: " + "; ".join(f"{k} = {v}" for k, v in estimated.items()))
     return "\n".join(lines)
+
+
+def register_cli(subparsers) -> None:
+    """Add `housingfe bearing ...` to the top-level CLI."""
+    register(subparsers)

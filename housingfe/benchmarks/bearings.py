@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.report import atomic_output_dir, format_table, write_csv
+from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 CASES = [  # (designation, model, load (Fx, Fy, Fz, Mx, My) [N, N m])
     ("SKF 6312", "lim-ball", (0.0, -10000.0, 4000.0, 0.0, 0.0)),

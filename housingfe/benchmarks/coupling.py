@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.report import atomic_output_dir, format_table, write_csv
+from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 BORES = [("pinion", "front"), ("pinion", "back"), ("wheel", "front"), ("wheel", "back")]
 BEARINGS = {"pinion": "SKF 6312", "wheel": "SKF 6215"}
@@ -42,7 +42,7 @@ ROD_STIFFNESSES = (1e8, 1e10, 1e12)                    # N/m per rod
 def _model(quick: bool):
     from mpi4py import MPI
 
-    from housingfe.model import build_model
+    from housingfe.fe.model import build_model
     from housingfe.scene import load_housing_scene
 
     f_max = 1500.0 if quick else 3000.0
@@ -55,9 +55,9 @@ def _model(quick: bool):
 
 def gearbox_parts(model, kind: str, rod_stiffness: float | None = None) -> dict:
     """Connections, shafts, bearings, gears and the gear mesh of the benchmark (keyword arguments of couple)."""
-    from housingfe import coupling as cp
     from housingfe.bearings import bearing_stiffness
-    from housingfe.shafts import RigidDisc, Shaft
+    from housingfe.drivetrain import coupling as cp
+    from housingfe.drivetrain.shafts import RigidDisc, Shaft
 
     axis = np.array([0.0, 1.0, 0.0])
     centres = {(s, side): cp.surface_centre(model, f"bore_{s}_{side}") for s, side in BORES}
@@ -99,7 +99,7 @@ def _solve(K, M, f_max, **kw):
 
 def _assembly_cpu(model) -> float:
     """CPU time of the housing's K and M assembly (forms already compiled)."""
-    from housingfe.model import foundation_forms
+    from housingfe.fe.model import foundation_forms
     from housingfe.solvers import elasticity
 
     extra = foundation_forms(model.scene, model.housing, model.V)
@@ -108,7 +108,7 @@ def _assembly_cpu(model) -> float:
 
 
 def run(quick: bool) -> tuple[list, dict]:
-    from housingfe import coupling as cp
+    from housingfe.drivetrain import coupling as cp
 
     model, f_max, t_build = _model(quick)
     t_asm = _assembly_cpu(model)

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.report import atomic_output_dir, format_table, write_csv
+from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 VARIANTS = [(1.0, False), (1.0, True), (1.5, False), (1.5, True), (2.0, False), (2.0, True)]
 
@@ -20,7 +20,7 @@ VARIANTS = [(1.0, False), (1.0, True), (1.5, False), (1.5, True), (2.0, False), 
 def _model(overrides):
     from mpi4py import MPI
 
-    from housingfe.model import build_model
+    from housingfe.fe.model import build_model
     from housingfe.scene import load_housing_scene
 
     scene, _ = load_housing_scene("box-free-frf", overrides)
@@ -28,7 +28,7 @@ def _model(overrides):
 
 
 def _bands(resp, f_lo, f_hi):
-    from housingfe.response import transfer_band_levels
+    from housingfe.response.observers import transfer_band_levels
 
     bands, _, tf = transfer_band_levels(resp, f_lo, f_hi)
     return bands, tf
@@ -36,9 +36,9 @@ def _bands(resp, f_lo, f_hi):
 
 def accuracy_study(quick: bool) -> tuple[list, dict]:
     """Band TF of every modal variant minus direct (dB), per load case and band."""
-    from housingfe.forced_response import damping_model
-    from housingfe.loads import assemble_load
-    from housingfe.response import SurfaceObserver, responses
+    from housingfe.fe.loads import assemble_load
+    from housingfe.response.forced import damping_model
+    from housingfe.response.observers import SurfaceObserver, responses
     from housingfe.solvers import harmonic, modal
 
     df = 19.52 if quick else 4.88
@@ -77,9 +77,9 @@ def accuracy_study(quick: bool) -> tuple[list, dict]:
 
 def speed_study(quick: bool) -> list:
     """Wall times on the default mesh: eigensolve, 820-line modal + residual sweep, direct per line."""
-    from housingfe.forced_response import damping_model
-    from housingfe.loads import assemble_load
-    from housingfe.response import SurfaceObserver, responses
+    from housingfe.fe.loads import assemble_load
+    from housingfe.response.forced import damping_model
+    from housingfe.response.observers import SurfaceObserver, responses
     from housingfe.solvers import harmonic, modal
 
     scene, model = _model([])

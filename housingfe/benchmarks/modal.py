@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.report import atomic_output_dir, format_table, write_csv
+from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 F_MAX = 4000.0          # Hz, the range of the thesis' free-box study
 SOLVE_TO = 1.08 * F_MAX  # solve a little beyond, so coarse meshes still deliver every reference mode
@@ -58,7 +58,7 @@ def run_housingfe_case(case: dict) -> dict:
     t0 = time.perf_counter()
     from mpi4py import MPI
 
-    from housingfe.model import build_model
+    from housingfe.fe.model import build_model
     from housingfe.scene import load_housing_scene
     from housingfe.solvers import modal
 

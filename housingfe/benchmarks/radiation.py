@@ -19,8 +19,8 @@ from pathlib import Path
 
 import numpy as np
 
+from housingfe.outputs import atomic_output_dir, format_table, write_csv
 from housingfe.radiation import analytic, fem, foller, numerical
-from housingfe.report import atomic_output_dir, format_table, write_csv
 
 A = 0.1  # m
 KA = np.array([0.1, 0.2, 0.5, 1.0, 2.0, 3.0, 4.0, 5.0])

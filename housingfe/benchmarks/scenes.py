@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.report import atomic_output_dir, format_table, write_csv
+from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 SCENES = ["box-supported", "box-supported-bc1", "box-supported-bc2", "box-supported-elastic", "box-halves",
           "box-halves-gasket", "gearbox-model", "gearbox-model-norim", "test-gearbox"]

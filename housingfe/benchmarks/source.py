@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.report import format_table, write_csv
+from housingfe.outputs import format_table, write_csv
 from housingfe.source import dynamics as dyn
 from housingfe.source.roosmalen import OperatingPoint, build, parse
 
@@ -113,7 +113,7 @@ def dynamics_rows(quick: bool) -> list[dict]:
 def other_rows(quick: bool) -> list[dict]:
     """Rows of the Fukuma / Trueman modules, if they provide `bench_rows(quick)`."""
     rows = []
-    for name in ("housingfe.source.fukuma", "housingfe.source.trueman"):
+    for name in ("housingfe.source.fukuma_run", "housingfe.source.trueman_run"):
         try:
             module = importlib.import_module(name)
         except ModuleNotFoundError:

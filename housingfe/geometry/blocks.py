@@ -24,7 +24,7 @@ import numpy as np
 # where that fails (thin walls at elements several times the wall thickness) HXT is used and the mesh says so.
 TET_ALGORITHM = 1
 HXT_ALGORITHM = 10
-# below this minimum shape ratio after the sliver refinement, fall back to HXT (housingfe.model rejects < 0.05)
+# below this minimum shape ratio after the sliver refinement, fall back to HXT (housingfe.fe.model rejects < 0.05)
 DELAUNAY_MIN_QUALITY = 0.06
 
 FaceClassifier = Callable[[np.ndarray, np.ndarray], Sequence[str]]
@@ -437,14 +437,13 @@ def _tet_qualities() -> tuple[np.ndarray, np.ndarray]:
     """Shape ratio and centroid (m) of every tetrahedron of the current gmsh mesh."""
     import gmsh
 
-    from housingfe.geometry.mesh import _tet_quality
 
     _, _, conn = gmsh.model.mesh.getElements(3)
     tags, coords, _ = gmsh.model.mesh.getNodes()
     xyz = np.zeros((int(tags.max()) + 1, 3))
     xyz[tags.astype(int)] = coords.reshape(-1, 3)
     corners = xyz[conn[0].reshape(-1, 4).astype(int)]
-    return _tet_quality(corners), corners.mean(axis=1)
+    return tet_quality(corners), corners.mean(axis=1)
 
 
 def _remesh_finer_at(centres: np.ndarray, size: float) -> None:
@@ -504,3 +503,10 @@ def _hxt_fallback(size: float, min_quality: float = 0.08, attempts: int = 3) -> 
         gmsh.option.setNumber("Mesh.RandomFactor", 1e-9 * (attempt + 2))
         gmsh.model.mesh.clear()
         gmsh.model.mesh.generate(3)
+
+
+def tet_quality(v: np.ndarray) -> np.ndarray:
+    e = [v[:, j] - v[:, i] for i, j in ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))]
+    vol = np.abs(np.einsum("ij,ij->i", e[0], np.cross(e[1], e[2]))) / 6
+    l_rms = np.sqrt(sum((ek**2).sum(axis=1) for ek in e) / 6)
+    return 6 * np.sqrt(2) * vol / l_rms**3

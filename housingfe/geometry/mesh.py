@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from housingfe.errors import InputError
-from housingfe.geometry.blocks import BlockModel, build_gmsh_model
+from housingfe.geometry.blocks import BlockModel, build_gmsh_model, tet_quality
 
 
 @dataclass
@@ -145,7 +145,7 @@ def element_quality(mesh) -> dict:
     n_local = mesh.topology.index_map(3).size_local
     xc = x[dofs[:n_local]]
     if xc.shape[1] == 4 or (xc.shape[1] == 10):
-        q = _tet_quality(xc[:, :4])
+        q = tet_quality(xc[:, :4])
         measure = "tet 6*sqrt(2)*V/l_rms^3"
     else:
         q = _hex_scaled_jacobian(xc[:, :8])
@@ -166,11 +166,7 @@ def _mpi_max():
     return MPI.MAX
 
 
-def _tet_quality(v: np.ndarray) -> np.ndarray:
-    e = [v[:, j] - v[:, i] for i, j in ((0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3))]
-    vol = np.abs(np.einsum("ij,ij->i", e[0], np.cross(e[1], e[2]))) / 6
-    l_rms = np.sqrt(sum((ek**2).sum(axis=1) for ek in e) / 6)
-    return 6 * np.sqrt(2) * vol / l_rms**3
+
 
 
 def _hex_scaled_jacobian(v: np.ndarray) -> np.ndarray:

@@ -16,8 +16,8 @@ def mesh_picture(scene_name: str, path: Path) -> None:
     from dolfinx import plot
     from mpi4py import MPI
 
+    from housingfe.fe.model import element_size
     from housingfe.geometry import build_mesh
-    from housingfe.model import element_size
     from housingfe.scene import load_housing_scene
 
     scene, _ = load_housing_scene(scene_name)

@@ -9,8 +9,8 @@ import numpy as np
 
 from housingfe import levels
 from housingfe.errors import InputError
+from housingfe.outputs import atomic_output_dir, format_table, write_csv, write_json
 from housingfe.radiation import foller
-from housingfe.report import atomic_output_dir, format_table, write_csv, write_json
 
 # Quantity name in FollerResult -> (key in the published table, label, format)
 APPENDIX_E_ROWS = (

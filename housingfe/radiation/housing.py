@@ -30,7 +30,7 @@ class HousingSoundPower:
 
 def housing_plates(model, spec) -> list[Plate]:
     """Föller plates from the mesh: area and perimeter of each listed surface, fc from the material."""
-    from housingfe.response import surface_outline
+    from housingfe.response.observers import surface_outline
 
     m = model.material
     plates = []
@@ -46,7 +46,7 @@ def housing_plates(model, spec) -> list[Plate]:
 
 def radiation_points(model, spec):
     """Facet points (and one id per plate) of the listed plates, for the numerical model."""
-    from housingfe.response import SamplePoints, facet_points
+    from housingfe.response.observers import SamplePoints, facet_points
 
     pts, nrm, w, keys = [], [], [], []
     for i, p in enumerate(spec.plates):

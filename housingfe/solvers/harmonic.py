@@ -2,7 +2,7 @@
 
 Two solvers, one result type (`HarmonicResult`): for every load case, blocks of vectors Psi with
 coefficients c(omega), u(omega) = Psi c(omega).  The vectors go through a `reduce` function (surface
-Gram matrix, point values, load projections: see housingfe.response) as soon as they exist, so a long
+Gram matrix, point values, load projections: see housingfe.response.observers) as soon as they exist, so a long
 direct sweep never keeps its solution vectors.
 
 * direct: one sparse factorisation per frequency, in the real 2x2 block form

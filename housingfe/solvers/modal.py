@@ -24,7 +24,7 @@ from housingfe.errors import SolverError
 # f_max; the lowest elastic mode of NAFEMS FV12 (a 10 m x 50 mm plate, the most slender scene) is at 4.4e-10
 # of it.  Below 1e-13 lambda_scale an eigenvalue is zero to double precision.
 RIGID_EIGENVALUE_RATIO = 1e-13
-# Kept for small dense models that have no matrix scale at hand (housingfe.interior): a frequency ratio.
+# Kept for small dense models that have no matrix scale at hand (housingfe.drivetrain.interior): a frequency ratio.
 RIGID_FREQUENCY_RATIO = 1e-4
 
 

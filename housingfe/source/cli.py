@@ -3,8 +3,8 @@
 The scene is a built-in name (housingfe/scenes/<name>.toml) or a path to a TOML file with
 [scene] kind = "source" and a [source] table whose `model` picks the implementation:
   "roosmalen" -> housingfe.source.roosmalen.run_scene   (van Roosmalen 1994, Ch. 2)
-  "fukuma"    -> housingfe.source.fukuma.run_scene      (Fukuma et al. 1973)
-  "trueman"   -> housingfe.source.trueman.run_scene     (Trueman 1974)
+  "fukuma"    -> housingfe.source.fukuma_run.run_scene     (Fukuma et al. 1973)
+  "trueman"   -> housingfe.source.trueman_run.run_scene    (Trueman 1974)
 each called as run_scene(scene: dict, scene_path: str, out_dir: pathlib.Path) with out_dir an already
 created temporary folder that replaces the result folder (default results/<scene name>) on success.
 """
@@ -15,12 +15,12 @@ import importlib
 from pathlib import Path
 
 from housingfe.errors import InputError
-from housingfe.scene import read_scene_dict
+from housingfe.scenefile import read_scene_dict
 
 MODELS = {
     "roosmalen": "housingfe.source.roosmalen",
-    "fukuma": "housingfe.source.fukuma",
-    "trueman": "housingfe.source.trueman",
+    "fukuma": "housingfe.source.fukuma_run",
+    "trueman": "housingfe.source.trueman_run",
 }
 
 
@@ -43,7 +43,7 @@ def load_scene(name_or_path: str) -> tuple[dict, Path]:
 
 def run(name_or_path: str, out: str | None = None) -> Path:
     """Run a source scene and return the result folder."""
-    from housingfe.report import atomic_output_dir
+    from housingfe.outputs import atomic_output_dir
 
     scene, path = load_scene(name_or_path)
     model = scene["source"]["model"]

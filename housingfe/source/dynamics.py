@@ -40,7 +40,7 @@ BEARING_DOFS = {"pinion": [0, 1, 2, 3, 4], "wheel": [6, 7, 8, 9, 10]}
 
 # ------------------------------------------------------------------------------------ parameters
 @dataclass(frozen=True)
-class Interior:
+class LumpedInterior:
     """Parameters of the lumped model (SI).  Masses [kg], inertias [kg m^2] (axial = polar about the
     shaft axis, diametral = about a transverse axis through the gear centre), torsional shaft
     stiffnesses [N m/rad], bearing stiffness diagonals [N/m, N/m, N/m, N m/rad, N m/rad] for x, y, z,
@@ -98,7 +98,7 @@ def _cylinder(density: float, diameter: float, length: float) -> tuple[float, fl
 
 
 def derive_interior(pair: GearPair, geometry: ShaftGeometry = ShaftGeometry(), loss_factor: float = 0.1,
-                    bearings: dict | None = None) -> Interior:
+                    bearings: dict | None = None) -> LumpedInterior:
     """Lumped parameters from gear and shaft geometry (Appendix C's table did not survive): each gear
     is a solid cylinder of the mean of tip and root diameter over its face width, plus its shaft
     between the bearings (solid, `*_shaft_diameter`); diametral inertia about the gear centre by the
@@ -119,7 +119,7 @@ def derive_interior(pair: GearPair, geometry: ShaftGeometry = ShaftGeometry(), l
         out[name] = (m, jp, jd)
     k = tuple(math.pi * G * d**4 / (32 * l) for d, l in zip(geometry.torsion_diameters, geometry.torsion_lengths))
     b = bearings or APPENDIX_C_BEARINGS
-    return Interior(*out["pinion"], *out["wheel"], coupling_inertia=geometry.coupling_inertia,
+    return LumpedInterior(*out["pinion"], *out["wheel"], coupling_inertia=geometry.coupling_inertia,
                     torsion_stiffness=k, pinion_bearings=tuple(b["pinion"]), wheel_bearings=tuple(b["wheel"]),
                     loss_factor=loss_factor)
 
@@ -160,7 +160,7 @@ def mesh_direction(pair: GearPair, axial_moment: bool = True) -> np.ndarray:
     return h
 
 
-def assemble(pair: GearPair, interior: Interior, mean_mesh_stiffness: float, axial_moment: bool = True) -> Matrices:
+def assemble(pair: GearPair, interior: LumpedInterior, mean_mesh_stiffness: float, axial_moment: bool = True) -> Matrices:
     """Mass, stiffness and damping matrices of the 14-DOF model (mean mesh stiffness for the modes)."""
     it = interior
     M = np.diag([it.pinion_mass] * 3 + [it.pinion_inertia_diametral] * 2 + [it.pinion_inertia_axial]
@@ -409,7 +409,7 @@ class BearingSpectra:
     lumped: np.ndarray | None = None      # (2, 5, n_freq): unsplit [Fx, Fy, Fz, Mx, My] per shaft at the gear centre
 
 
-def bearing_spectra(state: SteadyState, mats: Matrices, interior: Interior, geometry: ShaftGeometry,
+def bearing_spectra(state: SteadyState, mats: Matrices, interior: LumpedInterior, geometry: ShaftGeometry,
                     pair: GearPair, speed_rpm: float, torque: float) -> BearingSpectra:
     """Bearing loads of both shafts from the steady state (see `BearingSpectra`)."""
     pos = state.harmonics >= 1

@@ -25,8 +25,8 @@ stiffness K (2.0e8 N/m, 20 N/(mm um) over b = 10 mm), the accelerometer radius (
 positions of Fig. 5 (figure missing; only A1 = mid-span, zl = 110 mm, is stated).
 
 Public API: `ShaftBearing`, `GearBody`, `FukumaPair`, `influence_coefficients`, `equivalent_inertia`,
-`harmonic_response`, `conversion_ratios`, `bearing_load_spectra`, `run_scene`,
-`bench_rows`.
+`harmonic_response`, `conversion_ratios`, `bearing_load_spectra`; the scene runner (`run_scene`,
+`bench_rows`) is housingfe.source.fukuma_run.
 """
 from __future__ import annotations
 
@@ -380,6 +380,3 @@ def bearing_load_spectra(pair: FukumaPair, z: float, rpm: float, te_harmonics_m,
                           names=["driving_left", "driving_right", "driven_left", "driven_right"],
                           z=np.array([-z * length, (1 - z) * length] * 2), loads=loads)
 
-
-# re-exported so the CLI finds them here
-from housingfe.source.fukuma_run import bench_rows, run_scene  # noqa: E402,F401

@@ -35,8 +35,8 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from housingfe.report import format_table, write_csv, write_json
-from housingfe.scene import SceneInfo, validate
+from housingfe.outputs import format_table, write_csv, write_json
+from housingfe.scenefile import SceneInfo, parse_table
 
 
 class _Strict(BaseModel):
@@ -120,7 +120,7 @@ class FukumaScene(_Strict):
 
 def parse_scene(scene: dict, scene_path: str) -> FukumaScene:
     """Validate a scene dict; bad input -> InputError("<file>: <key>: <problem>")."""
-    return validate(FukumaScene, scene, scene_path)
+    return parse_table(FukumaScene, scene, scene_path)
 
 
 def build_pair(sc: FukumaScene):

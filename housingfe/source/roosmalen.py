@@ -22,7 +22,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt
 
 from housingfe.errors import InputError
-from housingfe.report import format_table, write_csv, write_json
+from housingfe.outputs import format_table, write_csv, write_json
 from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair, tooth_profile
 from housingfe.source.stiffness import (
@@ -123,13 +123,13 @@ class SourceTable(_Strict):
 
 def parse(scene: dict, scene_path: str) -> SourceTable:
     """Validate the [source] table; InputError naming the file and the first bad key."""
-    from housingfe.scene import validate
+    from housingfe.scenefile import parse_table
 
-    return validate(SourceTable, scene.get("source", {}), scene_path, prefix="source.")
+    return parse_table(SourceTable, scene.get("source", {}), scene_path, prefix="source.")
 
 
 def build(table: SourceTable, scene_path: str = "scene"):
-    """GearPair, Corrections, ShaftGeometry, Interior and MeshModel from a validated table."""
+    """GearPair, Corrections, ShaftGeometry, LumpedInterior and MeshModel from a validated table."""
     gears = table.gears.model_dump(exclude_none=True)
     pair = GearPair.from_table(gears, where=f"{scene_path}: source.gears")
     corr = Corrections.from_table(table.corrections.model_dump(), where=f"{scene_path}: source.corrections")

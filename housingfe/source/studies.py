@@ -15,7 +15,7 @@ import math
 import sys
 from pathlib import Path
 
-from housingfe.report import format_table, write_csv
+from housingfe.outputs import format_table, write_csv
 from housingfe.source.gears import GearPair
 from housingfe.source.stiffness import MeshModel, stiffness_curve
 

@@ -15,7 +15,8 @@ What differs from the thesis's program (on purpose):
   speed card); the generator is numpy's PCG64 with an explicit seed.
 
 Public API: `critical_speeds`, `mesh_transfer`, `mesh_torques`, `random_te`, `mesh_load_envelopes`,
-`mesh_torque_from_receptances`, `shaft_end_stiffness`, `run_scene`, `bench_rows`.
+`mesh_torque_from_receptances`, `shaft_end_stiffness`; the scene runner (`run_scene`, `bench_rows`) is
+housingfe.source.trueman_run.
 """
 from __future__ import annotations
 
@@ -33,7 +34,6 @@ from housingfe.source.trueman_model import DriveConfig, DriveModel, build_drive,
 __all__ = [
     "DriveConfig",
     "DriveModel",
-    "bench_rows",
     "build_drive",
     "critical_speeds",
     "mesh_load_envelopes",
@@ -42,7 +42,6 @@ __all__ = [
     "mesh_transfer",
     "random_te",
     "rpm_to_omega",
-    "run_scene",
     "shaft_end_stiffness",
     "thesis_propagation_factors",
     "thesis_style_transfer",
@@ -227,6 +226,3 @@ def thesis_style_transfer(model: DriveModel, omega: float) -> np.ndarray:
     np.fill_diagonal(scaled, np.diag(h))
     return scaled
 
-
-# re-exported here so scenes and the benchmark only need this module
-from housingfe.source.trueman_run import bench_rows, run_scene  # noqa: E402,F401

@@ -37,8 +37,8 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from housingfe.report import format_table, write_csv, write_json
-from housingfe.scene import SceneInfo, validate
+from housingfe.outputs import format_table, write_csv, write_json
+from housingfe.scenefile import SceneInfo, parse_table
 from housingfe.source import trueman_data as data
 
 if TYPE_CHECKING:
@@ -123,7 +123,7 @@ class TruemanScene(_Strict):
 
 def parse_scene(scene: dict, scene_path: str) -> TruemanScene:
     """Validate a scene dict; bad input -> InputError("<file>: <key>: <problem>")."""
-    return validate(TruemanScene, scene, scene_path)
+    return parse_table(TruemanScene, scene, scene_path)
 
 
 def drive_config(sc: TruemanScene, conf) -> DriveConfig:

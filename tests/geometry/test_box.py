@@ -40,7 +40,7 @@ def test_mesh_tags_and_areas(coarse_box_model, comm, element):
     for n in range(1, 9):
         assert f"bolt_{n}" in hm.facet_groups
     assert {"top", "front", "back", "left", "right", "flange"} <= set(hm.cell_groups)
-    from housingfe.model import MIN_ELEMENT_QUALITY
+    from housingfe.fe.model import MIN_ELEMENT_QUALITY
 
     # structured hexes are perfect boxes; Delaunay tetrahedra must pass the threshold the model enforces
     assert hm.quality["min"] > (0.999 if element == "hex" else MIN_ELEMENT_QUALITY)

@@ -9,7 +9,7 @@ from dolfinx import fem
 from dolfinx.cpp.mesh import entities_to_geometry
 
 from housingfe.geometry.housings import appendix_e_plates, appendix_e_total_area
-from housingfe.published import thesis
+from housingfe.verification.published import thesis
 from tests.conftest import load_scene
 
 # The Appendix E table prints 3 significant digits (e.g. 0.0177 m2, 0.532 m): half a unit in the last digit
@@ -143,7 +143,7 @@ def test_bad_bore_names_the_parameter():
 def _frequencies(scene_name, *overrides):
     from mpi4py import MPI
 
-    from housingfe.model import build_model
+    from housingfe.fe.model import build_model
     from housingfe.solvers import modal
 
     scene = load_scene(scene_name, *overrides)
@@ -173,7 +173,7 @@ def test_stiff_joint_layer_converges_to_monolithic():
     are assembled on it."""
     from mpi4py import MPI
 
-    from housingfe.model import build_model, material_field
+    from housingfe.fe.model import build_model, material_field
     from housingfe.solvers import elasticity, modal
 
     coarse = ("mesh.size=0.06", "analysis.modal.f_max=1600.0", "regions.joint.density=7850.0")

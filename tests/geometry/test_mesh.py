@@ -20,8 +20,8 @@ FREQ_SCENE = (*SCENE, "analysis.modal.f_max=1500.0")
 
 def fingerprint(scene_args, comm) -> dict:
     """Global node and cell counts and a hash of the sorted node coordinates (gathered from all ranks)."""
+    from housingfe.fe.model import element_size
     from housingfe.geometry import build_mesh
-    from housingfe.model import element_size
     from tests.conftest import load_scene
 
     scene = load_scene(*scene_args)
@@ -37,7 +37,7 @@ def fingerprint(scene_args, comm) -> dict:
 
 
 def frequencies(comm) -> dict:
-    from housingfe.model import build_model
+    from housingfe.fe.model import build_model
     from housingfe.solvers import modal
     from tests.conftest import load_scene
 

@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from housingfe.forced_response import run as run_forced
-from housingfe.model import build_model
+from housingfe.fe.model import build_model
 from housingfe.report import sound_power_rows
+from housingfe.response.forced import run as run_forced
 from tests.conftest import load_scene
 
 PLATE = ["geometry.a=0.3", "geometry.b=0.2", "geometry.h=0.005", "mesh.size=0.05", "analysis.modal.f_max=1500.0",

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from housingfe.errors import SolverError
-from housingfe.model import build_model
+from housingfe.fe.model import build_model
 from housingfe.solvers import elasticity, modal
 from tests.conftest import load_scene
 
@@ -125,7 +125,7 @@ def test_free_plate_has_six_rigid_modes_below_a_low_f_max(comm):
 
 def test_simply_supported_plate_harmonic_basis_counts_rigid_modes(comm):
     """harmonic.json's facts for the issue's plate: a basis to 3.7 Hz = three rigid modes, one elastic mode."""
-    from housingfe import forced_response
+    from housingfe.response import forced as forced_response
 
     scene = load_scene("nafems-fv12", SIMPLY_SUPPORTED,
                        "analysis.harmonic={f_min=0.5, f_max=2.4666667, df=0.5, surface=\"top\", "

@@ -12,6 +12,7 @@ import pytest
 
 from housingfe.errors import InputError
 from housingfe.source import fukuma as fk
+from housingfe.source import fukuma_run
 
 KP, KS, L = 2.39e7, 9.5e7, 0.220
 
@@ -137,7 +138,7 @@ def test_run_scene_outputs(name, tmp_path):
 
     scene, path = _load(name)
     scene["sweep"]["points"] = 9
-    fk.run_scene(scene, path, tmp_path)
+    fukuma_run.run_scene(scene, path, tmp_path)
     rows = list(csv.DictReader(io.StringIO((tmp_path / "conversion_ratios.csv").read_text())))
     assert len(rows) == 9
     mid = rows[4]
@@ -159,7 +160,7 @@ def test_bad_scene_raises_input_error(mutate, key):
     scene, path = _load("fukuma-series-a")
     mutate(scene)
     with pytest.raises(InputError, match=key) as info:
-        fk.run_scene(scene, path, Path("/nonexistent"))
+        fukuma_run.run_scene(scene, path, Path("/nonexistent"))
     assert str(info.value).startswith(path)
 
 

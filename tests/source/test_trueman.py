@@ -12,6 +12,7 @@ import scipy.sparse as sp
 from housingfe.errors import InputError
 from housingfe.source import trueman as tr
 from housingfe.source import trueman_data as data
+from housingfe.source import trueman_run
 
 INCH = data.INCH
 
@@ -235,7 +236,7 @@ def test_run_scene_type_b_writes_critical_speeds_and_envelopes(tmp_path):
     scene, path = _load_scene("trueman-type-b")
     scene["forced"]["speeds"] = 7            # keep the test fast
     scene["forced"]["machines"] = 10
-    tr.run_scene(scene, path, tmp_path)
+    trueman_run.run_scene(scene, path, tmp_path)
     crit = json.loads((tmp_path / "critical_speeds.json").read_text())
     assert _rel(crit["type B"], data.TABLE_6_1_RPM["type B"]).max() < 0.01
     rows = list(csv.DictReader(io.StringIO((tmp_path / "mesh_load_envelopes.csv").read_text())))
@@ -263,5 +264,5 @@ def test_bad_scene_raises_input_error_naming_file_and_key(mutate, key):
     scene, path = _load_scene("trueman-type-b")
     mutate(scene)
     with pytest.raises(InputError, match=key) as info:
-        tr.run_scene(scene, path, Path("/nonexistent"))
+        trueman_run.run_scene(scene, path, Path("/nonexistent"))
     assert str(info.value).startswith(path)

@@ -1,0 +1,21 @@
+"""`housingfe bench <name>`: dispatch to housingfe.benchmarks.<name>.main(out_dir, quick)."""
+from __future__ import annotations
+
+import importlib
+import pkgutil
+from pathlib import Path
+
+from housingfe.errors import InputError
+
+
+def available() -> list[str]:
+    """Names of the benchmarks that exist."""
+    return sorted(m.name for m in pkgutil.iter_modules([str(Path(__file__).parent)]) if not m.name.startswith("_"))
+
+
+def main(which: str, out_dir: str | None = None, quick: bool = False) -> None:
+    """Run one benchmark; results go to out_dir (default results/bench-<which>)."""
+    if which not in available():
+        raise InputError(f"bench: unknown benchmark {which!r} (available: {', '.join(available())})")
+    module = importlib.import_module(f"housingfe.benchmarks.{which}")
+    module.main(Path(out_dir or f"results/bench-{which}"), quick)

@@ -1,0 +1,443 @@
+"""The gearbox interior of a housing scene: the `[coupling]` table -> bore masters, shafts, gears, bearings,
+gear meshes and tie rods -> a coupled system (housingfe.drivetrain.coupling).
+
+Validated like the rest of a scene (unknown keys are errors that name the key).  All values SI: m, N, N m,
+N/m, N m/rad, rev/min only where the key says so.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Annotated
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
+
+from housingfe.errors import InputError
+
+# housingfe.drivetrain.coupling (PETSc) is imported inside the functions: validating a scene stays light.
+
+Vector3 = tuple[float, float, float]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class BoreMasterSpec(_Strict):
+    """A bore master: surface of the housing, centre (m; default: centre of the surface's bounding box),
+    axis, kind (rbe2 | rbe3 | star) and rod_stiffness (N/m per rod, star only)."""
+
+    name: str
+    surface: str
+    centre: Vector3 | None = None
+    axis: Vector3 = (0.0, 0.0, 1.0)
+    kind: str = Field("rbe2", pattern="^(rbe2|rbe3|star)$")
+    rod_stiffness: PositiveFloat | None = None
+
+
+class DiscSpec(_Strict):
+    """A gear as a rigid cylinder (m) on shaft node `node`."""
+
+    node: int = Field(ge=0)
+    outer_diameter: PositiveFloat
+    width: PositiveFloat
+    inner_diameter: float = Field(0.0, ge=0.0)
+
+
+class ShaftSpec(_Strict):
+    """A stepped Timoshenko shaft: segments [[length, outer_d(, inner_d)], ...] (m) from origin along axis."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_]+$")
+    origin: Vector3
+    axis: Vector3
+    segments: list[list[float]]
+    elements_per_segment: PositiveInt = 4
+    discs: list[DiscSpec] = []
+
+
+Matrix6 = list[Annotated[list[float], Field(min_length=6, max_length=6)]]
+
+
+class BearingSpec(_Strict):
+    """A bearing from a shaft node (e.g. "pinion:0") to a bore master (None: ground), in the bearing frame
+    (z = shaft axis, rotated to global axes by `axis`; the spin row and column are always freed).  One of:
+    designation (catalogue, with its mean `load` (Fx, Fy, Fz, Mx, My) in N, N m, and optionally the stiffness
+    `model`), `stiffness` (6 diagonal values, N/m and N m/rad) or `stiffness_matrix` (6x6, may be
+    non-symmetric, e.g. fluid film) with an optional `damping_matrix` (6x6, N s/m, N m s/rad).  `name` labels
+    the bearing position in reports."""
+
+    name: str | None = None
+    shaft_node: str
+    bore: str | None = None
+    axis: Vector3 = (0.0, 0.0, 1.0)
+    designation: str | None = None
+    load: tuple[float, float, float, float, float] | None = None
+    model: str | None = Field(None, pattern="^(lim-ball|lim-roller|sliced-roller|sliced-roller-thesis|self-aligning)$")
+    # tilt (rad) held by the shaft instead of zero moments (a shaft on two bearings sets the tilt; see
+    # housingfe.verification.bearing_rows)
+    fixed_tilt: tuple[float, float] | None = None
+    stiffness: tuple[float, float, float, float, float, float] | None = None
+    stiffness_matrix: Matrix6 | None = Field(None, min_length=6, max_length=6)
+    damping_matrix: Matrix6 | None = Field(None, min_length=6, max_length=6)
+
+    @model_validator(mode="after")
+    def _one(self):
+        given = [x is not None for x in (self.designation, self.stiffness, self.stiffness_matrix)]
+        if sum(given) != 1:
+            raise ValueError("give one of designation (+ load), stiffness or stiffness_matrix")
+        if self.designation is not None and self.load is None:
+            raise ValueError("load: required with a designation (N, N m)")
+        if self.damping_matrix is not None and self.stiffness_matrix is None:
+            raise ValueError("damping_matrix: only with stiffness_matrix")
+        return self
+
+    @property
+    def label(self) -> str:
+        return self.name or f"{self.shaft_node}-{self.bore or 'ground'}"
+
+    def matrices(self) -> tuple[np.ndarray, np.ndarray | None]:
+        """(K, C) 6x6 in the bearing frame (N/m, N m/rad; N s/m); C None without damping."""
+        if self.designation is not None:
+            from housingfe.bearings import bearing_stiffness
+
+            return bearing_stiffness(self.designation, self.load, model=self.model, fixed_tilt=self.fixed_tilt).K, None
+        if self.stiffness is not None:
+            return np.diag(self.stiffness), None
+        C = None if self.damping_matrix is None else np.array(self.damping_matrix, float)
+        return np.array(self.stiffness_matrix, float), C
+
+
+class GearMeshSpec(_Strict):
+    """Mesh stiffness (N/m) along the line of action `direction` through the contact `point` (m)."""
+
+    a: str
+    b: str
+    stiffness: PositiveFloat
+    point: Vector3
+    direction: Vector3
+    damping: float = Field(0.0, ge=0.0)
+
+
+class TieRodSpec(_Strict):
+    """A solid round Timoshenko beam (steel, m) between two nodes.  rigid_end_a / rigid_end_b: lengths (m) from
+    each node along the rod that are rigid (the part inside a shaft: the rod is clamped to the shaft's surface,
+    not to its axis); the beam spans the rest."""
+
+    a: str
+    b: str
+    diameter: PositiveFloat
+    rigid_end_a: float = Field(0.0, ge=0.0)
+    rigid_end_b: float = Field(0.0, ge=0.0)
+
+
+class CouplingSpec(_Strict):
+    bores: list[BoreMasterSpec] = []
+    shafts: list[ShaftSpec] = []
+    bearings: list[BearingSpec] = []
+    gear_meshes: list[GearMeshSpec] = []
+    tie_rods: list[TieRodSpec] = []
+
+
+    @model_validator(mode="after")
+    def _unique(self):
+        names = [b.name for b in self.bores] + [s.name for s in self.shafts]
+        dup = sorted({n for n in names if names.count(n) > 1})
+        if dup:
+            raise ValueError(f"bores: names must be unique among bores and shafts ({', '.join(dup)})")
+        return self
+
+
+# ------------------------------------------------------------------------------------------------ parts
+@dataclass
+class Parts:
+    """The interior as housingfe.drivetrain.coupling inputs: connections, shafts {name: Shaft}, bearings (Elements;
+    bearings[i] is that of spec.bearings[i]), gear meshes, tie rods (Elements)."""
+
+    connections: list
+    shafts: dict
+    bearings: list
+    gear_meshes: list
+    tie_rods: list          # Elements (beam K, M between the two nodes, rigid ends included)
+    positions: dict         # node name (bores, shaft nodes) -> position (m)
+
+    @property
+    def elements(self) -> list:
+        return self.bearings + self.tie_rods
+
+
+def _check(spec: CouplingSpec) -> CouplingSpec:
+    if isinstance(spec, CouplingSpec):
+        return spec
+    from pydantic import ValidationError
+
+    try:
+        return CouplingSpec.model_validate(spec)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        msg = err["msg"].removeprefix("Value error, ")
+        raise InputError(f"coupling.{'.'.join(str(p) for p in err['loc'])}: {msg}") from None
+
+
+def parts(spec: CouplingSpec, bore_centres: dict) -> Parts:
+    """Build the coupling inputs; bore_centres: bore name -> centre (m) (given or measured on the mesh)."""
+    from housingfe.drivetrain import coupling as cp
+    from housingfe.drivetrain.shafts import RigidDisc, Shaft
+
+    connections = [cp.BoreConnection(b.name, b.surface, tuple(bore_centres[b.name]), b.axis, b.kind,
+                                     b.rod_stiffness) for b in spec.bores]
+    shafts = {}
+    for i, s in enumerate(spec.shafts):
+        shaft = Shaft.stepped([tuple(seg) for seg in s.segments], origin=s.origin, axis=s.axis,
+                              elements_per_segment=s.elements_per_segment)
+        for d in s.discs:
+            if d.node >= len(shaft.nodes):
+                raise InputError(f"coupling.shafts.{i}.discs: node {d.node} out of range 0..{len(shaft.nodes) - 1}")
+            shaft.add_disc(d.node, RigidDisc.cylinder(d.outer_diameter, d.width, d.inner_diameter))
+        shafts[s.name] = shaft
+    known = set(bore_centres) | {f"{n}:{i}" for n, sh in shafts.items() for i in range(len(sh.nodes))}
+    bearings = []
+    for i, b in enumerate(spec.bearings):
+        for key, node in (("shaft_node", b.shaft_node), ("bore", b.bore)):
+            if node is not None and node not in known:
+                raise InputError(f"coupling.bearings.{i}.{key}: unknown node {node!r} (shaft nodes are "
+                                 f"'<shaft>:<index>', bores by name)")
+        try:
+            K, C = b.matrices()
+        except InputError as exc:
+            raise InputError(f"coupling.bearings.{i} ({b.label}): {exc}") from None
+        bearings.append(cp.bearing(b.shaft_node, b.bore, K, b.axis, C))
+    for kind, items in (("gear_meshes", spec.gear_meshes), ("tie_rods", spec.tie_rods)):
+        for i, g in enumerate(items):
+            for key in ("a", "b"):
+                if getattr(g, key) not in known:
+                    raise InputError(f"coupling.{kind}.{i}.{key}: unknown node {getattr(g, key)!r}")
+    meshes = [cp.GearMesh(g.a, g.b, g.stiffness, g.point, g.direction, g.damping) for g in spec.gear_meshes]
+    position = {**{n: np.asarray(x, float) for n, x in bore_centres.items()},
+                **{f"{n}:{i}": x for n, sh in shafts.items() for i, x in enumerate(sh.nodes)}}
+    rods = [tie_rod_element(t, position[t.a], position[t.b], f"coupling.tie_rods.{i}")
+            for i, t in enumerate(spec.tie_rods)]
+    return Parts(connections, shafts, bearings, meshes, rods, position)
+
+
+def tie_rod_element(t: TieRodSpec, pa: np.ndarray, pb: np.ndarray, key: str):
+    """The Element of a tie rod: a steel Timoshenko beam between the ends of its rigid parts, moved to the two
+    nodes by rigid arms (u_end = u_node + theta_node x r), K = T^T k T, M = T^T m T."""
+    from housingfe.drivetrain import coupling as cp
+    from housingfe.drivetrain.shafts import STEEL, CircularSection, beam_element_matrices
+
+    length = float(np.linalg.norm(pb - pa))
+    if t.rigid_end_a + t.rigid_end_b >= length:
+        raise InputError(f"{key}: rigid ends ({t.rigid_end_a} + {t.rigid_end_b} m) leave no rod "
+                         f"between nodes {length:.4g} m apart")
+    e = (pb - pa) / length
+    ra, rb = t.rigid_end_a * e, -t.rigid_end_b * e
+    k, m = beam_element_matrices(pa + ra, pb + rb, CircularSection(t.diameter), STEEL)
+    T = np.zeros((12, 12))
+    for i, r in enumerate((ra, rb)):
+        T[6 * i:6 * i + 3, 6 * i:6 * i + 6] = cp.rigid_arm(r)
+        T[6 * i + 3:6 * i + 6, 6 * i + 3:6 * i + 6] = np.eye(3)
+    return cp.Element((t.a, t.b), T.T @ k @ T, T.T @ m @ T, None)
+
+
+def bore_centres(model, spec: CouplingSpec) -> dict:
+    """Bore name -> centre (m): the given one, or the centre of the bore surface's bounding box."""
+    from housingfe.drivetrain import coupling as cp
+
+    out = {}
+    for i, b in enumerate(spec.bores):
+        if b.surface not in model.housing.facet_groups:
+            raise InputError(f"coupling.bores.{i}.surface: no surface {b.surface!r} "
+                             f"(known: {', '.join(sorted(model.housing.facet_groups))})")
+        out[b.name] = np.asarray(b.centre if b.centre is not None else cp.surface_centre(model, b.surface), float)
+    return out
+
+
+def couple_from_spec(model, spec: CouplingSpec | dict):
+    """housingfe.drivetrain.coupling.couple() from a scene's [coupling] section (a CouplingSpec or the raw dict)."""
+    from housingfe.drivetrain import coupling as cp
+
+    spec = _check(spec)
+    p = parts(spec, bore_centres(model, spec))
+    return cp.couple(model, p.connections, p.elements, p.shafts, p.gear_meshes)
+
+
+# -------------------------------------------------------------------------------- interior on rigid bores
+@dataclass
+class RigidBoreModes:
+    """Eigenmodes of the interior alone with every bore master held fixed (the thesis' check of Sec. 4.6).
+
+    frequencies_hz: all modes below f_max, mechanisms (zero modes, e.g. a free gear-train rotation) first;
+    bearing_energy: fraction of each mode's strain energy stored in the bearings (close to 1: the interior moves
+    as a whole on its bearings; small: shafts / rods bend); mechanisms: number of zero modes."""
+
+    frequencies_hz: np.ndarray
+    bearing_energy: np.ndarray
+    mechanisms: int
+    dofs: int
+
+
+def interior_matrices(spec: CouplingSpec, centres: dict):
+    """Dense K, M (and the bearings' K alone) of the interior with the bore masters fixed (SI units).
+    Returns (K, M, K_bearings, node names in DOF order)."""
+    from housingfe.drivetrain import coupling as cp
+
+    p = parts(spec, centres)
+    names = [f"{n}:{i}" for n, sh in p.shafts.items() for i in range(len(sh.nodes))]
+    index = {n: 6 * i for i, n in enumerate(names)}
+    size = 6 * len(names)
+    K, M, Kb = np.zeros((size, size)), np.zeros((size, size)), np.zeros((size, size))
+
+    def add(target, nodes, block):
+        # rows/columns of bore masters (fixed) and ground (None) are dropped
+        keep = [(j, index[n]) for j, n in enumerate(nodes) if n in index]
+        for a, ia in keep:
+            for b, ib in keep:
+                target[ia:ia + 6, ib:ib + 6] += block[6 * a:6 * a + 6, 6 * b:6 * b + 6]
+
+    for name, shaft in p.shafts.items():
+        ks, ms = shaft.matrices()
+        nodes = [f"{name}:{i}" for i in range(len(shaft.nodes))]
+        add(K, nodes, ks)
+        add(M, nodes, ms)
+    for e in p.bearings:
+        add(K, list(e.nodes), e.K)
+        add(Kb, list(e.nodes), e.K)
+    for g in p.gear_meshes:
+        add(K, [g.a, g.b], cp.gear_mesh_element(g, p.positions[g.a], p.positions[g.b]).K)
+    for e in p.tie_rods:
+        add(K, list(e.nodes), e.K)
+        add(M, list(e.nodes), e.M)
+    return K, M, Kb, names
+
+
+def rigid_bore_modes(spec: CouplingSpec, centres: dict, f_max: float) -> RigidBoreModes:
+    """Modes of the interior on rigid bores below f_max (Hz), dense (a few hundred DOFs).  Uses the symmetric
+    part of K (a non-symmetric fluid-film stiffness has complex modes; its symmetric part is reported)."""
+    import scipy.linalg as sl
+
+    from housingfe.solvers.modal import RIGID_FREQUENCY_RATIO
+
+    K, M, Kb, _ = interior_matrices(_check(spec), centres)
+    K, Kb = (K + K.T) / 2, (Kb + Kb.T) / 2
+    lam, vecs = sl.eigh(K, M, subset_by_value=(-np.inf, (2 * np.pi * f_max) ** 2))
+    f = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
+    rigid = f < RIGID_FREQUENCY_RATIO * f_max
+    energy = np.array([v @ Kb @ v / (v @ K @ v) if not r else 0.0 for v, r in zip(vecs.T, rigid)])
+    return RigidBoreModes(f, energy, int(rigid.sum()), K.shape[0])
+
+
+# ------------------------------------------------------------------------------------------- coupled model
+@dataclass
+class CoupledInterior:
+    """A housing model coupled with its interior: what the solvers (K, M, C) and the reports need.
+
+    system: housingfe.drivetrain.coupling.CoupledSystem (independent DOFs q); parts: the built elements; rigid: the
+    interior's modes on rigid bores; centres: bore centres (m)."""
+
+    model: object
+    spec: CouplingSpec
+    parts: Parts
+    system: object
+    rigid: RigidBoreModes
+    centres: dict
+    _basis_K: object = field(default=None, repr=False)   # built on first use (projected solver only)
+
+    @property
+    def K(self):
+        return self.system.K
+
+    @property
+    def M(self):
+        return self.system.M
+
+    @property
+    def C(self):
+        return self.system.C
+
+    def basis_stiffness(self):
+        """A symmetric positive semi-definite stand-in for K, for the modal basis of the projected solver: every
+        bearing matrix replaced by the nearest PSD matrix to its symmetric part (fluid films have a non-symmetric
+        K whose symmetric part can be indefinite).  Same DOFs as K, built once."""
+        if self._basis_K is None:
+            from housingfe.drivetrain import coupling as cp
+
+            bearings = [b.model_copy(update={"designation": None, "load": None, "model": None, "fixed_tilt": None,
+                                             "stiffness": None, "damping_matrix": None,
+                                             "stiffness_matrix": nearest_psd(b.matrices()[0]).tolist()})
+                        for b in self.spec.bearings]
+            p = parts(self.spec.model_copy(update={"bearings": bearings}), self.centres)
+            self._basis_K = cp.couple(self.model, p.connections, p.elements, p.shafts, p.gear_meshes).K
+        return self._basis_K
+
+    def expected_mechanisms(self) -> int:
+        """Zero modes the coupled model must have: the housing's six rigid-body motions if it is free, plus the
+        interior's own mechanisms on fixed bores (each counted independently, by a dense rank count)."""
+        return self.model.rigid_modes_expected + self.rigid.mechanisms
+
+    def fe_vector(self, q):
+        """The housing displacement (PETSc Vec on model.V) of a coupled vector q."""
+        return self.system.fe_vector(q, self.model.V)
+
+    def fe_modes(self, result):
+        """A ModalResult whose vectors are the housing parts of the coupled modes (for the housing reports)."""
+        import dataclasses
+
+        return dataclasses.replace(result, vectors=[self.fe_vector(q) for q in result.vectors])
+
+    def interior_fraction(self, vectors) -> np.ndarray:
+        """Share of each mass-normalised coupled mode's kinetic energy in the interior (shafts, gears, rods):
+        1 - u_fe^T M_fe u_fe."""
+        out = []
+        for q in vectors:
+            u = self.fe_vector(q)
+            y = self.model.M.createVecLeft()
+            self.model.M.mult(u, y)
+            out.append(1.0 - y.dot(u) / q.dot(_mult(self.system.M, q)))
+        return np.array(out)
+
+    def shaft_axis(self, node: str) -> np.ndarray:
+        """Unit axis of the shaft a node "<shaft>:<i>" belongs to."""
+        shaft = self.parts.shafts.get(node.split(":")[0]) if ":" in node else None
+        if shaft is None:
+            raise InputError(f"{node!r} is not a shaft node ('<shaft>:<index>'; shafts: "
+                             f"{', '.join(self.parts.shafts) or 'none'})")
+        return shaft.axis
+
+    def node_load(self, node: str, kind: str, direction, key: str):
+        """Coupled load vector of a unit force (N) or moment (N m) along `direction` on an extra node."""
+        if node not in self.system.nodes:
+            raise InputError(f"{key}: unknown node {node!r} (known: shaft nodes '<shaft>:<index>', bores "
+                             f"{', '.join(self.centres) or 'none'})")
+        d = np.asarray(direction, float) / np.linalg.norm(direction)
+        value = np.zeros(6)
+        value[(0 if kind == "force" else 3):(3 if kind == "force" else 6)] = d
+        return self.system.load(node_loads={node: value})
+
+
+def nearest_psd(K: np.ndarray) -> np.ndarray:
+    """The symmetric positive semi-definite matrix nearest (Frobenius) to K: clip the negative eigenvalues of its
+    symmetric part."""
+    lam, vec = np.linalg.eigh((K + K.T) / 2)
+    return (vec * np.clip(lam, 0.0, None)) @ vec.T
+
+
+def _mult(A, x):
+    y = A.createVecLeft()
+    A.mult(x, y)
+    return y
+
+
+def build_interior(model, spec: CouplingSpec, f_max: float) -> CoupledInterior:
+    """Couple a HousingModel with the interior of its scene; modes of the interior on rigid bores below f_max."""
+    import time
+
+    from housingfe.drivetrain import coupling as cp
+
+    t0 = time.perf_counter()
+    spec = _check(spec)
+    centres = bore_centres(model, spec)
+    p = parts(spec, centres)
+    system = cp.couple(model, p.connections, p.elements, p.shafts, p.gear_meshes)
+    rigid = rigid_bore_modes(spec, centres, f_max)
+    model.timings["coupling_s"] = time.perf_counter() - t0
+    return CoupledInterior(model, spec, p, system, rigid, centres)

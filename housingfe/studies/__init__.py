@@ -1,0 +1,1 @@
+"""Studies that run the chain several times, e.g. the bearing configurations of the test gearbox (Sec. 5.8)."""
