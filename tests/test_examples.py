@@ -140,13 +140,18 @@ def test_bearing_example_hertz_ratio_is_three_halves(bearing_run):
     printed = [line.split() for line in stdout.splitlines() if line.strip().startswith("radial, zero clearance")
                and line.split()[3] == "y"]
     assert printed and float(printed[0][-1]) == pytest.approx(1.5, abs=5e-4)
+    # the radial clearance adds deflection (the play closes first) but no stiffness at the load: ratio > 1.5
+    row = _row(rows, "radial, catalogue", "y")
+    assert float(row["ratio_K_over_secant"]) > 1.6
+    assert abs(float(row["deflection_m_or_rad"])) > abs(float(_row(rows, "radial, zero clearance", "y")
+                                                               ["deflection_m_or_rad"]))
 
 
 def test_bearing_example_matrices_symmetric_and_catalogue_equals_explicit(bearing_run):
     """K is symmetric (conservative bearing) with a zero torsion row/column, and the explicit internal geometry
     in the example is the catalogue entry (same K to round-off)."""
     _, _, K = bearing_run
-    assert len(K) == 5
+    assert len(K) == 6
     for case, k in K.items():
         assert np.max(np.abs(k - k.T)) <= 1e-12 * np.max(np.abs(k)), case
         assert not np.any(k[5]) and not np.any(k[:, 5]), case
