@@ -321,3 +321,13 @@ def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) ->
     return parse_table(HousingScene, data, path), path
 
 
+def build_model_from_scene(scene: HousingScene, comm):
+    """The housing FE model (housingfe.fe.model.HousingModel) of a housing scene: build_model on the scene's
+    geometry, material, regions, supports, mesh spec and analysis.f_max; keeps the scene on the model for the
+    reports."""
+    from housingfe.fe.model import build_model
+
+    model = build_model(scene.geometry, scene.material.resolve(), scene.mesh, scene.analysis.f_max, comm,
+                        regions=scene.regions, supports=scene.supports)
+    model.scene = scene
+    return model

@@ -42,14 +42,13 @@ ROD_STIFFNESSES = (1e8, 1e10, 1e12)                    # N/m per rod
 def _model(quick: bool):
     from mpi4py import MPI
 
-    from housingfe.fe.model import build_model
-    from housingfe.scene import load_housing_scene
+    from housingfe.scene import build_model_from_scene, load_housing_scene
 
     f_max = 1500.0 if quick else 3000.0
     size = 0.03 if quick else 0.02
     scene, _ = load_housing_scene("gearbox-model", [f"mesh.size={size}", f"analysis.modal.f_max={f_max}"])
     t0 = time.perf_counter()
-    model = build_model(scene, MPI.COMM_WORLD)
+    model = build_model_from_scene(scene, MPI.COMM_WORLD)
     return model, f_max, time.perf_counter() - t0
 
 

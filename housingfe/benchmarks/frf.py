@@ -20,11 +20,10 @@ VARIANTS = [(1.0, False), (1.0, True), (1.5, False), (1.5, True), (2.0, False), 
 def _model(overrides):
     from mpi4py import MPI
 
-    from housingfe.fe.model import build_model
-    from housingfe.scene import load_housing_scene
+    from housingfe.scene import build_model_from_scene, load_housing_scene
 
     scene, _ = load_housing_scene("box-free-frf", overrides)
-    return scene, build_model(scene, MPI.COMM_WORLD)
+    return scene, build_model_from_scene(scene, MPI.COMM_WORLD)
 
 
 def _bands(resp, f_lo, f_hi):
@@ -46,7 +45,7 @@ def accuracy_study(quick: bool) -> tuple[list, dict]:
     spec = scene.analysis.harmonic
     loads = [assemble_load(load, model.housing, model.V, model.bcs) for load in scene.loads]
     observer = SurfaceObserver(model, spec.surface, [], loads)
-    damping = damping_model(scene, model)
+    damping = damping_model(scene.damping, model)
     freqs = spec.frequencies
     t0 = time.perf_counter()
     direct = responses(harmonic.direct(model.K, model.M, loads, freqs, damping, observer.reduce), observer, loads)
@@ -88,7 +87,7 @@ def speed_study(quick: bool) -> list:
     t0 = time.perf_counter()
     observer = SurfaceObserver(model, spec.surface, spec.sample_points, loads)
     t_obs = time.perf_counter() - t0
-    damping = damping_model(scene, model)
+    damping = damping_model(scene.damping, model)
     freqs = spec.frequencies
     t0 = time.perf_counter()
     modes = modal.solve_modes(model.K, model.M, spec.modal_basis_factor * spec.f_max)

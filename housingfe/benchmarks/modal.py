@@ -58,15 +58,14 @@ def run_housingfe_case(case: dict) -> dict:
     t0 = time.perf_counter()
     from mpi4py import MPI
 
-    from housingfe.fe.model import build_model
-    from housingfe.scene import load_housing_scene
+    from housingfe.scene import build_model_from_scene, load_housing_scene
     from housingfe.solvers import modal
 
     overrides = [f"mesh.element=\"{case['element']}\"", f"mesh.degree={case['degree']}",
                  f"mesh.size={case['size']}", f"mesh.layers={case['layers']}",
                  f"analysis.modal.f_max={SOLVE_TO}"]
     scene, _ = load_housing_scene("box-free", overrides)
-    model = build_model(scene, MPI.COMM_WORLD)
+    model = build_model_from_scene(scene, MPI.COMM_WORLD)
     result = modal.solve_modes(model.K, model.M, SOLVE_TO)
     freqs = result.frequencies_hz[result.rigid_count:]
     return {"dofs": model.dofs, "frequencies_hz": freqs.tolist(), "complete": result.complete,

@@ -318,6 +318,8 @@ def rigid_bore_modes(spec: CouplingSpec, centres: dict, f_max: float) -> RigidBo
     from housingfe.solvers.modal import RIGID_FREQUENCY_RATIO
 
     K, M, Kb, _ = interior_matrices(_check(spec), centres)
+    if not len(K):      # no shafts: bearings between bores and ground only, nothing moves on rigid bores
+        return RigidBoreModes(np.zeros(0), np.zeros(0), 0, 0)
     K, Kb = (K + K.T) / 2, (Kb + Kb.T) / 2
     lam, vecs = sl.eigh(K, M, subset_by_value=(-np.inf, (2 * np.pi * f_max) ** 2))
     f = np.sqrt(np.clip(lam, 0.0, None)) / (2 * np.pi)
@@ -353,6 +355,59 @@ class CoupledInterior:
     @property
     def C(self):
         return self.system.C
+
+    # ---------------------------------------------- the Structure protocol (housingfe.fe.structure)
+    @property
+    def dofs(self) -> int:
+        return self.system.size
+
+    @property
+    def expected_zero_modes(self) -> int:
+        return self.expected_mechanisms()
+
+    @property
+    def housing(self):
+        return self.model.housing
+
+    @property
+    def V(self):
+        return self.model.V
+
+    @property
+    def symmetric(self) -> bool:
+        """False with a non-symmetric bearing stiffness (fluid films)."""
+        return self.system.symmetric
+
+    def load_case(self, load, key: str | None = None):
+        """The LoadCase (coupled vector, per unit amplitude) of a load spec: on a drivetrain node (load.node)
+        or on a housing surface (mapped to the coupled DOFs)."""
+        from housingfe.fe.loads import LoadCase
+
+        if getattr(load, "node", None) is not None:
+            vec = self.node_load(load.node, load.kind, load.direction, f"{key or 'loads'}.node")
+            return LoadCase(load.name, load.kind, vec, load, 0.0, self.system.nodes[load.node][0])
+        lc = self.model.load_case(load, key)
+        lc.vector = self.system.load(fe_load=lc.vector)
+        return lc
+
+    def load_vector(self, load):
+        """Coupled load vector (PETSc Vec, per unit amplitude) of a load spec."""
+        return self.load_case(load).vector
+
+    def to_housing(self, vec):
+        """The housing displacement field of a coupled vector (= fe_vector)."""
+        return self.fe_vector(vec)
+
+    def node_displacement(self, q, node: str) -> np.ndarray:
+        """Six displacement components (m, rad) of an interior node in the coupled vector q."""
+        return self.system.node_displacement(q, node)
+
+    def material_damping_matrix(self):
+        """Per-material loss factors are not mapped to the coupled DOFs: None without them, else InputError."""
+        if self.model.material_damping_matrix() is not None:
+            raise InputError("damping: per-material loss factors are not mapped to the coupled model yet; give "
+                             "damping.loss_factor or damping.modal_damping_ratio")
+        return None
 
     def basis_stiffness(self):
         """A symmetric positive semi-definite stand-in for K, for the modal basis of the projected solver: every

@@ -1,6 +1,8 @@
-"""The FE model of a housing scene: mesh, displacement space, boundary conditions, K and M.
+"""The FE model of a housing: mesh, displacement space, boundary conditions, K and M.
 
-Builds only what the scene needs: the element size follows from the highest frequency of interest.
+Builds only what the analysis needs: the element size follows from the highest frequency of interest.  Takes
+explicit inputs (geometry, material, regions, supports, mesh spec, f_max); the scene-level entry point is
+housingfe.scene.build_model_from_scene.
 """
 from __future__ import annotations
 
@@ -11,7 +13,6 @@ from housingfe.errors import InputError
 from housingfe.geometry import HousingMesh, build_mesh
 from housingfe.geometry.mesh import bending_wavelength
 from housingfe.materials import Material
-from housingfe.scene import HousingScene
 
 # Elements that fail this quality are rejected before any solve (hex: scaled Jacobian, tet: shape ratio).
 MIN_ELEMENT_QUALITY = 0.05
@@ -26,11 +27,11 @@ MEMORY_PER_DOF_BYTES = 13e3
 
 @dataclass
 class HousingModel:
-    """Everything the solvers need.  K, M are PETSc matrices with Dirichlet rows eliminated
-    (1 on K's diagonal, 0 on M's); rigid_modes_expected is 6 for a free structure, else 0 (partial
-    supports may still leave mechanisms, which the modal result counts)."""
+    """Everything the solvers need; a housingfe.fe.structure.Structure.  K, M are PETSc matrices with Dirichlet
+    rows eliminated (1 on K's diagonal, 0 on M's); rigid_modes_expected is 6 for a free structure, else 0
+    (partial supports may still leave mechanisms, which the modal result counts).  `scene`: the housing scene
+    it was built from, when built by housingfe.scene.build_model_from_scene (for the reports only)."""
 
-    scene: HousingScene
     housing: HousingMesh
     material: Material
     V: object
@@ -40,41 +41,95 @@ class HousingModel:
     rigid_modes_expected: int
     timings: dict = field(default_factory=dict)
     materials: object = None
+    scene: object = None
+    element_degree: int = 2
+
+    # ----------------------------------------------------------------------- the Structure protocol
+    C = None               # no viscous damping matrix on the bare housing
+    symmetric = True       # K is symmetric (linear elasticity)
 
     @property
     def dofs(self) -> int:
         return self.V.dofmap.index_map.size_global * self.V.dofmap.index_map_bs
 
+    @property
+    def expected_zero_modes(self) -> int | None:
+        """6 rigid-body modes for a free housing; None when supported (partial supports may leave mechanisms)."""
+        return self.rigid_modes_expected or None
 
-def element_size(scene: HousingScene, material: Material) -> float:
-    """Element size (m): explicit, or the bending wavelength of the thinnest wall at f_max divided by
-    elements_per_wavelength."""
-    if scene.mesh.size is not None:
-        return scene.mesh.size
-    wavelength = bending_wavelength(scene.analysis.f_max, scene.geometry.min_thickness,
+    def load_case(self, load, key: str | None = None):
+        """The housingfe.fe.loads.LoadCase (unit-amplitude vector, N per unit load) of a surface load spec."""
+        from housingfe.fe.loads import assemble_load
+
+        if getattr(load, "node", None) is not None:
+            raise InputError(f"{key or 'loads'}.node: node loads need a drivetrain interior ([coupling])")
+        return assemble_load(load, self.housing, self.V, self.bcs)
+
+    def load_vector(self, load):
+        """Load vector (PETSc Vec, N per unit amplitude) of a surface load spec."""
+        return self.load_case(load).vector
+
+    def to_housing(self, vec):
+        """The housing field of a vector in this model's DOFs: the vector itself."""
+        return vec
+
+    def basis_stiffness(self):
+        """The symmetric stiffness for a modal basis: K itself."""
+        return self.K
+
+    def material_damping_matrix(self):
+        """K_eta = int eta sigma:eps dx from the per-material loss factors (PETSc Mat, N/m), None if all are 0."""
+        import numpy as np
+        from dolfinx.fem.petsc import assemble_matrix
+        from mpi4py import MPI
+
+        from housingfe.solvers.elasticity import stiffness_form
+
+        eta = self.materials.eta
+        if self.V.mesh.comm.allreduce(float(np.abs(eta.x.array).max(initial=0.0)), op=MPI.MAX) == 0.0:
+            return None
+        D = assemble_matrix(stiffness_form(self.V, self.materials, weight=eta), bcs=self.bcs, diagonal=0.0)
+        D.assemble()
+        return D
+
+
+def element_size(mesh, geometry, f_max: float, material: Material) -> float:
+    """Element size (m): explicit mesh.size, or the bending wavelength of the geometry's thinnest wall at f_max
+    (Hz) divided by mesh.elements_per_wavelength.  mesh: a housingfe.scene.MeshSpec; geometry: a geometry spec."""
+    if mesh.size is not None:
+        return mesh.size
+    wavelength = bending_wavelength(f_max, geometry.min_thickness,
                                     material.youngs_modulus, material.poisson_ratio, material.density)
-    return wavelength / scene.mesh.elements_per_wavelength
+    return wavelength / mesh.elements_per_wavelength
 
 
-def build_model(scene: HousingScene, comm) -> HousingModel:
-    """Mesh the scene's geometry and assemble K and M."""
+def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regions: dict | None = None,
+                supports=()) -> HousingModel:
+    """Mesh a housing geometry and assemble K and M.
+
+    geometry: a geometry spec (housingfe.geometry.specs); material: the housing's Material (SI); mesh: a
+    housingfe.scene.MeshSpec (element, degree, size or elements_per_wavelength, layers, allow_large); f_max: the
+    highest frequency of interest (Hz), which sets the element size when mesh.size is not given; regions: cell
+    group name -> Material (or a material spec with .resolve()) overriding `material` there; supports: support
+    specs (kind fixed | normal | elastic, surface, stiffnesses in N/m^3)."""
     from housingfe.solvers import elasticity
 
-    material = scene.material.resolve()
-    size = element_size(scene, material)
-    check_model_size(scene, size, comm)
-    housing = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, comm)
+    regions = dict(regions or {})
+    size = element_size(mesh, geometry, f_max, material)
+    check_model_size(geometry, mesh, size, comm)
+    housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm)
     if housing.quality["min"] < MIN_ELEMENT_QUALITY:
         raise InputError(f"mesh: element quality {housing.quality['min']:.3f} < {MIN_ELEMENT_QUALITY} "
                          f"({housing.quality['measure']}); change mesh.size or mesh.element")
     t0 = time.perf_counter()
-    V = elasticity.displacement_space(housing.mesh, scene.mesh.degree)
-    materials = material_field(scene, housing, material)
-    bcs = boundary_conditions(scene, housing, V)
-    K, M = elasticity.assemble_stiffness_mass(V, materials, bcs, foundation_forms(scene, housing, V))
+    V = elasticity.displacement_space(housing.mesh, mesh.degree)
+    materials = material_field(regions, housing, material)
+    bcs = boundary_conditions(supports, geometry, housing, V)
+    K, M = elasticity.assemble_stiffness_mass(V, materials, bcs, foundation_forms(supports, housing, V))
     timings = {"mesh_s": housing.mesh_time_s, "assembly_s": time.perf_counter() - t0}
-    free = not bcs and not any(s.kind == "elastic" for s in scene.supports)
-    return HousingModel(scene, housing, material, V, bcs, K, M, 6 if free else 0, timings, materials)
+    free = not bcs and not any(s.kind == "elastic" for s in supports)
+    return HousingModel(housing, material, V, bcs, K, M, 6 if free else 0, timings, materials,
+                        element_degree=mesh.degree)
 
 
 def available_memory_bytes() -> tuple[int, int]:
@@ -90,21 +145,20 @@ def available_memory_bytes() -> tuple[int, int]:
     return info.get("MemAvailable", info.get("MemFree", 0)), info.get("MemTotal", 0)
 
 
-def check_model_size(scene: HousingScene, size: float, comm) -> dict:
+def check_model_size(geometry, mesh, size: float, comm) -> dict:
     """Estimate DOFs and peak memory before meshing (housingfe.geometry.mesh.estimate_dofs, MEMORY_*) and raise
     InputError in one line when the estimate exceeds the memory available on this machine (MemAvailable of
     /proc/meminfo; all ranks of a run share the machine), unless mesh.allow_large is set.  The message names
     the element size, its key, and the geometry's largest dimension.  Returns the estimate."""
     from housingfe.geometry.mesh import estimate_dofs
 
-    mesh = scene.mesh
-    dofs = estimate_dofs(scene.geometry, mesh.element, mesh.degree, size, mesh.layers)
+    dofs = estimate_dofs(geometry, mesh.element, mesh.degree, size, mesh.layers)
     need = MEMORY_BASE_BYTES * comm.size + MEMORY_PER_DOF_BYTES * dofs
     available, total = comm.bcast(available_memory_bytes() if comm.rank == 0 else None, root=0)
     estimate = {"dofs": dofs, "memory_bytes": need, "available_bytes": available, "total_bytes": total}
     if available and need > available and not mesh.allow_large:
         size_key = "mesh.size" if mesh.size is not None else "mesh.elements_per_wavelength"
-        lengths = {k: v for k, v in scene.geometry.model_dump().items()
+        lengths = {k: v for k, v in geometry.model_dump().items()
                    if isinstance(v, float) and not isinstance(v, bool)}
         largest = max(lengths, key=lengths.get) if lengths else None
         dims = f" (largest dimension: geometry.{largest} = {lengths[largest]:g} m)" if largest else ""
@@ -115,19 +169,19 @@ def check_model_size(scene: HousingScene, size: float, comm) -> dict:
     return estimate
 
 
-def material_field(scene: HousingScene, housing: HousingMesh, default: Material):
-    """Per-cell material properties: the scene material, overridden in the named regions."""
+def material_field(regions: dict, housing: HousingMesh, default: Material):
+    """Per-cell material properties: `default`, overridden in the named regions (name -> Material or spec)."""
     from housingfe.solvers.elasticity import MaterialField
 
     groups = {}
-    for name, spec in scene.regions.items():
+    for name, spec in regions.items():
         if name not in housing.cell_groups:
             raise InputError(f"regions.{name}: no such cell group (known: {', '.join(sorted(housing.cell_groups))})")
-        groups[housing.cell_groups[name]] = spec.resolve()
+        groups[housing.cell_groups[name]] = spec if isinstance(spec, Material) else spec.resolve()
     return MaterialField(housing.mesh, default, housing.cell_tags, groups)
 
 
-def foundation_forms(scene: HousingScene, housing: HousingMesh, V) -> list:
+def foundation_forms(supports, housing: HousingMesh, V) -> list:
     """Stiffness forms of the elastic supports."""
     import ufl
 
@@ -135,7 +189,7 @@ def foundation_forms(scene: HousingScene, housing: HousingMesh, V) -> list:
 
     forms = []
     ds = ufl.Measure("ds", domain=housing.mesh, subdomain_data=housing.facet_tags)
-    for i, support in enumerate(scene.supports):
+    for i, support in enumerate(supports):
         if support.kind == "elastic":
             tags = _surface_tags(housing, support.surface, f"supports[{i}].surface")
             forms.append(foundation_form(V, ds(tags), support.normal_stiffness, support.tangential_stiffness or 0.0))
@@ -148,12 +202,12 @@ def _surface_tags(housing: HousingMesh, name: str, key: str) -> tuple[int, ...]:
     return housing.facet_tag_values(name)
 
 
-def boundary_conditions(scene: HousingScene, housing: HousingMesh, V) -> list:
-    """Dirichlet conditions the scene asks for: supports (fixed / normal) and plate edge conditions."""
+def boundary_conditions(supports, geometry, housing: HousingMesh, V) -> list:
+    """Dirichlet conditions: supports (fixed / normal) and the plate geometry's edge conditions."""
     from housingfe.solvers.elasticity import clamp_bc
 
     bcs = []
-    for i, support in enumerate(scene.supports):
+    for i, support in enumerate(supports):
         if support.kind == "elastic":
             continue
         _surface_tags(housing, support.surface, f"supports[{i}].surface")
@@ -162,7 +216,6 @@ def boundary_conditions(scene: HousingScene, housing: HousingMesh, V) -> list:
             bcs += clamp_bc(V, facets)
         else:
             bcs += clamp_bc(V, facets, components=(_normal_axis(housing, facets, f"supports[{i}]"),))
-    geometry = scene.geometry
     if geometry.kind == "plate":
         for edge, condition in geometry.edges.model_dump().items():
             facets = housing.facets(f"edge_{edge}")

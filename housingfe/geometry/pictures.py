@@ -21,7 +21,7 @@ def mesh_picture(scene_name: str, path: Path) -> None:
     from housingfe.scene import load_housing_scene
 
     scene, _ = load_housing_scene(scene_name)
-    size = element_size(scene, scene.material.resolve())
+    size = element_size(scene.mesh, scene.geometry, scene.analysis.f_max, scene.material.resolve())
     hm = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, MPI.COMM_SELF)
     topology, cell_types, x = plot.create_vtk_mesh(hm.mesh, hm.mesh.topology.dim)
     grid = pyvista.UnstructuredGrid(topology, cell_types, x)

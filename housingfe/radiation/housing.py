@@ -58,9 +58,9 @@ def radiation_points(model, spec):
     return SamplePoints(np.concatenate(pts), np.concatenate(nrm), np.concatenate(w)), ids.ravel()
 
 
-def sound_power(forced, model, plate_ids=None) -> list[HousingSoundPower]:
-    """Sound power of every load case of a ForcedResult (the first solver's responses)."""
-    spec = model.scene.radiation
+def sound_power(forced, model, spec, plate_ids=None) -> list[HousingSoundPower]:
+    """Sound power of every load case of a ForcedResult (the first solver's responses); spec: the radiation
+    spec (housingfe.scene.RadiationSpec); plate_ids: from radiation_points (numerical model)."""
     solver = next(iter(forced.responses))
     area = forced.observer.area
     plates = housing_plates(model, spec) if spec.model == "foller" else []

@@ -1,4 +1,5 @@
-"""The harmonic analysis of a scene: loads -> solver(s) -> responses, with the solver chosen per problem."""
+"""The harmonic analysis of a housing run: load specs on a Structure -> solver(s) -> unit-load responses per load
+case, with the solver chosen per problem.  Takes explicit specs (no scene); the sound power is a later stage."""
 from __future__ import annotations
 
 import time
@@ -6,8 +7,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from housingfe.fe.loads import assemble_load
-from housingfe.response.observers import SurfaceObserver, responses
+from housingfe.response.observers import responses
 from housingfe.solvers import harmonic, modal
 
 
@@ -23,7 +23,7 @@ class ForcedResult:
     timings: dict = field(default_factory=dict)
     facts: dict = field(default_factory=dict)
     sound_power: list | None = None
-    to_fe: object = None          # q -> housing vector (coupled models), for deflection shapes
+    to_fe: object = None          # structure.to_housing: solver vector -> housing vector, for deflection shapes
     angular_velocity_node: str | None = None
     response_points: list = field(default_factory=list)      # housingfe.response.observers.ResponsePoint
     deflection_shapes: list = field(default_factory=list)    # DeflectionShape, scaled by the load amplitude
@@ -42,9 +42,9 @@ class DeflectionShape:
     solver: str
 
 
-def damping_model(scene, model) -> harmonic.Damping:
-    """Damping of the scene: global eta, eta per band, modal xi, or per-material eta (matrix D)."""
-    spec = scene.damping
+def damping_model(spec, structure) -> harmonic.Damping:
+    """Damping of a DampingSpec (housingfe.scene): global eta, eta per band, modal xi, or per-material eta (the
+    structure's material damping matrix D)."""
     if spec.loss_factor is not None:
         eta = spec.loss_factor
         return harmonic.Damping(lambda f: np.full(np.shape(f), eta))
@@ -56,31 +56,10 @@ def damping_model(scene, model) -> harmonic.Damping:
         return harmonic.Damping(lambda f: np.zeros(np.shape(f)), modal_ratios=tuple(spec.modal_damping_ratios))
     if spec.modal_damping_ratio is not None:
         return harmonic.Damping(lambda f: np.zeros(np.shape(f)), modal_ratio=spec.modal_damping_ratio)
-    D = _material_damping_matrix(model)
-    return harmonic.Damping(lambda f: np.zeros(np.shape(f)), D=D)
+    return harmonic.Damping(lambda f: np.zeros(np.shape(f)), D=structure.material_damping_matrix())
 
 
-def _material_damping_matrix(model):
-    """K_eta = int eta sigma:eps dx from per-material loss factors (None if all are zero)."""
-    from dolfinx.fem.petsc import assemble_matrix
-
-    from housingfe.solvers.elasticity import stiffness_form
-
-    eta = model.materials.eta
-    if model.V.mesh.comm.allreduce(float(np.abs(eta.x.array).max(initial=0.0)), op=_max()) == 0.0:
-        return None
-    D = assemble_matrix(stiffness_form(model.V, model.materials, weight=eta), bcs=model.bcs, diagonal=0.0)
-    D.assemble()
-    return D
-
-
-def _max():
-    from mpi4py import MPI
-
-    return MPI.MAX
-
-
-def choose_solver(spec, damping: harmonic.Damping, interior=None) -> list[str]:
+def choose_solver(spec, damping: harmonic.Damping, structure=None) -> list[str]:
     """Solvers to run: 'auto' is modal for proportional damping, direct when a non-proportional damping
     matrix (material loss factors, bearing damping) or a non-symmetric stiffness (fluid films) is present."""
     from housingfe.errors import InputError
@@ -88,7 +67,7 @@ def choose_solver(spec, damping: harmonic.Damping, interior=None) -> list[str]:
     if damping.modal_ratios and spec.solver in ("direct", "both"):
         raise InputError("damping.modal_damping_ratios: per-mode damping exists only in the modal solver; "
                          "use solver = \"modal\" or a loss factor")
-    non_modal = interior is not None and (interior.C is not None or not interior.system.symmetric)
+    non_modal = structure is not None and (structure.C is not None or not getattr(structure, "symmetric", True))
     if non_modal and spec.solver == "modal":
         raise InputError("analysis.harmonic.solver: the interior has bearing damping or a non-symmetric "
                          "stiffness, which the modal solver cannot take; use \"projected\", \"direct\" or \"auto\"")
@@ -101,37 +80,25 @@ def choose_solver(spec, damping: harmonic.Damping, interior=None) -> list[str]:
     return [spec.solver]
 
 
-def assemble_loads(model, interior=None) -> list:
-    """The scene's load cases in the solver's DOFs: housing loads (FE vectors, mapped to the coupled DOFs when
-    there is an interior) and loads on interior nodes."""
-    from housingfe.fe.loads import LoadCase
-
-    out = []
-    for i, load in enumerate(model.scene.loads):
-        if load.node is not None:
-            vec = interior.node_load(load.node, load.kind, load.direction, f"loads.{i}.node")
-            out.append(LoadCase(load.name, load.kind, vec, load, 0.0, interior.system.nodes[load.node][0]))
-            continue
-        lc = assemble_load(load, model.housing, model.V, model.bcs)
-        if interior is not None:
-            lc.vector = interior.system.load(fe_load=lc.vector)
-        out.append(lc)
-    return out
+def assemble_loads(structure, loads) -> list:
+    """The load cases (housingfe.fe.loads.LoadCase) of load specs in the structure's DOFs (housing surface loads,
+    and loads on drivetrain nodes for a coupled structure)."""
+    return [structure.load_case(load, f"loads.{i}") for i, load in enumerate(loads)]
 
 
-def run(model, spec, interior=None) -> ForcedResult:
+def run(structure, spec, loads, damping, *, extra_points: dict | None = None) -> ForcedResult:
     """Assemble the loads, run the chosen solver(s) on spec.frequencies and evaluate the responses.
-    interior: the coupled interior (housingfe.drivetrain.interior.CoupledInterior) or None for the housing alone."""
-    from housingfe.response.observers import CoupledObserver
 
-    scene = model.scene
+    structure: a housingfe.fe.structure.Structure (the housing model, or the housing coupled with its interior);
+    spec: the harmonic spec (housingfe.scene.HarmonicSpec); loads: load specs (housingfe.scene.LoadSpec); damping:
+    a housingfe.scene.DampingSpec; extra_points: named point sets whose complex displacements are kept per line
+    (e.g. the radiating facets for the numerical radiation model: housingfe.radiation.housing.radiation_points).
+    The sound power is not computed here (housingfe.radiation)."""
+    from housingfe.response.harmonic import StructureObserver
+
     t0 = time.perf_counter()
-    loads = assemble_loads(model, interior)
-    extra, plate_ids = {}, None
-    if scene.radiation is not None and scene.radiation.model == "numerical":
-        from housingfe.radiation.housing import RADIATION_POINTS, radiation_points
-
-        extra[RADIATION_POINTS], plate_ids = radiation_points(model, scene.radiation)
+    loads = assemble_loads(structure, loads)
+    extra = dict(extra_points or {})
     if spec.points:
         from housingfe.response.observers import (
             RESPONSE_POINTS,
@@ -139,30 +106,21 @@ def run(model, spec, interior=None) -> ForcedResult:
             response_point_samples,
         )
 
-        points = locate_response_points(model.housing, spec.points)
+        points = locate_response_points(structure.housing, spec.points)
         extra[RESPONSE_POINTS] = response_point_samples(points)
     else:
         points = []
-    if interior is None:
-        observer = SurfaceObserver(model, spec.surface, spec.sample_points, loads, extra)
-        K, M, C = model.K, model.M, None
-    else:
-        nodes = [spec.angular_velocity_node] if spec.angular_velocity_node else []
-        for node in nodes:
-            interior.shaft_axis(node)     # a clear error for a node that is not on a shaft
-        observer = CoupledObserver(interior, spec.surface, spec.sample_points, loads, extra, nodes)
-        K, M, C = interior.K, interior.M, interior.C
-    damping = damping_model(scene, model)
-    if interior is not None and damping.D is not None:
-        from housingfe.errors import InputError
-
-        raise InputError("damping: per-material loss factors are not mapped to the coupled model yet; give "
-                         "damping.loss_factor or damping.modal_damping_ratio")
+    nodes = [spec.angular_velocity_node] if spec.angular_velocity_node else []
+    for node in nodes:
+        structure.shaft_axis(node)     # a clear error for a node that is not on a shaft
+    observer = StructureObserver(structure, spec.surface, spec.sample_points, loads, extra, nodes)
+    K, M, C = structure.K, structure.M, structure.C
+    damping = damping_model(damping, structure)
     freqs = spec.frequencies
     timings = {"loads_and_observer_s": time.perf_counter() - t0}
     facts = {"frequencies": len(freqs), "df_hz": spec.df, "surface_area_m2": observer.area}
     results, resp = {}, {}
-    for solver in choose_solver(spec, damping, interior):
+    for solver in choose_solver(spec, damping, structure):
         t1 = time.perf_counter()
         if solver == "modal":
             f_basis = spec.modal_basis_factor * spec.f_max
@@ -179,7 +137,7 @@ def run(model, spec, interior=None) -> ForcedResult:
             name = result.solver
         elif solver == "projected":
             f_basis = spec.modal_basis_factor * spec.f_max
-            K_sym = K if interior is None or interior.system.symmetric else interior.basis_stiffness()
+            K_sym = K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
             modes = modal.solve_modes(K_sym, M, f_basis)
             timings["modal_eigensolve_s"] = time.perf_counter() - t1
             facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
@@ -192,24 +150,18 @@ def run(model, spec, interior=None) -> ForcedResult:
         timings[f"{name}_s"] = time.perf_counter() - t1
         results[name], resp[name] = result, responses(result, observer, loads)
     forced = ForcedResult(spec, loads, resp, observer, results, timings, facts,
-                          to_fe=None if interior is None else interior.fe_vector,
+                          to_fe=structure.to_housing,
                           angular_velocity_node=spec.angular_velocity_node, response_points=points)
     if spec.deflection_shapes_hz:
         t1 = time.perf_counter()
         forced.deflection_shapes = deflection_shapes(forced, K, M, damping, C)
         timings["deflection_shapes_s"] = time.perf_counter() - t1
     if spec.angular_velocity_node:
-        add_angular_velocity_transfer(forced, interior)
-    if scene.radiation is not None:
-        from housingfe.radiation.housing import sound_power
-
-        t1 = time.perf_counter()
-        forced.sound_power = sound_power(forced, model, plate_ids)
-        timings["radiation_s"] = time.perf_counter() - t1
+        add_angular_velocity_transfer(forced, structure)
     return forced
 
 
-def add_angular_velocity_transfer(forced: ForcedResult, interior) -> None:
+def add_angular_velocity_transfer(forced: ForcedResult, structure) -> None:
     """TF_omega = L_v - L_omega (dB, v0 = omega0 = 5e-8, thesis eq. 5.5) per load response, with omega the
     angular velocity of `angular_velocity_node` about its shaft axis; stored in response.extras as
     "L_omega_dB" (per unit load) and "TF_omega_dB"."""
@@ -217,7 +169,7 @@ def add_angular_velocity_transfer(forced: ForcedResult, interior) -> None:
     from housingfe.response.observers import node_key
 
     node = forced.angular_velocity_node
-    axis = interior.shaft_axis(node)
+    axis = structure.shaft_axis(node)
     for resps in forced.responses.values():
         for r in resps:
             theta = axis @ r.extras["point_values"][node_key(node)][3:6]

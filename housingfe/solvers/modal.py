@@ -234,3 +234,48 @@ def _mult(M: PETSc.Mat, x: PETSc.Vec) -> PETSc.Vec:
     y = M.createVecLeft()
     M.mult(x, y)
     return y
+
+
+# ------------------------------------------------------------------------------------ the stage API
+@dataclass
+class ModalBasis(ModalResult):
+    """A ModalResult plus the structure (housingfe.fe.structure.Structure) it belongs to: the input of
+    housingfe.response.harmonic.harmonic_response and of the modal reports."""
+
+    structure: object = None
+
+    @property
+    def expected_zero_modes(self) -> int | None:
+        return self.structure.expected_zero_modes
+
+    def check_zero_modes(self) -> None:
+        """SolverError unless the rigid-body / mechanism count equals the structure's expected_zero_modes
+        (no check when the structure does not know it, e.g. partial supports)."""
+        expected = self.expected_zero_modes
+        if expected is not None and self.rigid_count != expected:
+            raise SolverError(f"the model must have {expected} rigid-body / mechanism modes, found "
+                              f"{self.rigid_count}: lowest frequencies "
+                              f"{np.round(self.frequencies_hz[:expected + 1], 4).tolist()} Hz")
+
+    def to_housing(self) -> ModalResult:
+        """The same modes as housing FE fields (structure.to_housing of every vector), for the housing reports."""
+        import dataclasses
+
+        return ModalResult(**{f.name: getattr(self, f.name) for f in dataclasses.fields(ModalResult)
+                              if f.name != "vectors"},
+                           vectors=[self.structure.to_housing(x) for x in self.vectors])
+
+
+def modes(structure, f_max: float, *, tol: float = 1e-10, check: bool = True) -> ModalBasis:
+    """All modes of a structure (housingfe.fe.structure.Structure: K, M, expected_zero_modes) below f_max (Hz),
+    complete by the inertia count (solve_modes; SolverError if not).  Eigenvalues in rad^2/s^2, vectors
+    mass-normalised in the structure's DOFs.  check: also raise SolverError when the number of zero modes is
+    not the structure's expected_zero_modes (ModalBasis.check_zero_modes)."""
+    import dataclasses
+
+    result = solve_modes(structure.K, structure.M, f_max, tol=tol)
+    basis = ModalBasis(**{f.name: getattr(result, f.name) for f in dataclasses.fields(ModalResult)},
+                       structure=structure)
+    if check:
+        basis.check_zero_modes()
+    return basis

@@ -206,9 +206,8 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
     from housingfe import levels, outputs
     from housingfe.bearings.configurations import configurations
     from housingfe.drivetrain.interior import build_interior
-    from housingfe.fe.model import build_model
     from housingfe.response import forced as forced_response
-    from housingfe.scene import load_housing_scene
+    from housingfe.scene import build_model_from_scene, load_housing_scene
 
     t_start = time.perf_counter()
     scene, _ = load_housing_scene(scene_name, list(overrides))
@@ -217,7 +216,7 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
                          "analysis.harmonic.angular_velocity_node")
     configs = list(configs or [*configurations(), THESIS_SELF_ALIGNING, APPENDIX_C_MOMENTS])
     comm = MPI.COMM_WORLD
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     t_model = time.perf_counter() - t_start
     spec = scene.analysis.harmonic
     results = {}
@@ -225,7 +224,7 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
         t0 = time.perf_counter()
         cspec, loads, forces = configuration_spec(scene.coupling, name, torque)
         interior = build_interior(model, cspec, spec.modal_basis_factor * spec.f_max)
-        forced = forced_response.run(model, spec, interior)
+        forced = forced_response.run(interior, spec, scene.loads, scene.damping)
         solver = next(iter(forced.responses))
         r = forced.responses[solver][0]
         omega2 = r.extras["omega_mean_square"]

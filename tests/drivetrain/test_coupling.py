@@ -20,7 +20,7 @@ from housingfe.drivetrain import coupling as cp
 from housingfe.drivetrain import interior
 from housingfe.drivetrain.shafts import CircularSection, RigidDisc, Shaft
 from housingfe.errors import InputError
-from housingfe.fe.model import build_model
+from housingfe.scene import build_model_from_scene
 from housingfe.solvers import elasticity, harmonic, modal
 from tests.conftest import load_scene
 
@@ -38,12 +38,12 @@ def block_scene(E, *extra, rho=RHO):
 @pytest.fixture(scope="module")
 def stiff_block(comm):
     """A block 100x stiffer than steel: its first elastic mode is far above the spring modes."""
-    return build_model(block_scene(2.1e13), comm)
+    return build_model_from_scene(block_scene(2.1e13), comm)
 
 
 @pytest.fixture(scope="module")
 def steel_block(comm):
-    return build_model(block_scene(2.1e11), comm)
+    return build_model_from_scene(block_scene(2.1e11), comm)
 
 
 def rigid_block_frequencies(k6, master):
@@ -158,7 +158,7 @@ def test_pinned_shaft_on_bearings_matches_timoshenko(comm):
     """A shaft on two bearing springs (stiff radially/axially, free in tilt and spin) to masters tied by RBE2
     to a free block of 10^6 kg (rigid up to ~10 kHz): the pinned-pinned Timoshenko bending frequency; seven
     rigid modes (the block's six and the shaft's spin)."""
-    model = build_model(block_scene(2.1e16, rho=1e9), comm)
+    model = build_model_from_scene(block_scene(2.1e16, rho=1e9), comm)
     L, d = 0.5, 0.02
     shaft = Shaft.stepped([(L / 2, d), (L / 2, d)], origin=(A / 2, B / 2, 0.0), axis=(1, 0, 0),
                           elements_per_segment=10)
@@ -183,7 +183,7 @@ def test_pinned_shaft_on_bearings_matches_timoshenko(comm):
 def test_gear_mesh_torsion(comm):
     """Two gears (rigid discs) on stiff supports, coupled by a mesh spring on the line of action:
     one rigid mode (the train turns) and omega^2 = k (r1^2/J1 + r2^2/J2)."""
-    model = build_model(block_scene(2.1e13, 'geometry.edges={x0="clamped", x1="clamped", y0="free", y1="free"}'),
+    model = build_model_from_scene(block_scene(2.1e13, 'geometry.edges={x0="clamped", x1="clamped", y0="free", y1="free"}'),
                         comm)
     r1, r2, k_mesh = 0.05, 0.08, 1e7
     g1, g2 = RigidDisc.cylinder(2 * r1, 0.02), RigidDisc.cylinder(2 * r2, 0.02)
@@ -289,7 +289,7 @@ def test_gearbox_with_real_bores(comm):
     found (inertia count)."""
     from housingfe.benchmarks.coupling import gearbox_parts
 
-    model = build_model(load_scene("gearbox-model", "mesh.size=0.04", "analysis.modal.f_max=600.0"), comm)
+    model = build_model_from_scene(load_scene("gearbox-model", "mesh.size=0.04", "analysis.modal.f_max=600.0"), comm)
     system = cp.couple(model, **gearbox_parts(model, "rbe2"))
     res = modal.solve_modes(system.K, system.M, 600.0)
     assert res.rigid_count == 7 and res.complete
@@ -446,7 +446,7 @@ def test_two_ranks_give_the_serial_answer(steel_block):
     env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OPENBLAS_NUM_THREADS": "1"}
     proc = subprocess.run([shutil.which("mpirun"), "-n", "2", sys.executable, "-m", "tests.drivetrain.test_coupling"],
-                          capture_output=True, text=True, env=env, timeout=300, cwd=Path(__file__).parents[1])
+                          capture_output=True, text=True, env=env, timeout=300, cwd=Path(__file__).parents[2])
     assert proc.returncode == 0, proc.stderr
     two = json.loads(proc.stdout.strip().splitlines()[-1])
     assert two["ranks"] == 2 and min(two["bore_nodes"]) > 0        # the bore is split between the ranks
@@ -465,6 +465,6 @@ def test_two_ranks_give_the_serial_answer(steel_block):
 if __name__ == "__main__":       # mpirun -n 2 python -m tests.drivetrain.test_coupling: the 2-rank half of the test above
     from mpi4py import MPI
 
-    result = mpi_case(build_model(block_scene(2.1e11), MPI.COMM_WORLD))
+    result = mpi_case(build_model_from_scene(block_scene(2.1e11), MPI.COMM_WORLD))
     if MPI.COMM_WORLD.rank == 0:
         print(json.dumps(result))

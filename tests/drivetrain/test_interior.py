@@ -111,14 +111,14 @@ def test_bad_interior_input():
 def gearbox_low(comm):
     """test-gearbox-interior on its own mesh at three low lines, modal solver."""
     from housingfe.drivetrain.interior import build_interior
-    from housingfe.fe.model import build_model
     from housingfe.response import forced as forced_response
+    from housingfe.scene import build_model_from_scene
 
     scene = load_scene("test-gearbox-interior", "analysis.harmonic.f_min=20.0", "analysis.harmonic.f_max=30.0",
                        "analysis.harmonic.df=5.0")
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     interior = build_interior(model, scene.coupling, 1500.0)
-    return scene, interior, forced_response.run(model, scene.analysis.harmonic, interior)
+    return scene, interior, forced_response.run(interior, scene.analysis.harmonic, scene.loads, scene.damping)
 
 
 def test_wheel_torque_turns_the_free_gear_train(gearbox_low):
@@ -146,8 +146,7 @@ def _variant_scene(tmp_path, comm, **harmonic):
     harmonic settings: (scene, model)."""
     import tomllib
 
-    from housingfe.fe.model import build_model
-    from housingfe.scene import load_housing_scene
+    from housingfe.scene import build_model_from_scene, load_housing_scene
     from housingfe.scenefile import SCENE_DIR
 
     with open(SCENE_DIR / "test-gearbox-interior.toml", "rb") as fh:
@@ -157,7 +156,7 @@ def _variant_scene(tmp_path, comm, **harmonic):
     path = tmp_path / "scene.toml"
     path.write_text(_toml(data))
     scene, _ = load_housing_scene(str(path))
-    return scene, build_model(scene, comm)
+    return scene, build_model_from_scene(scene, comm)
 
 
 def test_coupled_modal_matches_direct(comm, tmp_path):
@@ -169,7 +168,7 @@ def test_coupled_modal_matches_direct(comm, tmp_path):
     scene, model = _variant_scene(tmp_path, comm, f_min=300.0, f_max=600.0, df=100.0, solver="both",
                                   modal_basis_factor=3.0)
     interior = build_interior(model, scene.coupling, 1800.0)
-    forced = forced_response.run(model, scene.analysis.harmonic, interior)
+    forced = forced_response.run(interior, scene.analysis.harmonic, scene.loads, scene.damping)
     m, d = forced.responses["modal+residual"][0], forced.responses["direct"][0]
     assert np.max(np.abs(m.transfer_db - d.transfer_db)) < 0.05
     assert np.max(np.abs(m.extras["TF_omega_dB"] - d.extras["TF_omega_dB"])) < 0.05
@@ -184,11 +183,11 @@ def test_projected_solver_with_a_journal_bearing_matches_a_dense_solve(comm):
     from housingfe.bearings import JournalBearing, short_bearing_coefficients
     from housingfe.drivetrain import coupling as cp
     from housingfe.drivetrain.interior import nearest_psd
-    from housingfe.fe.model import build_model
+    from housingfe.scene import build_model_from_scene
     from housingfe.solvers import harmonic, modal
     from tests.drivetrain.test_coupling import BOTTOM_CENTRE, K_SPRING, block_scene
 
-    block = build_model(block_scene(2.1e13), comm)
+    block = build_model_from_scene(block_scene(2.1e13), comm)
     film = short_bearing_coefficients(JournalBearing(0.05, 0.025, 50e-6, 0.02), 300.0, (0.0, -1000.0))
     con = cp.BoreConnection("bore", "bottom", BOTTOM_CENTRE, (0, 0, 1), "rbe3")
     system = cp.couple(block, [con], [cp.bearing("bore", None, K_SPRING + film.K, (0, 0, 1), film.C)])

@@ -41,12 +41,12 @@ def test_guard_compares_with_available_memory_and_can_be_overridden(comm, monkey
     scene = load_scene("box-free", "mesh.size=0.04")
     monkeypatch.setattr(model_module, "available_memory_bytes", lambda: (10**8, 2 * 10**8))
     with pytest.raises(InputError, match="0.1 GB available"):
-        model_module.check_model_size(scene, 0.04, comm)
+        model_module.check_model_size(scene.geometry, scene.mesh, 0.04, comm)
     allowed = load_scene("box-free", "mesh.size=0.04", "mesh.allow_large=true")
-    estimate = model_module.check_model_size(allowed, 0.04, comm)
+    estimate = model_module.check_model_size(allowed.geometry, allowed.mesh, 0.04, comm)
     assert estimate["memory_bytes"] > 10**8
     monkeypatch.setattr(model_module, "available_memory_bytes", lambda: (64 * 10**9, 64 * 10**9))
-    assert model_module.check_model_size(scene, 0.04, comm)["dofs"] > 0
+    assert model_module.check_model_size(scene.geometry, scene.mesh, 0.04, comm)["dofs"] > 0
 
 
 @pytest.mark.parametrize("name, overrides, factor", [
@@ -55,10 +55,10 @@ def test_guard_compares_with_available_memory_and_can_be_overridden(comm, monkey
     ("test-gearbox-interior", (), 3.0),                # tetrahedra with round bores: a factor 3
 ])
 def test_dof_estimate_is_within_a_stated_factor_of_the_mesh(comm, name, overrides, factor):
-    from housingfe.fe.model import build_model
+    from housingfe.scene import build_model_from_scene
 
     scene = load_scene(name, *overrides)
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     m = scene.mesh
     estimate = estimate_dofs(scene.geometry, m.element, m.degree, model.housing.element_size, m.layers)
     assert 1 / factor < estimate / model.dofs < factor, (estimate, model.dofs)

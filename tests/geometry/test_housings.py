@@ -143,11 +143,11 @@ def test_bad_bore_names_the_parameter():
 def _frequencies(scene_name, *overrides):
     from mpi4py import MPI
 
-    from housingfe.fe.model import build_model
+    from housingfe.scene import build_model_from_scene
     from housingfe.solvers import modal
 
     scene = load_scene(scene_name, *overrides)
-    model = build_model(scene, MPI.COMM_WORLD)
+    model = build_model_from_scene(scene, MPI.COMM_WORLD)
     result = modal.solve_modes(model.K, model.M, scene.analysis.modal.f_max)
     return result.frequencies_hz[result.rigid_count:]
 
@@ -173,16 +173,17 @@ def test_stiff_joint_layer_converges_to_monolithic():
     are assembled on it."""
     from mpi4py import MPI
 
-    from housingfe.fe.model import build_model, material_field
+    from housingfe.fe.model import material_field
+    from housingfe.scene import build_model_from_scene
     from housingfe.solvers import elasticity, modal
 
     coarse = ("mesh.size=0.06", "analysis.modal.f_max=1600.0", "regions.joint.density=7850.0")
     mono = _frequencies("box-halves", *coarse[:2])
     steel_scene = load_scene("box-halves-gasket", *coarse, "regions.joint.youngs_modulus=210e9")
-    model = build_model(steel_scene, MPI.COMM_WORLD)
+    model = build_model_from_scene(steel_scene, MPI.COMM_WORLD)
     steel = modal.solve_modes(model.K, model.M, 1600.0)
     soft_scene = load_scene("box-halves-gasket", *coarse, "regions.joint.youngs_modulus=1e8")
-    K, M = elasticity.assemble_stiffness_mass(model.V, material_field(soft_scene, model.housing,
+    K, M = elasticity.assemble_stiffness_mass(model.V, material_field(soft_scene.regions, model.housing,
                                                                       soft_scene.material.resolve()), [], [])
     soft = modal.solve_modes(K, M, 1600.0)
     steel_f = steel.frequencies_hz[6:]

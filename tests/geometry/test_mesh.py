@@ -25,7 +25,7 @@ def fingerprint(scene_args, comm) -> dict:
     from tests.conftest import load_scene
 
     scene = load_scene(*scene_args)
-    size = element_size(scene, scene.material.resolve())
+    size = element_size(scene.mesh, scene.geometry, scene.analysis.f_max, scene.material.resolve())
     housing = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, comm)
     mesh = housing.mesh
     owned = mesh.geometry.x[:mesh.geometry.index_map().size_local]
@@ -37,12 +37,12 @@ def fingerprint(scene_args, comm) -> dict:
 
 
 def frequencies(comm) -> dict:
-    from housingfe.fe.model import build_model
+    from housingfe.scene import build_model_from_scene
     from housingfe.solvers import modal
     from tests.conftest import load_scene
 
     scene = load_scene(*FREQ_SCENE)
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     result = modal.solve_modes(model.K, model.M, scene.analysis.modal.f_max)
     return {"dofs": model.dofs, "frequencies_hz": result.frequencies_hz[result.rigid_count:].tolist()}
 

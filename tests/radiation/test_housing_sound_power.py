@@ -2,9 +2,9 @@
 import numpy as np
 import pytest
 
-from housingfe.fe.model import build_model
 from housingfe.report import sound_power_rows
-from housingfe.response.forced import run as run_forced
+from housingfe.run import forced_response
+from housingfe.scene import build_model_from_scene
 from tests.conftest import load_scene
 
 PLATE = ["geometry.a=0.3", "geometry.b=0.2", "geometry.h=0.005", "mesh.size=0.05", "analysis.modal.f_max=1500.0",
@@ -15,8 +15,8 @@ PLATE = ["geometry.a=0.3", "geometry.b=0.2", "geometry.h=0.005", "mesh.size=0.05
 
 def forced_with(comm, radiation):
     scene = load_scene("nafems-fv12", *PLATE, f"radiation={radiation}")
-    model = build_model(scene, comm)
-    return model, run_forced(model, scene.analysis.harmonic)
+    model = build_model_from_scene(scene, comm)
+    return model, forced_response(scene, model, model)
 
 
 def test_erp_is_lv_plus_area_level(comm):

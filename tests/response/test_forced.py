@@ -6,9 +6,9 @@ import pytest
 
 from housingfe.errors import SolverError
 from housingfe.fe.loads import assemble_load
-from housingfe.fe.model import build_model
 from housingfe.response.forced import run as run_forced
 from housingfe.response.observers import SurfaceObserver, responses
+from housingfe.scene import build_model_from_scene
 from housingfe.solvers import elasticity, harmonic, modal
 from tests.conftest import load_scene
 
@@ -29,8 +29,8 @@ def plate_both(comm):
     """Free plate, both solvers, modal basis only up to f_max (the hardest case for the residual)."""
     scene = harmonic_plate('analysis.harmonic.solver="both"', "analysis.harmonic.modal_basis_factor=1.0",
                            "damping.loss_factor=0.01")
-    model = build_model(scene, comm)
-    return model, run_forced(model, scene.analysis.harmonic)
+    model = build_model_from_scene(scene, comm)
+    return model, run_forced(model, scene.analysis.harmonic, scene.loads, scene.damping)
 
 
 def test_modal_plus_residual_matches_direct_in_every_band(plate_both):
@@ -71,7 +71,7 @@ def test_static_limit_and_resonance_peak_follows_one_over_eta(comm):
     from petsc4py import PETSc
 
     scene = harmonic_plate('geometry.edges={x0="clamped"}', "analysis.modal.f_max=400.0")
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     load = assemble_load(scene.loads[0], model.housing, model.V, model.bcs)
     modes = modal.solve_modes(model.K, model.M, 3 * 400.0)
     f1 = modes.frequencies_hz[0]
@@ -110,7 +110,7 @@ def test_load_vectors_carry_the_exact_resultants(comm):
     """A force patch carries 1 N along its direction and no moment about its centre; a couple carries
     1 N m about its axis and no net force."""
     scene = harmonic_plate()
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     rigid = elasticity.rigid_body_vectors(model.V)
     force = assemble_load(scene.loads[1], model.housing, model.V, model.bcs)
     d = np.array(scene.loads[1].direction) / np.linalg.norm(scene.loads[1].direction)
@@ -129,7 +129,7 @@ def test_load_vectors_carry_the_exact_resultants(comm):
 
 def test_undamped_line_at_an_eigenfrequency_is_reported_singular(comm):
     scene = harmonic_plate()
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     load = assemble_load(scene.loads[0], model.housing, model.V, model.bcs)
     modes = modal.solve_modes(model.K, model.M, 1500.0)
     f_hit = np.array([modes.frequencies_hz[modes.rigid_count]])
@@ -145,7 +145,7 @@ def test_per_mode_damping_ratios_set_each_peak(comm):
     """Viscous xi per mode: the resonance peak of one strongly driven mode drops ~10x when its ratio is 10x
     larger, while the first mode's peak barely moves."""
     scene = harmonic_plate()
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     load = assemble_load(scene.loads[0], model.housing, model.V, model.bcs)
     modes = modal.solve_modes(model.K, model.M, 1500.0)
     n0 = modes.rigid_count

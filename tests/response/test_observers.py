@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 from housingfe.errors import InputError
-from housingfe.fe.model import build_model
 from housingfe.response.forced import POINT_COLUMNS, point_rows
 from housingfe.response.forced import run as run_forced
 from housingfe.response.observers import (
@@ -22,6 +21,7 @@ from housingfe.response.observers import (
     closest_point_on_triangles,
     response_point_samples,
 )
+from housingfe.scene import build_model_from_scene
 from tests.conftest import load_scene
 from tests.response.test_forced import LOADS, PLATE
 
@@ -55,8 +55,8 @@ def free_plate(comm):
                   'analysis.harmonic.points=[{name="drive", point=[0.07, 0.05, 0.006], direction=[0, 0, -1]}, '
                   '{name="corner", point=[0.29, 0.19, 0.005], direction="normal"}, {name="edge", point=[0.3, 0.1, 0.0025]}]',
                   LOADS.replace("radius=0.01}", "radius=0.01, amplitude=2.5}", 1))
-    model = build_model(scene, comm)
-    return model, run_forced(model, scene.analysis.harmonic)
+    model = build_model_from_scene(scene, comm)
+    return model, run_forced(model, scene.analysis.harmonic, scene.loads, scene.damping)
 
 
 def _H(forced, solver, load, row):
@@ -200,8 +200,8 @@ def test_cantilever_point_frf_at_low_frequency_is_the_static_tip_deflection(comm
                   'loads=[{name="tip", kind="force", surface="edge_x1", point=[0.3, 0.1, 0.0025], '
                   'direction=[0, 0, 1], radius=0.2}]',
                   'analysis.harmonic.points=[{name="tip", point=[0.3, 0.1, 0.0025], direction=[0, 0, 1]}]')
-    model = build_model(scene, comm)
-    forced = run_forced(model, scene.analysis.harmonic)
+    model = build_model_from_scene(scene, comm)
+    forced = run_forced(model, scene.analysis.harmonic, scene.loads, scene.damping)
     load = assemble_load(scene.loads[0], model.housing, model.V, model.bcs)
     ksp = PETSc.KSP().create(comm)
     ksp.setOperators(model.K)

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from housingfe.errors import SolverError
-from housingfe.fe.model import build_model
+from housingfe.scene import build_model_from_scene
 from housingfe.solvers import elasticity, modal
 from tests.conftest import load_scene
 
@@ -15,7 +15,7 @@ def test_nafems_fv12_free_square_plate(comm):
 
     The structured square hex mesh keeps the plate's 90-degree symmetry, so the pair cannot split."""
     scene = load_scene("nafems-fv12")
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     result = modal.solve_modes(model.K, model.M, scene.analysis.modal.f_max)
     f = result.frequencies_hz[6:]
     reference = np.array([1.622, 2.360, 2.922, 4.233, 4.233, 7.416])
@@ -30,7 +30,7 @@ def test_simply_supported_square_plate_matches_kirchhoff(comm):
                        "mesh.size=0.0625", "analysis.modal.f_max=130.0",
                        'geometry.edges={x0="simply_supported",x1="simply_supported",'
                        'y0="simply_supported",y1="simply_supported"}')
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     m = model.material
     D = m.youngs_modulus * h**3 / (12 * (1 - m.poisson_ratio**2))
     f11 = math.pi / 2 * (2 / a**2) * math.sqrt(D / (m.density * h))
@@ -48,7 +48,7 @@ def test_inertia_count_equals_dense_eigenvalue_count(comm):
     if comm.size > 1:
         pytest.skip("dense comparison on one rank")
     scene = load_scene("nafems-fv12", "mesh.size=2.5", "mesh.degree=2")
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     K = model.K.copy().convert("dense").getDenseArray()
     M = model.M.copy().convert("dense").getDenseArray()
     lam = scipy.linalg.eigh(K, M, eigvals_only=True)
@@ -105,7 +105,7 @@ def test_rigid_count_does_not_depend_on_f_max(comm, f_max):
     """Issue 12 item 4: FV12's plate simply supported (w = 0 on the edges) keeps its three in-plane rigid
     motions, counted as three whatever f_max; its first elastic mode is Kirchhoff's f_11 = 2.377 Hz."""
     scene = load_scene("nafems-fv12", SIMPLY_SUPPORTED)
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     result = modal.solve_modes(model.K, model.M, f_max)
     assert result.rigid_count == 3
     m = model.material
@@ -117,7 +117,7 @@ def test_rigid_count_does_not_depend_on_f_max(comm, f_max):
 def test_free_plate_has_six_rigid_modes_below_a_low_f_max(comm):
     """The free FV12 plate solved only to 3 Hz (f_max close to its 1.622 Hz first mode) still has six."""
     scene = load_scene("nafems-fv12")
-    model = build_model(scene, comm)
+    model = build_model_from_scene(scene, comm)
     result = modal.solve_modes(model.K, model.M, 3.0)
     assert result.rigid_count == 6
     assert result.frequencies_hz[6] == pytest.approx(1.622, rel=0.015)
@@ -133,7 +133,7 @@ def test_simply_supported_plate_harmonic_basis_counts_rigid_modes(comm):
                        "loads=[{name=\"top\", kind=\"force\", surface=\"top\", point=[3.1, 2.7, 0.05], "
                        "direction=[0.0, 0.0, -1.0], radius=0.2}]",
                        "damping={loss_factor=0.01}")
-    forced = forced_response.run(build_model(scene, comm), scene.analysis.harmonic, None)
+    forced = forced_response.run(build_model_from_scene(scene, comm), scene.analysis.harmonic, scene.loads, scene.damping)
     assert forced.facts["basis_f_max_hz"] == pytest.approx(3.7)
     assert forced.facts["rigid_modes"] == 3
     assert forced.facts["modes_in_basis"] == 1
