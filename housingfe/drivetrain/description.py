@@ -1,0 +1,380 @@
+"""One description of a gearbox's drivetrain, and its two reductions.
+
+A `Drivetrain` holds what the gearbox interior IS (SI units throughout): the gear set (a GearPair of
+housingfe.source.gears with its flank corrections: masses, inertias, base circles and helix follow from it), the two
+shafts (diameter, where they end, where the gear centre sits in the housing frame), the bearings (designation, or a
+6-diagonal, or a full 6x6 K and C; position along the shaft; which housing bore carries them), the quill shafts and
+couplings to the motor and the brake (Appendix C's shafts 1-4 and DOFs 13, 14), and the pinion torque of the
+operating point (it sets the bearing loads and the mean mesh stiffness).
+
+Two reductions of it:
+
+* `to_lumped()` -> (LumpedInterior, ShaftGeometry, MeshModel): van Roosmalen's 14-DOF source model on RIGID bores
+  (housingfe.source.dynamics), what `housingfe source gearset-*` and `housingfe.source.operating.SourceModel` use;
+* `to_coupling_spec()` -> CouplingSpec: the FE interior (Timoshenko shafts, rigid gear discs, 6x6 bearings at the
+  housing's bores, the gear mesh) that housingfe.drivetrain.interior couples with the housing model.
+
+Where the thesis' two models genuinely differ, the description keeps both as named choices of each reduction
+(docs/drivetrain.md says which scene uses which, and why):
+
+* bearing stiffness: `lumped_bearing_stiffness` ("appendix_c": the printed diagonal of Appendix C, the only bearing
+  numbers of the source model that survived) vs the bearings' own 6x6 matrices (Lim's model of the designation at
+  the load of the operating point) in the FE reduction;
+* bearing positions: `lumped_bearing_spans` (bearing to gear FACE, Fig. 2.6 of the source model: 60 mm assumed,
+  i.e. 93 / 91 mm from the gear centre) vs `BearingSeat.position` (mid bearing plate of the reconstructed housing,
+  107.5 mm, measured on the mesh) in the FE reduction;
+* quill shafts and couplings: in the lumped model only (torsion springs and inertias to the motor and brake); the
+  FE shafts end flush with the bearing plates (`ShaftLine.ends`) and have no drive line beyond them.
+
+The layer contract puts housingfe.source below housingfe.drivetrain: the interior takes its gears, tooth forces and
+mesh stiffness from the source, never the other way round.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+
+from housingfe.errors import InputError
+from housingfe.source import dynamics as dyn
+from housingfe.source.gears import GearPair
+from housingfe.source.stiffness import (
+    Corrections,
+    MeshModel,
+    ShaftBending,
+    normal_force_from_torque,
+    stiffness_curve,
+)
+
+Vector3 = tuple[float, float, float]
+SHAFTS = ("pinion", "wheel")
+
+
+# ------------------------------------------------------------------------------------------------ parts
+@dataclass(frozen=True)
+class GearSet:
+    """The gear pair with its flank corrections and the settings of its mesh-stiffness model (housingfe.source):
+    n_slices points per contact line, torque_configuration of Fig. 2.7.  `name` labels it (e.g. "gearset-A")."""
+
+    name: str
+    pair: GearPair
+    corrections: Corrections = field(default_factory=Corrections)
+    n_slices: int = 24
+    torque_configuration: int = 2
+
+    @classmethod
+    def from_scene(cls, scene: str) -> "GearSet":
+        """The gear set of a source scene (a built-in name such as "gearset-A", or a path to a TOML file)."""
+        from housingfe.scenefile import read_scene_dict
+        from housingfe.source import roosmalen
+
+        data, path = read_scene_dict(scene)
+        table = roosmalen.parse(data, str(path))
+        pair, corr, _, _, model = roosmalen.build(table, str(path))
+        return cls(data.get("scene", {}).get("name", str(scene)), pair, corr, model.n_slices,
+                   model.torque_configuration)
+
+    def gear_body(self, gear: int) -> tuple[float, float, float]:
+        """(outer diameter, axial width, mass-equivalent) of gear 0 (pinion) / 1 (wheel) as a solid cylinder: the
+        mean of tip and root diameter over its face width (both helices and the gap of a double helical gear), m."""
+        p = self.pair
+        width = p.face_width[gear] * (2 if p.kind == "double_helical" else 1) + (
+            p.helix_gap if p.kind == "double_helical" else 0.0)
+        return 0.5 * float(p.tip_diameter[gear] + p.root_diameter[gear]), width, p.density
+
+
+@dataclass(frozen=True)
+class ShaftLine:
+    """A gear shaft: solid `diameter` (m) between its ends, the gear centre at `centre` (m, housing frame), the
+    shaft along the unit `axis`; `ends` (m) are the shaft ends along the axis from the gear centre (the FE shaft)."""
+
+    name: Literal["pinion", "wheel"]
+    diameter: float
+    centre: Vector3
+    axis: Vector3
+    ends: tuple[float, float]
+
+    def point(self, s: float) -> np.ndarray:
+        """Position (m) of the point `s` (m) along the axis from the gear centre."""
+        a = np.asarray(self.axis, float) / np.linalg.norm(self.axis)
+        return np.asarray(self.centre, float) + s * a
+
+
+@dataclass(frozen=True)
+class BearingSeat:
+    """A bearing of the FE reduction: on shaft `shaft` at `position` (m along its axis from the gear centre), in
+    the housing bore surface `bore`.  One of designation (catalogue; its load follows from the gear forces at the
+    drivetrain's torque), stiffness (6-diagonal, N/m, N m/rad) or stiffness_matrix (6x6, with optional
+    damping_matrix, N s/m).  `locating`: takes the shaft's axial force."""
+
+    name: str
+    shaft: Literal["pinion", "wheel"]
+    position: float
+    bore: str
+    locating: bool = False
+    designation: str | None = None
+    model: str | None = None
+    stiffness: tuple[float, ...] | None = None
+    stiffness_matrix: tuple[tuple[float, ...], ...] | None = None
+    damping_matrix: tuple[tuple[float, ...], ...] | None = None
+
+
+@dataclass(frozen=True)
+class QuillShaft:
+    """A torsion shaft outside the gearbox (Appendix C, shafts 1-4): solid, diameter and length (m)."""
+
+    name: str
+    diameter: float
+    length: float
+
+    def stiffness(self, shear_modulus: float) -> float:
+        """Torsional stiffness pi G d^4 / (32 l) [N m/rad]."""
+        return math.pi * shear_modulus * self.diameter**4 / (32 * self.length)
+
+
+@dataclass(frozen=True)
+class Coupling:
+    """A coupling between two quill shafts (Appendix C DOFs 13 and 14): its polar inertia (kg m^2)."""
+
+    name: str
+    inertia: float
+
+
+@dataclass(frozen=True)
+class GearForces:
+    """Mean gear force on the pinion (N, housing frame) at the mesh `point` (m); mean mesh stiffness (N/m) along
+    the unit contact normal `direction`."""
+
+    force_on_pinion: np.ndarray
+    stiffness: float
+    direction: np.ndarray
+    point: np.ndarray
+
+
+# ------------------------------------------------------------------------------------------- description
+@dataclass(frozen=True)
+class Drivetrain:
+    """The drivetrain of a gearbox (see the module docstring).  torque: pinion torque (N m) of the operating point;
+    loss_factor: of the lumped model's modal damping (Sec. 2.5).
+
+    Reduction choices: lumped_bearing_stiffness ("appendix_c" or {"pinion": 5 values, "wheel": 5 values}, x, y, z
+    [N/m], theta_x, theta_y [N m/rad]); lumped_bearing_spans {"pinion": (front, back), "wheel": ...} bearing to
+    gear face (m); coupling_mesh_positions: mesh positions per pitch for the FE's mean mesh stiffness;
+    elements_per_segment of the FE shafts; hold_tilt: the FE bearings' tilt held at zero by the shaft."""
+
+    gears: GearSet
+    shafts: tuple[ShaftLine, ShaftLine]
+    bearings: tuple[BearingSeat, ...]
+    quill_shafts: tuple[QuillShaft, QuillShaft, QuillShaft, QuillShaft]
+    couplings: tuple[Coupling, Coupling]
+    torque: float = 2000.0
+    loss_factor: float = 0.1
+    lumped_bearing_stiffness: str | dict = "appendix_c"
+    lumped_bearing_spans: dict = field(default_factory=lambda: {"pinion": (0.06, 0.06), "wheel": (0.06, 0.06)})
+    coupling_mesh_positions: int = 16
+    elements_per_segment: int = 4
+    hold_tilt: bool = True
+
+    def __post_init__(self):
+        if [s.name for s in self.shafts] != list(SHAFTS):
+            raise InputError("drivetrain: shafts: need (pinion, wheel)")
+        if not (math.isfinite(self.torque) and self.torque > 0):
+            raise InputError(f"drivetrain: torque: {self.torque} N m must be finite and > 0")
+        for b in self.bearings:
+            if sum(x is not None for x in (b.designation, b.stiffness, b.stiffness_matrix)) != 1:
+                raise InputError(f"drivetrain: bearings: {b.name}: give one of designation, stiffness, "
+                                 "stiffness_matrix")
+            lo, hi = self.shaft(b.shaft).ends
+            if not lo < b.position < hi:
+                raise InputError(f"drivetrain: bearings: {b.name}: position {b.position} m is off the shaft "
+                                 f"({lo}..{hi} m)")
+
+    def shaft(self, name: str) -> ShaftLine:
+        return self.shafts[SHAFTS.index(name)]
+
+    # ---------------------------------------------------------------------------------- gear properties
+    def gear_inertia(self, gear: int) -> tuple[float, float, float]:
+        """Mass (kg), polar and diametral inertia (kg m^2, about the gear centre) of the gear body alone (solid
+        cylinder of `GearSet.gear_body`, no shaft, no bore)."""
+        d, width, rho = self.gears.gear_body(gear)
+        return dyn._cylinder(rho, d, width)
+
+    # ---------------------------------------------------------------------------------- lumped reduction
+    def lumped_bearings(self) -> dict:
+        """{"pinion": 5 values, "wheel": 5 values}: the bearing diagonal of the lumped model."""
+        if self.lumped_bearing_stiffness == "appendix_c":
+            return {k: tuple(v) for k, v in dyn.APPENDIX_C_BEARINGS.items()}
+        if isinstance(self.lumped_bearing_stiffness, dict):
+            return {k: tuple(self.lumped_bearing_stiffness[k]) for k in SHAFTS}
+        raise InputError(f"drivetrain: lumped_bearing_stiffness: {self.lumped_bearing_stiffness!r} (known: "
+                         "'appendix_c' or a dict of diagonals)")
+
+    def shaft_geometry(self) -> dyn.ShaftGeometry:
+        """The ShaftGeometry of the lumped model."""
+        spans = self.lumped_bearing_spans
+        return dyn.ShaftGeometry(
+            pinion_spans=tuple(spans["pinion"]), pinion_shaft_diameter=self.shaft("pinion").diameter,
+            wheel_spans=tuple(spans["wheel"]), wheel_shaft_diameter=self.shaft("wheel").diameter,
+            torsion_diameters=tuple(q.diameter for q in self.quill_shafts),
+            torsion_lengths=tuple(q.length for q in self.quill_shafts),
+            coupling_inertia=tuple(c.inertia for c in self.couplings))
+
+    def to_lumped(self) -> tuple[dyn.LumpedInterior, dyn.ShaftGeometry, MeshModel]:
+        """The lumped source model on rigid bores: (LumpedInterior, ShaftGeometry, MeshModel).  Masses and
+        inertias: gear body + its shaft between the bearings (housingfe.source.dynamics.derive_interior)."""
+        geometry = self.shaft_geometry()
+        interior = dyn.derive_interior(self.gears.pair, geometry, self.loss_factor, self.lumped_bearings())
+        model = MeshModel(self.gears.pair,
+                          shafts=(ShaftBending(*geometry.pinion_spans, geometry.pinion_shaft_diameter),
+                                  ShaftBending(*geometry.wheel_spans, geometry.wheel_shaft_diameter)),
+                          corrections=self.gears.corrections, n_slices=self.gears.n_slices,
+                          torque_configuration=self.gears.torque_configuration)
+        return interior, geometry, model
+
+    def source_model(self, **kwargs):
+        """housingfe.source.operating.SourceModel of the lumped reduction (kwargs: its options)."""
+        from housingfe.source.operating import SourceModel
+
+        interior, geometry, model = self.to_lumped()
+        return SourceModel(self.gears.pair, self.gears.corrections, interior, geometry, mesh_model=model, **kwargs)
+
+    # -------------------------------------------------------------------------------------- FE reduction
+    def gear_forces(self) -> GearForces:
+        """Mean tooth force and mean mesh stiffness at `torque`, placed in the housing: the line of action in the
+        transverse plane at the operating pressure angle from the common tangent, tilted out of it by the base
+        helix angle (0 for a double helical set, whose halves cancel axially); contact at the operating pitch
+        point."""
+        pair = self.gears.pair
+        lumped_model = self.to_lumped()[2]
+        normal = normal_force_from_torque(pair, self.torque)
+        stiffness = stiffness_curve(lumped_model, normal, self.coupling_mesh_positions).mean
+        p, w = self.shaft("pinion"), self.shaft("wheel")
+        a = np.asarray(p.axis, float) / np.linalg.norm(p.axis)
+        centres = np.asarray(w.centre, float) - np.asarray(p.centre, float)
+        e_c = centres - (centres @ a) * a
+        e_c /= np.linalg.norm(e_c)
+        tangent = np.cross(a, e_c)
+        alpha = pair.operating_pressure_angle
+        beta_b = 0.0 if pair.kind == "double_helical" else pair.base_helix_angle
+        n = np.cos(beta_b) * (np.sin(alpha) * e_c + np.cos(alpha) * tangent) + np.sin(beta_b) * a
+        z1, z2 = pair.teeth
+        point = np.asarray(p.centre, float) + pair.centre_distance * z1 / (z1 + z2) * e_c
+        # the wheel pushes the pinion along -n
+        return GearForces(-normal * n, stiffness, n, point)
+
+    def bearing_loads(self, forces: GearForces | None = None) -> dict:
+        """{bearing name: (Fx, Fy, Fz, Mx, My)} (N) in each bearing's frame (housingfe.drivetrain.coupling.axis_frame
+        of the shaft axis): the mean gear force shared by the two bearings of each shaft by statics, the
+        locating bearing taking all of the axial force."""
+        from housingfe.drivetrain.coupling import axis_frame
+
+        forces = forces or self.gear_forces()
+        out = {}
+        for shaft, sign in (("pinion", 1.0), ("wheel", -1.0)):
+            line = self.shaft(shaft)
+            seats = [b for b in self.bearings if b.shaft == shaft]
+            if len(seats) != 2 or sum(b.locating for b in seats) != 1:
+                raise InputError(f"drivetrain: bearings: shaft {shaft} needs two bearings, one locating")
+            front = next(b for b in seats if b.locating)
+            back = next(b for b in seats if not b.locating)
+            a = np.asarray(line.axis, float) / np.linalg.norm(line.axis)
+            f = sign * forces.force_on_pinion
+            axial = (f @ a) * a
+            m = np.cross(forces.point - line.point(front.position), f)
+            m -= (m @ a) * a
+            r_back = np.cross(m, a) / (back.position - front.position)
+            for seat, load in ((front, (f - axial) - r_back + axial), (back, r_back)):
+                local = axis_frame(line.axis).T @ load
+                out[seat.name] = (float(local[0]), float(local[1]), float(local[2]), 0.0, 0.0)
+        return out
+
+    def shaft_nodes(self, name: str) -> tuple[list[list[float]], dict]:
+        """FE segments [[length, diameter], ...] (m) of a shaft from its front end, split at its bearings and the
+        gear centre, and {"gear" | bearing name: node index} (elements_per_segment elements per segment)."""
+        line = self.shaft(name)
+        stops = {"gear": 0.0, **{b.name: b.position for b in self.bearings if b.shaft == name}}
+        cuts = sorted({line.ends[0], line.ends[1], *stops.values()})
+        segments = [[hi - lo, line.diameter] for lo, hi in zip(cuts[:-1], cuts[1:])]
+        nodes = {k: cuts.index(s) * self.elements_per_segment for k, s in stops.items()}
+        return segments, nodes
+
+    def to_coupling_spec(self, forces: GearForces | None = None):
+        """The FE interior on the housing's bores (housingfe.drivetrain.interior.CouplingSpec): bore masters of
+        kind rbe2 at the bearing bores, the two shafts with their gears as rigid discs bored to the shaft, the
+        bearings (designation at the statics load, tilt held), the gear mesh (mean stiffness at `torque`)."""
+        from housingfe.drivetrain.interior import CouplingSpec
+
+        forces = forces or self.gear_forces()
+        loads = self.bearing_loads(forces)
+        shafts, bearings, nodes = [], [], {}
+        for g, name in enumerate(SHAFTS):
+            line = self.shaft(name)
+            segments, index = self.shaft_nodes(name)
+            nodes[name] = index
+            d, width, _ = self.gears.gear_body(g)
+            shafts.append({"name": name, "origin": tuple(float(x) for x in line.point(line.ends[0])),
+                           "axis": line.axis, "segments": segments, "elements_per_segment": self.elements_per_segment,
+                           "discs": [{"node": index["gear"], "outer_diameter": d, "width": width,
+                                      "inner_diameter": line.diameter}]})
+        for b in sorted(self.bearings, key=lambda b: (SHAFTS.index(b.shaft), b.position)):
+            entry = {"name": b.name, "shaft_node": f"{b.shaft}:{nodes[b.shaft][b.name]}", "bore": b.name,
+                     "axis": self.shaft(b.shaft).axis}
+            if b.designation is not None:
+                entry.update(designation=b.designation, load=loads[b.name], model=b.model,
+                             fixed_tilt=(0.0, 0.0) if self.hold_tilt else None)
+            elif b.stiffness is not None:
+                entry["stiffness"] = b.stiffness
+            else:
+                entry.update(stiffness_matrix=[list(r) for r in b.stiffness_matrix],
+                             damping_matrix=None if b.damping_matrix is None else [list(r) for r in b.damping_matrix])
+            bearings.append(entry)
+        bores = [{"name": b["name"], "surface": s.bore, "axis": b["axis"]}
+                 for b, s in zip(bearings, sorted(self.bearings, key=lambda b: (SHAFTS.index(b.shaft), b.position)))]
+        mesh = {"a": f"pinion:{nodes['pinion']['gear']}", "b": f"wheel:{nodes['wheel']['gear']}",
+                "stiffness": forces.stiffness, "point": tuple(float(x) for x in forces.point),
+                "direction": tuple(float(x) for x in forces.direction)}
+        return CouplingSpec.model_validate({"bores": bores, "shafts": shafts, "bearings": bearings,
+                                            "gear_meshes": [mesh]})
+
+
+# ------------------------------------------------------------------------------------------ test gearbox
+# The thesis' Ch. 5 test gearbox in the frame of the `test-gearbox` housing scene: shafts along +y, gear centres
+# in the plane y = 0 at x = -0.126 (pinion) / 0.074 (wheel), z = 0.200 m; shafts ending flush with the outer faces
+# of the bearing plates (y = -/+0.140 m), bearings mid-plate (y = -/+0.1075 m).
+TEST_GEARBOX_CENTRES = {"pinion": (-0.126, 0.0, 0.200), "wheel": (0.074, 0.0, 0.200)}
+TEST_GEARBOX_BEARINGS = {"ball": {"pinion": "SKF 6316", "wheel": "SKF 6219"}}
+GEAR_SETS = {"A": "gearset-A", "B": "gearset-B", "C": "gearset-C", "D": "gearset-D",
+             "uncorrected": "gearset-uncorrected", "double_helical": "gearset-double-helical"}
+
+
+def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 2000.0) -> Drivetrain:
+    """The Ch. 5 test gearbox (van Roosmalen 1994) as one description: gear set A-D, "uncorrected" or
+    "double_helical" (the gear data of the gearset-* scenes), bearings "ball" (SKF 6316 pinion / 6219 wheel, Lim's
+    model, the front bearings locating), pinion torque (N m).  Shaft, quill-shaft and coupling dimensions are the
+    ASSUMPTIONS of docs/source.md (Appendix C's parameter table did not survive)."""
+    if gear_set not in GEAR_SETS:
+        raise InputError(f"test_gearbox: gear_set: {gear_set!r} unknown (known: {', '.join(GEAR_SETS)})")
+    if bearings not in TEST_GEARBOX_BEARINGS:
+        raise InputError(f"test_gearbox: bearings: {bearings!r} unknown (known: {', '.join(TEST_GEARBOX_BEARINGS)}; "
+                         "the other configurations: housingfe.studies.bearing_variants)")
+    axis = (0.0, 1.0, 0.0)
+    shafts = (ShaftLine("pinion", 0.080, TEST_GEARBOX_CENTRES["pinion"], axis, (-0.140, 0.140)),   # SKF 6316 bore
+              ShaftLine("wheel", 0.095, TEST_GEARBOX_CENTRES["wheel"], axis, (-0.140, 0.140)))      # SKF 6219 bore
+    seats = tuple(BearingSeat(f"{shaft}_{side}", shaft, s, f"bore_{shaft}_{side}", locating=side == "front",
+                              designation=TEST_GEARBOX_BEARINGS[bearings][shaft])
+                  for shaft in SHAFTS for side, s in (("front", -0.1075), ("back", 0.1075)))
+    quills = (QuillShaft("motor_far", 0.040, 1.5), QuillShaft("motor_pinion", 0.060, 0.25),
+              QuillShaft("wheel_brake", 0.075, 0.25), QuillShaft("brake_far", 0.055, 1.5))
+    return Drivetrain(gears=GearSet.from_scene(GEAR_SETS[gear_set]), shafts=shafts, bearings=seats,
+                      quill_shafts=quills, couplings=(Coupling("motor", 0.02), Coupling("brake", 0.05)),
+                      torque=torque)
+
+
+test_gearbox.__test__ = False     # not a pytest test despite its name
+
+
+def with_torque(drivetrain: Drivetrain, torque: float) -> Drivetrain:
+    """The same drivetrain at another pinion torque (N m)."""
+    return replace(drivetrain, torque=torque)

@@ -1,0 +1,119 @@
+"""One drivetrain description (housingfe.drivetrain.description): its lumped reduction is the source model of the
+gearset-* scenes, its FE reduction the [coupling] of test-gearbox-interior, and the gear bodies agree between both."""
+import math
+
+import numpy as np
+import pytest
+
+from housingfe.drivetrain.description import GEAR_SETS, BearingSeat, test_gearbox
+from housingfe.drivetrain.interior import CouplingSpec
+from housingfe.drivetrain.shafts import STEEL, RigidDisc
+from housingfe.errors import InputError
+from housingfe.scenefile import read_scene_dict
+from housingfe.source import roosmalen
+
+
+def _scene_source(name):
+    data, path = read_scene_dict(name)
+    return roosmalen.build(roosmalen.parse(data, str(path)), str(path))
+
+
+@pytest.mark.parametrize("gear_set", ["A", "B", "double_helical"])
+def test_lumped_reduction_is_the_gearset_scene(gear_set):
+    pair, corr, geometry, interior, model = _scene_source(GEAR_SETS[gear_set])
+    li, geo, mm = test_gearbox(gear_set).to_lumped()
+    assert geo == geometry                      # 60 mm spans, 80 / 95 mm shafts, quill shafts 1-4, couplings
+    assert li == interior                       # exactly: masses, inertias, torsion, Appendix C bearings
+    assert mm.shafts == model.shafts and mm.corrections == corr
+    assert (mm.n_slices, mm.torque_configuration) == (model.n_slices, model.torque_configuration)
+
+
+def test_gear_bodies_agree_between_the_reductions():
+    """Gear mass and inertias from the GearPair (solid cylinder of the mean of tip and root diameter, thesis
+    Appendix C lumping) against (a) the lumped model = gear + its shaft between the bearings and (b) the FE disc
+    (bored to the shaft) + the shaft through it."""
+    d = test_gearbox("A")
+    pair = d.gears.pair
+    li, geo, _ = d.to_lumped()
+    for g, (mass, jp, jd), dshaft, spans in ((0, (li.pinion_mass, li.pinion_inertia_axial, li.pinion_inertia_diametral),
+                                              geo.pinion_shaft_diameter, geo.pinion_spans),
+                                             (1, (li.wheel_mass, li.wheel_inertia_axial, li.wheel_inertia_diametral),
+                                              geo.wheel_shaft_diameter, geo.wheel_spans)):
+        dg = 0.5 * (pair.tip_diameter[g] + pair.root_diameter[g])
+        b = pair.face_width[g]
+        m_gear = 7850.0 * math.pi * dg**2 / 4 * b
+        m_gear_d, jp_gear, jd_gear = d.gear_inertia(g)
+        assert m_gear_d == pytest.approx(m_gear, rel=1e-12)
+        assert jp_gear == pytest.approx(m_gear * dg**2 / 8, rel=1e-12)
+        assert jd_gear == pytest.approx(m_gear * (3 * dg**2 / 4 + b**2) / 12, rel=1e-12)
+        # (a) lumped: plus the shaft between the bearings
+        m_shaft = 7850.0 * math.pi * dshaft**2 / 4 * sum(spans)
+        assert mass == pytest.approx(m_gear + m_shaft, rel=1e-12)
+        assert jp == pytest.approx(jp_gear + m_shaft * dshaft**2 / 8, rel=1e-12)
+        assert jd > jd_gear
+        # (b) FE: the bored disc plus the shaft inside the face width is the same solid cylinder
+        disc = RigidDisc.cylinder(dg, b, dshaft, rho=STEEL.density)
+        m_core = STEEL.density * math.pi * dshaft**2 / 4 * b
+        assert disc.mass + m_core == pytest.approx(m_gear, rel=1e-12)
+        assert disc.polar_inertia + m_core * dshaft**2 / 8 == pytest.approx(jp_gear, rel=1e-12)
+
+
+def test_coupling_reduction_is_the_test_gearbox_interior():
+    """The FE reduction of the gear set B description against the scene's [coupling] table (written to 5-6
+    significant digits: loads to 0.1 N, the mesh stiffness to 5 digits)."""
+    data, _ = read_scene_dict("test-gearbox-interior")
+    ref = CouplingSpec.model_validate(data["coupling"])
+    spec = test_gearbox("B").to_coupling_spec()
+    assert spec.bores == ref.bores
+    for s, r in zip(spec.shafts, ref.shafts, strict=True):
+        assert (s.name, s.axis, s.elements_per_segment) == (r.name, r.axis, r.elements_per_segment)
+        np.testing.assert_allclose(s.origin, r.origin, atol=1e-12)
+        np.testing.assert_allclose(s.segments, r.segments, atol=1e-12)
+        assert [dd.node for dd in s.discs] == [dd.node for dd in r.discs]
+        assert s.discs[0].outer_diameter == pytest.approx(r.discs[0].outer_diameter, abs=1e-6)
+        assert (s.discs[0].width, s.discs[0].inner_diameter) == (r.discs[0].width, r.discs[0].inner_diameter)
+    for b, r in zip(spec.bearings, ref.bearings, strict=True):
+        assert (b.name, b.shaft_node, b.bore, b.axis, b.designation, b.model, b.fixed_tilt) == \
+               (r.name, r.shaft_node, r.bore, r.axis, r.designation, r.model, r.fixed_tilt)
+        np.testing.assert_allclose(b.load, r.load, atol=0.051)
+    (m,), (mr,) = spec.gear_meshes, ref.gear_meshes
+    assert (m.a, m.b) == (mr.a, mr.b)
+    assert m.stiffness == pytest.approx(mr.stiffness, rel=5e-5)
+    np.testing.assert_allclose(m.point, mr.point, atol=1e-12)
+    np.testing.assert_allclose(m.direction, mr.direction, atol=6e-7)
+
+
+def test_bearing_loads_balance_the_gear_force():
+    """Statics of each two-bearing shaft: the bearing loads add up to the tooth force (2000 N m on the pinion:
+    the tangential force is T / r_b per unit normal), the locating bearing takes all of the axial force."""
+    d = test_gearbox("A")
+    forces = d.gear_forces()
+    loads = d.bearing_loads(forces)
+    rb1 = d.gears.pair.base_diameter[0] / 2
+    # torque about the pinion axis (global y) = 2000 N m
+    arm = forces.point - np.asarray(d.shaft("pinion").centre)
+    assert abs(np.cross(arm, forces.force_on_pinion)[1]) == pytest.approx(2000.0, rel=1e-9)
+    assert np.linalg.norm(forces.force_on_pinion) == pytest.approx(
+        2000.0 / (rb1 * math.cos(d.gears.pair.base_helix_angle)), rel=1e-9)
+    from housingfe.drivetrain.coupling import axis_frame
+
+    R = axis_frame((0.0, 1.0, 0.0))
+    for shaft, sign in (("pinion", 1.0), ("wheel", -1.0)):
+        total = R @ (np.array(loads[f"{shaft}_front"][:3]) + np.array(loads[f"{shaft}_back"][:3]))
+        np.testing.assert_allclose(total, sign * forces.force_on_pinion, atol=1e-8)
+        assert loads[f"{shaft}_back"][2] == 0.0
+
+
+def test_bad_descriptions_are_input_errors():
+    with pytest.raises(InputError, match="gear_set"):
+        test_gearbox("Z")
+    with pytest.raises(InputError, match="bearings"):
+        test_gearbox("A", bearings="magnetic")
+    d = test_gearbox("A")
+    import dataclasses
+
+    off = BearingSeat("pinion_front", "pinion", -0.2, "bore_pinion_front", locating=True, designation="SKF 6316")
+    with pytest.raises(InputError, match="off the shaft"):
+        dataclasses.replace(d, bearings=(off, *d.bearings[1:]))
+    with pytest.raises(InputError, match="torque"):
+        dataclasses.replace(d, torque=0.0)
