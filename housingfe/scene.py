@@ -13,6 +13,7 @@ from pydantic import (
     Field,
     PositiveFloat,
     PositiveInt,
+    field_validator,
     model_validator,
 )
 
@@ -216,15 +217,25 @@ class RadiationPlate(_Strict):
 
 class RadiationSpec(_Strict):
     """Sound power from the forced response (eq. 4.16): L_W = L_v + 10 lg(S/S0) + L_sigma with L_sigma from
-    "erp" (sigma = 1), "foller" (the box model of Sec. 4.7 on the plates below, areas and perimeters taken
-    from the mesh) or "numerical" (Rayleigh integral per plate over the computed velocity field)."""
+    a registered radiation model (housingfe.radiation.radiators.RADIATORS): "erp" (sigma = 1), "foller" (the box
+    model of Sec. 4.7 on the plates below, areas and perimeters taken from the mesh) or "numerical" (Rayleigh
+    integral per plate over the computed velocity field)."""
 
-    model: Literal["erp", "foller", "numerical"]
+    model: str
     plates: list[RadiationPlate] = []
+
+    @field_validator("model")
+    @classmethod
+    def _registered(cls, name):
+        from housingfe.radiation.radiators import check_radiator  # loaded on use: the scene check stays light
+
+        return check_radiator(name)
 
     @model_validator(mode="after")
     def _check(self):
-        if self.model != "erp" and not self.plates:
+        from housingfe.radiation.radiators import RADIATORS
+
+        if RADIATORS[self.model].needs_plates and not self.plates:
             raise ValueError(f"plates: the {self.model} model needs the radiating plates "
                              "(surface and thickness of each)")
         return self

@@ -248,9 +248,33 @@ def bearing_from_table(table: dict, where: str = "bearing") -> RollingBearing:
 
 
 # ----------------------------------------------------------------------------------------------- models
+# Registry of the bearing models by name: a model is a _Model subclass decorated with @register_bearing_model;
+# `make_model`, the `housingfe bearing` CLI and the scene schema (housingfe.drivetrain.interior.BearingSpec.model)
+# all take their names from here.
+BEARING_MODELS: dict[str, type] = {}
+
+
+def register_bearing_model(cls):
+    """Class decorator: add a bearing model (a _Model subclass with `name` and the bearing `kinds` it fits) to
+    BEARING_MODELS."""
+    if not cls.name or cls.name in BEARING_MODELS:
+        raise ValueError(f"bearing model {cls.name!r}: needs a new, non-empty name")
+    BEARING_MODELS[cls.name] = cls
+    return cls
+
+
+def check_bearing_model(name: str) -> str:
+    """`name` if it is a registered bearing model, else ValueError "'<name>' is not a bearing model; known: ..."."""
+    if name not in BEARING_MODELS:
+        raise ValueError(f"{name!r} is not a bearing model; known: {', '.join(BEARING_MODELS)}")
+    return name
+
+
 class _Model:
-    """One bearing model: energy, load vector and analytic Jacobian as functions of the 5 mean DOFs."""
+    """One bearing model: energy, load vector and analytic Jacobian as functions of the 5 mean DOFs.
+    kinds: the RollingBearing kinds the model fits."""
     name = ""
+    kinds: tuple[str, ...] = ()
     exponent = 1.5
     carries_moments = True
 
@@ -290,9 +314,11 @@ class _Model:
         raise NotImplementedError
 
 
+@register_bearing_model
 class LimBall(_Model):
     """Lim's ball bearing, Eqs. (3.1)-(3.9); Jacobian = Appendix D (C-1a..p) in vector form."""
     name = "lim-ball"
+    kinds = ("ball",)
     exponent = 1.5
 
     def __init__(self, bearing: RollingBearing):
@@ -330,9 +356,11 @@ class LimBall(_Model):
         return self.r_j
 
 
+@register_bearing_model
 class LimRoller(_Model):
     """Lim's roller bearing, Eqs. (3.13)-(3.14), (C-2): fixed contact angle, n = 10/9, uniform load per roller."""
     name = "lim-roller"
+    kinds = ("cylindrical_roller", "tapered_roller")
     exponent = 10.0 / 9.0
 
     def __init__(self, bearing: RollingBearing):
@@ -354,10 +382,12 @@ class LimRoller(_Model):
         return energy, force, jac, q_j, np.full(len(d), self.bearing.contact_angle)
 
 
+@register_bearing_model
 class SelfAligningRoller(LimRoller):
     """Double-row spherical roller bearing: rows at +-alpha0, contact normals through the sphere centre, so a
     tilt of the inner ring compresses no roller and the moment stiffness is zero by construction."""
     name = "self-aligning"
+    kinds = ("spherical_roller",)
     carries_moments = False
 
     def __init__(self, bearing: RollingBearing):
@@ -374,6 +404,7 @@ class SelfAligningRoller(LimRoller):
         self.gap = b.radial_clearance * math.cos(a)
 
 
+@register_bearing_model
 class SlicedRoller(_Model):
     """Thesis Sec. 3.3.2: rollers sliced along their length, non-uniform load, Weber–Banaschek per slice.
 
@@ -383,6 +414,7 @@ class SlicedRoller(_Model):
     so F = sum F_jk g_jk and K = sum dF_jk/d(delta) g_jk g_jk^T with g_jk = d(approach)/dq (virtual work).
     """
     name = "sliced-roller"
+    kinds = ("cylindrical_roller", "tapered_roller")
     exponent = 10.0 / 9.0
     tilt_factor = 1.0       # approach of slice a: delta_j - tilt_factor * a * gamma_j
 
@@ -418,17 +450,13 @@ class SlicedRoller(_Model):
         return energy, force, jac, per_roller, np.full(len(self.psi), self.bearing.contact_angle)
 
 
+@register_bearing_model
 class SlicedRollerThesis(SlicedRoller):
     """The sliced roller with the thesis' own Eq. (3.16): slice a moves by delta_j - a sin(gamma_j/2), i.e. half
     the ring tilt (the roller's rotation) instead of the approach of the two rings.  For comparison with the
     thesis' numbers only; its tilt stiffness from the slicing is 1/4 of "sliced-roller"."""
     name = "sliced-roller-thesis"
     tilt_factor = 0.5
-
-
-_MODELS = {"lim-ball": LimBall, "lim-roller": LimRoller, "sliced-roller": SlicedRoller,
-           "sliced-roller-thesis": SlicedRollerThesis,
-           "self-aligning": SelfAligningRoller}
 
 
 def default_model(bearing: RollingBearing) -> str:
@@ -440,14 +468,16 @@ def default_model(bearing: RollingBearing) -> str:
 def make_model(bearing: RollingBearing, model: str | None = None) -> _Model:
     """Instantiate a model by name (None: default_model); checks that model and kind match."""
     name = model or default_model(bearing)
-    if name not in _MODELS:
-        raise InputError(f"{bearing.designation}: model={name!r}: must be one of {sorted(_MODELS)}")
-    if (name == "lim-ball") != (bearing.kind == "ball"):
-        raise InputError(f"{bearing.designation}: model {name!r} does not fit a {bearing.kind} bearing")
-    if (name == "self-aligning") != (bearing.kind == "spherical_roller"):
-        raise InputError(f"{bearing.designation}: model {name!r} does not fit a {bearing.kind} bearing "
-                         "(spherical roller bearings use 'self-aligning')")
-    return _MODELS[name](bearing)
+    if name not in BEARING_MODELS:
+        raise InputError(f"{bearing.designation}: model={name!r}: must be one of {sorted(BEARING_MODELS)}")
+    cls = BEARING_MODELS[name]
+    if bearing.kind not in cls.kinds:
+        # spherical roller bearings carry no moment: only a self-aligning model fits them
+        hint = (" (spherical roller bearings use 'self-aligning')"
+                if "spherical_roller" in (bearing.kind, *cls.kinds) and "ball" not in (bearing.kind, *cls.kinds)
+                else "")
+        raise InputError(f"{bearing.designation}: model {name!r} does not fit a {bearing.kind} bearing{hint}")
+    return cls(bearing)
 
 
 # ----------------------------------------------------------------------------------------------- solver

@@ -10,7 +10,15 @@ from dataclasses import dataclass, field
 from typing import Annotated
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PositiveFloat,
+    PositiveInt,
+    field_validator,
+    model_validator,
+)
 
 from housingfe.errors import InputError
 
@@ -72,7 +80,7 @@ class BearingSpec(_Strict):
     axis: Vector3 = (0.0, 0.0, 1.0)
     designation: str | None = None
     load: tuple[float, float, float, float, float] | None = None
-    model: str | None = Field(None, pattern="^(lim-ball|lim-roller|sliced-roller|sliced-roller-thesis|self-aligning)$")
+    model: str | None = None     # a name in housingfe.bearings.rolling.BEARING_MODELS (checked below)
     # tilt (rad) held by the shaft instead of zero moments (a shaft on two bearings sets the tilt; see
     # housingfe.verification.bearing_rows)
     fixed_tilt: tuple[float, float] | None = None
@@ -90,6 +98,13 @@ class BearingSpec(_Strict):
         if self.damping_matrix is not None and self.stiffness_matrix is None:
             raise ValueError("damping_matrix: only with stiffness_matrix")
         return self
+
+    @field_validator("model")
+    @classmethod
+    def _registered_model(cls, name):
+        from housingfe.bearings.rolling import check_bearing_model  # the registry of bearing models
+
+        return name if name is None else check_bearing_model(name)
 
     @property
     def label(self) -> str:

@@ -8,7 +8,9 @@ Public API (SI units; velocities are complex peak phasors, mean squares are rms^
 - numerical radiation efficiency from surface data: `rayleigh_radiated_power` (plane baffled radiator),
   `baffled_plates_radiated_power` (housing, plate by plate), `helmholtz_fem_radiation` (closed bodies,
   exterior Helmholtz FE in a complex-PETSc subprocess);
-- sound power (eq. 4.16): `sound_power_level`, `radiation_index_from_levels`, `sound_power_spectrum`.
+- sound power (eq. 4.16): `sound_power_level`, `radiation_index_from_levels`, `sound_power_spectrum`;
+- the radiation models of a housing by name (`RADIATORS`: "erp", "foller", "numerical"; `register_radiator` adds
+  one) and `sound_power(response, radiator) -> SoundPower` (housingfe.radiation.radiators).
 Sub-command: `housingfe radiation foller <table.toml|builtin:scale-model|builtin:test-gearbox>`.
 """
 from housingfe.radiation.analytic import (
@@ -52,6 +54,14 @@ from housingfe.radiation.power import (
     sound_power_level,
     sound_power_spectrum,
 )
+from housingfe.radiation.radiators import (
+    RADIATORS,
+    Radiator,
+    SoundPower,
+    radiator_from_spec,
+    register_radiator,
+    sound_power,
+)
 
 __all__ = [
     "AIR_DENSITY",
@@ -60,7 +70,10 @@ __all__ = [
     "FemSweep",
     "FollerResult",
     "Plate",
+    "RADIATORS",
+    "Radiator",
     "RadiationResult",
+    "SoundPower",
     "SoundPowerSpectrum",
     "area_level_db",
     "baffled_piston_geometry",
@@ -76,8 +89,11 @@ __all__ = [
     "power_level_db",
     "radiation_index_db",
     "radiation_index_from_levels",
+    "radiator_from_spec",
     "rayleigh_radiated_power",
     "register_cli",
+    "register_radiator",
+    "sound_power",
     "sound_power_level",
     "sound_power_spectrum",
     "sphere_cap_sigma",

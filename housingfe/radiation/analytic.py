@@ -18,6 +18,7 @@ from scipy.special import eval_legendre, j1, spherical_jn, spherical_yn
 
 from housingfe.errors import InputError
 from housingfe.levels import AIR_DENSITY, SPEED_OF_SOUND
+from housingfe.radiation.registry import Radiator, register_radiator
 
 __all__ = ["AIR_DENSITY", "SPEED_OF_SOUND"]  # re-exported: the package's one c and rho (housingfe.levels)
 
@@ -149,3 +150,17 @@ def radiation_index_db(sigma) -> np.ndarray:
     s = _non_negative("sigma", sigma)
     with np.errstate(divide="ignore"):
         return 10.0 * np.log10(s)
+
+
+@register_radiator("erp")
+class ErpRadiator(Radiator):
+    """Equivalent radiated power as a radiation model: sigma = 1, L_sigma = 0 dB at every line."""
+
+    needs_plates = False
+
+    @classmethod
+    def from_spec(cls, spec, housing, material) -> ErpRadiator:
+        return cls()
+
+    def radiation_index_db(self, response) -> np.ndarray:
+        return np.zeros(len(response.frequencies))

@@ -23,6 +23,7 @@ import numpy as np
 
 from housingfe.errors import InputError
 from housingfe.radiation.analytic import SPEED_OF_SOUND, plate_critical_frequency
+from housingfe.radiation.registry import Radiator, register_radiator
 
 SLOPE_DB_PER_DECADE = 25.0   # Fig. 4.22 caption; reproduces the numbers of Appendix E
 PISTON_FACTOR = 1.13         # eq. (4.11)
@@ -305,3 +306,41 @@ def load_plate_table(spec: str) -> tuple[list[Plate], float]:
     if not isinstance(c, (int, float)) or not np.isfinite(c) or c <= 0:
         raise InputError(f"{spec}: c: must be a positive number (m/s)")
     return plates_from_table(data, spec), float(c)
+
+
+# ------------------------------------------------------------------ as a radiation model of a housing
+@register_radiator("foller")
+class FollerRadiator(Radiator):
+    """Föller's box model (Sec. 4.7) on given plates: L_sigma per line from `foller_radiation_index`."""
+
+    def __init__(self, plates):
+        self.plates = tuple(plates)
+
+    @classmethod
+    def from_spec(cls, spec, housing, material) -> FollerRadiator:
+        """The housing's own plates: area and perimeter of each listed surface measured on the mesh (a
+        HousingMesh), f_c from the material (E, density, Poisson ratio) and the listed thickness."""
+        from housingfe.response.observers import surface_outline
+
+        plates = []
+        for i, p in enumerate(spec.plates):
+            if p.surface not in housing.facet_groups:
+                raise InputError(f"radiation.plates[{i}].surface: no surface {p.surface!r}")
+            vertices, triangles = surface_outline(housing, p.surface)
+            plates.append(plate_from_triangles(p.surface, vertices, triangles, p.thickness, count=p.count,
+                                               youngs_modulus_pa=material.youngs_modulus,
+                                               density_kg_m3=material.density,
+                                               poisson_ratio=material.poisson_ratio))
+        return cls(plates)
+
+    def radiation_index_db(self, response) -> np.ndarray:
+        return foller_radiation_index(self.plates, response.frequencies).L_sigma_db
+
+    def facts(self) -> dict:
+        """Appendix E quantities of the plates (they do not depend on frequency) and the plates themselves."""
+        fr = foller_radiation_index(self.plates, [1.0])
+        facts = {k: getattr(fr, k) for k in ("S_mean", "U_mean", "fc_mean", "sigma_P", "point_P_dB",
+                                              "zero_dB_crossing_hz", "compactness_lhs", "is_compact")}
+        facts["plates"] = [{"surface": p.name, "count": p.count, "area_m2": p.area_m2, "perimeter_m": p.perimeter_m,
+                            "thickness_m": p.thickness_m, "fc_hz": p.fc_hz} for p in self.plates]
+        return facts

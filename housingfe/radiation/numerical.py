@@ -26,6 +26,7 @@ from scipy.spatial.distance import cdist
 
 from housingfe.errors import InputError
 from housingfe.radiation.analytic import AIR_DENSITY, SPEED_OF_SOUND
+from housingfe.radiation.registry import Radiator, register_radiator
 
 _BLOCK_ENTRIES = 4_000_000  # entries of the resistance matrix built at once (~32 MB per temporary array)
 
@@ -167,3 +168,57 @@ def disc_quadrature(radius_m: float, n_radial: int = 16, n_angular: int = 48, ce
                            np.zeros(R.size)]) + np.asarray(center, dtype=float)
     normals = np.tile([0.0, 0.0, 1.0], (R.size, 1))
     return pts, normals, W.ravel()
+
+
+# ------------------------------------------------------------------ as a radiation model of a housing
+RADIATION_POINTS = "radiation"     # the observer's point set of the numerical radiator
+
+
+def housing_plate_points(housing, surfaces):
+    """Facet points (midpoint, outward normal, area weight) of the listed surfaces of a HousingMesh, and one plate
+    id per point: a listed surface may fold (a flange top and its rim), so each plane part of a surface is a
+    plate of its own, radiating in its own baffle.  Identical on every rank."""
+    from housingfe.response.observers import SamplePoints, facet_points
+
+    pts, nrm, w, keys = [], [], [], []
+    for i, surface in enumerate(surfaces):
+        sp, _ = facet_points(housing, surface)
+        pts.append(sp.points), nrm.append(sp.normals), w.append(sp.weights)
+        keys.append(np.column_stack([np.full(len(sp.weights), i), np.round(sp.normals, 3)]))
+    _, ids = np.unique(np.concatenate(keys), axis=0, return_inverse=True)
+    return SamplePoints(np.concatenate(pts), np.concatenate(nrm), np.concatenate(w)), ids.ravel()
+
+
+@register_radiator("numerical")
+class NumericalRadiator(Radiator):
+    """The Rayleigh integral plate by plate (`baffled_plates_radiated_power`) over the computed velocity at the
+    facet midpoints of the listed surfaces: L_sigma = 10 lg(P / (rho c S <v~^2>)) per line."""
+
+    def __init__(self, surfaces, points=None, plate_ids=None):
+        self.surfaces = tuple(surfaces)
+        self.points, self.plate_ids = points, plate_ids
+
+    @classmethod
+    def from_spec(cls, spec, housing, material) -> NumericalRadiator:
+        return cls([p.surface for p in spec.plates])
+
+    def extra_points(self, structure) -> dict:
+        """{RADIATION_POINTS: the facet points of the surfaces} on structure.housing (computed once)."""
+        if self.points is None:
+            self.points, self.plate_ids = housing_plate_points(structure.housing, self.surfaces)
+        return {RADIATION_POINTS: self.points}
+
+    def radiation_index_db(self, response) -> np.ndarray:
+        """From the displacement per unit load at the points (response.extras["point_values"][RADIATION_POINTS],
+        present when extra_points was given to the forced response) times the load amplitude (rms)."""
+        if self.points is None:
+            raise InputError("radiation: the numerical model needs the response at its points: pass "
+                             "radiator.extra_points(structure) to the forced response")
+        disp = response.extras["point_values"][RADIATION_POINTS]
+        out = np.empty(len(response.frequencies))
+        for k, f in enumerate(response.frequencies):
+            v = 1j * 2 * np.pi * f * disp[:, k] * response.amplitude[k]
+            r = baffled_plates_radiated_power(self.points.points, self.points.normals, self.points.weights, v,
+                                              self.plate_ids, f, velocity_is_rms=True)
+            out[k] = 10 * np.log10(max(r.sigma, 1e-30))
+        return out

@@ -6,7 +6,8 @@ Rows come from three places:
    Sec. 4.5 gearbox model, the closest mode pair of Sec. 4.3, the gasket's effect on the eigenfrequencies
    of Sec. 4.4) and the Sec. 5.8 bearing-variant study;
 2. geometry reconstructions that can be checked without FE (Appendix E plate areas and perimeters);
-3. the `published_rows()` of the modules listed in ROW_PROVIDERS (bearings, radiation, source).
+3. the `published_rows()` of the row providers: every module housingfe/verification/<topic>_rows.py
+   (ROW_PROVIDERS; today bearings, radiation, source).
 
 FE results are cached in `<results>/<scene>/` (default `results/`).  A cached result is reused only when its
 stamp `.validate-key` holds the same key: a sha256 of the resolved scene (after defaults and overrides) and
@@ -43,9 +44,21 @@ STAMP = ".validate-key"
 # the bearing-variant study (thesis Sec. 5.8, Fig. 5.18) and the configurations it needs
 VARIANT_SCENE = "test-gearbox-interior"
 VARIANT_CONFIGS = ("ball", "self_aligning", "ball_zero_moment")
-# modules whose published_rows() join the table: every name must import and define published_rows()
-# (tests/verification/test_validate.py checks it), so a renamed module fails loudly instead of silently dropping rows
-ROW_PROVIDERS = ("housingfe.verification.bearing_rows", "housingfe.verification.radiation_rows", "housingfe.verification.source_rows")
+
+
+def row_providers(package: str = "housingfe.verification") -> tuple[str, ...]:
+    """The row providers: every module `<package>.<topic>_rows`, in name order.  Each must define
+    published_rows() (tests/verification/test_validate.py checks it, and that no other module of the package
+    defines one), so adding a provider is adding its module; a module that fails to import is reported as a
+    failed provider by `provider_rows`, not silently dropped."""
+    import pkgutil
+
+    path = importlib.import_module(package).__path__
+    return tuple(sorted(f"{package}.{m.name}" for m in pkgutil.iter_modules(path) if m.name.endswith("_rows")))
+
+
+# modules whose published_rows() join the table (found by name, see row_providers)
+ROW_PROVIDERS = row_providers()
 # Appendix E tables that a gearbox scene's reconstruction is checked against
 APPENDIX_E = {"gearbox-model": "scale_model", "test-gearbox": "test_gearbox"}
 # `housingfe validate --quick` (CI): the small FE scenes and every row that needs no FE (providers, Appendix E

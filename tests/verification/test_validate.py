@@ -166,6 +166,33 @@ def test_every_row_provider_exists_and_has_published_rows():
         assert callable(importlib.import_module(name).published_rows), name
 
 
+def test_row_providers_are_the_rows_modules_and_no_other_module_has_rows():
+    """A provider is found by its name (verification/<topic>_rows.py); a module that defines published_rows()
+    under another name would silently drop out of the table."""
+    import pkgutil
+
+    import housingfe.verification as package
+
+    assert validate.ROW_PROVIDERS == ("housingfe.verification.bearing_rows", "housingfe.verification.radiation_rows",
+                                      "housingfe.verification.source_rows")
+    for m in pkgutil.iter_modules(package.__path__):
+        name = f"housingfe.verification.{m.name}"
+        assert hasattr(importlib.import_module(name), "published_rows") == (name in validate.ROW_PROVIDERS), name
+
+
+def test_a_new_rows_module_is_a_provider(tmp_path, monkeypatch):
+    """Adding a provider = adding its module: a toy package with toy_rows.py is found and its rows collected."""
+    (tmp_path / "toyprov").mkdir()
+    (tmp_path / "toyprov" / "__init__.py").write_text("")
+    (tmp_path / "toyprov" / "helpers.py").write_text("X = 1\n")
+    (tmp_path / "toyprov" / "toy_rows.py").write_text(
+        "def published_rows():\n    return [{'scene': 'toy', 'quantity': 'q', 'ours': 1.0}]\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert validate.row_providers("toyprov") == ("toyprov.toy_rows",)
+    monkeypatch.setattr(validate, "ROW_PROVIDERS", validate.row_providers("toyprov"))
+    assert validate.provider_rows() == [{"scene": "toy", "quantity": "q", "ours": 1.0}]
+
+
 def test_radiation_rows_carry_appendix_e_and_reproduce_it():
     from housingfe.verification import radiation_rows as validation
 
