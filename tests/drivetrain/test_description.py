@@ -18,7 +18,7 @@ def _scene_source(name):
     return roosmalen.build(roosmalen.parse(data, str(path)), str(path))
 
 
-@pytest.mark.parametrize("gear_set", ["A", "B", "double_helical"])
+@pytest.mark.parametrize("gear_set", list(GEAR_SETS))
 def test_lumped_reduction_is_the_gearset_scene(gear_set):
     pair, corr, geometry, interior, model = _scene_source(GEAR_SETS[gear_set])
     li, geo, mm = test_gearbox(gear_set).to_lumped()
