@@ -135,8 +135,9 @@ class Response:
         """Surface-averaged mean-square normal velocity <v^2> (m^2/s^2, rms^2) per line."""
         return self.result.mean_square_velocity
 
+    @property
     def velocity_level_db(self) -> np.ndarray:
-        """L_v (dB re v0 = 5e-8 m/s) per line."""
+        """L_v (dB re v0 = 5e-8 m/s) per line (a property, as on LoadResponse)."""
         return levels.level(self.mean_square_velocity(), levels.V0)
 
     def at_points(self, kind: str = "displacement", direction=None) -> dict:
@@ -179,7 +180,7 @@ class Response:
         ref = self.loads[0] if load is None else next((ld for ld in self.loads if ld.name == load), None)
         if ref is None:
             raise InputError(f"transfer_db: no load named {load!r}")
-        return self.velocity_level_db() - levels.level(np.abs(ref.amplitude(self.frequencies)) ** 2, 1.0)
+        return self.velocity_level_db - levels.level(np.abs(ref.amplitude(self.frequencies)) ** 2, 1.0)
 
 
 def harmonic_response(structure_or_basis, loads, damping, frequencies, *, surface: str = "outer", points=(),

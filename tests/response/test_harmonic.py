@@ -90,7 +90,7 @@ def test_complex_spectrum_scales_the_response(plate):
     # TF = L_v - L_F does not depend on the spectrum
     np.testing.assert_allclose(shaped.transfer_db(), unit.transfer_db(), atol=1e-9)
     bands, levels = shaped.band_levels(100.0, 1500.0)
-    assert len(levels) == len(bands.nominal) and np.nanmax(levels) > np.max(shaped.velocity_level_db()) - 1e-9
+    assert len(levels) == len(bands.nominal) and np.nanmax(levels) > np.max(shaped.velocity_level_db) - 1e-9
 
 
 def test_load_table_spectrum_interpolates_real_and_imaginary_parts():
