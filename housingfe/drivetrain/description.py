@@ -240,7 +240,52 @@ class Drivetrain:
         interior, geometry, model = self.to_lumped()
         return SourceModel(self.gears.pair, self.gears.corrections, interior, geometry, mesh_model=model, **kwargs)
 
+    # ------------------------------------------------------------------------- lumped <-> housing frames
+    def lumped_frame(self) -> np.ndarray:
+        """3x3, columns = the lumped model's x, y, z in the housing frame: x along the centre line (pinion to
+        wheel), z along the shaft axis, y = z cross x (housingfe.source.dynamics.mesh_direction)."""
+        p, w = self.shaft("pinion"), self.shaft("wheel")
+        a = np.asarray(p.axis, float) / np.linalg.norm(p.axis)
+        c = np.asarray(w.centre, float) - np.asarray(p.centre, float)
+        e_c = c - (c @ a) * a
+        e_c /= np.linalg.norm(e_c)
+        return np.column_stack([e_c, np.cross(a, e_c), a])
+
+    def lumped_to_housing(self, values: np.ndarray) -> np.ndarray:
+        """Forces and moments (or displacements and rotations) of the lumped model, (6, ...) = (x, y, z, theta_x,
+        theta_y, theta_z) in its frame, as (6, ...) in the housing frame.
+
+        The two reductions have opposite helix hands: the lumped mesh normal has the axial component
+        -sin(beta_b) (dynamics.mesh_direction), the FE one +sin(beta_b) (`gear_forces`); Appendix F does not give
+        the hand and each model is mirror-symmetric, so each is computed as it was, and vectors passed from the
+        lumped model to the housing are mirrored z -> -z first: vectors (x, y, -z), pseudo-vectors (-x, -y, z)."""
+        v = np.asarray(values)
+        R = self.lumped_frame()
+        f = np.tensordot(R * np.array([1.0, 1.0, -1.0]), v[:3], axes=1)
+        m = np.tensordot(R * np.array([-1.0, -1.0, 1.0]), v[3:6], axes=1)
+        return np.concatenate([f, m])
+
+    def lumped_bearing_position(self, shaft: str, z: float) -> np.ndarray:
+        """Housing position (m) of a point at lumped axial coordinate z (m, BearingSpectra.z) on a shaft
+        (mirrored like `lumped_to_housing`)."""
+        return self.shaft(shaft).point(-z)
+
     # -------------------------------------------------------------------------------------- FE reduction
+    def mesh_node_loads(self, force: complex = 1.0, forces: GearForces | None = None) -> dict:
+        """{gear node of the FE reduction: (6,) load [N, N m] in the housing frame} of a mesh force `force` (N,
+        positive = compression, e.g. Excitation.mesh_force[n]) along the FE contact normal at the contact point:
+        -force n on the pinion, +force n on the wheel, with their moments about the gear centres (the loads the
+        gear-mesh element of the coupled model carries)."""
+        forces = forces or self.gear_forces()
+        n = forces.direction
+        out = {}
+        for name, sign in (("pinion", -1.0), ("wheel", 1.0)):
+            node = f"{name}:{self.shaft_nodes(name)[1]['gear']}"
+            f = sign * force * n
+            arm = forces.point - np.asarray(self.shaft(name).centre, float)
+            out[node] = np.concatenate([f, np.cross(arm, n) * sign * force])
+        return out
+
     def gear_forces(self) -> GearForces:
         """Mean tooth force and mean mesh stiffness at `torque`, placed in the housing: the line of action in the
         transverse plane at the operating pressure angle from the common tangent, tilted out of it by the base

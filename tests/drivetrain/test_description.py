@@ -117,3 +117,21 @@ def test_bad_descriptions_are_input_errors():
         dataclasses.replace(d, bearings=(off, *d.bearings[1:]))
     with pytest.raises(InputError, match="torque"):
         dataclasses.replace(d, torque=0.0)
+
+
+@pytest.mark.parametrize("gear_set", ["A", "C"])
+def test_lumped_mesh_loads_map_onto_the_fe_mesh_loads(gear_set):
+    """The lumped model's generalized mesh force on each gear (-F h, Appendix C with the axial tilt term) moved into
+    the housing frame (`lumped_to_housing`, mirrored for the helix hand) is the FE reduction's mesh load on the gear
+    node: force along the contact normal and its moment about the gear centre, all six components.  (Single helical
+    only: for the double helical set the lumped normal keeps the axial component and cos(beta_b) of one helix,
+    the FE reduction takes beta_b = 0 as the halves cancel; docs/drivetrain.md.)"""
+    from housingfe.source.dynamics import mesh_direction
+
+    d = test_gearbox(gear_set)
+    h = mesh_direction(d.gears.pair)
+    fe = d.mesh_node_loads(1.0)
+    for node, dofs in (("pinion:8", slice(0, 6)), ("wheel:8", slice(6, 12))):
+        np.testing.assert_allclose(d.lumped_to_housing(-h[dofs]), fe[node], atol=1e-12)
+    # action = reaction: the forces cancel
+    np.testing.assert_allclose(fe["pinion:8"][:3] + fe["wheel:8"][:3], 0.0, atol=1e-15)
