@@ -12,9 +12,49 @@ the four side midpoints, on the flange centre line.
 """
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
+from pydantic import PositiveFloat, model_validator
 
 from housingfe.geometry.blocks import BlockModel, cells_where, unique_planes
+from housingfe.geometry.registry import StrictSpec as _Strict
+from housingfe.geometry.registry import register_geometry
+
+
+class BoxGeometry(_Strict):
+    """The open welded box of Sec. 4.2 (lengths in m; H from the flange underside to the top)."""
+
+    kind: Literal["box"]
+    length: PositiveFloat
+    width: PositiveFloat
+    height: PositiveFloat
+    wall_thickness: PositiveFloat
+    flange_thickness: PositiveFloat
+    flange_width: PositiveFloat
+    bolt_patch_size: PositiveFloat = 0.024
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        if 2 * self.wall_thickness >= min(self.length, self.width):
+            raise ValueError("wall_thickness: walls thicker than half the length/width leave no box")
+        if self.flange_thickness + self.wall_thickness >= self.height:
+            raise ValueError("height: must exceed flange_thickness + wall_thickness")
+        if self.bolt_patch_size >= self.flange_width:
+            raise ValueError("bolt_patch_size: must be smaller than flange_width")
+        # a flange wider than the box itself is a unit typo (5.0 for 0.05 m), not a housing: it would mesh
+        # metres of flange at millimetre elements
+        if self.flange_width > max(self.length, self.width):
+            raise ValueError(f"flange_width: {self.flange_width:g} m is wider than the box itself "
+                             f"({self.length:g} x {self.width:g} m); lengths are in m")
+        if self.flange_thickness > self.height:
+            raise ValueError(f"flange_thickness: {self.flange_thickness:g} m exceeds the box height "
+                             f"{self.height:g} m; lengths are in m")
+        return self
+
+    @property
+    def min_thickness(self) -> float:
+        return min(self.wall_thickness, self.flange_thickness)
 
 
 def box_model(length: float, width: float, height: float, wall_thickness: float,
@@ -81,3 +121,12 @@ def _plate_of_outer_face(c: np.ndarray, n: np.ndarray, L2: float, W2: float, H: 
     if abs(n[0]) > 0.5:
         return "left" if n[0] < 0 else "right"
     return "front" if n[1] < 0 else "back"
+
+
+def build_box(g: BoxGeometry) -> BlockModel:
+    """Block model of a validated BoxGeometry."""
+    return box_model(g.length, g.width, g.height, g.wall_thickness, g.flange_thickness, g.flange_width,
+                     g.bolt_patch_size)
+
+
+register_geometry(BoxGeometry, build_box)

@@ -8,7 +8,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from housingfe.errors import InputError
-from housingfe.geometry.blocks import BlockModel, build_gmsh_model, tet_quality
+from housingfe.geometry.blocks import build_gmsh_model, tet_quality
+
+# the registry's lookup, with the built-in kinds registered (specs imports their modules)
+from housingfe.geometry.specs import block_model_for
 
 
 @dataclass
@@ -52,30 +55,6 @@ def bending_wavelength(frequency: float, thickness: float, youngs_modulus: float
     omega = 2 * math.pi * frequency
     k = (omega**2 * density * thickness / D) ** 0.25
     return 2 * math.pi / k
-
-
-def block_model_for(geometry) -> BlockModel:
-    """The block model of a validated scene geometry section (see housingfe.scene)."""
-    from housingfe.geometry.box import box_model
-    from housingfe.geometry.plate import plate_model
-
-    if geometry.kind == "box":
-        return box_model(geometry.length, geometry.width, geometry.height, geometry.wall_thickness,
-                         geometry.flange_thickness, geometry.flange_width, geometry.bolt_patch_size)
-    if geometry.kind == "plate":
-        return plate_model(geometry.a, geometry.b, geometry.h)
-    if geometry.kind == "box-halves":
-        from housingfe.geometry.housings import box_halves_model
-
-        return box_halves_model(geometry.length, geometry.width, geometry.height, geometry.wall_thickness,
-                                geometry.flange_thickness, geometry.flange_width, geometry.bolt_patch_size,
-                                geometry.joint, geometry.joint_thickness, geometry.bearing_point_offset,
-                                geometry.bearing_point_size)
-    if geometry.kind == "gearbox":
-        from housingfe.geometry.housings import gearbox_model
-
-        return gearbox_model(geometry)
-    raise InputError(f"geometry.kind: no builder for {geometry.kind!r}")
 
 
 # DOFs per cell of the estimated element grid for quadratic elements, measured (issue 12): hex27 34-38 (box-free

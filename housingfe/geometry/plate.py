@@ -5,9 +5,45 @@ edge_x1 (x = a), edge_y0, edge_y1; the faces top (z = h) and bottom (z = 0).
 """
 from __future__ import annotations
 
+from typing import Literal
+
 import numpy as np
+from pydantic import PositiveFloat, model_validator
 
 from housingfe.geometry.blocks import BlockModel, cells_where
+from housingfe.geometry.registry import StrictSpec as _Strict
+from housingfe.geometry.registry import register_geometry
+
+EdgeCondition = Literal["free", "clamped", "simply_supported"]
+
+
+class PlateEdges(_Strict):
+    x0: EdgeCondition = "free"
+    x1: EdgeCondition = "free"
+    y0: EdgeCondition = "free"
+    y1: EdgeCondition = "free"
+
+
+class PlateGeometry(_Strict):
+    """Rectangular plate a x b x h (m) with per-edge conditions; simply supported = zero transverse
+    displacement on the edge face."""
+
+    kind: Literal["plate"]
+    a: PositiveFloat
+    b: PositiveFloat
+    h: PositiveFloat
+    edges: PlateEdges = PlateEdges()
+
+    @model_validator(mode="after")
+    def _thin(self):
+        if self.h > min(self.a, self.b):
+            raise ValueError(f"h: a plate {self.h:g} m thick and {min(self.a, self.b):g} m wide is not a plate; "
+                             f"lengths are in m")
+        return self
+
+    @property
+    def min_thickness(self) -> float:
+        return self.h
 
 
 def plate_model(a: float, b: float, h: float) -> BlockModel:
@@ -24,3 +60,11 @@ def plate_model(a: float, b: float, h: float) -> BlockModel:
 
     return BlockModel(grid=grid, cells=cells_where(grid, lambda x, y, z: "plate"), classify_face=classify,
                       thin_dimensions=(h,))
+
+
+def build_plate(g: PlateGeometry) -> BlockModel:
+    """Block model of a validated PlateGeometry (the edge conditions are supports, set by the FE model)."""
+    return plate_model(g.a, g.b, g.h)
+
+
+register_geometry(PlateGeometry, build_plate)
