@@ -14,6 +14,7 @@ x(t) = x_mean + Re(sum_n A_n exp(i 2 pi n f_tooth t)).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -114,12 +115,12 @@ class SourceModel:
     def operating_point(self, speed_rpm: float, torque_nm: float) -> Excitation:
         """The excitation at a pinion speed (rev/min, within speed_range_rpm) and pinion torque (N m, > 0)."""
         lo, hi = self.speed_range_rpm
-        if not (isinstance(speed_rpm, (int, float)) and math.isfinite(speed_rpm)) or speed_rpm <= 0:
+        if not (isinstance(speed_rpm, numbers.Real) and math.isfinite(speed_rpm)) or speed_rpm <= 0:
             raise InputError(f"operating_point: speed_rpm: {speed_rpm!r} must be a finite number > 0 rev/min")
         if not lo <= speed_rpm <= hi:
             raise InputError(f"operating_point: speed_rpm: {speed_rpm:g} rev/min is outside the supported range "
                              f"{lo:g}..{hi:g} rev/min")
-        if not (isinstance(torque_nm, (int, float)) and math.isfinite(torque_nm)) or torque_nm <= 0:
+        if not (isinstance(torque_nm, numbers.Real) and math.isfinite(torque_nm)) or torque_nm <= 0:
             raise InputError(f"operating_point: torque_nm: {torque_nm!r} must be a finite number > 0 N m (the "
                              "mesh stiffness is computed at the loaded tooth deflection; an unloaded mesh is not "
                              "supported)")

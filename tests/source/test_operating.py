@@ -32,6 +32,9 @@ def test_tooth_band_levels_are_those_of_the_source_command(model):
         assert ex.L_omega_tooth_band == pytest.approx(ref, abs=1e-9)
         assert ex.tooth_frequency_hz == pytest.approx(0.4 * rpm, rel=1e-12)       # 24 teeth
         np.testing.assert_allclose(ex.frequency_hz, ex.harmonic * 0.4 * rpm, rtol=1e-12)
+    # numpy scalars are numbers too
+    assert model.operating_point(np.int64(500), np.float64(2000.0)).L_omega_tooth_band == pytest.approx(
+        model.operating_point(500.0, 2000.0).L_omega_tooth_band, abs=1e-12)
     # and the description of the test gearbox gives the same model
     from housingfe.drivetrain.description import test_gearbox
 
@@ -82,7 +85,8 @@ def test_bearing_loads_and_levels(model):
 
 @pytest.mark.parametrize("speed, torque, key", [(-100.0, 2000.0, "speed_rpm"), (0.0, 2000.0, "speed_rpm"),
                                                 (3000.0, 2000.0, "speed_rpm"), (float("nan"), 2000.0, "speed_rpm"),
-                                                (1000.0, 0.0, "torque_nm"), (1000.0, -500.0, "torque_nm")])
+                                                ("fast", 2000.0, "speed_rpm"), (1000.0, 0.0, "torque_nm"),
+                                                (1000.0, -500.0, "torque_nm")])
 def test_bad_operating_points_are_input_errors(model, speed, torque, key):
     with pytest.raises(InputError, match=key):
         model.operating_point(speed, torque)
