@@ -44,7 +44,7 @@ def _run(scene, out: Path, comm, t_start: float) -> Path:
     modes = None
     if modal_spec is not None:
         modes = modal.modes(structure, modal_spec.f_max, tol=modal_spec.tolerance)
-        summary = modal_summary(model, modes, modal_checks(model, modes, interior), time.perf_counter() - t_start)
+        summary = modal_summary(model, modes, modal_checks(model, modes), time.perf_counter() - t_start)
         if interior is not None:
             summary["interior"] = interior_summary(interior, modes)
             summary["published"] += published.interior_comparison(scene, summary["interior"])
@@ -87,23 +87,21 @@ def forced_response(scene, model, structure):
     return forced
 
 
-def modal_checks(model, result, interior=None) -> dict:
+def modal_checks(model, result) -> dict:
     """Rigid-body count (result: a ModalBasis, checked against its structure's expected zero modes) and the mass /
     centre of gravity that the rigid modes carry (free structures).  With an
     interior the expected zero modes are the housing's plus the interior's mechanisms on fixed bores (counted
     independently on the small interior matrices), and the mass includes shafts and gears."""
-    from housingfe.solvers import elasticity, modal
+    from housingfe.solvers import modal
 
     n_rigid = result.rigid_count
     expected = result.expected_zero_modes
     checks: dict = {"rigid_modes_expected": expected or 0}
     result.check_zero_modes()
     if model.rigid_modes_expected == 6 and n_rigid >= 6:
-        if interior is None:
-            M, fields = model.M, elasticity.rigid_body_vectors(model.V)
-        else:
-            M, fields = interior.M, interior.system.rigid_body_vectors(model.V)
-        checks.update(modal.rigid_body_mass_properties(M, result.vectors[:n_rigid], fields))
+        structure = result.structure
+        checks.update(modal.rigid_body_mass_properties(structure.M, result.vectors[:n_rigid],
+                                                       structure.rigid_body_vectors()))
     checks["geometry_mass_kg"] = model.material.density * model.housing.volume
     checks["geometry_centre_of_gravity_m"] = model.housing.centroid
     return checks

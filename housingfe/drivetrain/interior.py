@@ -413,6 +413,10 @@ class CoupledInterior:
         """The housing displacement field of a coupled vector (= fe_vector)."""
         return self.fe_vector(vec)
 
+    def rigid_body_vectors(self) -> list:
+        """The six exact rigid-body motions (translations, rotations about the origin) in the coupled DOFs."""
+        return self.system.rigid_body_vectors(self.model.V)
+
     def node_displacement(self, q, node: str) -> np.ndarray:
         """Six displacement components (m, rad) of an interior node in the coupled vector q."""
         return self.system.node_displacement(q, node)

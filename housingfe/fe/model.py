@@ -73,6 +73,12 @@ class HousingModel:
         """The housing field of a vector in this model's DOFs: the vector itself."""
         return vec
 
+    def rigid_body_vectors(self) -> list:
+        """The six exact rigid-body motions (translations, rotations about the origin) as FE vectors."""
+        from housingfe.solvers.elasticity import rigid_body_vectors
+
+        return rigid_body_vectors(self.V)
+
     def basis_stiffness(self):
         """The symmetric stiffness for a modal basis: K itself."""
         return self.K
