@@ -101,7 +101,7 @@ def _assembly_cpu(model) -> float:
     from housingfe.fe.model import foundation_forms
     from housingfe.solvers import elasticity
 
-    extra = foundation_forms(model.scene, model.housing, model.V)
+    extra = foundation_forms(model.scene.supports, model.housing, model.V)
     _, cpu, _ = _timed(lambda: elasticity.assemble_stiffness_mass(model.V, model.materials, model.bcs, extra))
     return cpu
 
