@@ -53,10 +53,10 @@ def register(subparsers) -> None:
                    help="mean load on the inner ring [N, N, N, N m, N m]")
     p.add_argument("--preload-axial", type=float, default=0.0, metavar="N",
                    help="axial preload added to FZ [N]")
-    p.add_argument("--model", default=None,
-                   choices=["lim-ball", "lim-roller", "sliced-roller", "sliced-roller-thesis", "self-aligning"],
-                   help="default: lim-ball for balls, sliced-roller (thesis Sec. 3.3.2) for rollers, "
-                        "self-aligning for spherical roller bearings")
+    p.add_argument("--model", default=None, metavar="NAME",
+                   help="a registered bearing model (housingfe.bearings.rolling.BEARING_MODELS: lim-ball, lim-roller, "
+                        "sliced-roller, ...); default: lim-ball for balls, sliced-roller (thesis Sec. 3.3.2) for "
+                        "rollers, self-aligning for spherical roller bearings")
     p.add_argument("--fixed-tilt", action="store_true",
                    help="hold the tilt at zero (shaft held by a second bearing); MX, MY are then outputs")
     p.add_argument("--json", action="store_true",
@@ -124,6 +124,13 @@ def _cmd_bearing(args: argparse.Namespace) -> int:
     from housingfe.bearings import bearing_stiffness
 
     geometry = bearing_from_arguments(args)
+    if args.model is not None:
+        from housingfe.bearings.rolling import check_bearing_model
+
+        try:
+            check_bearing_model(args.model)
+        except ValueError as exc:
+            raise InputError(f"--model: {exc}") from None
     result = bearing_stiffness(geometry, args.load, model=args.model, preload_axial=args.preload_axial,
                                fixed_tilt=(0.0, 0.0) if args.fixed_tilt else None)
     if args.json:
