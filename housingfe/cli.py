@@ -51,6 +51,29 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_mesh_picture(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from mpi4py import MPI
+
+    from housingfe.fe.model import element_size
+    from housingfe.geometry import build_mesh
+    from housingfe.geometry.pictures import mesh_picture
+    from housingfe.scene import load_housing_scene
+
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    for name in args.scenes:
+        scene, _ = load_housing_scene(name)
+        size = element_size(scene.mesh, scene.geometry, scene.analysis.f_max, scene.material.resolve())
+        hm = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, MPI.COMM_SELF)
+        label = f"{scene.scene.name}: {hm.mesh.topology.index_map(3).size_global} {hm.element} cells, " \
+                f"h = {size * 1e3:.1f} mm"
+        mesh_picture(hm, out / f"{name}-mesh.png", label)
+        print(out / f"{name}-mesh.png")
+    return 0
+
+
 def _register_extension(name: str, sub) -> None:
     """Add the sub-commands of one concern; a concern that is absent or broken costs only its own commands
     (its tests report the breakage), never the whole CLI."""
@@ -105,6 +128,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default=None, help="result folder (default results/bench-<which>)")
     p.add_argument("--quick", action="store_true", help="small subset, for a smoke run")
     p.set_defaults(func=_cmd_bench)
+
+    p = sub.add_parser("mesh-picture", help="PNG of a scene's mesh coloured by feature (for the docs)")
+    p.add_argument("scenes", nargs="+", help="built-in scene names or TOML paths")
+    p.add_argument("--out", default="docs/img", help="folder for <scene>-mesh.png")
+    p.set_defaults(func=_cmd_mesh_picture)
 
     for name in _EXTENSIONS:
         _register_extension(name, sub)

@@ -54,9 +54,10 @@ def _run(scene, out: Path, comm, t_start: float) -> Path:
     with outputs.atomic_output_dir(out, comm) as tmp:
         if modes is not None:
             housing_modes = modes.to_housing()
-            report.write_modal_outputs(tmp, model, housing_modes, summary, comm)
+            report.write_modal_outputs(tmp, model, housing_modes, summary, comm, scene.output)
         if forced is not None:
-            report.write_harmonic_outputs(tmp, model, forced, comm)
+            report.write_harmonic_outputs(tmp, model, forced, comm, scene_name=scene.scene.name,
+                                          pictures=scene.output.pictures)
     if comm.rank == 0:
         if modes is not None:
             print(report.modal_summary_text(summary))
@@ -71,18 +72,20 @@ def forced_response(scene, model, structure):
     power of the scene's radiation spec (if any) stored on the result."""
     from housingfe.response import forced as forced_stage
 
-    extra, plate_ids = {}, None
     radiation = scene.radiation
-    if radiation is not None and radiation.model == "numerical":
-        from housingfe.radiation.housing import RADIATION_POINTS, radiation_points
-
-        extra[RADIATION_POINTS], plate_ids = radiation_points(model, radiation)
-    forced = forced_stage.run(structure, scene.analysis.harmonic, scene.loads, scene.damping, extra_points=extra)
+    radiator = None
     if radiation is not None:
+        from housingfe.radiation.radiators import radiator_from_spec
+
+        # the radiator says which extra surface points it needs (the numerical model: its plates' facet points)
+        radiator = radiator_from_spec(radiation, model.housing, model.material)
+    extra = radiator.extra_points(structure) if radiator is not None else {}
+    forced = forced_stage.run(structure, scene.analysis.harmonic, scene.loads, scene.damping, extra_points=extra)
+    if radiator is not None:
         from housingfe.radiation.housing import sound_power
 
         t1 = time.perf_counter()
-        forced.sound_power = sound_power(forced, model, radiation, plate_ids)
+        forced.sound_power = sound_power(forced, model, radiation, radiator=radiator)
         forced.timings["radiation_s"] = time.perf_counter() - t1
     return forced
 

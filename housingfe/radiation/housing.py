@@ -41,17 +41,14 @@ def radiation_points(model, spec):
     return housing_plate_points(model.housing, [p.surface for p in spec.plates])
 
 
-def sound_power(forced, model, spec=None, plate_ids=None, *, radiator: Radiator | None = None
+def sound_power(forced, model, spec, plate_ids=None, *, radiator: Radiator | None = None
                 ) -> list[HousingSoundPower]:
     """Sound power of every load case of a ForcedResult (the first solver's responses).
 
-    model: the HousingModel (its housing and material); spec: the scene's radiation section (default
-    model.scene.radiation); radiator: the one whose extra_points the forced response evaluated (default: made from
-    spec; for the numerical model the points already in forced.observer with their `plate_ids`)."""
-    if isinstance(spec, np.ndarray):     # the older call sound_power(forced, model, plate_ids)
-        spec, plate_ids = None, spec
+    model: the HousingModel (its housing and material); spec: the scene's radiation section; radiator: the one
+    whose extra_points the forced response evaluated (default: made from spec; for the numerical model the points
+    already in forced.observer with their `plate_ids`)."""
     if radiator is None:
-        spec = spec if spec is not None else model.scene.radiation
         radiator = radiator_from_spec(spec, model.housing, model.material)
         if isinstance(radiator, NumericalRadiator) and plate_ids is not None:
             radiator.points, radiator.plate_ids = forced.observer.extra_samples[RADIATION_POINTS], plate_ids

@@ -46,19 +46,19 @@ def modal_summary_text(summary: dict) -> str:
     return "\n".join(lines)
 
 
-def write_modal_outputs(folder: Path, model, result, summary: dict, comm) -> None:
-    """modes.json, summary.txt, modes.xdmf (ParaView) and PNG pictures into `folder` (collective)."""
-    scene = model.scene
-    if scene.output.paraview:
+def write_modal_outputs(folder: Path, model, result, summary: dict, comm, output) -> None:
+    """modes.json, summary.txt, modes.xdmf (ParaView) and PNG pictures into `folder` (collective); `output` says
+    which (paraview, pictures, mode_pictures: a housingfe.scene.OutputSpec or anything with those attributes)."""
+    if output.paraview:
         write_modes_xdmf(folder / "modes.xdmf", model, result, comm)
     if comm.rank != 0:
         return
     write_json(folder / "modes.json", summary)
     (folder / "summary.txt").write_text(modal_summary_text(summary) + "\n")
-    if scene.output.pictures:
+    if output.pictures:
         plot_frequencies(folder / "frequencies.png", summary)
-        if comm.size == 1 and scene.output.mode_pictures:
-            plot_mode_shapes(folder / "modes.png", model, result, scene.output.mode_pictures)
+        if comm.size == 1 and output.mode_pictures:
+            plot_mode_shapes(folder / "modes.png", model, result, output.mode_pictures)
 
 
 def write_modes_xdmf(path: Path, model, result, comm) -> None:
@@ -277,9 +277,9 @@ def harmonic_summary_text(forced) -> str:
     return "\n".join(lines)
 
 
-def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
-    """frf.csv, bands.csv, receptance.csv, points.csv, harmonic.json, TF plots, operating deflection shapes
-    (ods_<load>.xdmf)."""
+def write_harmonic_outputs(folder: Path, model, forced, comm, *, scene_name: str, pictures: bool) -> None:
+    """frf.csv, bands.csv, receptance.csv, points.csv, harmonic.json, TF plots (if `pictures`), operating deflection
+    shapes (ods_<load>.xdmf); `scene_name` labels harmonic.json."""
     ods_files = write_deflection_shapes(folder, model, forced, comm) if forced.deflection_shapes else {}
     if comm.rank != 0:
         return
@@ -313,7 +313,7 @@ def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
                 rec.append([lj.name, ri.name, f, h.real, h.imag, abs(h)])
     write_csv(folder / "receptance.csv", ["response_at", "load_case", "frequency_hz", "real", "imag", "abs"], rec)
     write_json(folder / "harmonic.json", {
-        "scene": model.scene.scene.name, "solvers": solvers, "timings_s": forced.timings, **forced.facts,
+        "scene": scene_name, "solvers": solvers, "timings_s": forced.timings, **forced.facts,
         "band_comparison_vs_direct": band_comparison(forced),
         "sample_points": {N: {"points_m": s.points, "weights_m2": s.weights}
                           for N, s in forced.observer.samples.items()},
@@ -335,10 +335,10 @@ def write_harmonic_outputs(folder: Path, model, forced, comm) -> None:
                   tf_omega_rows(forced))
         write_csv(folder / "tf_omega_bands.csv", ["load_case", "solver", "band_nominal_hz", "band_center_hz",
                                                   "TF_omega_dB"], tf_omega_band_rows(forced))
-    if model.scene.output.pictures:
+    if pictures:
         plot_transfer_functions(folder / "tf_bands.png", forced, rows, solvers)
     if forced.sound_power:
-        write_sound_power(folder, forced, model.scene.output.pictures)
+        write_sound_power(folder, forced, pictures)
 
 
 def tf_omega_rows(forced) -> list:
