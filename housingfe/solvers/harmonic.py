@@ -91,14 +91,10 @@ def modal_superposition(K, M, modal_result, loads, frequencies, damping: Damping
     lam_e = lam[n_rigid:]
     eta = damping.hysteretic(frequencies)
     xi = damping.ratios(len(lam_e))
+    eta_modal = None
     if damping.D is not None and xi is None:
         eta_modal = np.array([phi.dot(_mult(damping.D, phi)) / l for phi, l in zip(elastic, lam_e)])
-        denominators = lam_e[:, None] * (1 + 1j * eta_modal[:, None]) - omega[None, :] ** 2
-    elif xi is not None:
-        w_n = np.sqrt(lam_e)
-        denominators = lam_e[:, None] - omega[None, :] ** 2 + 2j * xi[:, None] * w_n[:, None] * omega[None, :]
-    else:
-        denominators = lam_e[:, None] * (1 + 1j * eta[None, :]) - omega[None, :] ** 2
+    denominators = modal_denominators(lam_e, omega, eta, xi, eta_modal)
     _check_not_singular(denominators, lam_e, frequencies)
 
     shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
@@ -124,6 +120,19 @@ def modal_superposition(K, M, modal_result, loads, frequencies, damping: Damping
         ksp.destroy()
     return HarmonicResult(np.asarray(frequencies, float), blocks, "modal+residual" if residual else "modal",
                           {"modal_superposition_s": time.perf_counter() - t0}, modal_vectors=kept)
+
+
+def modal_denominators(lam_e: np.ndarray, omega: np.ndarray, eta: np.ndarray, xi: np.ndarray | None,
+                       eta_modal: np.ndarray | None = None) -> np.ndarray:
+    """(modes, lines) denominators of the elastic modal coordinates, lambda_i (1 + i eta) - omega^2 (hysteretic,
+    eta per line or eta_modal per mode) or lambda_i - omega^2 + 2 i xi_i omega_i omega (viscous xi per mode);
+    lambda in rad^2/s^2, omega in rad/s."""
+    if eta_modal is not None:
+        return lam_e[:, None] * (1 + 1j * eta_modal[:, None]) - omega[None, :] ** 2
+    if xi is not None:
+        w_n = np.sqrt(lam_e)
+        return lam_e[:, None] - omega[None, :] ** 2 + 2j * xi[:, None] * w_n[:, None] * omega[None, :]
+    return lam_e[:, None] * (1 + 1j * np.asarray(eta)[None, :]) - omega[None, :] ** 2
 
 
 def _residual_vector(ksp, M, f, rigid, elastic, lam_e, shift) -> PETSc.Vec:
@@ -165,46 +174,14 @@ def projected(K, M, modal_result, loads, frequencies, damping: Damping, reduce, 
     omega = 2 * math.pi * np.asarray(frequencies, dtype=float)
     lam = modal_result.eigenvalues
     n_rigid = modal_result.rigid_count
-    phis = list(modal_result.vectors)
     lam_e = lam[n_rigid:]
-    shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
-    ksp = _factor(_shifted(K_sym, M, shift), "projected_")
-    basis = list(phis)
-    for load in loads:
-        r = _residual_vector(ksp, M, load.vector, phis[:n_rigid], phis[n_rigid:], lam_e, shift)
-        for b in basis:                         # M-orthogonal to the basis (twice: round-off)
-            r.axpy(-b.dot(_mult(M, r)), b)
-        for b in basis:
-            r.axpy(-b.dot(_mult(M, r)), b)
-        norm = math.sqrt(max(r.dot(_mult(M, r)), 0.0))
-        if norm > 1e-12 * math.sqrt(max(load.vector.norm(), 1e-300)):
-            r.scale(1.0 / norm)
-            basis.append(r)
-    ksp.destroy()
+    basis = ritz_basis(K_sym, M, modal_result, [load.vector for load in loads], shift=shift)
     t1 = time.perf_counter()
-    KB = [_mult(K, b) for b in basis]
-    MB = [_mult(M, b) for b in basis]
-    Kr = np.array([[a.dot(kb) for kb in KB] for a in basis])
-    Mr = np.array([[a.dot(mb) for mb in MB] for a in basis])
-    Cr = np.zeros_like(Kr)
-    if C is not None:
-        CB = [_mult(C, b) for b in basis]
-        Cr = np.array([[a.dot(cb) for cb in CB] for a in basis])
+    Kr, Mr, Cr = project(basis, K, M, C)
     Fr = np.array([[b.dot(load.vector) for load in loads] for b in basis])
-    n_modes = len(phis)
-    xi = damping.ratios(len(lam_e))
-    D = np.zeros_like(Kr)
-    if xi is not None:
-        idx = np.arange(n_rigid, n_modes)
-        D[idx, idx] = 2 * xi * np.sqrt(np.clip(lam_e, 0.0, None))
-    eta = np.zeros(len(omega)) if xi is not None else damping.hysteretic(frequencies)
-    coeffs = np.zeros((len(loads), len(basis), len(omega)), dtype=complex)
-    for k, (w, e) in enumerate(zip(omega, eta)):
-        A = Kr * (1 + 1j * e) + 1j * w * (Cr + D) - w * w * Mr
-        try:
-            coeffs[:, :, k] = np.linalg.solve(A, Fr).T
-        except np.linalg.LinAlgError as exc:
-            raise SolverError(f"projected solver: singular reduced system at {frequencies[k]:.6g} Hz") from exc
+    D = modal_damping_matrix(len(basis), n_rigid, lam_e, damping.ratios(len(lam_e)))
+    eta = np.zeros(len(omega)) if D is not None else damping.hysteretic(frequencies)
+    coeffs = solve_reduced(Kr, Mr, Cr if D is None else Cr + D, omega, eta, Fr)
     t2 = time.perf_counter()
     reduced = reduce(basis)
     every = np.arange(len(omega))
@@ -214,6 +191,69 @@ def projected(K, M, modal_result, loads, frequencies, damping: Damping, reduce, 
                            "projected_lines_s": t2 - t1, "projected_basis_size": len(basis)},
                           modal_vectors=[basis] * len(loads))
 
+
+def ritz_basis(K_sym, M, modal_result, load_vectors, *, shift: float | None = None) -> list:
+    """The modes of modal_result plus, per load vector, the static residual vector of the modes left out,
+    M-orthonormalised against the basis (Ritz vectors: exact for the loads' static response).  K_sym: a symmetric
+    positive semi-definite stiffness (the modes' own)."""
+    lam = modal_result.eigenvalues
+    n_rigid = modal_result.rigid_count
+    phis = list(modal_result.vectors)
+    lam_e = lam[n_rigid:]
+    shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
+    ksp = _factor(_shifted(K_sym, M, shift), "projected_")
+    basis = list(phis)
+    for f in load_vectors:
+        r = _residual_vector(ksp, M, f, phis[:n_rigid], phis[n_rigid:], lam_e, shift)
+        for b in basis:                         # M-orthogonal to the basis (twice: round-off)
+            r.axpy(-b.dot(_mult(M, r)), b)
+        for b in basis:
+            r.axpy(-b.dot(_mult(M, r)), b)
+        norm = math.sqrt(max(r.dot(_mult(M, r)), 0.0))
+        if norm > 1e-12 * math.sqrt(max(f.norm(), 1e-300)):
+            r.scale(1.0 / norm)
+            basis.append(r)
+    ksp.destroy()
+    return basis
+
+
+def project(basis, K, M, C=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Galerkin projections (Kr, Mr, Cr) = B^T (K, M, C) B of PETSc matrices on a list of vectors B (Cr = 0 without
+    C)."""
+    KB = [_mult(K, b) for b in basis]
+    MB = [_mult(M, b) for b in basis]
+    Kr = np.array([[a.dot(kb) for kb in KB] for a in basis]).reshape(len(basis), len(basis))
+    Mr = np.array([[a.dot(mb) for mb in MB] for a in basis]).reshape(len(basis), len(basis))
+    Cr = np.zeros_like(Kr)
+    if C is not None:
+        CB = [_mult(C, b) for b in basis]
+        Cr = np.array([[a.dot(cb) for cb in CB] for a in basis]).reshape(len(basis), len(basis))
+    return Kr, Mr, Cr
+
+
+def modal_damping_matrix(size: int, n_rigid: int, lam_e: np.ndarray, xi: np.ndarray | None) -> np.ndarray | None:
+    """(size, size) viscous damping 2 xi_i omega_i on the elastic modes (the first n_rigid + len(lam_e) vectors of a
+    Ritz basis; zero on the rigid modes and the residual vectors), or None for hysteretic damping (xi None)."""
+    if xi is None:
+        return None
+    D = np.zeros((size, size))
+    idx = np.arange(n_rigid, n_rigid + len(lam_e))
+    D[idx, idx] = 2 * xi * np.sqrt(np.clip(lam_e, 0.0, None))
+    return D
+
+
+def solve_reduced(Kr, Mr, Cr, omega, eta, Fr) -> np.ndarray:
+    """(loads, n, lines) solutions c of (Kr (1 + i eta) + i omega Cr - omega^2 Mr) c = Fr per line (omega rad/s, eta
+    per line; Fr (n, loads)), batched."""
+    omega = np.asarray(omega, float)
+    A = (Kr[None] * (1 + 1j * np.asarray(eta, float))[:, None, None] + 1j * omega[:, None, None] * Cr[None]
+         - omega[:, None, None] ** 2 * Mr[None])
+    try:
+        c = np.linalg.solve(A, np.broadcast_to(Fr.astype(complex), (len(omega),) + Fr.shape))
+    except np.linalg.LinAlgError as exc:
+        raise SolverError("projected solver: singular reduced system (an undamped line at a rigid-body or "
+                          "eigenfrequency)") from exc
+    return np.transpose(c, (2, 1, 0))
 
 # ----------------------------------------------------------------------------------------- direct
 def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None) -> HarmonicResult:

@@ -128,7 +128,6 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     purify: SLEPc's eigenvector purification costs one extra solve per mode (2.4 s of a 10 s box run);
     constrained rows are decoupled (1 on K's, 0 on M's diagonal), so it is off and residuals are reported.
     """
-    comm = K.getComm()
     sigma_max = (2 * math.pi * f_max) ** 2
     t0 = time.perf_counter()
     expected = count_eigenvalues_below(K, M, sigma_max)
@@ -137,13 +136,36 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     shift = -((2 * math.pi * (shift_hz if shift_hz is not None else 0.01 * f_max)) ** 2)
     requested = expected if nev is None else nev
     t0 = time.perf_counter()
-    eps = SLEPc.EPS().create(comm)
+    pairs = _krylov_schur(K, M, shift, requested, ncv, tol, purify, sigma_max)
+    if nev is None and len(pairs) < requested:
+        # SLEPc's nev closest to the shift can miss one of a close pair near f_max (seen on the coupled test
+        # gearbox: 62 of 63): ask again for a few more; the extras above f_max are dropped
+        pairs = _krylov_schur(K, M, shift, requested + max(2, requested // 20), ncv, tol, purify, sigma_max,
+                              keep=requested)
+    t_solve = time.perf_counter() - t0
+    values = np.array([p[0] for p in pairs])
+    vectors = [_mass_normalise(M, p[1]) for p in pairs]
+    residuals = np.array([_residual(K, M, lam, x, sigma_max) for lam, x in zip(values, vectors)])
+    result = ModalResult(values, vectors, expected, residuals, f_max,
+                         {"inertia_s": t_inertia, "eigensolve_s": t_solve}, eigenvalue_scale(K, M))
+    if require_complete and not result.complete:
+        raise SolverError(f"incomplete eigen-solution: {len(values)} eigenvalues returned, "
+                          f"{expected} lie below f_max = {f_max:g} Hz (inertia count)")
+    return result
+
+
+def _krylov_schur(K, M, shift: float, nev: int, ncv, tol: float, purify: bool, sigma_max: float,
+                  keep: int | None = None) -> list:
+    """(eigenvalue, vector) pairs below sigma_max (at most `keep`, default nev), ascending: Krylov-Schur with
+    shift-and-invert (MUMPS Cholesky) about `shift` (rad^2/s^2)."""
+    keep = nev if keep is None else keep
+    eps = SLEPc.EPS().create(K.getComm())
     eps.setOperators(K, M)
     eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
     eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
     eps.setTarget(shift)
-    eps.setDimensions(nev=max(requested, 1), ncv=ncv or max(2 * requested, requested + 24))
+    eps.setDimensions(nev=max(nev, 1), ncv=ncv or max(2 * nev, nev + 24))
     eps.setPurify(purify)
     eps.setTolerances(tol=tol, max_it=500)
     st = eps.getST()
@@ -156,26 +178,16 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     pc.setFactorSolverType("mumps")
     eps.setFromOptions()
     eps.solve()
-    t_solve = time.perf_counter() - t0
-
     pairs = []
     for i in range(eps.getConverged()):
         lam = eps.getEigenvalue(i).real
-        if lam < sigma_max and len(pairs) < requested:
+        if lam < sigma_max:
             x = K.createVecRight()
             eps.getEigenvector(i, x)
             pairs.append((lam, x))
     eps.destroy()
     pairs.sort(key=lambda p: p[0])
-    values = np.array([p[0] for p in pairs])
-    vectors = [_mass_normalise(M, p[1]) for p in pairs]
-    residuals = np.array([_residual(K, M, lam, x, sigma_max) for lam, x in zip(values, vectors)])
-    result = ModalResult(values, vectors, expected, residuals, f_max,
-                         {"inertia_s": t_inertia, "eigensolve_s": t_solve}, eigenvalue_scale(K, M))
-    if require_complete and not result.complete:
-        raise SolverError(f"incomplete eigen-solution: {len(values)} eigenvalues returned, "
-                          f"{expected} lie below f_max = {f_max:g} Hz (inertia count)")
-    return result
+    return pairs[:keep]
 
 
 def eigenvalue_scale(K: PETSc.Mat, M: PETSc.Mat) -> float:
