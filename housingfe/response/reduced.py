@@ -1,0 +1,196 @@
+"""A structure reduced once on a Ritz basis, then evaluated at any lines and load amplitudes in milliseconds.
+
+A run-up asks for the response at every harmonic of the tooth frequency at every speed (hundreds of lines whose
+load amplitudes change with speed and torque).  `harmonic_response` rebuilds the surface quantities of the modes
+per call; `RitzReduction` builds them once:
+
+    reduction = RitzReduction(basis, {"mesh": F_mesh, "torque": F_torque}, damping, nodes=("wheel:8",))
+    resp = reduction.evaluate(f, {"mesh": a_mesh})    # a_mesh: complex rms amplitude per line (N)
+    resp.mean_square_velocity                         # <v^2> over the surface per line (m^2/s^2)
+    reduction.node_rotation(resp, "wheel:8", axis)    # complex rms rotation of an interior node (rad)
+
+The Ritz basis is the modal basis plus, per unit load, the static residual vector of the modes left out
+(housingfe.solvers.harmonic.ritz_basis, as the projected solver): exact for the loads' static response and the
+kept modes' dynamics.  K, M and C are projected on it (C: bearing damping; K may be non-symmetric: fluid films) and
+the small system is solved per line.  Modal damping (a ratio xi) is applied to the modes of the reduced system.
+
+Stored once per Ritz vector: the surface Gram matrix Psi^T W Psi, the values at the kept point sets and interior
+nodes.  `reanalyse(structure, loads)` projects ANOTHER structure on the same vectors (a torque with other bearing
+and mesh stiffnesses, another gear set): a Rayleigh-Ritz re-analysis that reuses the basis and the surface data
+(its frequency error against a fresh basis is reported by `housingfe bench runup`).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from types import SimpleNamespace
+
+import numpy as np
+import scipy.linalg
+
+from housingfe.errors import InputError
+from housingfe.response.harmonic import Load, StructureObserver, loss_factor
+from housingfe.response.observers import node_key, responses
+from housingfe.solvers import harmonic
+
+
+@dataclass
+class ReducedSystem:
+    """The structure projected on the Ritz vectors: Kr, Mr, Cr (n x n; N/m, kg, N s/m in Ritz coordinates), the
+    load projections Fr (n, loads), the modal damping matrix D (or None), the modes of the reduced system
+    (frequencies_hz, vectors Y mass-normalised on Mr, symmetric part of Kr)."""
+
+    Kr: np.ndarray
+    Mr: np.ndarray
+    Cr: np.ndarray
+    Fr: np.ndarray
+    D: np.ndarray | None
+    frequencies_hz: np.ndarray
+    Y: np.ndarray
+
+
+class RitzReduction:
+    """The response quantities of a ModalBasis (housingfe.solvers.modal.modes) extended by the static residual
+    vectors of a fixed set of unit loads (name -> PETSc Vec in the structure's DOFs, per unit amplitude).
+
+    damping: housingfe.solvers.harmonic.Damping (modal ratio or loss factor) or a loss factor eta (-); surface: the
+    observed (radiating) surface; nodes: interior nodes whose six components are kept (coupled structures);
+    extra_points: named SamplePoints whose normal displacement is kept (a radiator's facet points)."""
+
+    def __init__(self, basis, loads: dict, damping, *, surface: str = "outer", nodes=(),
+                 extra_points: dict | None = None):
+        if not loads:
+            raise InputError("loads: at least one load")
+        t0 = time.perf_counter()
+        self.basis = basis
+        structure = basis.structure
+        self.damping = damping if isinstance(damping, harmonic.Damping) else loss_factor(damping)
+        if self.damping.D is not None:
+            raise InputError("damping: per-material loss factors need the direct solver, not a Ritz reduction")
+        self.names = list(loads)
+        K_sym = structure.K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
+        self.vectors = harmonic.ritz_basis(K_sym, structure.M, basis, list(loads.values()))
+        t1 = time.perf_counter()
+        unit = [Load(name, vec) for name, vec in loads.items()]
+        self.observer = StructureObserver(structure, surface, (), unit[:1], extra_points, nodes)
+        self.reduced = self.observer.reduce(self.vectors)
+        t2 = time.perf_counter()
+        self.structure = structure
+        self.system = self._project(structure, loads)
+        self.timings = {"ritz_vectors_s": t1 - t0, "surface_reduction_s": t2 - t1,
+                        "projection_s": time.perf_counter() - t2}
+
+    # ------------------------------------------------------------------------------------------- projection
+    def _project(self, structure, loads: dict) -> ReducedSystem:
+        Kr, Mr, Cr = harmonic.project(self.vectors, structure.K, structure.M, structure.C)
+        Fr = np.array([[b.dot(loads[name]) for name in self.names] for b in self.vectors])
+        Ks = 0.5 * (Kr + Kr.T)
+        Ms = 0.5 * (Mr + Mr.T)
+        lam, Y = scipy.linalg.eigh(Ks, Ms)
+        lam = np.clip(lam, 0.0, None)
+        xi = self.damping.ratios(len(lam))
+        D = None
+        if xi is not None:
+            # modal damping on the modes of the reduced system: D = Mr Y diag(2 xi omega) Y^T Mr
+            MY = Ms @ Y
+            D = (MY * (2 * xi * np.sqrt(lam))) @ MY.T
+        return ReducedSystem(Kr, Mr, Cr, Fr, D, np.sqrt(lam) / (2 * math.pi), Y)
+
+    def reanalyse(self, structure, loads: dict) -> "RitzReduction":
+        """The same Ritz vectors and surface data with another structure's K, M, C and loads projected on them
+        (same DOFs; e.g. the coupled model at another torque).  Loads: the same names."""
+        if set(loads) != set(self.names):
+            raise InputError(f"reanalyse: loads must be {', '.join(self.names)}")
+        if structure.dofs != self.structure.dofs:
+            raise InputError("reanalyse: the structure has other DOFs than the reduced one")
+        t0 = time.perf_counter()
+        other = object.__new__(RitzReduction)
+        other.__dict__.update(self.__dict__)
+        other.structure = structure
+        other.system = other._project(structure, loads)
+        other.timings = {**self.timings, "reanalysis_s": time.perf_counter() - t0}
+        return other
+
+    @property
+    def area(self) -> float:
+        """Area (m^2) of the observed surface."""
+        return self.observer.area
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """Eigenfrequencies (Hz) of the reduced system (the basis' modes, then the residual vectors' pseudo-modes)."""
+        return self.system.frequencies_hz
+
+    # ------------------------------------------------------------------------------------------- evaluation
+    def coefficients(self, frequencies, amplitudes: dict) -> np.ndarray:
+        """(vectors, lines) complex Ritz coordinates of the summed response to the loads with their complex rms
+        `amplitudes` (name -> number or array per line, in the load's unit; loads left out have amplitude 0)."""
+        f = np.asarray(frequencies, float)
+        unknown = set(amplitudes) - set(self.names)
+        if unknown:
+            raise InputError(f"amplitudes: unknown load(s) {', '.join(sorted(unknown))} (known: "
+                             f"{', '.join(self.names)})")
+        a = np.zeros((len(self.names), len(f)), complex)
+        for j, name in enumerate(self.names):
+            if name in amplitudes:
+                a[j] = np.broadcast_to(np.asarray(amplitudes[name], complex), f.shape)
+        s = self.system
+        eta = np.zeros(len(f)) if s.D is not None else self.damping.hysteretic(f)
+        C = s.Cr if s.D is None else s.Cr + s.D
+        c = np.zeros((len(self.vectors), len(f)), complex)
+        omega = 2 * math.pi * f
+        for j in range(len(self.names)):        # one batched solve per load, weighted by its amplitudes
+            if np.any(a[j]):
+                c += harmonic.solve_reduced(s.Kr, s.Mr, C, omega, eta, s.Fr[:, j:j + 1])[0] * a[j][None, :]
+        return c
+
+    def evaluate(self, frequencies, amplitudes: dict):
+        """The summed response (housingfe.response.observers.LoadResponse with amplitude 1: the amplitudes are in
+        it) at `frequencies` (Hz): mean_square_velocity (m^2/s^2 per line), velocity_level_db, and in
+        extras["point_values"] the kept point sets and nodes (displacements m, rotations rad, complex rms)."""
+        f = np.asarray(frequencies, float)
+        c = self.coefficients(f, amplitudes)
+        return self.response_of(f, c)
+
+    def response_of(self, frequencies, coefficients):
+        """The LoadResponse of given Ritz coordinates (vectors, lines)."""
+        f = np.asarray(frequencies, float)
+        result = harmonic.HarmonicResult(f, [[harmonic.Block(self.reduced, coefficients, np.arange(len(f)))]],
+                                         "ritz")
+        case = SimpleNamespace(name="sum", kind="", amplitude=lambda fr: np.ones(np.shape(fr)))
+        return responses(result, self.observer, [case])[0]
+
+    def node_rotation(self, response, node: str, axis) -> np.ndarray:
+        """Complex rms rotation (rad) of an interior node about the unit `axis` per line of `response`."""
+        values = response.extras["point_values"].get(node_key(node))
+        if values is None:
+            raise InputError(f"node {node!r} was not kept by this reduction (nodes=...)")
+        a = np.asarray(axis, float) / np.linalg.norm(axis)
+        return a @ values[3:6]
+
+    def modal_contributions(self, frequency_hz: float, coefficients: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(frequencies_hz, share) of the reduced system's modes in the surface <v^2> at one line: share_i =
+        Re(z_i^* (G z)_i) / (z^H G z) in the modes' coordinates z = Y^T Mr c (the shares sum to 1; a negative
+        share is a mode cancelling others)."""
+        s = self.system
+        z = s.Y.T @ (0.5 * (s.Mr + s.Mr.T)) @ np.asarray(coefficients, complex)
+        G = s.Y.T @ self.reduced.gram @ s.Y
+        part = np.real(np.conj(z) * (G @ z))
+        total = part.sum()
+        return s.frequencies_hz, part / total if total > 0 else part
+
+
+def modal_basis_summary(basis, reduction: RitzReduction | None = None) -> dict:
+    """JSON-able facts of a modal basis (and of the Ritz reduction built on it)."""
+    n = basis.rigid_count
+    out = {"f_max_hz": basis.f_max, "modes": len(basis.eigenvalues), "zero_modes": n,
+           "elastic_frequencies_hz": [float(x) for x in basis.frequencies_hz[n:]], "complete": bool(basis.complete),
+           "dofs": int(basis.structure.dofs)}
+    if reduction is not None:
+        out["ritz_vectors"] = len(reduction.vectors)
+        out["residual_vectors"] = len(reduction.vectors) - len(basis.eigenvalues)
+    return out
+
+
+__all__ = ["ReducedSystem", "RitzReduction", "modal_basis_summary"]
