@@ -162,7 +162,12 @@ class Drivetrain:
     Reduction choices: lumped_bearing_stiffness ("appendix_c" or {"pinion": 5 values, "wheel": 5 values}, x, y, z
     [N/m], theta_x, theta_y [N m/rad]); lumped_bearing_spans {"pinion": (front, back), "wheel": ...} bearing to
     gear face (m); coupling_mesh_positions: mesh positions per pitch for the FE's mean mesh stiffness;
-    elements_per_segment of the FE shafts; hold_tilt: the FE bearings' tilt held at zero by the shaft."""
+    elements_per_segment of the FE shafts; hold_tilt: the FE bearings' tilt held at zero by the shaft.
+    bearing_configuration: a configuration of housingfe.bearings.configurations ("angular_contact",
+    "self_aligning", "tapered_roller", "cylindrical_roller", "fluid_film") whose 6x6 K (and C) replace the seats'
+    own bearings in the FE reduction, at the statics loads of `torque` and, for the speed-dependent fluid film, the
+    pinion speed bearing_speed_rpm (rev/min; the wheel turns the other way at z1/z2 of it); None: the seats' own
+    designations / matrices."""
 
     gears: GearSet
     shafts: tuple[ShaftLine, ShaftLine]
@@ -176,6 +181,8 @@ class Drivetrain:
     coupling_mesh_positions: int = 16
     elements_per_segment: int = 4
     hold_tilt: bool = True
+    bearing_configuration: str | None = None
+    bearing_speed_rpm: float = 1500.0
 
     def __post_init__(self):
         if [s.name for s in self.shafts] != list(SHAFTS):
@@ -335,6 +342,26 @@ class Drivetrain:
                 out[seat.name] = (float(local[0]), float(local[1]), float(local[2]), 0.0, 0.0)
         return out
 
+    def configuration_matrices(self, loads: dict | None = None) -> dict | None:
+        """{seat name: (K 6x6, C 6x6 or None)} of `bearing_configuration` at the statics loads (None without a
+        configuration).  The seats must be named as the configuration's positions (pinion_front, ...); both
+        front bearings locate axially (a double helical wheel is otherwise axially free)."""
+        if self.bearing_configuration is None:
+            return None
+        from housingfe.bearings.configurations import bearing_matrices, configurations
+
+        if self.bearing_configuration not in configurations():
+            raise InputError(f"drivetrain: bearings: {self.bearing_configuration!r} unknown (known: ball, "
+                             f"{', '.join(configurations())})")
+        loads = loads or self.bearing_loads()
+        z1, z2 = self.gears.pair.teeth
+        speeds = {"pinion": self.bearing_speed_rpm, "wheel": -self.bearing_speed_rpm * z1 / z2}
+        try:
+            return bearing_matrices(self.bearing_configuration, loads, speeds, axial_location="both")
+        except InputError as exc:
+            raise InputError(f"drivetrain: bearings = {self.bearing_configuration!r} at {self.torque:g} N m: "
+                             f"{exc}") from None
+
     def shaft_nodes(self, name: str) -> tuple[list[list[float]], dict]:
         """FE segments [[length, diameter], ...] (m) of a shaft from its front end, split at its bearings and the
         gear centre, and {"gear" | bearing name: node index} (elements_per_segment elements per segment)."""
@@ -353,6 +380,7 @@ class Drivetrain:
 
         forces = forces or self.gear_forces()
         loads = self.bearing_loads(forces)
+        matrices = self.configuration_matrices(loads)
         shafts, bearings, nodes = [], [], {}
         for g, name in enumerate(SHAFTS):
             line = self.shaft(name)
@@ -366,7 +394,11 @@ class Drivetrain:
         for b in sorted(self.bearings, key=lambda b: (SHAFTS.index(b.shaft), b.position)):
             entry = {"name": b.name, "shaft_node": f"{b.shaft}:{nodes[b.shaft][b.name]}", "bore": b.name,
                      "axis": self.shaft(b.shaft).axis}
-            if b.designation is not None:
+            if matrices is not None:
+                K, C = matrices[b.name]
+                entry.update(stiffness_matrix=np.asarray(K, float).tolist(),
+                             damping_matrix=None if C is None else np.asarray(C, float).tolist())
+            elif b.designation is not None:
                 entry.update(designation=b.designation, load=loads[b.name], model=b.model,
                              fixed_tilt=(0.0, 0.0) if self.hold_tilt else None)
             elif b.stiffness is not None:
@@ -397,24 +429,28 @@ GEAR_SETS = {"A": "gearset-A", "B": "gearset-B", "C": "gearset-C", "D": "gearset
 def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 2000.0) -> Drivetrain:
     """The Ch. 5 test gearbox (van Roosmalen 1994) as one description: gear set A-D, "uncorrected" or
     "double_helical" (the gear data of the gearset-* scenes), bearings "ball" (SKF 6316 pinion / 6219 wheel, Lim's
-    model, the front bearings locating), pinion torque (N m).  Shaft, quill-shaft and coupling dimensions are the
+    model, the front bearings locating) or a configuration of housingfe.bearings.configurations (Secs. 5.8, 5.9:
+    "angular_contact", "self_aligning", "tapered_roller" with the single helical sets; "cylindrical_roller",
+    "fluid_film" with the double helical set, which puts no axial load on them), pinion torque (N m).  Shaft, quill-shaft and coupling dimensions are the
     ASSUMPTIONS of docs/source.md (Appendix C's parameter table did not survive)."""
     if gear_set not in GEAR_SETS:
         raise InputError(f"test_gearbox: gear_set: {gear_set!r} unknown (known: {', '.join(GEAR_SETS)})")
-    if bearings not in TEST_GEARBOX_BEARINGS:
-        raise InputError(f"test_gearbox: bearings: {bearings!r} unknown (known: {', '.join(TEST_GEARBOX_BEARINGS)}; "
-                         "the other configurations: housingfe.studies.bearing_variants)")
+    from housingfe.bearings.configurations import configurations
+
+    known = ["ball", *configurations()]
+    if bearings not in known:
+        raise InputError(f"test_gearbox: bearings: {bearings!r} unknown (known: {', '.join(known)})")
     axis = (0.0, 1.0, 0.0)
     shafts = (ShaftLine("pinion", 0.080, TEST_GEARBOX_CENTRES["pinion"], axis, (-0.140, 0.140)),   # SKF 6316 bore
               ShaftLine("wheel", 0.095, TEST_GEARBOX_CENTRES["wheel"], axis, (-0.140, 0.140)))      # SKF 6219 bore
     seats = tuple(BearingSeat(f"{shaft}_{side}", shaft, s, f"bore_{shaft}_{side}", locating=side == "front",
-                              designation=TEST_GEARBOX_BEARINGS[bearings][shaft])
+                              designation=TEST_GEARBOX_BEARINGS["ball"][shaft])
                   for shaft in SHAFTS for side, s in (("front", -0.1075), ("back", 0.1075)))
     quills = (QuillShaft("motor_far", 0.040, 1.5), QuillShaft("motor_pinion", 0.060, 0.25),
               QuillShaft("wheel_brake", 0.075, 0.25), QuillShaft("brake_far", 0.055, 1.5))
     return Drivetrain(gears=GearSet.from_scene(GEAR_SETS[gear_set]), shafts=shafts, bearings=seats,
                       quill_shafts=quills, couplings=(Coupling("motor", 0.02), Coupling("brake", 0.05)),
-                      torque=torque)
+                      torque=torque, bearing_configuration=None if bearings == "ball" else bearings)
 
 
 test_gearbox.__test__ = False     # not a pytest test despite its name

@@ -282,10 +282,13 @@ def modes(structure, f_max: float, *, tol: float = 1e-10, check: bool = True) ->
     """All modes of a structure (housingfe.fe.structure.Structure: K, M, expected_zero_modes) below f_max (Hz),
     complete by the inertia count (solve_modes; SolverError if not).  Eigenvalues in rad^2/s^2, vectors
     mass-normalised in the structure's DOFs.  check: also raise SolverError when the number of zero modes is
-    not the structure's expected_zero_modes (ModalBasis.check_zero_modes)."""
+    not the structure's expected_zero_modes (ModalBasis.check_zero_modes).  A structure with a non-symmetric
+    stiffness (fluid-film bearings: structure.symmetric False) gets the modes of its symmetric positive
+    semi-definite stand-in structure.basis_stiffness(), the basis of the projected solver."""
     import dataclasses
 
-    result = solve_modes(structure.K, structure.M, f_max, tol=tol)
+    K = structure.K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
+    result = solve_modes(K, structure.M, f_max, tol=tol)
     basis = ModalBasis(**{f.name: getattr(result, f.name) for f in dataclasses.fields(ModalResult)},
                        structure=structure)
     if check:
