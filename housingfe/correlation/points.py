@@ -1,0 +1,69 @@
+"""Computed mode shapes at measured channels: each measured point is snapped to the nearest point of the
+housing's surface (housingfe.response.observers.locate_response_points), and the FE displacement there is
+projected on the channel's direction (PointEvaluator).  Same result on every MPI rank."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from housingfe.correlation.uff import ModeSet
+from housingfe.errors import InputError
+from housingfe.response.observers import PointEvaluator, SamplePoints, locate_response_points
+from housingfe.scene import ResponsePointSpec
+
+
+@dataclass
+class Channels:
+    """Measured channels snapped to the model: snapped points (m), unit directions, snapping distances (m)."""
+
+    points: np.ndarray
+    directions: np.ndarray
+    distances: np.ndarray
+
+
+def snap_channels(housing, points: np.ndarray, directions: np.ndarray, *, surface: str | None = None,
+                  tolerance: float | None = None, source: str = "measured") -> Channels:
+    """Snap channel points (m) to the housing surface (all tagged surfaces, or `surface`); InputError naming
+    the channel when a point lies farther than `tolerance` (default one element size)."""
+    pts = np.asarray(points, float).reshape(-1, 3)
+    unique, inverse = np.unique(np.round(pts, 9), axis=0, return_inverse=True)
+    specs = [ResponsePointSpec(name=f"p{k}", point=list(map(float, p)), surface=surface, tolerance=tolerance)
+             for k, p in enumerate(unique)]
+    try:
+        located = locate_response_points(housing, specs)
+    except InputError as exc:
+        msg = str(exc).split(": ", 1)[-1]
+        raise InputError(f"{source}: measured point: {msg}") from None
+    snapped = np.array([rp.point for rp in located])[inverse.ravel()]
+    dist = np.array([rp.distance for rp in located])[inverse.ravel()]
+    d = np.asarray(directions, float).reshape(-1, 3)
+    return Channels(snapped, d / np.linalg.norm(d, axis=1)[:, None], dist)
+
+
+class ChannelSampler:
+    """Evaluates FE fields (PETSc Vecs of the housing space V) on a fixed set of channels."""
+
+    def __init__(self, V, channels: Channels):
+        self.channels = channels
+        self.evaluator = PointEvaluator(V, SamplePoints(channels.points, channels.directions,
+                                                        np.ones(len(channels.points))))
+
+    def sample(self, vectors) -> np.ndarray:
+        """(channels x len(vectors)) displacement components along the channel directions (m per unit)."""
+        return np.column_stack([self.evaluator.normal_values(v) for v in vectors]) if len(vectors) else \
+            np.zeros((len(self.channels.points), 0))
+
+
+def computed_modes_at(basis, measured: ModeSet, *, elastic_only: bool = True, surface: str | None = None,
+                      tolerance: float | None = None) -> ModeSet:
+    """The modes of a housingfe.solvers.modal.ModalBasis sampled on the channels of a measured ModeSet (same
+    point ids, snapped points, directions); elastic modes only unless elastic_only is False."""
+    structure = basis.structure
+    channels = snap_channels(structure.housing, measured.points, measured.directions, surface=surface,
+                             tolerance=tolerance, source=measured.source or "measured")
+    start = basis.rigid_count if elastic_only else 0
+    vectors = [structure.to_housing(x) for x in basis.vectors[start:]]
+    shapes = ChannelSampler(structure.V, channels).sample(vectors)
+    return ModeSet(basis.frequencies_hz[start:].copy(), measured.node_ids.copy(), channels.points,
+                   channels.directions, shapes, None, "computed")

@@ -1,0 +1,532 @@
+"""Model updating: a bounded least-squares fit (scipy.optimize.least_squares, trust-region reflective) of
+chosen scene parameters to measured or published modal data.
+
+Every evaluation builds the models through the scene API (housingfe.scene.load_housing_scene with the
+parameters as --set overrides, build_model_from_scene) and solves their modes (housingfe.solvers.modal.modes).
+Residuals are relative and divided by the target's sigma (a relative standard deviation), so the cost is a
+chi-square and the parameter covariance is (J^T J)^-1 of the scaled Jacobian.
+
+Targets (kind):
+  mass       the housing's mass (kg) from the rigid-body translation of a free scene: t^T M t
+  frequency  the n-th elastic mode (Hz)
+  count      the number of elastic modes below band_hz, as a smooth surrogate: ln(sqrt(f_N f_N+1) / band) is
+             zero when the band edge lies midway (geometrically) between mode N and N+1; a count is an
+             integer and would give a zero gradient
+  close_pair two adjacent modes (Hz): the adjacent pair nearest to the published one; residual = the larger
+             relative error of the two
+  paired     measured modes (UFF/CSV): each measured mode paired with a computed one by MAC on the measured
+             channels (pair_modes); residual = frequency error (+ (1 - MAC) / sigma_mac if use_mac)
+Roles: "calibration" targets drive the fit, "holdout" targets are only evaluated before and after it.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Literal, Optional
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, model_validator
+
+from housingfe.errors import InputError, SolverError
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class ParameterSpec(_Strict):
+    """A fitted parameter: the dotted scene keys it sets (the same value in every scene that has the key),
+    bounds and start in the keys' units (SI)."""
+
+    name: str = Field(min_length=1)
+    keys: list[str] = Field(min_length=1)
+    lower: float
+    upper: float
+    start: float
+
+    @model_validator(mode="after")
+    def _check(self):
+        if not self.lower < self.upper:
+            raise ValueError("lower: must be below upper")
+        if not self.lower <= self.start <= self.upper:
+            raise ValueError("start: must lie within [lower, upper]")
+        return self
+
+
+class TargetSpec(_Strict):
+    """One published or measured quantity (see the module docstring for the kinds)."""
+
+    name: str = Field(min_length=1)
+    scene: str = Field(min_length=1)
+    kind: Literal["mass", "frequency", "count", "close_pair", "paired"]
+    value: Optional[float | list[float]] = None
+    sigma: PositiveFloat = 0.02            # relative standard deviation of the value
+    role: Literal["calibration", "holdout"] = "calibration"
+    mode: Optional[int] = Field(None, ge=1)           # frequency: 1 = first elastic mode
+    band_hz: Optional[PositiveFloat] = None           # count
+    measured: Optional[str] = None                    # paired: UFF or CSV file
+    threshold: float = Field(0.6, ge=0.0, le=1.0)     # paired: MAC threshold
+    use_mac: bool = False                             # paired: add (1 - MAC) / sigma_mac residuals
+    sigma_mac: PositiveFloat = 0.1
+
+    @model_validator(mode="after")
+    def _check(self):
+        need = {"mass": ["value"], "frequency": ["value", "mode"], "count": ["value", "band_hz"],
+                "close_pair": ["value"], "paired": ["measured"]}[self.kind]
+        for key in need:
+            if getattr(self, key) is None:
+                raise ValueError(f"{key}: required for a {self.kind} target")
+        if self.kind == "close_pair" and not (isinstance(self.value, list) and len(self.value) == 2):
+            raise ValueError("value: a close_pair target gives two frequencies [f1, f2] (Hz)")
+        if self.kind in ("mass", "frequency", "count") and isinstance(self.value, list):
+            raise ValueError(f"value: one number for a {self.kind} target")
+        return self
+
+
+class UpdateSpec(_Strict):
+    """An updating problem: parameters, targets, overrides used during the search (e.g. a coarse mesh) and
+    in the confirmation (default: none, the scenes' own mesh)."""
+
+    name: str = "update"
+    parameters: list[ParameterSpec] = Field(min_length=1)
+    targets: list[TargetSpec] = Field(min_length=1)
+    search_overrides: dict[str, list[str]] = {}    # scene -> overrides during the search
+    confirm_overrides: dict[str, list[str]] = {}   # scene -> overrides of the confirmation run
+    mesh_correction: bool = True    # scale the search predictions by (confirm / search) at the start point
+    multistart: list[dict[str, float]] = []        # further start points (parameter name -> value)
+    max_evaluations: int = Field(60, ge=1)
+    fd_step: PositiveFloat = 0.02   # forward-difference step, fraction of each parameter's range
+
+
+def load_update_spec(path: str) -> UpdateSpec:
+    """Read an updating spec (TOML); InputError naming the file and key."""
+    import tomllib
+    from pathlib import Path
+
+    from housingfe.scenefile import parse_table
+
+    p = Path(path)
+    if not p.is_file():
+        raise InputError(f"{path}: update spec not found")
+    try:
+        with open(p, "rb") as fh:
+            data = tomllib.load(fh)
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise InputError(f"{path}: malformed TOML: {exc}") from None
+    spec = parse_table(UpdateSpec, data, path)
+    return resolve_measured_paths(spec, p.parent)
+
+
+def resolve_measured_paths(spec: UpdateSpec, base) -> UpdateSpec:
+    """Measured files relative to the spec's folder."""
+    from pathlib import Path
+
+    targets = []
+    for t in spec.targets:
+        if t.measured is not None and not Path(t.measured).is_absolute():
+            t = t.model_copy(update={"measured": str(Path(base) / t.measured)})
+        targets.append(t)
+    return spec.model_copy(update={"targets": targets})
+
+
+# ------------------------------------------------------------------------------------------ evaluation
+@dataclass
+class SceneResult:
+    """Modes of one scene at one parameter set: elastic frequencies (Hz), the basis, mass (kg, free scenes)."""
+
+    frequencies_hz: np.ndarray
+    basis: object
+    mass_kg: float | None
+    dofs: int
+    seconds: float
+
+
+def check_parameter_keys(spec: UpdateSpec) -> None:
+    """InputError "<scene>: <key>: ..." for a parameter key that no scene of the spec defines (a parameter
+    overrides an existing value; a misspelt key would otherwise add a new one)."""
+    from housingfe.scenefile import read_scene_dict
+
+    scenes = {t.scene for t in spec.targets}
+    data = {s: read_scene_dict(s)[0] for s in scenes}
+    for p in spec.parameters:
+        for key in p.keys:
+            if not any(_present(d, key) for d in data.values()):
+                raise InputError(f"{', '.join(sorted(scenes))}: {key}: unknown parameter key "
+                                 f"(parameter {p.name!r}: no scene of the spec has it)")
+
+
+def _present(data: dict, key: str) -> bool:
+    node = data
+    for part in key.split("."):
+        if not isinstance(node, dict) or part not in node:
+            return False
+        node = node[part]
+    return True
+
+
+class SceneEvaluator:
+    """Builds and solves the spec's scenes for a parameter vector; caches by (values, overrides)."""
+
+    def __init__(self, spec: UpdateSpec, comm=None, log: Callable[[str], None] | None = None):
+        from mpi4py import MPI
+
+        from housingfe.scenefile import read_scene_dict
+
+        self.spec = spec
+        self.comm = comm or MPI.COMM_WORLD
+        self.log = log or (lambda s: None)
+        self.cache: dict = {}
+        self.seconds: list[float] = []
+        scenes = sorted({t.scene for t in spec.targets})
+        self.scene_data = {s: read_scene_dict(s)[0] for s in scenes}
+        self.measured = {}
+        for t in spec.targets:
+            if t.kind == "paired":
+                from housingfe.correlation.uff import read_measured_modes
+
+                self.measured[t.name] = read_measured_modes(t.measured)
+
+    def overrides(self, scene: str, values: np.ndarray, extra: list[str]) -> list[str]:
+        out = list(extra)
+        for p, v in zip(self.spec.parameters, values):
+            for key in p.keys:
+                if _present(self.scene_data[scene], key):
+                    out.append(f"{key}={float(v)!r}")
+        return out
+
+    def f_needed(self, scene: str) -> tuple[int, float]:
+        """(elastic modes needed, first f_max guess in Hz) for a scene's targets."""
+        n, f = 1, 0.0
+        for t in self.spec.targets:
+            if t.scene != scene:
+                continue
+            if t.kind == "frequency":
+                n, f = max(n, t.mode), max(f, 1.3 * t.value)
+            elif t.kind == "count":
+                n, f = max(n, int(round(t.value)) + 1), max(f, 1.15 * t.band_hz)
+            elif t.kind == "close_pair":
+                n, f = max(n, 2), max(f, 1.3 * max(t.value))
+            elif t.kind == "paired":
+                fm = self.measured[t.name].frequencies_hz
+                n, f = max(n, len(fm)), max(f, 1.3 * float(fm.max()))
+        return n, f or 1000.0
+
+    def solve(self, scene: str, values: np.ndarray, extra: list[str], need_mass: bool) -> SceneResult:
+        from housingfe.scene import build_model_from_scene, load_housing_scene
+        from housingfe.solvers.modal import modes
+
+        key = (scene, tuple(np.round(values, 12)), tuple(extra))
+        if key in self.cache:
+            return self.cache[key]
+        t0 = time.perf_counter()
+        sc, _ = load_housing_scene(scene, self.overrides(scene, values, extra))
+        model = build_model_from_scene(sc, self.comm)
+        n, f_max = self.f_needed(scene)
+        for _ in range(8):
+            basis = modes(model, f_max)
+            freqs = basis.frequencies_hz[basis.rigid_count:]
+            if len(freqs) >= n:
+                break
+            # modal density of plates is about constant: scale f_max to the count still missing
+            f_max *= min(3.0, max(1.2, 1.1 * (n + 2) / max(len(freqs), 1)))
+        else:
+            raise SolverError(f"{scene}: fewer than {n} elastic modes below {f_max:.0f} Hz")
+        mass = None
+        if need_mass:
+            t = model.rigid_body_vectors()[0]
+            y = t.duplicate()
+            model.M.mult(t, y)
+            mass = float(t.dot(y))
+        result = SceneResult(freqs, basis, mass, model.dofs, time.perf_counter() - t0)
+        self.seconds.append(result.seconds)
+        self.cache[key] = result
+        return result
+
+
+def _nearest_pair(freqs: np.ndarray, pair: list[float]) -> tuple[float, float]:
+    if len(freqs) < 2:
+        return float("nan"), float("nan")
+    f1, f2 = freqs[:-1], freqs[1:]
+    err = np.maximum(np.abs(np.log(f1 / pair[0])), np.abs(np.log(f2 / pair[1])))
+    k = int(np.argmin(err))
+    return float(f1[k]), float(f2[k])
+
+
+@dataclass
+class TargetValue:
+    """A target evaluated: residuals (scaled), the model's value for display, the published value."""
+
+    name: str
+    role: str
+    residuals: np.ndarray
+    model: object
+    published: object
+
+
+def evaluate_targets(evaluator: SceneEvaluator, values: np.ndarray, extra: dict[str, list[str]],
+                     roles=("calibration",), correction: dict | None = None) -> list[TargetValue]:
+    """Evaluate the targets of the given roles at one parameter vector (physical units).  `correction`:
+    target name -> factor on the model frequencies/mass (the search-mesh correction)."""
+    from housingfe.correlation.mac import mac, pair_modes
+    from housingfe.correlation.points import computed_modes_at
+
+    out = []
+    for t in evaluator.spec.targets:
+        if t.role not in roles:
+            continue
+        need_mass = t.kind == "mass"
+        r = evaluator.solve(t.scene, values, extra.get(t.scene, []), need_mass)
+        c = (correction or {}).get(t.name, 1.0)
+        f = r.frequencies_hz * c
+        if t.kind == "mass":
+            if r.mass_kg is None or r.basis.rigid_count != 6:
+                raise InputError(f"targets.{t.name}: a mass target needs a free-free scene ({t.scene} is supported)")
+            m = r.mass_kg * c
+            out.append(TargetValue(t.name, t.role, np.array([(m / t.value - 1) / t.sigma]), m, t.value))
+        elif t.kind == "frequency":
+            fm = f[t.mode - 1]
+            out.append(TargetValue(t.name, t.role, np.array([(fm / t.value - 1) / t.sigma]), fm, t.value))
+        elif t.kind == "count":
+            n = int(round(t.value))
+            surrogate = math.log(math.sqrt(f[n - 1] * f[n]) / t.band_hz)
+            count = int(np.sum(f < t.band_hz))
+            out.append(TargetValue(t.name, t.role, np.array([surrogate / t.sigma]),
+                                   {"count": count, f"f{n}": float(f[n - 1]), f"f{n + 1}": float(f[n])}, n))
+        elif t.kind == "close_pair":
+            p = _nearest_pair(f, t.value)
+            err = max(abs(p[0] / t.value[0] - 1), abs(p[1] / t.value[1] - 1))
+            out.append(TargetValue(t.name, t.role, np.array([err / t.sigma]), p, tuple(t.value)))
+        else:
+            meas = evaluator.measured[t.name]
+            comp = computed_modes_at(r.basis, meas)
+            comp_f = comp.frequencies_hz * c
+            m = mac(meas.shapes, comp.shapes)
+            pairing = pair_modes(m, meas.frequencies_hz, comp_f, t.threshold, frequency_weight=0.5)
+            by_meas = {p.measured: p for p in pairing.pairs}
+            res = []
+            for i, fm_i in enumerate(meas.frequencies_hz):
+                p = by_meas.get(i)
+                j = p.computed if p is not None else int(np.argmax(m[i]))
+                res.append((comp_f[j] / fm_i - 1) / t.sigma)
+                if t.use_mac:
+                    res.append((1 - m[i, j]) / t.sigma_mac)
+            out.append(TargetValue(t.name, t.role, np.array(res), pairing, meas.frequencies_hz))
+    return out
+
+
+# ------------------------------------------------------------------------------------------ the fit
+@dataclass
+class UpdateResult:
+    """A finished fit: parameters (physical units), their standard deviations from the Jacobian, the
+    scaled Jacobian (residuals per unit parameter), history of (evaluation, cost, parameters), costs."""
+
+    names: list
+    start: np.ndarray
+    values: np.ndarray
+    std: np.ndarray
+    covariance: np.ndarray
+    jacobian: np.ndarray
+    residual_names: list
+    cost: float
+    history: list = field(default_factory=list)
+    evaluations: int = 0
+    seconds_per_evaluation: float = float("nan")
+    status: str = ""
+    correction: dict = field(default_factory=dict)
+
+
+def _residual_names(targets: list[TargetValue]) -> list[str]:
+    names = []
+    for tv in targets:
+        names += [tv.name] if len(tv.residuals) == 1 else [f"{tv.name}[{k}]" for k in range(len(tv.residuals))]
+    return names
+
+
+def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correction: dict | None = None) -> UpdateResult:
+    """Bounded least squares of the calibration residuals over the spec's parameters from `start`
+    (default: each parameter's start), forward-difference Jacobian with step fd_step x range; the search
+    uses search_overrides (a coarse mesh) and the search-mesh `correction`."""
+    from scipy.optimize import least_squares
+
+    spec = evaluator.spec
+    lo = np.array([p.lower for p in spec.parameters])
+    hi = np.array([p.upper for p in spec.parameters])
+    x0 = np.array([p.start for p in spec.parameters]) if start is None else np.asarray(start, float)
+    span = hi - lo
+    history: list = []
+    names_holder: list = []
+    n_eval = [0]
+    t_start = time.perf_counter()
+
+    def residuals(u):
+        x = lo + u * span
+        tvs = evaluate_targets(evaluator, x, spec.search_overrides, ("calibration",), correction)
+        if not names_holder:
+            names_holder.extend(_residual_names(tvs))
+        r = np.concatenate([tv.residuals for tv in tvs])
+        n_eval[0] += 1
+        history.append((n_eval[0], 0.5 * float(r @ r), x.copy()))
+        evaluator.log(f"eval {n_eval[0]:3d}  cost {0.5 * float(r @ r):10.4g}  x = "
+                      + ", ".join(f"{p.name}={v:.5g}" for p, v in zip(spec.parameters, x)))
+        return r
+
+    h = spec.fd_step
+
+    def jacobian(u):
+        r0 = residuals(u)
+        J = np.empty((len(r0), len(u)))
+        for k in range(len(u)):
+            du = h if u[k] + h <= 1.0 else -h      # step back at the upper bound
+            v = u.copy()
+            v[k] += du
+            J[:, k] = (residuals(v) - r0) / du
+        return J
+
+    u0 = (x0 - lo) / span
+    try:
+        sol = least_squares(residuals, u0, jac=jacobian, bounds=(0.0, 1.0), method="trf", x_scale=1.0,
+                            max_nfev=spec.max_evaluations, xtol=1e-4, ftol=1e-6)
+    except SolverError:
+        raise
+    J = jacobian(sol.x)
+    Jp = J / span[None, :]                            # residuals per physical unit
+    try:
+        cov = np.linalg.inv(Jp.T @ Jp)
+    except np.linalg.LinAlgError:
+        cov = np.full((len(x0), len(x0)), np.inf)
+    elapsed = time.perf_counter() - t_start
+    return UpdateResult([p.name for p in spec.parameters], x0, lo + sol.x * span, np.sqrt(np.abs(np.diag(cov))),
+                        cov, Jp, names_holder, float(sol.cost), history, n_eval[0],
+                        elapsed / max(n_eval[0], 1), sol.message, dict(correction or {}))
+
+
+def mesh_correction(evaluator: SceneEvaluator, x: np.ndarray) -> dict:
+    """target name -> (value on the confirmation mesh) / (value on the search mesh) at x, for mass and
+    frequency-like targets (the search then fits corrected coarse-mesh predictions)."""
+    spec = evaluator.spec
+    roles = ("calibration", "holdout")
+    fine = evaluate_targets(evaluator, x, spec.confirm_overrides, roles)
+    coarse = evaluate_targets(evaluator, x, spec.search_overrides, roles)
+    out = {}
+    for tf, tc, t in zip(fine, coarse, [t for t in spec.targets if t.role in roles]):
+        if t.kind == "mass":
+            out[t.name] = tf.model / tc.model
+        elif t.kind == "frequency":
+            out[t.name] = tf.model / tc.model
+        elif t.kind == "count":
+            n = int(round(t.value))
+            out[t.name] = math.sqrt(tf.model[f"f{n}"] * tf.model[f"f{n + 1}"] /
+                                    (tc.model[f"f{n}"] * tc.model[f"f{n + 1}"]))
+    return out
+
+
+# ------------------------------------------------------------------------------------------ the study
+def _display(v) -> str:
+    if isinstance(v, dict):
+        return ", ".join(f"{k} {x:.4g}" if isinstance(x, float) else f"{k} {x}" for k, x in v.items())
+    if isinstance(v, tuple):
+        return "/".join(f"{x:.1f}" for x in v)
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    if hasattr(v, "pairs"):
+        return f"{len(v.pairs)} paired, mean |df| {100 * v.mean_abs_error():.2f} %"
+    return str(v)
+
+
+def target_table(targets: list[TargetValue]) -> list[tuple]:
+    """Rows (target, role, published, model, chi = scaled residual(s) rms)."""
+    return [(tv.name, tv.role, _display(tv.published), _display(tv.model),
+             f"{float(np.sqrt(np.mean(tv.residuals ** 2))):.3g}") for tv in targets]
+
+
+def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], None] = print) -> dict:
+    """The whole study: targets before (start, confirmation mesh), a fit from every start point on the search
+    mesh (with the mesh correction), a refit after refreshing the correction at the best point, targets after
+    (confirmation mesh), identifiability (scaled Jacobian, parameter standard deviations, correlation).
+    Writes update.json, history.csv, targets.csv and convergence.png atomically into out_dir; returns the
+    summary dict."""
+    from housingfe.outputs import atomic_output_dir, format_table, write_csv, write_json
+
+    check_parameter_keys(spec)
+    evaluator = SceneEvaluator(spec, comm, log=echo)
+    names = [p.name for p in spec.parameters]
+    x0 = np.array([p.start for p in spec.parameters])
+    roles = ("calibration", "holdout")
+    differs = any(spec.search_overrides.get(s, []) != spec.confirm_overrides.get(s, [])
+                  for s in evaluator.scene_data)
+    correction = mesh_correction(evaluator, x0) if (spec.mesh_correction and differs) else {}
+    echo(f"mesh correction at the start: { {k: round(v, 4) for k, v in correction.items()} }")
+    before = evaluate_targets(evaluator, x0, spec.confirm_overrides, roles)
+    starts = [x0] + [np.array([float(ms.get(n, p.start)) for n, p in zip(names, spec.parameters)])
+                     for ms in spec.multistart]
+    for k, ms in enumerate(spec.multistart):
+        unknown = set(ms) - set(names)
+        if unknown:
+            raise InputError(f"multistart.{k}: {sorted(unknown)[0]}: not a parameter name ({', '.join(names)})")
+    fits = []
+    for k, s in enumerate(starts):
+        echo(f"--- start {k + 1}/{len(starts)}: " + ", ".join(f"{n}={v:.4g}" for n, v in zip(names, s)))
+        fits.append(fit(evaluator, s, correction=correction))
+        echo(f"    -> cost {fits[-1].cost:.4g}: " + ", ".join(f"{n}={v:.5g}" for n, v in zip(names, fits[-1].values)))
+    best = min(fits, key=lambda r: r.cost)
+    if correction:
+        correction = mesh_correction(evaluator, best.values)
+        echo(f"mesh correction at the best point: { {k: round(v, 4) for k, v in correction.items()} }")
+        best = fit(evaluator, best.values, correction=correction)
+        echo("    refit -> cost {:.4g}: ".format(best.cost) + ", ".join(f"{n}={v:.5g}" for n, v in zip(names, best.values)))
+    after = evaluate_targets(evaluator, best.values, spec.confirm_overrides, roles)
+    cal = lambda tvs, role: float(sum(0.5 * float(tv.residuals @ tv.residuals) for tv in tvs if tv.role == role))
+    summary = {
+        "name": spec.name,
+        "parameters": names,
+        "start": x0.tolist(),
+        "identified": best.values.tolist(),
+        "std": best.std.tolist(),
+        "correlation": (best.covariance / np.outer(best.std, best.std)).tolist() if np.all(np.isfinite(best.std)) else None,
+        "jacobian_scaled_per_unit": best.jacobian.tolist(),
+        "residual_names": best.residual_names,
+        "fits": [{"start": f.start.tolist(), "values": f.values.tolist(), "cost": f.cost, "evaluations": f.evaluations,
+                  "status": f.status} for f in fits],
+        "cost_before": {"calibration": cal(before, "calibration"), "holdout": cal(before, "holdout")},
+        "cost_after": {"calibration": cal(after, "calibration"), "holdout": cal(after, "holdout")},
+        "before": target_table(before),
+        "after": target_table(after),
+        "seconds_per_scene_solve_median": float(np.median(evaluator.seconds)) if evaluator.seconds else None,
+        "scene_solves": len(evaluator.seconds),
+        "seconds_per_evaluation": best.seconds_per_evaluation,
+        "mesh_correction": correction,
+    }
+    header = ["target", "role", "published", "model", "|chi|"]
+    echo("\nbefore (start, confirmation mesh):\n" + format_table(header, summary["before"]))
+    echo("\nafter (identified, confirmation mesh):\n" + format_table(header, summary["after"]))
+    echo("\nparameters: " + ", ".join(f"{n} = {v:.5g} +- {s:.2g}" for n, v, s in zip(names, best.values, best.std)))
+    echo(f"cost calibration {summary['cost_before']['calibration']:.4g} -> {summary['cost_after']['calibration']:.4g}, "
+         f"holdout {summary['cost_before']['holdout']:.4g} -> {summary['cost_after']['holdout']:.4g}; "
+         f"{summary['scene_solves']} scene solves, median {summary['seconds_per_scene_solve_median']:.2f} s")
+    with atomic_output_dir(out_dir, evaluator.comm) as out:
+        if evaluator.comm.rank == 0:
+            write_json(out / "update.json", summary)
+            write_csv(out / "history.csv", ["fit", "evaluation", "cost"] + names,
+                      [(k, e, c, *x) for k, f in enumerate(fits) for e, c, x in f.history])
+            write_csv(out / "targets.csv", ["when"] + header,
+                      [("before", *r) for r in summary["before"]] + [("after", *r) for r in summary["after"]])
+            _convergence_png(fits, out / "convergence.png")
+    return summary
+
+
+def _convergence_png(fits: list[UpdateResult], path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 3.2), dpi=110)
+    for k, f in enumerate(fits):
+        ax.semilogy([e for e, _, _ in f.history], [max(c, 1e-12) for _, c, _ in f.history], ".-", label=f"start {k + 1}")
+    ax.set_xlabel("evaluation")
+    ax.set_ylabel("cost 0.5 sum chi^2")
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
