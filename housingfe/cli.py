@@ -15,6 +15,7 @@ from housingfe.errors import InputError, SolverError
 # Modules that contribute sub-commands (each defines register_cli(subparsers)).
 _EXTENSIONS = (
     "housingfe.bearings.cli",
+    "housingfe.correlation.cli",
     "housingfe.radiation",
     "housingfe.source.cli",
     "housingfe.studies.bearing_variants",

@@ -141,3 +141,13 @@ def mac_png(mac_matrix: np.ndarray, path: str | Path, f_measured=None, f_compute
     fig.savefig(path)
     plt.close(fig)
     return path
+
+
+def frac(h_measured: np.ndarray, h_computed: np.ndarray) -> float:
+    """Frequency response assurance criterion of one FRF pair on the same lines:
+    |h_m^H h_c|^2 / ((h_m^H h_m)(h_c^H h_c)), 1 for proportional FRFs."""
+    a, b = np.asarray(h_measured).ravel(), np.asarray(h_computed).ravel()
+    if a.shape != b.shape:
+        raise InputError(f"frac: {a.size} and {b.size} lines; interpolate to the same lines first")
+    den = float(np.vdot(a, a).real * np.vdot(b, b).real)
+    return float(abs(np.vdot(a, b)) ** 2 / den) if den > 0 else 0.0

@@ -67,3 +67,15 @@ def computed_modes_at(basis, measured: ModeSet, *, elastic_only: bool = True, su
     shapes = ChannelSampler(structure.V, channels).sample(vectors)
     return ModeSet(basis.frequencies_hz[start:].copy(), measured.node_ids.copy(), channels.points,
                    channels.directions, shapes, None, "computed")
+
+
+def modal_receptance(shapes_response: np.ndarray, shapes_reference: np.ndarray, frequencies_hz: np.ndarray,
+                     lines_hz: np.ndarray, loss_factor: float = 0.002) -> np.ndarray:
+    """Point receptances (m/N, complex rms phasors, e^{iwt}) by modal superposition of mass-normalised elastic
+    modes sampled at channels: H_ij(f) = sum_r phi_ir phi_jr / (w_r^2 (1 + i eta) - w^2).  shapes_*:
+    (channels x modes) in m/sqrt(kg); returns (response channels, reference channels, lines).  Truncated
+    (no residual flexibility of the modes above the basis): for correlation inside the basis' band."""
+    wr2 = (2 * np.pi * np.asarray(frequencies_hz, float)) ** 2
+    w2 = (2 * np.pi * np.asarray(lines_hz, float)) ** 2
+    den = wr2[None, :] * (1 + 1j * loss_factor) - w2[:, None]            # (lines, modes)
+    return np.einsum("ir,jr,fr->ijf", shapes_response, shapes_reference, 1.0 / den)
