@@ -12,8 +12,38 @@ from housingfe.scene import load_housing_scene
 from housingfe.verification import published
 
 
+def _runup_runner(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
+    from housingfe.runup.scene import run_scene as run_runup
+
+    return run_runup(name_or_path, out_dir, overrides)
+
+
+def _source_runner(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
+    from housingfe.source.cli import run
+
+    if overrides:
+        raise InputError(f"{name_or_path}: --set: source scenes take no overrides (edit a copy of the scene)")
+    return run(name_or_path, out_dir)
+
+
+# scene kind -> runner (a registry: a new kind of scene is one entry); "housing" is run_housing_scene below
+SCENE_RUNNERS = {"runup": _runup_runner, "source": _source_runner}
+
+
 def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
-    """Run every analysis the scene lists and write the result folder; returns its path."""
+    """Run a scene of any kind (its [scene].kind picks the runner of SCENE_RUNNERS, housing scenes by default) and
+    write its result folder; returns its path."""
+    from housingfe.scenefile import read_scene_dict
+
+    data, _ = read_scene_dict(name_or_path)
+    info = data.get("scene")
+    kind = info.get("kind") if isinstance(info, dict) else None
+    runner = SCENE_RUNNERS.get(kind, run_housing_scene)
+    return runner(name_or_path, out_dir, overrides)
+
+
+def run_housing_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
+    """Run every analysis a housing scene lists and write the result folder; returns its path."""
     from mpi4py import MPI
 
     t_start = time.perf_counter()

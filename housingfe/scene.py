@@ -329,6 +329,9 @@ def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) ->
     kind = data.get("scene", {}).get("kind") if isinstance(data.get("scene"), dict) else None
     if kind == "source":
         raise InputError(f"{path}: scene.kind: this is a source scene; run it with `housingfe source`")
+    if kind == "runup":
+        raise InputError(f"{path}: scene.kind: this is a run-up scene, not a housing scene; run it with "
+                         "`housingfe run`")
     return parse_table(HousingScene, data, path), path
 
 

@@ -21,7 +21,7 @@ class _Strict(BaseModel):
 
 class SceneInfo(_Strict):
     name: str
-    kind: Literal["housing", "source"]
+    kind: Literal["housing", "source", "runup"]
     description: str = ""
 
 

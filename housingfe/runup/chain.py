@@ -1,0 +1,346 @@
+"""The noise chain end to end: gear set + speed + torque -> L_v, L_W, L_WA over speed (van Roosmalen 1994, Ch. 5).
+
+    model = build_gearbox_model(housing_model, drivetrain, f_lines_max=4000.0)   # once: coupled FE + Ritz basis
+    source = drivetrain.source_model()                                           # the lumped source (Ch. 2)
+    result = runup(model, source, speeds_rpm, torques_nm, routes=("tf_omega", "mesh_force"))
+    other = with_drivetrain(model, test_gearbox("B"))                           # another set: same basis
+
+Per run, once (`build_gearbox_model`): the housing coupled with the drivetrain's FE reduction (shafts, gears,
+bearings as 6x6 matrices at star connections to the bores, the gear mesh), its complete modal basis to
+basis_factor x the highest line, and a Ritz reduction (housingfe.response.reduced) on the two unit loads the routes
+need: a torque of 1 N m about the wheel axis at the wheel centre, and a unit compressive pair along the gear-mesh
+normal (the loads the gear-mesh element carries).  Per speed and torque: the source's operating point
+(housingfe.source.operating), then each route's L_v per tooth harmonic, then each radiator's L_sigma and L_W.
+
+Routes (`ROUTES`, a registry: `@register_route(name)`):
+
+* "tf_omega" — the thesis' route, eq. 5.5: L_v(f_n) = L_omega(f_n) + TF_omega(f_n), with
+  TF_omega = L_v - L_omega of the coupled model under the 1 N m wheel torque (Sec. 5.4), at every line.
+* "mesh_force" — the source's dynamic mesh excitation applied coherently on the coupled model's gear mesh.  The
+  coupled model already holds the mean mesh stiffness k_m, so the load is the part of the lumped mesh force that
+  k_m does not carry: F_exc,n = F_n - k_m d_n (F_n: the dynamic mesh force S(t) d(t) + F_e(t), d_n: the mesh
+  compression, both per harmonic from the harmonic balance; k_m: the mean of S(t)); with the lumped model's
+  interior it reproduces the lumped response exactly (tests/runup/test_chain.py).  The source's bearing forces are
+  NOT added: on the coupled model the shafts carry the mesh force to the bearings and bores themselves (adding the
+  rigid-bore reactions would count them twice).  It also gives L_omega of the wheel on the flexible housing.
+
+Amplitudes: the source's one-sided (peak) amplitudes A_n become rms phasors A_n / sqrt(2).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from housingfe import levels
+from housingfe.errors import InputError
+from housingfe.radiation.power import area_level_db
+from housingfe.response.reduced import RitzReduction, modal_basis_summary
+from housingfe.solvers import harmonic, modal
+
+ROUTES: dict = {}
+
+
+def register_route(name: str):
+    """Decorator: register an excitation route `fn(model, lines) -> RouteResult` under `name`."""
+    def add(fn):
+        if name in ROUTES:
+            raise ValueError(f"route {name!r} is registered twice")
+        ROUTES[name] = fn
+        return fn
+
+    return add
+
+
+# ------------------------------------------------------------------------------------------------ model
+@dataclass
+class GearboxModel:
+    """The coupled gearbox of a run-up (see the module docstring): drivetrain (housingfe.drivetrain.description
+    .Drivetrain), structure (CoupledInterior), basis (ModalBasis), reduction (RitzReduction on the loads
+    "wheel_torque" and "mesh"), radiators {name: Radiator}, wheel node and axis, the highest line (Hz), the
+    interior energy share of each basis mode, timings (s)."""
+
+    drivetrain: object
+    housing_model: object
+    structure: object
+    basis: object
+    reduction: RitzReduction
+    radiators: dict
+    wheel_node: str
+    wheel_axis: np.ndarray
+    f_lines_max: float
+    interior_share: np.ndarray
+    timings: dict = field(default_factory=dict)
+
+    @property
+    def area(self) -> float:
+        """Radiating surface (m^2)."""
+        return self.reduction.area
+
+    def summary(self) -> dict:
+        """JSON-able facts: the modal basis used, the Ritz reduction, the radiating area."""
+        out = modal_basis_summary(self.basis, self.reduction)
+        n = self.basis.rigid_count
+        out["interior_share"] = [float(x) for x in self.interior_share]
+        out["interior_dominated_modes_hz"] = [float(f) for f, s in
+                                              zip(self.basis.frequencies_hz[n:], self.interior_share) if s > 0.5]
+        out["area_m2"] = self.area
+        out["f_lines_max_hz"] = self.f_lines_max
+        out["ritz_frequencies_hz"] = [float(x) for x in self.reduction.frequencies_hz]
+        return out
+
+
+def unit_loads(structure, drivetrain) -> tuple[dict, str, np.ndarray]:
+    """({"wheel_torque": 1 N m about the wheel axis at the wheel centre, "mesh": unit compressive pair along the
+    FE mesh normal}, wheel node name, wheel axis) as coupled load vectors."""
+    wheel = f"wheel:{drivetrain.shaft_nodes('wheel')[1]['gear']}"
+    axis = np.asarray(drivetrain.shaft("wheel").axis, float)
+    axis /= np.linalg.norm(axis)
+    torque = structure.node_load(wheel, "moment", axis, "runup.wheel_torque")
+    mesh = structure.system.load(node_loads={k: np.real(v) for k, v in drivetrain.mesh_node_loads(1.0).items()})
+    return {"wheel_torque": torque, "mesh": mesh}, wheel, axis
+
+
+def build_gearbox_model(housing_model, drivetrain, f_lines_max: float, *, damping_ratio: float = 0.04,
+                        basis_factor: float = 1.5, radiators: dict | None = None,
+                        surface: str = "outer") -> GearboxModel:
+    """Couple `housing_model` (HousingModel with the bores of the drivetrain's bearings) with `drivetrain`, compute
+    its complete modal basis to basis_factor x f_lines_max (Hz) and the Ritz reduction of the two unit loads.
+    damping_ratio: modal xi (Sec. 5.4: 0.04); radiators: {name: Radiator} (their extra points are kept)."""
+    from housingfe.drivetrain.interior import build_interior
+
+    t0 = time.perf_counter()
+    radiators = dict(radiators or {})
+    f_basis = basis_factor * f_lines_max
+    structure = build_interior(housing_model, drivetrain.to_coupling_spec(), f_basis)
+    t1 = time.perf_counter()
+    basis = modal.modes(structure, f_basis)
+    t2 = time.perf_counter()
+    loads, wheel, axis = unit_loads(structure, drivetrain)
+    extra = {}
+    for radiator in radiators.values():
+        extra.update(radiator.extra_points(structure))
+    damping = harmonic.Damping(lambda f: np.zeros(np.shape(f)), modal_ratio=damping_ratio)
+    reduction = RitzReduction(basis, loads, damping, surface=surface, nodes=(wheel,), extra_points=extra)
+    share = structure.interior_fraction(basis.vectors[basis.rigid_count:])
+    t3 = time.perf_counter()
+    timings = {**housing_model.timings, "coupling_s": t1 - t0, "basis_s": t2 - t1, "reduction_s": t3 - t2}
+    return GearboxModel(drivetrain, housing_model, structure, basis, reduction, radiators, wheel, axis,
+                        float(f_lines_max), share, timings)
+
+
+def with_drivetrain(model: GearboxModel, drivetrain) -> GearboxModel:
+    """The same housing and Ritz vectors with another drivetrain of the same layout (gear set, torque, bearings):
+    its coupled K, M, C projected on the vectors (a Rayleigh-Ritz re-analysis, seconds instead of a new basis)."""
+    from housingfe.drivetrain.interior import build_interior
+
+    t0 = time.perf_counter()
+    structure = build_interior(model.housing_model, drivetrain.to_coupling_spec(),
+                               model.basis.f_max)
+    loads, wheel, axis = unit_loads(structure, drivetrain)
+    if wheel != model.wheel_node:
+        raise InputError("drivetrain: another shaft layout than the model's (the wheel node moved): build a new "
+                         "gearbox model")
+    reduction = model.reduction.reanalyse(structure, loads)
+    return replace(model, drivetrain=drivetrain, structure=structure, reduction=reduction,
+                   timings={**model.timings, "reanalysis_s": time.perf_counter() - t0})
+
+
+# ------------------------------------------------------------------------------------------------ lines
+@dataclass
+class Lines:
+    """Every tooth-harmonic line of a run-up (arrays of equal length, one entry per line): torque (N m), speed
+    (rev/min), harmonic n, frequency (Hz), L_omega (dB re 5e-8 rad/s, the source's narrow-band level of the wheel),
+    mesh_excitation (complex rms N, F_n - k_m d_n), point (index of the operating point);  per operating point:
+    points = [(torque, speed, tooth frequency Hz, L_omega in the tooth band dB, k_m N/m)]."""
+
+    torque: np.ndarray
+    speed: np.ndarray
+    harmonic: np.ndarray
+    frequency: np.ndarray
+    L_omega: np.ndarray
+    mesh_excitation: np.ndarray
+    point: np.ndarray
+    points: list
+
+
+def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float) -> tuple[Lines, float]:
+    """The source's lines up to f_lines_max (Hz) at every speed (rev/min) and torque (N m); also the time (s)."""
+    t0 = time.perf_counter()
+    cols = {k: [] for k in ("torque", "speed", "harmonic", "frequency", "L_omega", "mesh_excitation", "point")}
+    points = []
+    for torque in torques_nm:
+        k_m = float(np.mean(source.mesh_stiffness(float(torque))[0]))
+        for speed in speeds_rpm:
+            exc = source.operating_point(float(speed), float(torque))
+            keep = exc.frequency_hz <= f_lines_max * (1 + 1e-12)
+            n = int(keep.sum())
+            cols["torque"] += [float(torque)] * n
+            cols["speed"] += [float(speed)] * n
+            cols["harmonic"] += list(exc.harmonic[keep])
+            cols["frequency"] += list(exc.frequency_hz[keep])
+            cols["L_omega"] += list(exc.L_omega[keep])
+            cols["mesh_excitation"] += list((exc.mesh_force[keep] - k_m * exc.transmission_error[keep])
+                                            / math.sqrt(2.0))
+            cols["point"] += [len(points)] * n
+            points.append((float(torque), float(speed), float(exc.tooth_frequency_hz),
+                           float(exc.L_omega_tooth_band), k_m))
+    lines = Lines(*(np.array(cols[k], dtype=complex if k == "mesh_excitation" else float)
+                    for k in ("torque", "speed", "harmonic", "frequency", "L_omega", "mesh_excitation", "point")),
+                  points)
+    lines.harmonic = lines.harmonic.astype(int)
+    lines.point = lines.point.astype(int)
+    return lines, time.perf_counter() - t0
+
+
+# ------------------------------------------------------------------------------------------------ routes
+@dataclass
+class RouteResult:
+    """One route on every line: L_v (dB re 5e-8 m/s) per line, the response (LoadResponse, for the numerical
+    radiator), the Ritz coordinates (vectors, lines), L_omega of the wheel on the coupled model per line (dB re
+    5e-8 rad/s), TF_omega per line (dB) where the route has it."""
+
+    name: str
+    L_v: np.ndarray
+    response: object
+    coefficients: np.ndarray
+    L_omega_coupled: np.ndarray
+    tf_omega: np.ndarray | None = None
+
+
+def _wheel_omega_level(model: GearboxModel, response, frequency) -> np.ndarray:
+    rot = model.reduction.node_rotation(response, model.wheel_node, model.wheel_axis)
+    return levels.level(np.abs(2 * math.pi * np.asarray(frequency) * rot) ** 2, levels.OMEGA0)
+
+
+@register_route("tf_omega")
+def tf_omega_route(model: GearboxModel, lines: Lines) -> RouteResult:
+    """Eq. 5.5: L_v = L_omega (source) + TF_omega, TF_omega = L_v - L_omega of the coupled model under 1 N m at the
+    wheel centre, at every line."""
+    f = lines.frequency
+    c = model.reduction.coefficients(f, {"wheel_torque": 1.0})
+    resp = model.reduction.response_of(f, c)
+    tf = resp.velocity_level_db - _wheel_omega_level(model, resp, f)
+    # the wheel's L_omega on this route is the source's (the route's input): no coupled value of its own
+    return RouteResult("tf_omega", lines.L_omega + tf, resp, c, np.full(len(f), np.nan), tf)
+
+
+@register_route("mesh_force")
+def mesh_force_route(model: GearboxModel, lines: Lines) -> RouteResult:
+    """The mesh excitation F_n - k_m d_n (complex rms, N) on the coupled model's gear mesh, at every line."""
+    f = lines.frequency
+    c = model.reduction.coefficients(f, {"mesh": lines.mesh_excitation})
+    resp = model.reduction.response_of(f, c)
+    return RouteResult("mesh_force", resp.velocity_level_db, resp, c, _wheel_omega_level(model, resp, f))
+
+
+# ------------------------------------------------------------------------------------------------ run-up
+@dataclass
+class RunupResult:
+    """A run-up: lines (Lines), per route its RouteResult, per (route, radiator) L_sigma and L_W per line (dB),
+    totals per operating point (`totals`, a list of row dicts), the model facts and timings (s)."""
+
+    lines: Lines
+    routes: dict
+    L_sigma: dict
+    L_W: dict
+    area_level_db: float
+    radiators: list
+    totals: list
+    timings: dict
+
+    def harmonic_rows(self) -> list[dict]:
+        """One row per route, radiator and line (runup_harmonics.csv)."""
+        rows = []
+        ln = self.lines
+        a_w = levels.a_weighting_db(ln.frequency)
+        for route, rr in self.routes.items():
+            for rad in self.radiators:
+                Lw = self.L_W[route, rad]
+                for k in range(len(ln.frequency)):
+                    rows.append({"route": route, "radiation": rad, "torque_nm": ln.torque[k],
+                                 "speed_rpm": ln.speed[k], "harmonic": int(ln.harmonic[k]),
+                                 "frequency_hz": ln.frequency[k], "L_omega_dB": ln.L_omega[k],
+                                 "TF_omega_dB": rr.tf_omega[k] if rr.tf_omega is not None else float("nan"),
+                                 "L_omega_coupled_dB": rr.L_omega_coupled[k], "Lv_dB": rr.L_v[k],
+                                 "L_sigma_dB": self.L_sigma[route, rad][k], "Lw_dB": Lw[k],
+                                 "LwA_dB": Lw[k] + a_w[k]})
+        return rows
+
+    def series(self, route: str, radiation: str, torque: float, key: str) -> tuple[np.ndarray, np.ndarray]:
+        """(speeds rev/min, values) of a total (`key` of a totals row) over speed at one torque."""
+        rows = [r for r in self.totals if r["route"] == route and r["radiation"] == radiation
+                and r["torque_nm"] == torque]
+        return np.array([r["speed_rpm"] for r in rows]), np.array([r[key] for r in rows])
+
+
+def _energy_sum(values_db: np.ndarray, groups: np.ndarray, n_groups: int) -> np.ndarray:
+    power = np.zeros(n_groups)
+    np.add.at(power, groups, 10.0 ** (np.asarray(values_db) / 10.0))
+    with np.errstate(divide="ignore"):
+        return 10.0 * np.log10(power)
+
+
+def runup(model: GearboxModel, source, speeds_rpm, torques_nm, *, routes=("tf_omega", "mesh_force"),
+          lines: Lines | None = None) -> RunupResult:
+    """L_v, L_W and L_WA per tooth harmonic and in total at every speed (rev/min) and torque (N m) for every route
+    (ROUTES) and radiator of the model.  source: housingfe.source.operating.SourceModel (or `lines` computed
+    before, e.g. to reuse them across gear-set models)."""
+    unknown = [r for r in routes if r not in ROUTES]
+    if unknown:
+        raise InputError(f"runup.routes: {', '.join(unknown)} unknown (known: {', '.join(ROUTES)})")
+    timings = {}
+    if lines is None:
+        lines, timings["source_s"] = source_lines(source, speeds_rpm, torques_nm, model.f_lines_max)
+    t0 = time.perf_counter()
+    results = {name: ROUTES[name](model, lines) for name in routes}
+    timings["response_s"] = time.perf_counter() - t0
+    L_S = area_level_db(model.area)
+    f = lines.frequency
+    a_w = levels.a_weighting_db(f)
+    L_sigma, L_W = {}, {}
+    t0 = time.perf_counter()
+    for name, rr in results.items():
+        for rad_name, radiator in model.radiators.items():
+            t1 = time.perf_counter()
+            L_sigma[name, rad_name] = np.asarray(radiator.radiation_index_db(rr.response), float)
+            L_W[name, rad_name] = rr.L_v + L_S + L_sigma[name, rad_name]
+            timings[f"radiation_{rad_name}_s"] = timings.get(f"radiation_{rad_name}_s", 0.0) + time.perf_counter() - t1
+    timings["radiation_s"] = time.perf_counter() - t0
+    n_points = len(lines.points)
+    totals = []
+    for name, rr in results.items():
+        Lv_tot = _energy_sum(rr.L_v, lines.point, n_points)
+        Lw_c = _energy_sum(rr.L_omega_coupled, lines.point, n_points)
+        first = {p: k for k, p in reversed(list(enumerate(lines.point)))}
+        for rad_name in model.radiators:
+            Lw_tot = _energy_sum(L_W[name, rad_name], lines.point, n_points)
+            LwA_tot = _energy_sum(L_W[name, rad_name] + a_w, lines.point, n_points)
+            for p, (torque, speed, f_t, L_om, k_m) in enumerate(lines.points):
+                totals.append({"route": name, "radiation": rad_name, "torque_nm": torque, "speed_rpm": speed,
+                               "tooth_frequency_hz": f_t, "L_omega_dB": L_om,
+                               "L_omega_coupled_dB": float(rr.L_omega_coupled[first[p]]),
+                               "L_omega_coupled_all_dB": float(Lw_c[p]),
+                               "Lv_tooth_dB": float(rr.L_v[first[p]]), "Lv_dB": float(Lv_tot[p]),
+                               "Lw_dB": float(Lw_tot[p]), "LwA_dB": float(LwA_tot[p]),
+                               "harmonics": int(np.sum(lines.point == p))})
+    return RunupResult(lines, results, L_sigma, L_W, L_S, list(model.radiators), totals, timings)
+
+
+def peak_contributions(model: GearboxModel, result: RunupResult, route: str, point: int, top: int = 3) -> list:
+    """The modes that make the tooth-harmonic line of operating point `point` (index into lines.points) on a route:
+    [(frequency Hz, share of <v^2>, interior energy share of the nearest basis mode)], largest first."""
+    ln = result.lines
+    k = int(np.flatnonzero((ln.point == point) & (ln.harmonic == 1))[0])
+    freqs, share = model.reduction.modal_contributions(ln.frequency[k], result.routes[route].coefficients[:, k])
+    n = model.basis.rigid_count
+    elastic = model.basis.frequencies_hz[n:]
+    order = np.argsort(-share)[:top]
+    out = []
+    for i in order:
+        j = int(np.argmin(np.abs(elastic - freqs[i]))) if len(elastic) else 0
+        out.append((float(freqs[i]), float(share[i]),
+                    float(model.interior_share[j]) if len(elastic) else float("nan")))
+    return out

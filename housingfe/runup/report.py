@@ -1,0 +1,159 @@
+"""Run-up outputs: runup.csv (totals per speed, torque, route, radiation), runup_harmonics.csv (per tooth harmonic),
+spectra_<rpm>.csv / .png (like Figs. 5.2/5.5/5.8/5.9), runup.png (like Figs. 5.4/5.7/5.10 with the measured points),
+checks.csv and runup.json (timings, provenance, the modal basis used, checks, modal contributions per peak)."""
+from __future__ import annotations
+
+import platform
+from pathlib import Path
+
+import numpy as np
+
+from housingfe import outputs
+from housingfe.data import thesis
+
+TOTAL_COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "tooth_frequency_hz", "L_omega_dB",
+                 "L_omega_coupled_dB", "Lv_tooth_dB", "Lv_dB", "Lw_dB", "LwA_dB", "harmonics")
+HARMONIC_COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "harmonic", "frequency_hz", "L_omega_dB",
+                    "TF_omega_dB", "L_omega_coupled_dB", "Lv_dB", "L_sigma_dB", "Lw_dB", "LwA_dB")
+CHECK_COLUMNS = ("check", "quantity", "ours", "measured", "thesis_calculated", "goal", "passed", "note")
+
+
+def _fmt(v):
+    if isinstance(v, float):
+        return "" if not np.isfinite(v) else f"{v:.6g}"
+    return "" if v is None else v
+
+
+def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict) -> None:
+    """Every output file of a run-up into `folder` (rank 0)."""
+    totals = [r for _, res in results.values() for r in res.totals]
+    outputs.write_csv(folder / "runup.csv", TOTAL_COLUMNS, ([_fmt(r[k]) for k in TOTAL_COLUMNS] for r in totals))
+    harm = [r for _, res in results.values() for r in res.harmonic_rows()]
+    outputs.write_csv(folder / "runup_harmonics.csv", HARMONIC_COLUMNS,
+                      ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for r in harm))
+    outputs.write_csv(folder / "checks.csv", CHECK_COLUMNS, ([_fmt(r[k]) for k in CHECK_COLUMNS] for r in check_rows))
+    for speed in scene.runup.spectrum_speeds_rpm:
+        rows = [r for r in harm if abs(r["speed_rpm"] - speed) < 1e-9]
+        if rows:
+            outputs.write_csv(folder / f"spectra_{speed:g}rpm.csv", HARMONIC_COLUMNS,
+                              ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for r in rows))
+            spectrum_plot(folder / f"spectra_{speed:g}rpm.png", rows, speed, scene.radiation.models[0])
+    runup_plot(folder / "runup.png", scene, totals)
+    import dolfinx
+
+    outputs.write_json(folder / "runup.json", {
+        "scene": scene.scene.name, "description": scene.scene.description,
+        "scene_settings": scene.model_dump(mode="json"),
+        "timings_s": timings,
+        "modal_basis": gm.summary(),
+        "ritz_reanalysis": {f"{t:g}": m.reduction.frequencies_hz[:12].tolist() for t, (m, _) in results.items()},
+        "checks": check_rows, "peak_contributions": contributions,
+        "area_level_dB": next(iter(results.values()))[1].area_level_db,
+        "provenance": {"python": platform.python_version(), "dolfinx": dolfinx.__version__,
+                       "machine": platform.machine(), "mpi_ranks": gm.structure.V.mesh.comm.size},
+    })
+
+
+def spectrum_plot(path: Path, rows: list, speed: float, radiation: str) -> None:
+    """Lines of L_omega, L_v (per route) and L_WA at one speed (like Figs. 5.2/5.5/5.8/5.9)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 3, figsize=(13, 4))
+    routes = sorted({r["route"] for r in rows})
+    for j, route in enumerate(routes):
+        sel = [r for r in rows if r["route"] == route and r["radiation"] == radiation]
+        f = np.array([r["frequency_hz"] for r in sel])
+        off = (j - 0.5 * (len(routes) - 1)) * 0.02
+        if j == 0:
+            axes[0].vlines(f, 0, [r["L_omega_dB"] for r in sel], color="k", label="source (rigid bores)")
+        if route == "mesh_force":
+            axes[0].plot(f, [r["L_omega_coupled_dB"] for r in sel], "o", label="coupled model")
+        axes[1].vlines(f * (1 + off), 0, [r["Lv_dB"] for r in sel], color=f"C{j}", label=route)
+        axes[2].vlines(f * (1 + off), 0, [r["LwA_dB"] for r in sel], color=f"C{j}", label=route)
+    for ax, label in zip(axes, ("L_omega (dB re 5e-8 rad/s)", "L_v (dB re 5e-8 m/s)", f"L_WA (dB(A) re 1 pW, {radiation})")):
+        ax.set_xscale("log")
+        ax.set_xlabel("frequency (Hz)")
+        ax.set_ylabel(label)
+        ax.set_ylim(bottom=max(0.0, ax.get_ylim()[1] - 80))
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"tooth harmonics at {speed:g} rev/min")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def runup_plot(path: Path, scene, totals: list) -> None:
+    """L_omega, L_v and L_WA over speed (like Figs. 5.4/5.7/5.10) with the measured points of set A."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    tg = thesis()["test_gearbox"]
+    rad = scene.radiation.models[0]
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.2))
+    torques = sorted({r["torque_nm"] for r in totals})
+    routes = sorted({r["route"] for r in totals})
+    for ti, torque in enumerate(torques):
+        ls = "-" if ti == len(torques) - 1 else "--"
+        for j, route in enumerate(routes):
+            sel = [r for r in totals if r["route"] == route and r["radiation"] == rad and r["torque_nm"] == torque]
+            s = [r["speed_rpm"] for r in sel]
+            if j == 0:
+                axes[0].plot(s, [r["L_omega_dB"] for r in sel], "k" + ls, label=f"source, {torque:g} N m")
+            if route == "mesh_force":
+                axes[0].plot(s, [r["L_omega_coupled_dB"] for r in sel], ls, color="C1",
+                             label=f"coupled model, {torque:g} N m")
+            axes[1].plot(s, [r["Lv_dB"] for r in sel], ls, color=f"C{j}", label=f"{route}, {torque:g} N m")
+            axes[2].plot(s, [r["LwA_dB"] for r in sel], ls, color=f"C{j}", label=f"{route}, {torque:g} N m")
+        for other in scene.radiation.models[1:]:
+            for j, route in enumerate(routes):
+                sel = [r for r in totals if r["route"] == route and r["radiation"] == other
+                       and r["torque_nm"] == torque]
+                axes[2].plot([r["speed_rpm"] for r in sel], [r["LwA_dB"] for r in sel], ":", color=f"C{j}",
+                             label=f"{route}, {other}, {torque:g} N m")
+    if scene.drivetrain.gear_set == "A" and scene.drivetrain.bearings == "ball":
+        meas = tg["meas_L_omega_tooth_band_dB"]
+        axes[0].plot([float(k) for k in meas], list(meas.values()), "rs", ms=8, label="measured (Sec. 5.3)")
+        for s in tg["meas_high_Lv_speeds_rpm"]:
+            axes[1].axvline(s, color="r", alpha=0.4)
+        axes[1].plot([], [], "r", alpha=0.4, label="measured L_v peaks")
+        axes[2].plot([250, 500, 1000, 1500], [74, 80, 86, 89], "rs", ms=7, label="measured, speed law (Fig. 5.10)")
+        axes[2].axhline(tg["meas_Lw_max_dBA"], color="r", ls="--", alpha=0.6, label="measured max 100.5")
+        axes[2].axhline(tg["calc_Lw_max_dBA"], color="gray", ls="--", alpha=0.6, label="thesis calc. max 89.4")
+    for ax, label in zip(axes, ("L_omega, tooth band (dB re 5e-8 rad/s)", "L_v, all harmonics (dB re 5e-8 m/s)",
+                                f"L_WA (dB(A) re 1 pW), sigma: {rad}")):
+        ax.set_xlabel("pinion speed (rev/min)")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"{scene.scene.name}: gear set {scene.drivetrain.gear_set}, {scene.drivetrain.bearings} bearings")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def summary_text(scene, results: dict, gm, check_rows: list, timings: dict) -> str:
+    """The console summary: the model, the run-up maxima per route, the checks, the time split."""
+    b = gm.basis
+    lines = [f"{scene.scene.name}: coupled gearbox {gm.structure.dofs} DOFs, {len(b.eigenvalues)} modes to "
+             f"{b.f_max:.0f} Hz ({b.rigid_count} zero), {len(gm.reduction.vectors)} Ritz vectors; radiating area "
+             f"{gm.area:.3f} m2"]
+    for torque, (_, res) in results.items():
+        for route in res.routes:
+            for rad in res.radiators:
+                s, lwa = res.series(route, rad, torque, "LwA_dB")
+                i = int(np.argmax(lwa))
+                lines.append(f"  {torque:g} N m  {route:10s} sigma {rad:9s}: max L_WA {lwa[i]:.1f} dB(A) at "
+                             f"{s[i]:g} rpm")
+    lines.append("checks (ours | measured | thesis calc. | pass):")
+    for r in check_rows:
+        lines.append(f"  {r['quantity']}: {r['ours']} | {_fmt(r['measured'])} | {_fmt(r['thesis_calculated'])} | "
+                     f"{r['passed'] or '-'}")
+    split = ", ".join(f"{k[:-2]} {v:.1f}" for k, v in timings.items() if k.endswith("_s") and v >= 0.05)
+    lines.append(f"time (s): {split}")
+    return "\n".join(lines)

@@ -1,0 +1,243 @@
+"""Run-up scenes (`kind = "runup"`): a housing scene, a drivetrain description, a speed and torque range ->
+L_omega, L_v, L_W, L_WA over speed.  `housingfe run test-gearbox-runup`.
+
+    [scene]        name, kind = "runup", description
+    [housing]      scene = "test-gearbox" (a housing scene with the drivetrain's bores), set = [overrides]
+    [drivetrain]   gearbox = "test_gearbox", gear_set = "A", bearings = "ball", bearing_speed_rpm = 1500
+    [runup]        speeds, torques, f_max_hz (highest harmonic line), basis_factor, routes, damping_ratio, ...
+    [radiation]    models = ["erp", "foller"], plates = [...]  (the housing's radiating plates)
+
+Only this module reads a run-up scene; the stages get typed arguments (housingfe.runup.chain).
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Optional
+
+import numpy as np
+from pydantic import Field, PositiveFloat, PositiveInt, field_validator, model_validator
+
+from housingfe.errors import InputError
+from housingfe.scene import RadiationPlate
+from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table, read_scene_dict
+from housingfe.source.operating import SPEED_RANGE_RPM
+
+
+def _gearboxes() -> dict:
+    """Drivetrain descriptions by name (a registry: a new gearbox is one entry)."""
+    from housingfe.drivetrain.description import test_gearbox
+
+    return {"test_gearbox": test_gearbox}
+
+
+class HousingRef(_Strict):
+    """The housing: a housing scene (built-in name or path) with optional --set style overrides."""
+
+    scene: str = "test-gearbox"
+    set: list[str] = []
+
+
+class DrivetrainSpec(_Strict):
+    """The drivetrain description (housingfe.drivetrain.description): a registered gearbox and its choices."""
+
+    gearbox: str = "test_gearbox"
+    gear_set: str = "A"
+    bearings: str = "ball"
+    bearing_speed_rpm: PositiveFloat = 1500.0   # pinion speed at which speed-dependent bearings (fluid films) are taken
+
+    @field_validator("gearbox")
+    @classmethod
+    def _known(cls, name):
+        if name not in _gearboxes():
+            raise ValueError(f"{name!r} is not a drivetrain description (known: {', '.join(_gearboxes())})")
+        return name
+
+    @field_validator("gear_set")
+    @classmethod
+    def _gear_set(cls, name):
+        from housingfe.drivetrain.description import GEAR_SETS
+
+        if name not in GEAR_SETS:
+            raise ValueError(f"{name!r} is not a gear set (known: {', '.join(GEAR_SETS)})")
+        return name
+
+    @field_validator("bearings")
+    @classmethod
+    def _bearings(cls, name):
+        from housingfe.bearings.configurations import configurations
+
+        known = ["ball", *configurations()]
+        if name not in known:
+            raise ValueError(f"{name!r} is not a bearing configuration (known: {', '.join(known)})")
+        return name
+
+
+class RunupSpec(_Strict):
+    """Speeds (pinion, rev/min) from speed_min to speed_max in speed_step; torques (pinion, N m); the harmonics of
+    the tooth frequency up to f_max_hz; a modal basis to basis_factor x f_max_hz; routes of
+    housingfe.runup.chain.ROUTES; modal damping ratio (Sec. 5.4: 0.04); harmonics of the source's harmonic balance;
+    spectra at spectrum_speeds_rpm; the observed (radiating) surface."""
+
+    speed_min_rpm: PositiveFloat = 50.0
+    speed_max_rpm: PositiveFloat = 1500.0
+    speed_step_rpm: PositiveFloat = 50.0
+    torques_nm: list[PositiveFloat] = Field(default=[2000.0], min_length=1)
+    f_max_hz: PositiveFloat = 4000.0
+    basis_factor: float = Field(1.5, ge=1.0, le=4.0)
+    routes: list[str] = Field(default=["tf_omega", "mesh_force"], min_length=1)
+    damping_ratio: float = Field(0.04, gt=0.0, lt=1.0)
+    harmonics: PositiveInt = 30
+    spectrum_speeds_rpm: list[PositiveFloat] = [500.0, 1000.0, 1500.0]
+    surface: str = "outer"
+
+    @field_validator("routes")
+    @classmethod
+    def _routes(cls, names):
+        from housingfe.runup.chain import ROUTES
+
+        for name in names:
+            if name not in ROUTES:
+                raise ValueError(f"{name!r} is not a route (known: {', '.join(ROUTES)})")
+        return names
+
+    @model_validator(mode="after")
+    def _range(self):
+        lo, hi = SPEED_RANGE_RPM
+        if self.speed_min_rpm > self.speed_max_rpm:
+            raise ValueError(f"speed_min_rpm: {self.speed_min_rpm:g} is above speed_max_rpm {self.speed_max_rpm:g}")
+        for key in ("speed_min_rpm", "speed_max_rpm"):
+            v = getattr(self, key)
+            if not lo <= v <= hi:
+                raise ValueError(f"{key}: {v:g} rev/min is outside the range the source supports ({lo:g}..{hi:g} "
+                                 "rev/min, the thesis' run-up)")
+        return self
+
+    @property
+    def speeds(self) -> np.ndarray:
+        n = int(np.floor((self.speed_max_rpm - self.speed_min_rpm) / self.speed_step_rpm + 1e-9)) + 1
+        return self.speed_min_rpm + self.speed_step_rpm * np.arange(n)
+
+
+class RunupRadiation(_Strict):
+    """Radiation models (housingfe.radiation.radiators.RADIATORS) computed side by side; the first is the one the
+    checks use.  plates: the radiating plates (Föller, numerical)."""
+
+    models: list[str] = Field(default=["erp", "foller"], min_length=1)
+    plates: list[RadiationPlate] = []
+
+    @field_validator("models")
+    @classmethod
+    def _registered(cls, names):
+        from housingfe.radiation.radiators import check_radiator
+
+        return [check_radiator(n) for n in names]
+
+    @model_validator(mode="after")
+    def _plates(self):
+        from housingfe.radiation.radiators import RADIATORS
+
+        needs = [m for m in self.models if RADIATORS[m].needs_plates]
+        if needs and not self.plates:
+            raise ValueError(f"plates: the model(s) {', '.join(needs)} need the radiating plates")
+        return self
+
+
+class RunupScene(_Strict):
+    scene: SceneInfo
+    housing: HousingRef = HousingRef()
+    drivetrain: DrivetrainSpec = DrivetrainSpec()
+    runup: RunupSpec = RunupSpec()
+    radiation: RunupRadiation = RunupRadiation(models=["erp"])
+    reference: Optional[dict] = None
+
+    @model_validator(mode="after")
+    def _kind(self):
+        if self.scene.kind != "runup":
+            raise ValueError("scene.kind: a run-up scene has kind = \"runup\"")
+        return self
+
+
+def load_runup_scene(name_or_path: str, overrides: list[str] | None = None) -> tuple[RunupScene, Path]:
+    """Read and validate a run-up scene; InputError naming the file and key on any problem."""
+    data, path = read_scene_dict(name_or_path)
+    apply_overrides(data, overrides or [])
+    return parse_table(RunupScene, data, path), path
+
+
+def drivetrain_of(spec: DrivetrainSpec, torque: float):
+    """The Drivetrain of a scene's [drivetrain] at a pinion torque (N m)."""
+    from dataclasses import replace
+
+    dt = _gearboxes()[spec.gearbox](spec.gear_set, spec.bearings, torque)
+    return replace(dt, bearing_speed_rpm=spec.bearing_speed_rpm)
+
+
+def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
+    """`housingfe run <runup scene>`: build the coupled gearbox once, run the source and the routes over speed and
+    torque, write runup.csv, runup_harmonics.csv, spectra, plots, checks and runup.json atomically."""
+    from mpi4py import MPI
+
+    from housingfe import outputs
+    from housingfe.runup import checks, report
+    from housingfe.runup.chain import build_gearbox_model, runup, source_lines, with_drivetrain
+    from housingfe.scene import load_housing_scene
+
+    t_start = time.perf_counter()
+    scene, path = load_runup_scene(name_or_path, overrides)
+    comm = MPI.COMM_WORLD
+    out = Path(out_dir or f"results/{scene.scene.name}")
+    spec = scene.runup
+    housing_scene, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
+    try:
+        drivetrains = {t: drivetrain_of(scene.drivetrain, t) for t in spec.torques_nm}
+        for t, dt in drivetrains.items():     # a bearing that cannot carry its load stops here, before any FE
+            dt.to_coupling_spec()
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
+    timings = {}
+    t0 = time.perf_counter()
+    model = _housing_model(housing_scene, spec.f_max_hz, comm)
+    radiators = _radiators(scene.radiation, model)
+    timings["mesh_s"] = time.perf_counter() - t0
+    reference_torque = max(spec.torques_nm)
+    gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
+                             basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
+    timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
+    source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics)
+    results = {}
+    for torque in spec.torques_nm:
+        t1 = time.perf_counter()
+        m = gm if torque == reference_torque else with_drivetrain(gm, drivetrains[torque])
+        timings[f"reanalysis_{torque:g}Nm_s"] = time.perf_counter() - t1 if m is not gm else 0.0
+        lines, t_src = source_lines(source, spec.speeds, [torque], spec.f_max_hz)
+        timings["source_s"] = timings.get("source_s", 0.0) + t_src
+        res = runup(m, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
+        for k, v in res.timings.items():
+            timings[k] = timings.get(k, 0.0) + v
+        results[torque] = (m, res)
+    check_rows, contributions = checks.evaluate(scene, results, gm)
+    timings["total_s"] = time.perf_counter() - t_start
+    with outputs.atomic_output_dir(out, comm) as tmp:
+        if comm.rank == 0:
+            report.write(tmp, scene, results, gm, check_rows, contributions, timings)
+    if comm.rank == 0:
+        print(report.summary_text(scene, results, gm, check_rows, timings))
+        print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
+    return out
+
+
+def _housing_model(housing_scene, f_lines_max: float, comm):
+    """The housing FE model, meshed for the highest line of the run-up (the scene's mesh rule at f_lines_max)."""
+    from housingfe.fe.model import build_model
+
+    model = build_model(housing_scene.geometry, housing_scene.material.resolve(), housing_scene.mesh, f_lines_max,
+                        comm, regions=housing_scene.regions, supports=housing_scene.supports)
+    model.scene = housing_scene
+    return model
+
+
+def _radiators(spec: RunupRadiation, model) -> dict:
+    from housingfe.radiation.radiators import RADIATORS
+
+    return {name: RADIATORS[name].from_spec(spec, model.housing, model.material) for name in spec.models}
