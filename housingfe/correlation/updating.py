@@ -133,11 +133,14 @@ def resolve_measured_paths(spec: UpdateSpec, base) -> UpdateSpec:
 # ------------------------------------------------------------------------------------------ evaluation
 @dataclass
 class SceneResult:
-    """Modes of one scene at one parameter set: elastic frequencies (Hz), the basis, mass (kg, free scenes)."""
+    """Modes of one scene at one parameter set: elastic frequencies (Hz), rigid-body mode count, mass (kg, free
+    scenes), the elastic modes sampled on each paired target's measured channels (target name -> ModeSet).
+    The FE model and basis are not kept: a search makes hundreds of them."""
 
     frequencies_hz: np.ndarray
-    basis: object
+    rigid_count: int
     mass_kg: float | None
+    sampled: dict
     dofs: int
     seconds: float
 
@@ -212,7 +215,7 @@ class SceneEvaluator:
                 n, f = max(n, len(fm)), max(f, 1.3 * float(fm.max()))
         return n, f or 1000.0
 
-    def solve(self, scene: str, values: np.ndarray, extra: list[str], need_mass: bool) -> SceneResult:
+    def solve(self, scene: str, values: np.ndarray, extra: list[str]) -> SceneResult:
         from housingfe.scene import build_model_from_scene, load_housing_scene
         from housingfe.solvers.modal import modes
 
@@ -232,13 +235,18 @@ class SceneEvaluator:
             f_max *= min(3.0, max(1.2, 1.1 * (n + 2) / max(len(freqs), 1)))
         else:
             raise SolverError(f"{scene}: fewer than {n} elastic modes below {f_max:.0f} Hz")
+        from housingfe.correlation.points import computed_modes_at
+
+        sampled = {t.name: computed_modes_at(basis, self.measured[t.name]) for t in self.spec.targets
+                   if t.kind == "paired" and t.scene == scene}
         mass = None
-        if need_mass:
+        if any(t.kind == "mass" and t.scene == scene for t in self.spec.targets):
             t = model.rigid_body_vectors()[0]
             y = t.duplicate()
             model.M.mult(t, y)
             mass = float(t.dot(y))
-        result = SceneResult(freqs, basis, mass, model.dofs, time.perf_counter() - t0)
+        result = SceneResult(freqs, basis.rigid_count, mass, sampled, model.dofs, time.perf_counter() - t0)
+        del basis, model
         self.seconds.append(result.seconds)
         self.cache[key] = result
         return result
@@ -269,18 +277,16 @@ def evaluate_targets(evaluator: SceneEvaluator, values: np.ndarray, extra: dict[
     """Evaluate the targets of the given roles at one parameter vector (physical units).  `correction`:
     target name -> factor on the model frequencies/mass (the search-mesh correction)."""
     from housingfe.correlation.mac import mac, pair_modes
-    from housingfe.correlation.points import computed_modes_at
 
     out = []
     for t in evaluator.spec.targets:
         if t.role not in roles:
             continue
-        need_mass = t.kind == "mass"
-        r = evaluator.solve(t.scene, values, extra.get(t.scene, []), need_mass)
+        r = evaluator.solve(t.scene, values, extra.get(t.scene, []))
         c = (correction or {}).get(t.name, 1.0)
         f = r.frequencies_hz * c
         if t.kind == "mass":
-            if r.mass_kg is None or r.basis.rigid_count != 6:
+            if r.mass_kg is None or r.rigid_count != 6:
                 raise InputError(f"targets.{t.name}: a mass target needs a free-free scene ({t.scene} is supported)")
             m = r.mass_kg * c
             out.append(TargetValue(t.name, t.role, np.array([(m / t.value - 1) / t.sigma]), m, t.value))
@@ -299,7 +305,7 @@ def evaluate_targets(evaluator: SceneEvaluator, values: np.ndarray, extra: dict[
             out.append(TargetValue(t.name, t.role, np.array([err / t.sigma]), p, tuple(t.value)))
         else:
             meas = evaluator.measured[t.name]
-            comp = computed_modes_at(r.basis, meas)
+            comp = r.sampled[t.name]
             comp_f = comp.frequencies_hz * c
             m = mac(meas.shapes, comp.shapes)
             pairing = pair_modes(m, meas.frequencies_hz, comp_f, t.threshold, frequency_weight=0.5)
@@ -359,7 +365,11 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
     n_eval = [0]
     t_start = time.perf_counter()
 
-    def residuals(u):
+    best = [np.inf, None]
+
+    def residuals(u, budget=True):
+        if budget and n_eval[0] >= spec.max_evaluations:
+            raise _BudgetSpent
         x = lo + u * span
         tvs = evaluate_targets(evaluator, x, spec.search_overrides, ("calibration",), correction)
         if not names_holder:
@@ -367,38 +377,51 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
         r = np.concatenate([tv.residuals for tv in tvs])
         n_eval[0] += 1
         history.append((n_eval[0], 0.5 * float(r @ r), x.copy()))
+        if 0.5 * float(r @ r) < best[0]:
+            best[:] = [0.5 * float(r @ r), u.copy()]
         evaluator.log(f"eval {n_eval[0]:3d}  cost {0.5 * float(r @ r):10.4g}  x = "
                       + ", ".join(f"{p.name}={v:.5g}" for p, v in zip(spec.parameters, x)))
         return r
 
     h = spec.fd_step
 
-    def jacobian(u):
-        r0 = residuals(u)
+    def jacobian(u, budget=True):
+        r0 = residuals(u, budget)
         J = np.empty((len(r0), len(u)))
         for k in range(len(u)):
             du = h if u[k] + h <= 1.0 else -h      # step back at the upper bound
             v = u.copy()
             v[k] += du
-            J[:, k] = (residuals(v) - r0) / du
+            J[:, k] = (residuals(v, budget) - r0) / du
         return J
 
     u0 = (x0 - lo) / span
     try:
         sol = least_squares(residuals, u0, jac=jacobian, bounds=(0.0, 1.0), method="trf", x_scale=1.0,
                             max_nfev=spec.max_evaluations, xtol=1e-4, ftol=1e-6)
-    except SolverError:
-        raise
-    J = jacobian(sol.x)
+        u_best, message = sol.x, sol.message
+        if best[0] < 0.5 * float(sol.fun @ sol.fun):
+            u_best = best[1]
+    except _BudgetSpent:
+        u_best, message = best[1], f"stopped after max_evaluations = {spec.max_evaluations} model evaluations"
+    cost = float(best[0]) if u_best is best[1] else None
+    J = jacobian(u_best, budget=False)     # the sensitivities at the answer (cached where already computed)
+    r = residuals(u_best, budget=False)
+    cost = 0.5 * float(r @ r) if cost is None else cost
     Jp = J / span[None, :]                            # residuals per physical unit
     try:
         cov = np.linalg.inv(Jp.T @ Jp)
     except np.linalg.LinAlgError:
         cov = np.full((len(x0), len(x0)), np.inf)
     elapsed = time.perf_counter() - t_start
-    return UpdateResult([p.name for p in spec.parameters], x0, lo + sol.x * span, np.sqrt(np.abs(np.diag(cov))),
-                        cov, Jp, names_holder, float(sol.cost), history, n_eval[0],
-                        elapsed / max(n_eval[0], 1), sol.message, dict(correction or {}))
+    return UpdateResult([p.name for p in spec.parameters], x0, lo + u_best * span, np.sqrt(np.abs(np.diag(cov))),
+                        cov, Jp, names_holder, cost, history, n_eval[0],
+                        elapsed / max(n_eval[0], 1), message, dict(correction or {}))
+
+
+class _BudgetSpent(Exception):
+    """The spec's max_evaluations model evaluations are used up (least_squares' max_nfev does not count the
+    Jacobian's evaluations)."""
 
 
 def mesh_correction(evaluator: SceneEvaluator, x: np.ndarray) -> dict:
