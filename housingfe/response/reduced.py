@@ -56,10 +56,13 @@ class RitzReduction:
 
     damping: housingfe.solvers.harmonic.Damping (modal ratio or loss factor) or a loss factor eta (-); surface: the
     observed (radiating) surface; nodes: interior nodes whose six components are kept (coupled structures);
-    extra_points: named SamplePoints whose normal displacement is kept (a radiator's facet points)."""
+    extra_points: named SamplePoints whose normal displacement is kept (a radiator's facet points);
+    static_vectors: more force patterns whose static residual responses join the Ritz space without being loads —
+    where a re-analysis will change the stiffness (e.g. self-equilibrated unit pairs across each bearing: a bearing
+    stiffness change Delta K phi lies in their span, so the re-analysed modes stay accurate)."""
 
     def __init__(self, basis, loads: dict, damping, *, surface: str = "outer", nodes=(),
-                 extra_points: dict | None = None):
+                 extra_points: dict | None = None, static_vectors=()):
         if not loads:
             raise InputError("loads: at least one load")
         t0 = time.perf_counter()
@@ -70,7 +73,7 @@ class RitzReduction:
             raise InputError("damping: per-material loss factors need the direct solver, not a Ritz reduction")
         self.names = list(loads)
         K_sym = structure.K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
-        self.vectors = harmonic.ritz_basis(K_sym, structure.M, basis, list(loads.values()))
+        self.vectors = harmonic.ritz_basis(K_sym, structure.M, basis, list(loads.values()) + list(static_vectors))
         t1 = time.perf_counter()
         unit = [Load(name, vec) for name, vec in loads.items()]
         self.observer = StructureObserver(structure, surface, (), unit[:1], extra_points, nodes)

@@ -146,7 +146,7 @@ class RunupRadiation(_Strict):
 class RunupScene(_Strict):
     scene: SceneInfo
     housing: HousingRef = HousingRef()
-    drivetrain: DrivetrainSpec = DrivetrainSpec()
+    drivetrain: Optional[DrivetrainSpec] = None
     runup: RunupSpec = RunupSpec()
     radiation: RunupRadiation = RunupRadiation(models=["erp"])
     reference: Optional[dict] = None
@@ -155,6 +155,9 @@ class RunupScene(_Strict):
     def _kind(self):
         if self.scene.kind != "runup":
             raise ValueError("scene.kind: a run-up scene has kind = \"runup\"")
+        if self.drivetrain is None:
+            raise ValueError(f"drivetrain: missing [drivetrain]: the routes {', '.join(self.runup.routes)} act on "
+                             "the gears and shafts of a drivetrain description (e.g. gearbox = \"test_gearbox\")")
         return self
 
 

@@ -205,10 +205,10 @@ def ritz_basis(K_sym, M, modal_result, load_vectors, *, shift: float | None = No
     basis = list(phis)
     for f in load_vectors:
         r = _residual_vector(ksp, M, f, phis[:n_rigid], phis[n_rigid:], lam_e, shift)
-        for b in basis:                         # M-orthogonal to the basis (twice: round-off)
-            r.axpy(-b.dot(_mult(M, r)), b)
-        for b in basis:
-            r.axpy(-b.dot(_mult(M, r)), b)
+        for _ in range(2):                      # M-orthogonal to the basis: classical Gram-Schmidt, twice (CGS2)
+            Mr = _mult(M, r)
+            for b, c in [(b, b.dot(Mr)) for b in basis]:
+                r.axpy(-c, b)
         norm = math.sqrt(max(r.dot(_mult(M, r)), 0.0))
         if norm > 1e-12 * math.sqrt(max(f.norm(), 1e-300)):
             r.scale(1.0 / norm)

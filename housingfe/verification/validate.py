@@ -44,6 +44,9 @@ STAMP = ".validate-key"
 # the bearing-variant study (thesis Sec. 5.8, Fig. 5.18) and the configurations it needs
 VARIANT_SCENE = "test-gearbox-interior"
 VARIANT_CONFIGS = ("ball", "self_aligning", "ball_zero_moment")
+# Ch. 5 run-ups (housingfe.runup): the built-in scene and the overrides of each validated variant
+RUNUP_SCENES = (("test-gearbox-runup", ()), ("test-gearbox-runup-double-helical", ()),
+                ("test-gearbox-runup-double-helical", ("drivetrain.bearings=fluid_film",)))
 
 
 def row_providers(package: str = "housingfe.verification") -> tuple[str, ...]:
@@ -102,6 +105,11 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
                 rows += bearing_variant_rows(results)
             except ComputationFailed as exc:
                 failures.append(str(exc))
+            for name, overrides in RUNUP_SCENES:
+                try:
+                    rows += runup_rows(name, overrides, results)
+                except ComputationFailed as exc:
+                    failures.append(str(exc))
         rows += provider_rows(failures)
     write_outputs(rows, Path(out_dir), json_path)
     print(format_rows(rows))
@@ -331,6 +339,38 @@ def bearing_variant_rows(results: Path | None = None) -> list[dict]:
                        r["mean_dB_320_600Hz"], ref["fem_TF_ball_minus_self_aligning_mean_dB"], "dB", src))
         out.append(row(scene.scene.name, f"TF_omega {label}: s.d. over 320-600 Hz",
                        r["sd_dB_320_600Hz"], ref["fem_TF_ball_minus_self_aligning_sd_dB"], "dB", src))
+    return out
+
+
+def runup_rows(name: str, overrides=(), results: Path | None = None) -> list[dict]:
+    """Ch. 5 checks of a run-up scene (housingfe.runup.checks: L_WA maximum, resonant speeds, speed and torque
+    laws, L_omega in the tooth band) as validate rows; runup.json reused when its key matches, else computed
+    (about a minute)."""
+    from housingfe.runup.scene import load_runup_scene
+
+    results = RESULTS if results is None else results
+    scene, path = load_runup_scene(name, list(overrides))
+    housing, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
+    label = scene.scene.name + "".join(f"-{o.split('=', 1)[1]}" for o in overrides)
+    folder = results / label
+    extra = {"overrides": list(overrides), "housing": housing.model_dump(mode="json")}
+    reason = stale_reason(folder, scene, "runup.json", extra)
+    if reason:
+        compute({"kind": "run", "scene": str(path), "overrides": list(overrides)}, scene, folder, results,
+                f"housingfe run {name}" + "".join(f" --set {o}" for o in overrides), extra, reason)
+    with open(folder / "runup.json") as fh:
+        data = json.load(fh)
+    src = thesis_source("test_gearbox", "Ch. 5")
+    out = []
+    for c in data["checks"]:
+        ours, published = c["ours"], c["measured"]
+        note = "; ".join(x for x in (f"goal: {c['goal']}" if c["goal"] else "",
+                                     f"passed: {c['passed']}" if c["passed"] else "",
+                                     f"thesis calculated {c['thesis_calculated']}" if c["thesis_calculated"]
+                                     is not None else "", c["note"]) if x)
+        unit = "rpm" if c["check"] == "resonant_speeds" else "dB(A)" if c["check"] in (
+            "LwA_max", "speed_law", "torque_law") else "dB"
+        out.append(row(label, c["quantity"], ours, published, unit, src, note))
     return out
 
 

@@ -1,0 +1,62 @@
+"""Run-up scenes: bad input is one line naming the key, exit 2, no result folder (issue 14's list: an unknown
+gear set, a speed range outside what the source supports, a bearing that cannot carry the load at a torque, a
+missing drivetrain; plus an unknown route or radiator); the built-in scenes validate."""
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from housingfe.errors import InputError
+from housingfe.runup.scene import load_runup_scene
+
+HOUSINGFE = [sys.executable, "-m", "housingfe"]
+
+
+@pytest.mark.parametrize("name", ["test-gearbox-runup", "test-gearbox-runup-double-helical"])
+def test_builtin_scenes_validate(name):
+    scene, _ = load_runup_scene(name)
+    assert scene.runup.speeds[0] == 50.0 and scene.runup.speeds[-1] == 1500.0 and len(scene.runup.speeds) == 30
+    assert scene.drivetrain.gearbox == "test_gearbox"
+
+
+@pytest.mark.parametrize("override, key", [
+    ("drivetrain.gear_set=Z", "drivetrain.gear_set"),
+    ("runup.speed_max_rpm=3000.0", "runup.speed_max_rpm"),
+    ("runup.speed_min_rpm=10.0", "runup.speed_min_rpm"),
+    ('runup.routes=["tf_omega","shaker"]', "runup.routes"),
+    ('radiation.models=["erp","sonar"]', "radiation.models"),
+    ("runup.torques_nm=[-5.0]", "runup.torques_nm"),
+    ("runup.colour=1", "runup.colour"),
+])
+def test_bad_values_name_the_key(override, key):
+    with pytest.raises(InputError) as err:
+        load_runup_scene("test-gearbox-runup", [override])
+    assert f": {key}" in str(err.value)
+
+
+def test_missing_drivetrain_is_named(tmp_path):
+    text = (Path(__file__).parents[2] / "housingfe/scenes/test-gearbox-runup.toml").read_text()
+    start = text.index("[drivetrain]")
+    end = text.index("[runup]")
+    path = tmp_path / "no-drivetrain.toml"
+    path.write_text(text[:start] + text[end:])
+    with pytest.raises(InputError, match=r"no-drivetrain.toml: drivetrain: missing \[drivetrain\]: the routes "
+                                         r"tf_omega, mesh_force"):
+        load_runup_scene(str(path))
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--set", "drivetrain.gear_set=Z"], "drivetrain.gear_set: 'Z' is not a gear set"),
+    (["--set", "runup.speed_max_rpm=2000.0"], "outside the range the source supports"),
+    # single helical set A on cylindrical roller bearings: the axial tooth force has nothing to carry it
+    (["--set", "drivetrain.bearings=cylindrical_roller"], "cannot carry it"),
+])
+def test_cli_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
+    out = tmp_path / "out"
+    proc = subprocess.run(HOUSINGFE + ["run", "test-gearbox-runup", "--out", str(out), *args], capture_output=True,
+                          text=True, timeout=300)
+    assert proc.returncode == 2, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and words in lines[0] and "Traceback" not in proc.stderr, proc.stderr
+    assert not out.exists() and not list(tmp_path.glob(".out*"))
