@@ -143,6 +143,7 @@ class SceneResult:
     sampled: dict
     dofs: int
     seconds: float
+    f_max: float = 0.0
 
 
 def check_parameter_keys(spec: UpdateSpec) -> None:
@@ -171,7 +172,7 @@ def _present(data: dict, key: str) -> bool:
 class SceneEvaluator:
     """Builds and solves the spec's scenes for a parameter vector; caches by (values, overrides)."""
 
-    def __init__(self, spec: UpdateSpec, comm=None, log: Callable[[str], None] | None = None):
+    def __init__(self, spec: UpdateSpec, comm=None, log: Callable[[str], None] | None = None, isolate: bool = True):
         from mpi4py import MPI
 
         from housingfe.scenefile import read_scene_dict
@@ -181,6 +182,8 @@ class SceneEvaluator:
         self.log = log or (lambda s: None)
         self.cache: dict = {}
         self.seconds: list[float] = []
+        self.f_last: dict[str, float] = {}
+        self.isolate, self.pool = isolate, None
         scenes = sorted({t.scene for t in spec.targets})
         self.scene_data = {s: read_scene_dict(s)[0] for s in scenes}
         self.measured = {}
@@ -216,40 +219,71 @@ class SceneEvaluator:
         return n, f or 1000.0
 
     def solve(self, scene: str, values: np.ndarray, extra: list[str]) -> SceneResult:
-        from housingfe.scene import build_model_from_scene, load_housing_scene
-        from housingfe.solvers.modal import modes
-
+        """Modes (and mass, sampled shapes) of one scene at parameter values (physical units) with extra
+        overrides; cached.  On one rank the FE work runs in a worker process that is replaced every
+        WORKER_TASKS solves: building a model leaves ~50 MB per build behind in the process (measured on the
+        coarse box, gc.collect() does not return it), which a search of hundreds of builds cannot afford."""
         key = (scene, tuple(np.round(values, 12)), tuple(extra))
         if key in self.cache:
             return self.cache[key]
-        t0 = time.perf_counter()
-        sc, _ = load_housing_scene(scene, self.overrides(scene, values, extra))
-        model = build_model_from_scene(sc, self.comm)
-        n, f_max = self.f_needed(scene)
-        for _ in range(8):
-            basis = modes(model, f_max)
-            freqs = basis.frequencies_hz[basis.rigid_count:]
-            if len(freqs) >= n:
-                break
-            # modal density of plates is about constant: scale f_max to the count still missing
-            f_max *= min(3.0, max(1.2, 1.1 * (n + 2) / max(len(freqs), 1)))
-        else:
-            raise SolverError(f"{scene}: fewer than {n} elastic modes below {f_max:.0f} Hz")
-        from housingfe.correlation.points import computed_modes_at
+        n, f_guess = self.f_needed(scene)
+        f_max = max(f_guess, self.f_last.get(scene, 0.0))
+        need_mass = any(t.kind == "mass" and t.scene == scene for t in self.spec.targets)
+        measured = {t.name: self.measured[t.name] for t in self.spec.targets if t.kind == "paired" and t.scene == scene}
+        args = (scene, self.overrides(scene, values, extra), n, f_max, need_mass, measured)
+        if self.comm.size == 1 and self.isolate:
+            if self.pool is None:
+                from housingfe.correlation.worker import Worker
 
-        sampled = {t.name: computed_modes_at(basis, self.measured[t.name]) for t in self.spec.targets
-                   if t.kind == "paired" and t.scene == scene}
-        mass = None
-        if any(t.kind == "mass" and t.scene == scene for t in self.spec.targets):
-            t = model.rigid_body_vectors()[0]
-            y = t.duplicate()
-            model.M.mult(t, y)
-            mass = float(t.dot(y))
-        result = SceneResult(freqs, basis.rigid_count, mass, sampled, model.dofs, time.perf_counter() - t0)
-        del basis, model
+                self.pool = Worker(WORKER_TASKS)
+            result = self.pool.call("solve_scene", *args)
+        else:
+            result = solve_scene(*args, comm=self.comm)
+        self.f_last[scene] = result.f_max
         self.seconds.append(result.seconds)
         self.cache[key] = result
         return result
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.close()
+            self.pool = None
+
+
+WORKER_TASKS = 20
+
+
+def solve_scene(scene: str, overrides: list[str], n: int, f_max: float, need_mass: bool, measured: dict,
+                comm=None) -> SceneResult:
+    """Build a scene with overrides and solve at least n elastic modes (f_max raised until there are n);
+    the mass (kg) from the rigid x-translation t^T M t if need_mass; the modes sampled on the channels of
+    each measured ModeSet (name -> ModeSet)."""
+    from mpi4py import MPI
+
+    from housingfe.correlation.points import computed_modes_at
+    from housingfe.scene import build_model_from_scene, load_housing_scene
+    from housingfe.solvers.modal import modes
+
+    t0 = time.perf_counter()
+    sc, _ = load_housing_scene(scene, overrides)
+    model = build_model_from_scene(sc, comm or MPI.COMM_WORLD)
+    for _ in range(8):
+        basis = modes(model, f_max)
+        freqs = basis.frequencies_hz[basis.rigid_count:]
+        if len(freqs) >= n:
+            break
+        # modal density of plates is about constant: scale f_max to the count still missing
+        f_max *= min(3.0, max(1.2, 1.1 * (n + 2) / max(len(freqs), 1)))
+    else:
+        raise SolverError(f"{scene}: fewer than {n} elastic modes below {f_max:.0f} Hz")
+    sampled = {name: computed_modes_at(basis, m) for name, m in measured.items()}
+    mass = None
+    if need_mass:
+        t = model.rigid_body_vectors()[0]
+        y = t.duplicate()
+        model.M.mult(t, y)
+        mass = float(t.dot(y))
+    return SceneResult(freqs, basis.rigid_count, mass, sampled, model.dofs, time.perf_counter() - t0, f_max)
 
 
 def _nearest_pair(freqs: np.ndarray, pair: list[float]) -> tuple[float, float]:
@@ -467,8 +501,8 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
     """The whole study: targets before (start, confirmation mesh), a fit from every start point on the search
     mesh (with the mesh correction), a refit after refreshing the correction at the best point, targets after
     (confirmation mesh), identifiability (scaled Jacobian, parameter standard deviations, correlation).
-    Writes update.json, history.csv, targets.csv and convergence.png atomically into out_dir; returns the
-    summary dict."""
+    Writes update.json, history.csv, targets.csv and convergence.png atomically into out_dir (None: nothing
+    written); returns the summary dict."""
     from housingfe.outputs import atomic_output_dir, format_table, write_csv, write_json
 
     check_parameter_keys(spec)
@@ -499,6 +533,7 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
         best = fit(evaluator, best.values, correction=correction)
         echo("    refit -> cost {:.4g}: ".format(best.cost) + ", ".join(f"{n}={v:.5g}" for n, v in zip(names, best.values)))
     after = evaluate_targets(evaluator, best.values, spec.confirm_overrides, roles)
+    evaluator.close()
     cal = lambda tvs, role: float(sum(0.5 * float(tv.residuals @ tv.residuals) for tv in tvs if tv.role == role))
     summary = {
         "name": spec.name,
@@ -527,6 +562,8 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
     echo(f"cost calibration {summary['cost_before']['calibration']:.4g} -> {summary['cost_after']['calibration']:.4g}, "
          f"holdout {summary['cost_before']['holdout']:.4g} -> {summary['cost_after']['holdout']:.4g}; "
          f"{summary['scene_solves']} scene solves, median {summary['seconds_per_scene_solve_median']:.2f} s")
+    if out_dir is None:
+        return summary
     with atomic_output_dir(out_dir, evaluator.comm) as out:
         if evaluator.comm.rank == 0:
             write_json(out / "update.json", summary)
