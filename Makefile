@@ -9,8 +9,9 @@ export OPENBLAS_NUM_THREADS = 1
 bootstrap:
 	@bash scripts/bootstrap.sh
 
+# the main job: the Ch. 5 test gearbox's run-up, gear set -> L_WA over speed (about a minute)
 demo: bootstrap
-	$(VENV)/bin/housingfe run box-free --out results/box-free
+	$(VENV)/bin/housingfe run test-gearbox-runup --out results/test-gearbox-runup
 
 test: bootstrap
 	$(VENV)/bin/python -m pytest -q tests

@@ -59,10 +59,12 @@ class RitzReduction:
     extra_points: named SamplePoints whose normal displacement is kept (a radiator's facet points);
     static_vectors: more force patterns whose static residual responses join the Ritz space without being loads —
     where a re-analysis will change the stiffness (e.g. self-equilibrated unit pairs across each bearing: a bearing
-    stiffness change Delta K phi lies in their span, so the re-analysed modes stay accurate)."""
+    stiffness change Delta K phi lies in their span, so the re-analysed modes stay accurate); residual: False
+    keeps the modes only (no static vectors: the truncated modal superposition, for studies of what the modes
+    above the basis contribute)."""
 
     def __init__(self, basis, loads: dict, damping, *, surface: str = "outer", nodes=(),
-                 extra_points: dict | None = None, static_vectors=()):
+                 extra_points: dict | None = None, static_vectors=(), residual: bool = True):
         if not loads:
             raise InputError("loads: at least one load")
         t0 = time.perf_counter()
@@ -73,7 +75,9 @@ class RitzReduction:
             raise InputError("damping: per-material loss factors need the direct solver, not a Ritz reduction")
         self.names = list(loads)
         K_sym = structure.K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
-        self.vectors = harmonic.ritz_basis(K_sym, structure.M, basis, list(loads.values()) + list(static_vectors))
+        statics = list(loads.values()) + list(static_vectors) if residual else []
+        self.vectors = harmonic.ritz_basis(K_sym, structure.M, basis, statics)
+        self.loads = dict(loads)
         t1 = time.perf_counter()
         unit = [Load(name, vec) for name, vec in loads.items()]
         self.observer = StructureObserver(structure, surface, (), unit[:1], extra_points, nodes)
@@ -111,8 +115,17 @@ class RitzReduction:
         other = object.__new__(RitzReduction)
         other.__dict__.update(self.__dict__)
         other.structure = structure
+        other.loads = dict(loads)
         other.system = other._project(structure, loads)
         other.timings = {**self.timings, "reanalysis_s": time.perf_counter() - t0}
+        return other
+
+    def with_damping(self, damping) -> "RitzReduction":
+        """The same reduction with another damping (Damping or loss factor): only the small system changes."""
+        other = object.__new__(RitzReduction)
+        other.__dict__.update(self.__dict__)
+        other.damping = damping if isinstance(damping, harmonic.Damping) else loss_factor(damping)
+        other.system = other._project(self.structure, self.loads)
         return other
 
     @property

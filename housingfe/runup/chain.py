@@ -343,18 +343,26 @@ def runup(model: GearboxModel, source, speeds_rpm, torques_nm, *, routes=("tf_om
     return RunupResult(lines, results, L_sigma, L_W, L_S, list(model.radiators), totals, timings)
 
 
-def peak_contributions(model: GearboxModel, result: RunupResult, route: str, point: int, top: int = 3) -> list:
-    """The modes that make the tooth-harmonic line of operating point `point` (index into lines.points) on a route:
-    [(frequency Hz, share of <v^2>, interior energy share of the nearest basis mode)], largest first."""
+def peak_contributions(model: GearboxModel, result: RunupResult, route: str, point: int, top: int = 3) -> dict:
+    """Which modes make operating point `point` (index into lines.points) on a route: the harmonic whose line
+    carries the most A-weighted power (first radiator), and the modes with the largest shares of <v^2> on that
+    line: {"harmonic", "frequency_hz", "share_of_LwA", "modes": [(frequency Hz, share of <v^2>, interior energy
+    share of the nearest basis mode)]}.  Shares sum to 1 over all modes; a share above 1 is partly cancelled by
+    modes of negative share (out of phase)."""
     ln = result.lines
-    k = int(np.flatnonzero((ln.point == point) & (ln.harmonic == 1))[0])
+    idx = np.flatnonzero(ln.point == point)
+    rad = result.radiators[0]
+    lwa = result.L_W[route, rad][idx] + levels.a_weighting_db(ln.frequency[idx])
+    power = 10.0 ** (lwa / 10.0)
+    k = int(idx[np.argmax(lwa)])
     freqs, share = model.reduction.modal_contributions(ln.frequency[k], result.routes[route].coefficients[:, k])
     n = model.basis.rigid_count
     elastic = model.basis.frequencies_hz[n:]
     order = np.argsort(-share)[:top]
-    out = []
+    modes = []
     for i in order:
         j = int(np.argmin(np.abs(elastic - freqs[i]))) if len(elastic) else 0
-        out.append((float(freqs[i]), float(share[i]),
-                    float(model.interior_share[j]) if len(elastic) else float("nan")))
-    return out
+        modes.append((float(freqs[i]), float(share[i]),
+                      float(model.interior_share[j]) if len(elastic) else float("nan")))
+    return {"harmonic": int(ln.harmonic[k]), "frequency_hz": float(ln.frequency[k]),
+            "share_of_LwA": float(power.max() / power.sum()), "modes": modes}

@@ -104,10 +104,16 @@ def evaluate(scene, results: dict, gm) -> tuple[list[dict], list[dict]]:
                              "the thesis' reading of Fig. 5.10: 74/80/86/89 dB(A) at 250/500/1000/1500 rpm"))
         for peak in peaks(s, lwa):        # which modes make each L_WA peak (at its tooth frequency line)
             p = next(k for k, pt in enumerate(res.lines.points) if pt[0] == top and pt[1] == peak)
+            pc = peak_contributions(model, res, route, p)
             contributions.append({"route": route, "torque_nm": top, "speed_rpm": peak,
-                                  "tooth_frequency_hz": res.lines.points[p][2],
+                                  "tooth_frequency_hz": res.lines.points[p][2], "harmonic": pc["harmonic"],
+                                  "line_hz": pc["frequency_hz"], "line_share_of_LwA": pc["share_of_LwA"],
                                   "modes": [{"frequency_hz": f, "share": sh, "interior_share": si}
-                                            for f, sh, si in peak_contributions(model, res, route, p)]})
+                                            for f, sh, si in pc["modes"]]})
+            made_by = ", ".join(f"{f:.0f} Hz ({sh:.2f} of <v^2>, interior {si:.0%})" for f, sh, si in pc["modes"])
+            rows.append(_row("peak_modes", f"{route}: L_WA peak at {peak:g} rpm: harmonic {pc['harmonic']} "
+                             f"({pc['frequency_hz']:.0f} Hz, {pc['share_of_LwA']:.0%} of the L_WA) made by",
+                             made_by, None, None, "report"))
     if set_a:
         meas = tg["meas_L_omega_tooth_band_dB"]
         for speed in (500, 1000, 1500):
