@@ -126,7 +126,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_validate)
 
     p = sub.add_parser("bench", help="speed-against-error benchmarks (tables, CSV, PNG)")
-    p.add_argument("which", help="which benchmark: modal, frf, scenes, coupling, source, bearings, radiation")
+    from housingfe.benchmarks._dispatch import available
+
+    p.add_argument("which", help=f"which benchmark: {', '.join(available())}")
     p.add_argument("--out", default=None, help="result folder (default results/bench-<which>)")
     p.add_argument("--quick", action="store_true", help="small subset, for a smoke run")
     p.set_defaults(func=_cmd_bench)
