@@ -34,7 +34,8 @@ def load_scene(name_or_path: str) -> tuple[dict, Path]:
         raise InputError(f"{path}: scene.kind: {info.get('kind')!r} is not 'source' (run it with `housingfe run`)")
     source = scene.get("source")
     if not isinstance(source, dict):
-        raise InputError(f"{path}: source: missing [source] table")
+        raise InputError(f"{path}: source: missing [source] table (scene.kind = \"source\" is a gear source scene for "
+                         "`housingfe source`; a housing scene has kind = \"housing\")")
     model = source.get("model")
     if model not in MODELS:
         raise InputError(f"{path}: source.model: {model!r} is not one of {', '.join(MODELS)}")
