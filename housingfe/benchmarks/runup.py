@@ -65,13 +65,13 @@ def _setup(quick: bool):
 def end_to_end(scene, housing_scene, drivetrain, torque, comm) -> dict:
     """Section 1: every stage of the run-up timed on its own (s); returns the model, source, lines, result."""
     from housingfe.runup.chain import build_gearbox_model, runup, source_lines
-    from housingfe.runup.scene import _housing_model, _radiators
+    from housingfe.runup.scene import housing_model_for, radiators_of
 
     spec = scene.runup
     t_start = time.perf_counter()
     t0 = time.perf_counter()
-    housing_model = _housing_model(housing_scene, spec.f_max_hz, comm)
-    radiators = _radiators(scene.radiation, housing_model)
+    housing_model = housing_model_for(housing_scene, spec.f_max_hz, comm)
+    radiators = radiators_of(scene.radiation, housing_model)
     mesh_s = time.perf_counter() - t0
     mesh_split = dict(housing_model.timings)
     gm = build_gearbox_model(housing_model, drivetrain, spec.f_max_hz, damping_ratio=spec.damping_ratio,

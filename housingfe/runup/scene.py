@@ -200,8 +200,8 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         raise InputError(f"{path}: {exc}") from None
     timings = {}
     t0 = time.perf_counter()
-    model = _housing_model(housing_scene, spec.f_max_hz, comm)
-    radiators = _radiators(scene.radiation, model)
+    model = housing_model_for(housing_scene, spec.f_max_hz, comm)
+    radiators = radiators_of(scene.radiation, model)
     timings["mesh_s"] = time.perf_counter() - t0
     reference_torque = max(spec.torques_nm)
     gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
@@ -230,7 +230,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     return out
 
 
-def _housing_model(housing_scene, f_lines_max: float, comm):
+def housing_model_for(housing_scene, f_lines_max: float, comm):
     """The housing FE model, meshed for the highest line of the run-up (the scene's mesh rule at f_lines_max)."""
     from housingfe.fe.model import build_model
 
@@ -240,7 +240,8 @@ def _housing_model(housing_scene, f_lines_max: float, comm):
     return model
 
 
-def _radiators(spec: RunupRadiation, model) -> dict:
+def radiators_of(spec: RunupRadiation, model) -> dict:
+    """{name: Radiator} of a run-up scene's [radiation] on a housing model (its mesh and material)."""
     from housingfe.radiation.radiators import RADIATORS
 
     return {name: RADIATORS[name].from_spec(spec, model.housing, model.material) for name in spec.models}

@@ -80,7 +80,7 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
 
     from housingfe.response.reduced import RitzReduction
     from housingfe.runup.chain import build_gearbox_model, runup, source_lines, unit_loads, with_drivetrain
-    from housingfe.runup.scene import _housing_model, _radiators, drivetrain_of, load_runup_scene
+    from housingfe.runup.scene import drivetrain_of, housing_model_for, load_runup_scene, radiators_of
     from housingfe.scene import load_housing_scene
 
     t0 = time.perf_counter()
@@ -89,10 +89,10 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
     torque = max(spec.torques_nm)
     comm = MPI.COMM_WORLD
     housing_scene, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
-    model = _housing_model(housing_scene, spec.f_max_hz, comm)
+    model = housing_model_for(housing_scene, spec.f_max_hz, comm)
     dt = drivetrain_of(scene.drivetrain, torque)
     gm = build_gearbox_model(model, dt, spec.f_max_hz, damping_ratio=spec.damping_ratio,
-                             basis_factor=spec.basis_factor, radiators=_radiators(scene.radiation, model),
+                             basis_factor=spec.basis_factor, radiators=radiators_of(scene.radiation, model),
                              surface=spec.surface)
     lines, _ = source_lines(dt.source_model(harmonics=spec.harmonics), spec.speeds, [torque], spec.f_max_hz)
 

@@ -2,7 +2,15 @@
 import numpy as np
 import pytest
 
-from housingfe.correlation.uff import FRF, ModeSet, Nodes, read_mode_csv, read_measured_modes, read_uff, write_uff
+from housingfe.correlation.uff import (
+    FRF,
+    ModeSet,
+    Nodes,
+    read_measured_modes,
+    read_mode_csv,
+    read_uff,
+    write_uff,
+)
 from housingfe.errors import InputError
 
 

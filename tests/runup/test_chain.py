@@ -21,7 +21,7 @@ from housingfe.radiation.radiators import RADIATORS
 from housingfe.response.harmonic import Load, harmonic_response, loss_factor
 from housingfe.response.reduced import RitzReduction
 from housingfe.runup.chain import build_gearbox_model, runup, source_lines, unit_loads, with_drivetrain
-from housingfe.runup.scene import _housing_model
+from housingfe.runup.scene import housing_model_for
 from housingfe.scene import load_housing_scene
 from tests.test_cli import housingfe
 
@@ -48,7 +48,7 @@ def test_mesh_excitation_reproduces_the_lumped_response():
 @pytest.fixture(scope="module")
 def coarse(comm):
     hs, _ = load_housing_scene("test-gearbox", ["mesh.size=0.06"])
-    hm = _housing_model(hs, F_LINES, comm)
+    hm = housing_model_for(hs, F_LINES, comm)
     dt = test_gearbox("A")
     gm = build_gearbox_model(hm, dt, F_LINES, radiators={"erp": RADIATORS["erp"]()})
     src = dt.source_model()
