@@ -256,7 +256,93 @@ def solve_reduced(Kr, Mr, Cr, omega, eta, Fr) -> np.ndarray:
     return np.transpose(c, (2, 1, 0))
 
 # ----------------------------------------------------------------------------------------- direct
-def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None) -> HarmonicResult:
+def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None, *,
+           method: str = "auto") -> HarmonicResult:
+    """Direct solution per frequency (Hz) of (K_r + i K_i) u = f, K_r = K - omega^2 M, K_i = eta K (or the damping
+    matrix D) + omega C; all load cases per factor.
+
+    method: "complex" solves the n x n complex system in a worker process running the complex PETSc build
+    (housingfe.solvers._complex_worker: MUMPS LDL^T, ordering and symbolic factorisation done once for all lines);
+    "block" the real 2n x 2n block form in this process; "auto" (default): complex on one MPI rank when the complex
+    build is installed, block otherwise (the worker is a single process; the block form runs on every rank)."""
+    from housingfe.solvers import _complex_worker
+
+    if method not in ("auto", "complex", "block"):
+        raise ValueError(f"direct: unknown method {method!r}")
+    if method == "auto":
+        method = "complex" if K.getComm().getSize() == 1 and _complex_worker.available() else "block"
+    if method == "complex":
+        return _direct_complex(K, M, loads, frequencies, damping, reduce, C)
+    return _direct_block(K, M, loads, frequencies, damping, reduce, C)
+
+
+def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None) -> HarmonicResult:
+    """`direct` through the complex worker (one rank): solutions stream back line by line and are reduced at once."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+
+    from housingfe.solvers import _complex_worker
+
+    if K.getComm().getSize() != 1:
+        raise SolverError("direct solver: the complex worker runs on one MPI rank; use method='block' in parallel")
+    t0 = time.perf_counter()
+    frequencies = np.asarray(frequencies, dtype=float)
+    eta = np.asarray(damping.hysteretic(frequencies), dtype=float)
+    undamped = C is None and (damping.D is None or damping.modal_ratio is not None) and not np.any(eta)
+    use_D = damping.D is not None and damping.modal_ratio is None
+    symmetric = all(_is_symmetric(A) for A in (K, M, damping.D, C) if A is not None)
+    omega = 2 * math.pi * frequencies
+    if undamped:
+        for w, f_hz in zip(omega, frequencies):
+            _check_undamped_line(K, M, w * w, f_hz)
+    n = K.getSize()[0]
+    job = {"loads": np.array([load.vector.getArray() for load in loads], dtype=float).reshape(len(loads), n),
+           "omega": omega, "eta": np.broadcast_to(eta, omega.shape).copy(), "use_D": use_D, "symmetric": symmetric}
+    for name, A in (("K", K), ("M", M), ("D", damping.D if use_D else None), ("C", C)):
+        if A is not None:
+            indptr, indices, data = A.getValuesCSR()
+            job.update({f"{name}_indptr": indptr, f"{name}_indices": indices, f"{name}_data": np.real(data)})
+    blocks = [[] for _ in loads]
+    pair = np.array([[1.0], [1j]])
+    t_factor = 0.0
+    line_bytes = 8 + 16 * len(loads) * n
+    with tempfile.TemporaryDirectory(prefix="housingfe-direct-") as tmp:
+        np.savez(os.path.join(tmp, "job.npz"), **job)
+        with open(os.path.join(tmp, "stderr.txt"), "w+") as err:
+            proc = subprocess.Popen([sys.executable, "-m", "housingfe.solvers._complex_worker",
+                                     os.path.join(tmp, "job.npz")], stdout=subprocess.PIPE, stderr=err,
+                                    env=_complex_worker.complex_env())
+            try:
+                for k in range(len(frequencies)):
+                    raw = proc.stdout.read(line_bytes)
+                    if len(raw) < line_bytes:
+                        break
+                    t_factor += float(np.frombuffer(raw[:8], np.float64)[0])
+                    sol = np.frombuffer(raw[8:], np.complex128).reshape(len(loads), n)
+                    for j in range(len(loads)):
+                        ur, ui = K.createVecRight(), K.createVecRight()
+                        ur.setArray(sol[j].real)
+                        ui.setArray(sol[j].imag)
+                        blocks[j].append(Block(reduce([ur, ui]), pair, np.array([k])))
+            finally:
+                proc.stdout.close()
+                code = proc.wait()
+            err.seek(0)
+            message = err.read().strip()
+    if code == _complex_worker.SINGULAR_EXIT and message.startswith("SINGULAR"):
+        f_hz = frequencies[int(message.split()[1])]
+        raise SolverError(f"direct solver: singular system at {f_hz:.6g} Hz (undamped resonance?)")
+    if code != 0 or any(len(b) != len(frequencies) for b in blocks):
+        tail = " | ".join(message.splitlines()[-5:])
+        raise SolverError(f"direct solver: the complex worker failed (exit {code}): {tail}")
+    return HarmonicResult(frequencies, blocks, "direct",
+                          {"direct_s": time.perf_counter() - t0, "direct_factor_s": t_factor,
+                           "direct_s_per_frequency": (time.perf_counter() - t0) / max(len(frequencies), 1)})
+
+
+def _direct_block(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None) -> HarmonicResult:
     """Direct solution per frequency in the real 2x2 block form (MUMPS LDL^T), all load cases per factor."""
     t0 = time.perf_counter()
     eta = damping.hysteretic(frequencies)
