@@ -81,7 +81,6 @@ def _spec(scene, ema) -> UpdateSpec:
         max_evaluations=30)
 
 
-@pytest.mark.slow
 def test_synthetic_ema_is_paired_and_parameters_recovered(synthetic):
     scene, ema, truth, keep = synthetic
     evaluator = SceneEvaluator(_spec(scene, ema))
@@ -93,10 +92,14 @@ def test_synthetic_ema_is_paired_and_parameters_recovered(synthetic):
     assert min(p.mac for p in pairing.pairs) > 0.95
     result = fit(evaluator)
     E, h = result.values
+    print(f"recovered E = {E / 1e9:.2f} GPa (true {E_TRUE / 1e9:.0f}) +- {result.std[0] / 1e9:.2f}, h = {h * 1e3:.4f} mm "
+          f"(true {H_TRUE * 1e3:.1f}) +- {result.std[1] * 1e3:.4f}; {result.evaluations} evaluations, "
+          f"{result.seconds_per_evaluation:.2f} s each; {result.status}")
     assert E == pytest.approx(E_TRUE, rel=0.01)
     assert h == pytest.approx(H_TRUE, rel=0.01)
-    # the standard deviations from the Jacobian are small and cover the error within 3 sigma
-    assert result.std[0] < 0.01 * E_TRUE and result.std[1] < 0.01 * H_TRUE
+    # the standard deviations from the Jacobian (frequency sigma 0.5 %, mass 0.5 %) are a few per cent at most
+    # and cover the error within 3 sigma
+    assert result.std[0] < 0.02 * E_TRUE and result.std[1] < 0.02 * H_TRUE
     assert abs(E - E_TRUE) < 3 * result.std[0] + 1e-3 * E_TRUE
     after = evaluate_targets(evaluator, result.values, {})[0].model
     assert [(p.measured, p.computed) for p in after.pairs] == list(enumerate(keep))
@@ -114,16 +117,16 @@ def test_unknown_parameter_key_is_input_error(synthetic):
     assert "\n" not in str(exc.value)
 
 
-@pytest.mark.slow
 def test_cli_no_paired_modes_is_one_line_error(synthetic, tmp_path, capsys):
     from housingfe.cli import main
 
     scene, _, _, _ = synthetic
     rng = np.random.default_rng(3)
     rows = ["mode,frequency_hz,point,x,y,z,dx,dy,dz,value"]
-    for mode in (1, 2):          # two 'modes' measured at one point each: constant shapes, no plate mode
-        for p, (x, y) in enumerate(((0.1, 0.1), (0.3, 0.2))):
-            rows.append(f"{mode},{300.0 * mode},{p + 1},{x},{y},0.005,1,0,0,{rng.uniform(1, 2)}")
+    grid = [(x, y) for x in (0.03, 0.11, 0.2, 0.29, 0.37) for y in (0.03, 0.11, 0.19, 0.27)]
+    for mode in (1, 2):          # white-noise 'shapes' on 20 points: no smooth plate mode looks like them
+        for p, (x, y) in enumerate(grid):
+            rows.append(f"{mode},{300.0 * mode},{p + 1},{x},{y},0.005,0,0,1,{rng.standard_normal()}")
     (tmp_path / "bad.csv").write_text("\n".join(rows) + "\n")
     code = main(["correlate", str(scene), "--measured", str(tmp_path / "bad.csv"), "--out", str(tmp_path / "out")])
     err = capsys.readouterr().err.strip()
@@ -132,7 +135,6 @@ def test_cli_no_paired_modes_is_one_line_error(synthetic, tmp_path, capsys):
     assert not (tmp_path / "out").exists()
 
 
-@pytest.mark.slow
 def test_cli_correlate_and_export_round_trip(synthetic, tmp_path, capsys):
     """Our exported UFF read back as 'measured' correlates with the same model: every mode paired with
     itself at MAC ~ 1 and zero frequency error."""
