@@ -82,21 +82,22 @@ def correlate_measured(basis, measured, out_dir, threshold: float, loss_factor: 
     from housingfe.outputs import atomic_output_dir, write_csv
 
     comm = MPI.COMM_WORLD
+    say = print if comm.rank == 0 else (lambda *a, **k: None)
     comp = computed_modes_at(basis, measured)
     m = mac(measured.shapes, comp.shapes)
     pairing = pair_modes(m, measured.frequencies_hz, comp.frequencies_hz, threshold, frequency_weight=0.5)
     if not pairing.pairs:
         raise InputError(f"{source}: no measured mode pairs with a computed one at MAC >= {threshold:g} "
                          f"(best MAC {m.max():.2f}); check units, coordinates and directions of the channels")
-    print(pairing.format())
-    print(f"channels: {len(measured.node_ids)} (snapping distance max {np.max(np.linalg.norm(comp.points - measured.points, axis=1)) * 1e3:.2f} mm)")
+    say(pairing.format())
+    say(f"channels: {len(measured.node_ids)} (snapping distance max {np.max(np.linalg.norm(comp.points - measured.points, axis=1)) * 1e3:.2f} mm)")
     frf_rows = []
     if Path(source).suffix.lower() != ".csv":
         data = uff.read_uff(source)
         if data.frfs and data.nodes is not None:
             frf_rows = _frf_correlation(basis, data, loss_factor, frac)
             for row in frf_rows:
-                print(f"FRF {row[0]}:{row[1]} / {row[2]}:{row[3]}  FRAC {row[4]:.3f}")
+                say(f"FRF {row[0]}:{row[1]} / {row[2]}:{row[3]}  FRAC {row[4]:.3f}")
     with atomic_output_dir(out_dir, comm) as out:
         if comm.rank == 0:
             write_csv(out / "pairs.csv", ["measured", "f_measured_hz", "computed", "f_computed_hz", "error_percent",
@@ -110,7 +111,7 @@ def correlate_measured(basis, measured, out_dir, threshold: float, loss_factor: 
             if frf_rows:
                 write_csv(out / "frf.csv", ["response_node", "response_dir", "reference_node", "reference_dir", "frac"],
                           frf_rows)
-    print(f"written {out_dir}")
+    say(f"written {out_dir}")
 
 
 def _nodes_of(measured, comp):
@@ -172,4 +173,4 @@ def export_uff(basis, path: str, count: int, loss_factor: float) -> None:
 
     if MPI.COMM_WORLD.rank == 0:
         uff.write_uff(path, uff.Nodes(ids, samples.points), modes, frfs)
-    print(f"written {path}: {n} nodes, {modes.n_modes} modes up to {basis.f_max:g} Hz, {len(frfs)} FRFs (m/N)")
+        print(f"written {path}: {n} nodes, {modes.n_modes} modes up to {basis.f_max:g} Hz, {len(frfs)} FRFs (m/N)")
