@@ -81,6 +81,10 @@ class TargetSpec(_Strict):
             raise ValueError("value: a close_pair target gives two frequencies [f1, f2] (Hz)")
         if self.kind in ("mass", "frequency", "count") and isinstance(self.value, list):
             raise ValueError(f"value: one number for a {self.kind} target")
+        if self.kind in ("mass", "frequency") and not self.value > 0:
+            raise ValueError(f"value: a {self.kind} must be positive")
+        if self.kind == "count" and not (self.value >= 1 and float(self.value).is_integer()):
+            raise ValueError("value: a mode count is a whole number >= 1")
         return self
 
 

@@ -25,6 +25,8 @@ value = 24.5
     (lambda s: s.replace("start = 0.2", "start = 0.5"), "parameters.0.start: must lie within [lower, upper]"),
     (lambda s: s.replace('kind = "mass"', 'kind = "count"'), "targets.0.band_hz: required for a count target"),
     (lambda s: s + "colour = 1\n", "colour: unknown key"),
+    (lambda s: s.replace('kind = "mass"', 'kind = "count"\nband_hz = 4000.0').replace("value = 24.5", "value = 0"),
+     "targets.0.value: a mode count is a whole number >= 1"),
     (lambda s: s.replace('scene = "box-free"', 'scene = "no-such-scene"'), "no-such-scene: no such scene"),
 ])
 def test_update_bad_spec_is_one_line(tmp_path, capsys, edit, message):
