@@ -298,39 +298,57 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None) 
         for w, f_hz in zip(omega, frequencies):
             _check_undamped_line(K, M, w * w, f_hz)
     n = K.getSize()[0]
+    tmp = tempfile.TemporaryDirectory(prefix="housingfe-direct-")
+    err = open(os.path.join(tmp.name, "stderr.txt"), "w+")
+    # started first: its imports (~0.5 s) overlap with writing the job
+    proc = subprocess.Popen([sys.executable, "-m", "housingfe.solvers._complex_worker", "-"], stdin=subprocess.PIPE,
+                            stdout=subprocess.PIPE, stderr=err, env=_complex_worker.complex_env())
     job = {"loads": np.array([load.vector.getArray() for load in loads], dtype=float).reshape(len(loads), n),
            "omega": omega, "eta": np.broadcast_to(eta, omega.shape).copy(), "use_D": use_D, "symmetric": symmetric}
-    for name, A in (("K", K), ("M", M), ("D", damping.D if use_D else None), ("C", C)):
-        if A is not None:
-            indptr, indices, data = A.getValuesCSR()
-            job.update({f"{name}_indptr": indptr, f"{name}_indices": indices, f"{name}_data": np.real(data)})
     blocks = [[] for _ in loads]
     pair = np.array([[1.0], [1j]])
     t_factor = 0.0
-    line_bytes = 8 + 16 * len(loads) * n
-    with tempfile.TemporaryDirectory(prefix="housingfe-direct-") as tmp:
-        np.savez(os.path.join(tmp, "job.npz"), **job)
-        with open(os.path.join(tmp, "stderr.txt"), "w+") as err:
-            proc = subprocess.Popen([sys.executable, "-m", "housingfe.solvers._complex_worker",
-                                     os.path.join(tmp, "job.npz")], stdout=subprocess.PIPE, stderr=err,
-                                    env=_complex_worker.complex_env())
-            try:
-                for k in range(len(frequencies)):
-                    raw = proc.stdout.read(line_bytes)
-                    if len(raw) < line_bytes:
-                        break
-                    t_factor += float(np.frombuffer(raw[:8], np.float64)[0])
-                    sol = np.frombuffer(raw[8:], np.complex128).reshape(len(loads), n)
-                    for j in range(len(loads)):
-                        ur, ui = K.createVecRight(), K.createVecRight()
-                        ur.setArray(sol[j].real)
-                        ui.setArray(sol[j].imag)
-                        blocks[j].append(Block(reduce([ur, ui]), pair, np.array([k])))
-            finally:
-                proc.stdout.close()
-                code = proc.wait()
-            err.seek(0)
-            message = err.read().strip()
+    line_bytes = 16 + 16 * len(loads) * n
+    factorisations = 0
+    try:
+        K_pattern = None
+        for name, A in (("K", K), ("M", M), ("D", damping.D if use_D else None), ("C", C)):
+            if A is not None:
+                indptr, indices, data = A.getValuesCSR()
+                job[f"{name}_data"] = np.real(data)
+                if K_pattern is None:
+                    K_pattern = (indptr, indices)
+                if name == "K" or not (np.array_equal(indptr, K_pattern[0]) and np.array_equal(indices, K_pattern[1])):
+                    job.update({f"{name}_indptr": indptr, f"{name}_indices": indices})
+        np.savez(os.path.join(tmp.name, "job.npz"), **job)
+        del job
+        try:
+            proc.stdin.write((os.path.join(tmp.name, "job.npz") + "\n").encode())
+            proc.stdin.close()
+        except BrokenPipeError:   # the worker died at start: its stderr is reported below
+            pass
+        for k in range(len(frequencies)):
+            raw = proc.stdout.read(line_bytes)
+            if len(raw) < line_bytes:
+                break
+            head = np.frombuffer(raw[:16], np.float64)
+            t_factor += float(head[0])
+            factorisations += int(head[1])
+            sol = np.frombuffer(raw[16:], np.complex128).reshape(len(loads), n)
+            for j in range(len(loads)):
+                ur, ui = K.createVecRight(), K.createVecRight()
+                ur.setArray(sol[j].real)
+                ui.setArray(sol[j].imag)
+                blocks[j].append(Block(reduce([ur, ui]), pair, np.array([k])))
+    finally:
+        if proc.poll() is None and any(len(b) != len(frequencies) for b in blocks):
+            proc.kill()   # an exception here (in reduce, say): do not leave the worker running
+        proc.stdout.close()
+        code = proc.wait()
+        err.seek(0)
+        message = err.read().strip()
+        err.close()
+        tmp.cleanup()
     if code == _complex_worker.SINGULAR_EXIT and message.startswith("SINGULAR"):
         f_hz = frequencies[int(message.split()[1])]
         raise SolverError(f"direct solver: singular system at {f_hz:.6g} Hz (undamped resonance?)")
@@ -339,6 +357,7 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None) 
         raise SolverError(f"direct solver: the complex worker failed (exit {code}): {tail}")
     return HarmonicResult(frequencies, blocks, "direct",
                           {"direct_s": time.perf_counter() - t0, "direct_factor_s": t_factor,
+                           "direct_factorisations": factorisations,
                            "direct_s_per_frequency": (time.perf_counter() - t0) / max(len(frequencies), 1)})
 
 
