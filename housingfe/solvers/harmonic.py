@@ -5,10 +5,11 @@ coefficients c(omega), u(omega) = Psi c(omega).  The vectors go through a `reduc
 Gram matrix, point values, load projections: see housingfe.response.observers) as soon as they exist, so a long
 direct sweep never keeps its solution vectors.
 
-* direct: one sparse factorisation per frequency, in the real 2x2 block form
-  [[K_r, K_i], [K_i, -K_r]] [u_r; -u_i] = [f_r; f_i] with K_r = K - omega^2 M, K_i = eta K + omega C,
-  a symmetric indefinite system factorised by MUMPS (LDL^T).  It runs in the same real-PETSc process as
-  everything else (a complex PETSc build would need its own process, see docs/forced-response.md).
+* direct: one sparse factorisation per frequency of (K_r + i K_i), K_r = K - omega^2 M, K_i = eta K + omega C.
+  On one rank (default) the n x n complex system is factorised by MUMPS (LDL^T) in a worker process running
+  the complex PETSc build (housingfe.solvers._complex_worker), the ordering and symbolic analysis done once for
+  all lines.  Otherwise (method="block", several ranks) the real 2x2 block form
+  [[K_r, K_i], [K_i, -K_r]] [u_r; -u_i] = [f_r; f_i], a symmetric indefinite 2n x 2n system, in this process.
 * modal: superposition of the modes up to `basis_factor * f_max`, the rigid-body modes, and the
   residual flexibility of all modes left out.  For a free-free structure K is singular, so the residual
   uses the inertia-relief form: r = (K - s M)^-1 P f - sum_basis phi_n phi_n^T f / (omega_n^2 - s), with

@@ -97,9 +97,8 @@ def test_undamped_eigenfrequency_is_singular(plate):
         harmonic.direct(model.K, model.M, loads, f_hit, undamped, lambda v: v, method="complex")
 
 
-def test_a_dense_sweep_reuses_factorisations_and_still_equals_block_form(plate):
-    """Lines 5 Hz apart: most are solved by GMRES on a nearby line's factor; the answers stay those of the block
-    form to 1e-9."""
+def test_a_dense_sweep_equals_block_form(plate):
+    """Twenty lines 5 Hz apart on one symbolic factorisation: the answers stay those of the block form to 1e-9."""
     model, loads = plate
     freqs = np.arange(1300.0, 1400.0, 5.0)
     damping = harmonic.Damping(lambda f: np.full(np.shape(f), 0.02))
@@ -108,4 +107,4 @@ def test_a_dense_sweep_reuses_factorisations_and_still_equals_block_form(plate):
     old = harmonic.direct(model.K, model.M, loads, freqs, damping, copies, method="block")
     u_new, u_old = _solutions(new), _solutions(old)
     assert np.max(np.abs(u_new - u_old) / np.abs(u_old).max(axis=2, keepdims=True)) < 1e-9
-    assert new.timings["direct_factorisations"] < len(freqs) / 2
+    assert new.timings["direct_factorisations"] == len(freqs)
