@@ -1,0 +1,241 @@
+"""`housingfe bench all`: run every benchmark and regenerate docs/benchmarks.md in one command.
+
+Each benchmark (`housingfe bench <name>`) runs in its own process, one after the other, into
+<out>/<name>/ (default results/bench-all/<name>/); its wall time, peak resident memory (the child's own
+getrusage, so benchmarks do not inherit each other's memory) and the load average before and after are recorded.
+The page is generated: a header with the machine, load and versions, a summary table, then per benchmark every
+CSV it wrote rendered as a table and every PNG it drew, followed by the hand-written analysis of that benchmark from
+docs/benchmarks-notes.md (blocks introduced by `<!-- notes: <name> -->`; text before the first marker goes below
+the header).  Regeneration therefore never deletes analysis.  The page and its pictures are written atomically.
+
+--quick runs every benchmark's quick mode (a smoke test, minutes) and writes the page to <out>/benchmarks.md,
+never to docs/ (quick numbers are not the documented ones).  A full run with a failed benchmark also leaves docs/
+alone and writes <out>/benchmarks.md.
+"""
+from __future__ import annotations
+
+import csv
+import datetime
+import os
+import platform
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from housingfe.errors import SolverError
+
+# Page order; any other benchmark module found is appended after these.
+ORDER = ["modal", "frf", "scenes", "source", "bearings", "radiation", "coupling", "runup"]
+MAX_ROWS = 40           # a longer CSV shows its first rows and says how many more the file holds
+NOTES_MARK = re.compile(r"^<!--\s*notes:\s*([\w-]+)\s*-->\s*$", re.MULTILINE)
+
+
+def benchmarks() -> list[str]:
+    """The benchmarks `bench all` runs, in page order."""
+    from housingfe.benchmarks._dispatch import available
+
+    names = [n for n in available() if n != "all"]
+    return [n for n in ORDER if n in names] + [n for n in names if n not in ORDER]
+
+
+# ------------------------------------------------------------------------------------------------ running
+def run_benchmark(name: str, out_dir: Path, quick: bool, timeout_s: float | None = None) -> dict:
+    """Run `housingfe bench <name>` in a child process; wall time (s), peak RSS (GB), load averages, exit status."""
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    code = ("import sys; from housingfe.benchmarks._dispatch import main; "
+            "main(sys.argv[1], sys.argv[2], sys.argv[3] == '1')")
+    load_before = os.getloadavg()
+    t0 = time.perf_counter()
+    log = out_dir.parent / f"{name}.log"
+    with open(log, "w") as fh:
+        proc = subprocess.Popen([sys.executable, "-c", code, name, str(out_dir), "1" if quick else "0"],
+                                stdout=fh, stderr=subprocess.STDOUT)
+        try:
+            _, status, usage = os.wait4(proc.pid, 0)   # this child's own rusage (ru_maxrss in KiB on Linux)
+        except KeyboardInterrupt:
+            proc.kill()
+            raise
+        proc.returncode = os.waitstatus_to_exitcode(status)
+    wall = time.perf_counter() - t0
+    tail = log.read_text(errors="replace").strip().splitlines()[-1:] if proc.returncode else []
+    return {"name": name, "exit": proc.returncode, "wall_s": wall, "peak_gb": usage.ru_maxrss / 1024**2,
+            "load_before": load_before[0], "load_after": os.getloadavg()[0], "log": log,
+            "error": tail[0] if tail else ""}
+
+
+def machine_info() -> dict:
+    """Machine, date and versions recorded at the top of the page."""
+    info = {"date (UTC)": datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M"),
+            "machine": platform.machine(), "cores": str(os.cpu_count()), "os": platform.platform(),
+            "python": platform.python_version()}
+    try:
+        cpu = [ln.split(":", 1)[1].strip() for ln in Path("/proc/cpuinfo").read_text().splitlines()
+               if ln.startswith("model name")]
+        info["cpu"] = cpu[0] if cpu else "?"
+        mem = [ln.split()[1] for ln in Path("/proc/meminfo").read_text().splitlines() if ln.startswith("MemTotal")]
+        info["memory"] = f"{int(mem[0]) / 1024**2:.1f} GB"
+    except (OSError, IndexError, ValueError):
+        pass
+    import housingfe
+
+    info["housingfe"] = housingfe.__version__
+    try:
+        info["git"] = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                                     cwd=Path(__file__).parent, check=False).stdout.strip() or "?"
+    except OSError:
+        info["git"] = "?"
+    for module, attr in (("numpy", "__version__"), ("scipy", "__version__"), ("dolfinx", "__version__"),
+                         ("gmsh", "__version__")):
+        try:
+            info[module] = getattr(__import__(module), attr)
+        except Exception:   # noqa: BLE001 - a missing optional package is recorded, not fatal
+            info[module] = "not importable"
+    try:
+        from petsc4py import PETSc
+        from slepc4py import SLEPc
+
+        info["PETSc"] = ".".join(map(str, PETSc.Sys.getVersion()))
+        info["SLEPc"] = ".".join(map(str, SLEPc.Sys.getVersion()))
+    except Exception:   # noqa: BLE001
+        pass
+    ccx = shutil.which("ccx")
+    info["CalculiX"] = ccx or "not installed"
+    info["OPENBLAS_NUM_THREADS"] = os.environ.get("OPENBLAS_NUM_THREADS", "unset")
+    return info
+
+
+# ------------------------------------------------------------------------------------------------ the page
+def _cell(text: str) -> str:
+    """A CSV field as a Markdown table cell: floats to 4 significant digits, pipes escaped."""
+    try:
+        value = float(text)
+        if not text.strip().lstrip("-").isdigit() and value == value and abs(value) != float("inf"):
+            text = f"{value:.4g}"
+    except ValueError:
+        pass
+    return text.replace("|", "\\|").replace("\n", " ")
+
+
+def csv_table(path: Path, max_rows: int = MAX_ROWS) -> str:
+    """A CSV file (header line + rows) as a Markdown table."""
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows:
+        return f"*{path.name}: empty*\n"
+    header, body = rows[0], rows[1:]
+    lines = ["| " + " | ".join(_cell(h) for h in header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(_cell(c) for c in row) + " |" for row in body[:max_rows]]
+    if len(body) > max_rows:
+        lines.append(f"\n… {len(body) - max_rows} more rows in `{path.name}`")
+    return "\n".join(lines) + "\n"
+
+
+def split_notes(text: str) -> tuple[str, dict]:
+    """(preamble, {benchmark: notes}) of docs/benchmarks-notes.md: blocks start at `<!-- notes: name -->`."""
+    marks = list(NOTES_MARK.finditer(text))
+    preamble = text[:marks[0].start()] if marks else text
+    blocks = {}
+    for m, nxt in zip(marks, marks[1:] + [None]):
+        blocks[m.group(1)] = text[m.end():nxt.start() if nxt else len(text)].strip()
+    return preamble.strip(), blocks
+
+
+def render_page(results: list[dict], info: dict, notes: str, quick: bool) -> str:
+    """The Markdown page: header, summary, then per benchmark its tables ("csvs": paths), pictures ("images":
+    links relative to the page) and notes."""
+    preamble, blocks = split_notes(notes)
+    loads = [r["load_before"] for r in results] + [r["load_after"] for r in results]
+    out = ["# Benchmarks: speed next to error", "",
+           "<!-- generated by `housingfe bench all` from the benchmarks' CSV files; edit the analysis in "
+           "docs/benchmarks-notes.md, not here -->", "",
+           f"Generated by `housingfe bench all{' --quick' if quick else ''}` on {info.get('date (UTC)', '?')} UTC"
+           + (" — **quick mode: a smoke test, not the documented numbers**" if quick else "") + ".",
+           (f"Load average (1 min) during the runs: {min(loads):.2f} – {max(loads):.2f} on {info.get('cores', '?')} "
+            "cores" if loads else "No benchmark ran.")
+           + " — timings taken on a shared machine are pessimistic; ratios of two codes count only where the "
+             "benchmark interleaves them.", "",
+           "| machine and versions | |", "|---|---|"]
+    out += [f"| {k} | {_cell(str(v))} |" for k, v in info.items()]
+    out += ["", "| benchmark | status | wall s | peak memory GB | load before | load after |", "|---|---|---|---|---|---|"]
+    for r in results:
+        status = "ok" if r["exit"] == 0 else f"**failed** (exit {r['exit']}): {_cell(r.get('error', ''))}"
+        out.append(f"| [{r['name']}](#housingfe-bench-{r['name']}) | {status} | {r['wall_s']:.1f} | "
+                   f"{r['peak_gb']:.2f} | {r['load_before']:.2f} | {r['load_after']:.2f} |")
+    if preamble:
+        out += ["", preamble]
+    for r in results:
+        out += ["", f"## housingfe bench {r['name']}", ""]
+        for path in r.get("csvs", []):
+            out += [f"`{Path(path).name}`", "", csv_table(Path(path))]
+        for link in r.get("images", []):
+            out += [f"![{r['name']}]({link})", ""]
+        if r["name"] in blocks:
+            out += [blocks[r["name"]], ""]
+    rest = [n for n in blocks if n not in {r["name"] for r in results}]
+    for name in rest:      # notes of a benchmark that did not run this time are kept, not dropped
+        out += ["", f"## {name} (notes only: not run this time)", "", blocks[name], ""]
+    return "\n".join(out).rstrip() + "\n"
+
+
+def write_atomic(path: Path, data: bytes | str) -> None:
+    """Write a file through a temporary file in the same folder and a rename."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
+    tmp.write_bytes(data.encode() if isinstance(data, str) else data)
+    os.replace(tmp, path)
+
+
+def publish(results: list[dict], info: dict, notes_path: Path, page: Path, images_dir: Path | None,
+            quick: bool) -> Path:
+    """Collect each benchmark's CSVs and PNGs (from r["out"]) and write the page.  images_dir: where the PNGs are
+    copied (docs/img/bench), None to link them where they are."""
+    for r in results:
+        folder = Path(r["out"])
+        r["csvs"] = sorted(folder.glob("*.csv")) if folder.is_dir() else []
+        r["images"] = []
+        for png in sorted(folder.glob("*.png")) if folder.is_dir() else []:
+            if images_dir is None:
+                r["images"].append(os.path.relpath(png, page.parent))
+            else:
+                target = images_dir / f"{r['name']}-{png.name}"
+                write_atomic(target, png.read_bytes())
+                r["images"].append(os.path.relpath(target, page.parent))
+    notes = notes_path.read_text() if notes_path.is_file() else ""
+    write_atomic(page, render_page(results, info, notes, quick))
+    return page
+
+
+def docs_dir() -> Path:
+    """docs/ of the source checkout (this file is housingfe/benchmarks/all.py), else ./docs."""
+    here = Path(__file__).resolve().parents[2] / "docs"
+    return here if here.is_dir() else Path("docs")
+
+
+def main(out_dir: Path, quick: bool = False) -> None:
+    """Run every benchmark (quick modes with `quick`) into out_dir/<name>/ and write the page (see module doc)."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    docs = docs_dir()
+    results = []
+    for name in benchmarks():
+        print(f"bench all: {name} ({'quick' if quick else 'full'}) …", flush=True)
+        r = run_benchmark(name, out_dir / name, quick)
+        r["out"] = out_dir / name
+        print(f"bench all: {name}: {'ok' if r['exit'] == 0 else 'FAILED, see ' + str(r.get('log', out_dir))} "
+              f"{r['wall_s']:.1f} s, {r['peak_gb']:.2f} GB, load {r['load_before']:.2f} -> {r['load_after']:.2f}",
+              flush=True)
+        results.append(r)
+    failed = [r["name"] for r in results if r["exit"] != 0]
+    info = machine_info()
+    if quick or failed:
+        page = publish(results, info, docs / "benchmarks-notes.md", out_dir / "benchmarks.md", None, quick)
+    else:
+        page = publish(results, info, docs / "benchmarks-notes.md", docs / "benchmarks.md", docs / "img" / "bench",
+                       quick)
+    print(f"bench all: page written to {page}")
+    if failed:
+        raise SolverError(f"bench all: {len(failed)} benchmark(s) failed ({', '.join(failed)}); logs in {out_dir}; "
+                          "docs/benchmarks.md left unchanged")

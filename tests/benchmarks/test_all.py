@@ -1,0 +1,90 @@
+"""`housingfe bench all` page generation from small fake CSVs (no benchmark runs, no timings): tables, pictures,
+hand-written notes kept and placed, quick and failed runs never touching docs/."""
+import pytest
+
+from housingfe.benchmarks import all as bench_all
+from housingfe.errors import SolverError
+
+NOTES = """<!-- comment: the notes file's own explanation -->
+Intro written by hand.
+
+<!-- notes: modal -->
+Modal analysis: Q3 wins.
+
+<!-- notes: retired -->
+Notes of a benchmark that no longer runs.
+"""
+INFO = {"date (UTC)": "2026-11-23 22:00", "cores": "2", "PETSc": "3.18.5"}
+
+
+def _fake(tmp_path, name, rows, png=True):
+    folder = tmp_path / "results" / name
+    folder.mkdir(parents=True)
+    (folder / f"{name}.csv").write_text("case,dofs,wall_s,max_err_pct\n" + "".join(rows))
+    if png:
+        (folder / f"{name}.png").write_bytes(b"\x89PNG fake")
+    return folder
+
+
+def _result(name, folder, exit_code=0):
+    return {"name": name, "out": folder, "exit": exit_code, "wall_s": 12.345, "peak_gb": 0.5,
+            "load_before": 1.5, "load_after": 2.25, "error": "boom" if exit_code else ""}
+
+
+def test_page_has_every_table_picture_and_note_in_place(tmp_path):
+    modal = _fake(tmp_path, "modal", ["Q2 hex 23.4 mm,38997,10.912345,2.5912345\n", "Q3 hex|40,44256,16.9,1.07\n"])
+    frf = _fake(tmp_path, "frf", [f"line{i},1,{i}.5,0\n" for i in range(bench_all.MAX_ROWS + 5)], png=False)
+    notes = tmp_path / "notes.md"
+    notes.write_text(NOTES)
+    page = tmp_path / "docs" / "benchmarks.md"
+    bench_all.publish([_result("modal", modal), _result("frf", frf)], INFO, notes, page, tmp_path / "docs" / "img",
+                      quick=False)
+    text = page.read_text()
+    assert "| Q2 hex 23.4 mm | 38997 | 10.91 | 2.591 |" in text          # floats to 4 digits, integers kept
+    assert "Q3 hex\\|40" in text                                         # a pipe in a cell does not split it
+    assert "… 5 more rows in `frf.csv`" in text and "| line39 |" in text and "| line40 |" not in text
+    assert (tmp_path / "docs" / "img" / "modal-modal.png").read_bytes() == b"\x89PNG fake"
+    assert "![modal](img/modal-modal.png)" in text
+    assert "| PETSc | 3.18.5 |" in text and "Load average (1 min) during the runs: 1.50 – 2.25 on 2 cores" in text
+    # notes: intro below the header, each block after its own benchmark's table, a retired one kept
+    i_intro, i_modal_table = text.index("Intro written by hand."), text.index("| Q2 hex 23.4 mm")
+    i_modal_note, i_frf = text.index("Modal analysis: Q3 wins."), text.index("## housingfe bench frf")
+    assert i_intro < i_modal_table < i_modal_note < i_frf
+    assert "Notes of a benchmark that no longer runs." in text
+    assert not list(page.parent.glob(".*tmp*"))                          # atomic write left no temporary file
+
+
+def test_quick_and_failed_runs_leave_the_docs_alone(tmp_path, monkeypatch):
+    docs = tmp_path / "docs"
+    docs.mkdir()
+    (docs / "benchmarks.md").write_text("documented page")
+    (docs / "benchmarks-notes.md").write_text(NOTES)
+    monkeypatch.setattr(bench_all, "docs_dir", lambda: docs)
+    monkeypatch.setattr(bench_all, "benchmarks", lambda: ["modal", "frf"])
+    monkeypatch.setattr(bench_all, "machine_info", lambda: dict(INFO))
+    fail = set()
+
+    def fake_run(name, out_dir, quick):
+        out_dir.mkdir(parents=True, exist_ok=True)
+        (out_dir / f"{name}.csv").write_text(f"case,quick\n{name},{quick}\n")
+        return _result(name, out_dir, 1 if name in fail else 0)
+
+    monkeypatch.setattr(bench_all, "run_benchmark", fake_run)
+    bench_all.main(tmp_path / "out", quick=True)
+    assert (docs / "benchmarks.md").read_text() == "documented page"
+    quick_page = (tmp_path / "out" / "benchmarks.md").read_text()
+    assert "quick mode" in quick_page and "| modal | True |" in quick_page
+    fail.add("frf")
+    with pytest.raises(SolverError, match="frf"):
+        bench_all.main(tmp_path / "out2", quick=False)
+    assert (docs / "benchmarks.md").read_text() == "documented page"
+    assert "**failed** (exit 1): boom" in (tmp_path / "out2" / "benchmarks.md").read_text()
+    fail.clear()
+    bench_all.main(tmp_path / "out3", quick=False)
+    full = (docs / "benchmarks.md").read_text()
+    assert "| modal | False |" in full and "Modal analysis: Q3 wins." in full
+
+
+def test_bench_all_runs_every_other_benchmark_once():
+    names = bench_all.benchmarks()
+    assert "all" not in names and names[:2] == ["modal", "frf"] and len(set(names)) == len(names)
