@@ -109,10 +109,21 @@ def run(job_path: str | None, out) -> int:
     ksp.setOptionsPrefix("direct_")   # -direct_mat_mumps_icntl_* through PETSC_OPTIONS reach the worker
     ksp.setFromOptions()
     b, x = A.createVecs()
+    values = np.empty(len(indices), complex)
+    work = np.empty(len(indices))
     for k, (w, eta) in enumerate(zip(job["omega"], job["eta"])):
-        values = data["K"] + 1j * (data["D"] if use_D else eta * data["K"]) - w * w * data["M"]
+        # values = K + i (D or eta K) + i omega C - omega^2 M, in place (5 M entries at 39 k DOFs: temporaries cost)
+        np.multiply(data["M"], -w * w, out=work)
+        work += data["K"]
+        values.real = work
+        if use_D:
+            values.imag = data["D"]
+        else:
+            np.multiply(data["K"], eta, out=work)
+            values.imag = work
         if "C" in data:
-            values = values + 1j * w * data["C"]
+            np.multiply(data["C"], w, out=work)
+            values.imag += work
         A.setValuesCSR(indptr, indices, values)   # same pattern: the symbolic factorisation is kept
         A.assemble()
         ksp.setOperators(A)   # marks the operator changed: setUp redoes the numerical factorisation only
