@@ -15,7 +15,8 @@ the scenes' own meshes (ratios at the start and at the answer), and the answer i
     .venv/bin/python examples/correlate_box.py [--small] [--out DIR]
 
 --small fits the height alone to mass and first mode on coarse meshes (about a minute); the full study is
-`housingfe update examples/correlate_box.toml` (about 20 minutes on one core; docs/correlation.md).
+`housingfe update examples/correlate_box.toml` (three starts, about 30-40 minutes on one core;
+docs/correlation.md).
 """
 from __future__ import annotations
 
