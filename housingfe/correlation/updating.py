@@ -239,7 +239,7 @@ class SceneEvaluator:
             if self.pool is None:
                 from housingfe.correlation.worker import Worker
 
-                self.pool = Worker(WORKER_TASKS)
+                self.pool = Worker(WORKER_TASKS, module=__name__)
             result = self.pool.call("solve_scene", *args)
         else:
             result = solve_scene(*args, comm=self.comm)

@@ -28,26 +28,28 @@ def main() -> None:
     reply = os.fdopen(os.dup(1), "wb")
     os.dup2(2, 1)                              # prints of the FE stack go to stderr
     sys.stdout = sys.stderr
-    from housingfe.correlation import updating
+    import importlib
 
     while True:
         task = _read(sys.stdin.buffer)
         if task is None:
             return
-        name, args = pickle.loads(task)
+        module, name, args = pickle.loads(task)
         try:
-            out = (True, getattr(updating, name)(*args))
+            # the module is named by the caller, so that this module imports none of its callers (no cycle)
+            out = (True, getattr(importlib.import_module(module), name)(*args))
         except Exception as exc:  # noqa: BLE001 - sent back and re-raised in the parent
             out = (False, exc)
         _write(reply, pickle.dumps(out))
 
 
 class Worker:
-    """One worker subprocess; call(name, *args) runs housingfe.correlation.updating.<name>(*args) in it and
-    returns the result or re-raises its exception; restarted after `tasks` calls."""
+    """One worker subprocess; call(name, *args) runs <module>.<name>(*args) in it (module: a dotted module name,
+    e.g. housingfe.correlation.updating) and returns the result or re-raises its exception; restarted after
+    `tasks` calls."""
 
-    def __init__(self, tasks: int = 20):
-        self.tasks, self.done, self.proc = tasks, 0, None
+    def __init__(self, tasks: int = 20, module: str = "housingfe.correlation.updating"):
+        self.tasks, self.done, self.proc, self.module = tasks, 0, None, module
 
     def call(self, name: str, *args):
         if self.proc is not None and self.done >= self.tasks:
@@ -56,7 +58,7 @@ class Worker:
             self.proc = subprocess.Popen([sys.executable, "-m", "housingfe.correlation.worker"],
                                          stdin=subprocess.PIPE, stdout=subprocess.PIPE)
             self.done = 0
-        _write(self.proc.stdin, pickle.dumps((name, args)))
+        _write(self.proc.stdin, pickle.dumps((self.module, name, args)))
         payload = _read(self.proc.stdout)
         self.done += 1
         if payload is None:
