@@ -137,6 +137,7 @@ def split_notes(text: str) -> tuple[str, dict]:
     """(preamble, {benchmark: notes}) of docs/benchmarks-notes.md: blocks start at `<!-- notes: name -->`."""
     marks = list(NOTES_MARK.finditer(text))
     preamble = text[:marks[0].start()] if marks else text
+    preamble = re.sub(r"^\s*<!--.*?-->", "", preamble, count=1, flags=re.DOTALL)   # the file's own explanation
     blocks = {}
     for m, nxt in zip(marks, marks[1:] + [None]):
         blocks[m.group(1)] = text[m.end():nxt.start() if nxt else len(text)].strip()

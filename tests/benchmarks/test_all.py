@@ -51,6 +51,7 @@ def test_page_has_every_table_picture_and_note_in_place(tmp_path):
     i_modal_note, i_frf = text.index("Modal analysis: Q3 wins."), text.index("## housingfe bench frf")
     assert i_intro < i_modal_table < i_modal_note < i_frf
     assert "Notes of a benchmark that no longer runs." in text
+    assert "the notes file's own explanation" not in text
     assert not list(page.parent.glob(".*tmp*"))                          # atomic write left no temporary file
 
 
