@@ -232,10 +232,12 @@ def rigid_body_mass_properties(M: PETSc.Mat, rigid_modes: list, rigid_fields: li
     computed modes do not span the rigid motions, this mass is too small: a real check of the modes.
     """
     n = len(rigid_modes)
-    G = np.array([[rigid_modes[i].dot(_mult(M, rigid_modes[j])) for j in range(n)] for i in range(n)])
-    C = np.array([[rigid_modes[i].dot(_mult(M, r)) for r in rigid_fields] for i in range(n)])
+    M_modes = [_mult(M, x) for x in rigid_modes]      # one product per vector (12), not per pair (108)
+    M_fields = [_mult(M, r) for r in rigid_fields]
+    G = np.array([[rigid_modes[i].dot(M_modes[j]) for j in range(n)] for i in range(n)])
+    C = np.array([[rigid_modes[i].dot(mr) for mr in M_fields] for i in range(n)])
     B = C.T @ np.linalg.solve(G, C)
-    exact = np.array([[ri.dot(_mult(M, rj)) for rj in rigid_fields] for ri in rigid_fields])
+    exact = np.array([[ri.dot(mr) for mr in M_fields] for ri in rigid_fields])
     mass = float(np.mean(np.diag(B)[:3]))
     centre = np.array([B[1, 5], B[2, 3], B[0, 4]]) / mass
     return {"mass_kg": mass, "centre_of_gravity_m": centre,
