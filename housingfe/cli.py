@@ -68,7 +68,8 @@ def _cmd_mesh_picture(args: argparse.Namespace) -> int:
     for name in args.scenes:
         scene, _ = load_housing_scene(name)
         size = element_size(scene.mesh, scene.geometry, scene.analysis.f_max, scene.material.resolve())
-        hm = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, MPI.COMM_SELF)
+        hm = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, MPI.COMM_SELF,
+                        grading=scene.mesh.grading)
         label = f"{scene.scene.name}: {hm.mesh.topology.index_map(3).size_global} {hm.element} cells, " \
                 f"h = {size * 1e3:.1f} mm"
         mesh_picture(hm, out / f"{name}-mesh.png", label)

@@ -26,4 +26,5 @@ def coarse_box_model(comm):
     """The box-free scene on a coarse hex mesh (fast, still 6 rigid + a dozen elastic modes to 2.5 kHz)."""
     from housingfe.scene import build_model_from_scene
 
-    return build_model_from_scene(load_scene("box-free", "mesh.size=0.04", "analysis.modal.f_max=2500.0"), comm)
+    return build_model_from_scene(load_scene("box-free", "mesh.degree=2", "mesh.grading=1",
+                                                 "mesh.size=0.04", "analysis.modal.f_max=2500.0"), comm)

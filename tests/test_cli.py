@@ -12,7 +12,7 @@ import pytest
 from housingfe.scenefile import SCENE_DIR
 
 BOX = (SCENE_DIR / "box-free.toml").read_text()
-FAST = ["--set", "mesh.size=0.04", "--set", "analysis.modal.f_max=2500.0", "--set", "output.pictures=false"]
+FAST = ["--set", "mesh.degree=2", "--set", "mesh.size=0.04", "--set", "analysis.modal.f_max=2500.0", "--set", "output.pictures=false"]
 
 
 def housingfe(*args, cwd=None, mpi_ranks=None):

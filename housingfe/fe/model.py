@@ -123,7 +123,7 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
     regions = dict(regions or {})
     size = element_size(mesh, geometry, f_max, material)
     check_model_size(geometry, mesh, size, comm)
-    housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm)
+    housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm, grading=mesh.grading)
     if housing.quality["min"] < MIN_ELEMENT_QUALITY:
         raise InputError(f"mesh: element quality {housing.quality['min']:.3f} < {MIN_ELEMENT_QUALITY} "
                          f"({housing.quality['measure']}); change mesh.size or mesh.element")

@@ -67,7 +67,9 @@ DOFS_PER_GRID_CELL = {"hex": 37.0, "tet": 40.0}
 def estimate_dofs(geometry, element: str, degree: int, size: float, layers: int) -> int:
     """Displacement DOFs (3 per node) of the mesh `build_mesh` would make, estimated from the block model
     without meshing: every grid cell gets the structured divisions of its edges (size in m, `layers` through
-    wall thicknesses), times DOFS_PER_GRID_CELL scaled by (degree / 2)^3."""
+    wall thicknesses), times DOFS_PER_GRID_CELL scaled by degree^2 (degree + 1) / 12: the cells are mostly one
+    layer through a wall, p^2 nodes per cell in the plane times p + 1 through it (Q3 box, 40 mm: 44 256 DOFs,
+    estimate within 10 %)."""
     from housingfe.geometry.blocks import divisions
 
     model = block_model_for(geometry)
@@ -76,10 +78,10 @@ def estimate_dofs(geometry, element: str, degree: int, size: float, layers: int)
     for i, j, k in model.cells:
         cells += math.prod(divisions(float(d), size, model.thin_dimensions, layers)
                            for d in (steps[0][i], steps[1][j], steps[2][k]))
-    return int(round(DOFS_PER_GRID_CELL[element] * (degree / 2) ** 3 * cells))
+    return int(round(DOFS_PER_GRID_CELL[element] * degree ** 2 * (degree + 1) / 12 * cells))
 
 
-def build_mesh(geometry, element: str, size: float, layers: int, comm) -> HousingMesh:
+def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: float = 1.0) -> HousingMesh:
     """Build the gmsh model on rank 0, mesh it and distribute it as a dolfinx mesh.
 
     element: "hex" (structured quadratic-ready hexahedra) or "tet"; size: element size (m);
@@ -96,7 +98,7 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm) -> Housin
         try:
             gmsh.option.setNumber("General.Terminal", 0)
             gmsh.model.add("housing")
-            groups = build_gmsh_model(model, element, size, layers)
+            groups = build_gmsh_model(model, element, size, layers, grading)
         except Exception:
             gmsh.finalize()
             raise

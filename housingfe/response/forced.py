@@ -118,7 +118,8 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
     damping = damping_model(damping, structure)
     freqs = spec.frequencies
     timings = {"loads_and_observer_s": time.perf_counter() - t0}
-    facts = {"frequencies": len(freqs), "df_hz": spec.df, "surface_area_m2": observer.area}
+    facts = {"frequencies": len(freqs), "df_hz": spec.df, "surface_area_m2": observer.area,
+             "dofs": K.getSize()[0]}
     results, resp = {}, {}
     for solver in choose_solver(spec, damping, structure):
         t1 = time.perf_counter()

