@@ -183,6 +183,8 @@ SCENE_CASES = [
     ("mesh-zero-layers", _set("mesh.layers", 0), ["mesh.layers"]),
     ("mesh-unknown", _set("mesh.order", 2), ["mesh.order", "unknown key"]),
     ("mesh-negative-size", _set("mesh.size", -0.01), ["mesh.size"]),
+    ("mesh-grading-above-one", _set("mesh.grading", 1.5), ["mesh.grading"]),
+    ("mesh-grading-zero", _set("mesh.grading", 0.0), ["mesh.grading"]),
     # [analysis]
     ("analysis-none", _set("analysis", {}), ["analysis"]),
     ("analysis-missing", _del("analysis"), ["analysis"]),
