@@ -339,8 +339,9 @@ def main(out_dir: Path, quick: bool = False) -> None:
         note = (f"{repeats} interleaved round(s); highest 1-min load average before a run: {idle:.2f} "
                 f"({'machine otherwise idle' if idle < 1.0 else 'NOT idle: timings are pessimistic'}; 2 cores)")
         (tmp / "modal_bench.txt").write_text(table + "\n" + speedup + "\n" + note + "\n")
-    print(f"reference: {label('housingfe', REFERENCE)}, {provenance.get('dofs')} DOFs, {len(ref)} elastic modes "
-          f"below {F_MAX:g} Hz, first {ref[0]:.2f} Hz ({REFERENCE_FILE.name})")
+    print(f"reference: Richardson extrapolation of Q3 hexahedra at "
+          f"{', '.join(f'{1e3 * h:g}' for h in provenance['case']['sizes_m'])} mm ({provenance.get('dofs')} DOFs), "
+          f"{len(ref)} elastic modes below {F_MAX:g} Hz, first {ref[0]:.2f} Hz ({REFERENCE_FILE.name})")
     print(table)
     print(speedup)
     print(note)
