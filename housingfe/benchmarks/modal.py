@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from housingfe.benchmarks._launch import mpi_environment, mpi_launcher
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 F_MAX = 4000.0          # Hz, the range of the thesis' free-box study
@@ -160,11 +161,10 @@ def _case_in_subprocess(code: str, case: dict) -> dict:
     with tempfile.TemporaryDirectory() as tmp:
         job = Path(tmp) / "job.json"
         job.write_text(json.dumps({"code": code, "case": case, "workdir": tmp}))
-        ranks = case.get("ranks", 1)
-        launcher = ["mpirun", "-n", str(ranks), "--oversubscribe"] if ranks > 1 else []
         t0 = time.perf_counter()
-        proc = subprocess.run(launcher + [sys.executable, "-m", "housingfe.benchmarks.modal", str(job)],
-                              capture_output=True, text=True)
+        proc = subprocess.run(mpi_launcher(case.get("ranks", 1))
+                              + [sys.executable, "-m", "housingfe.benchmarks.modal", str(job)],
+                              capture_output=True, text=True, env=mpi_environment())
         wall = time.perf_counter() - t0
         if proc.returncode != 0:
             return {"error": proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed",

@@ -1,0 +1,22 @@
+"""Launching a benchmark case on several MPI ranks."""
+from __future__ import annotations
+
+import os
+
+
+def mpi_launcher(ranks: int) -> list[str]:
+    """The command prefix that starts `ranks` MPI processes (empty for one rank: a plain process)."""
+    if ranks <= 1:
+        return []
+    return ["mpirun", "-n", str(ranks), "--oversubscribe"]
+
+
+def mpi_environment(env: dict | None = None) -> dict:
+    """The environment for the launched ranks: one BLAS thread per rank (the ranks would otherwise fight over
+    the cores) and, when run as root (containers, CI), Open MPI's explicit consent to that."""
+    out = dict(os.environ if env is None else env)
+    out.setdefault("OPENBLAS_NUM_THREADS", "1")
+    if os.geteuid() == 0:
+        out.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
+        out.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
+    return out
