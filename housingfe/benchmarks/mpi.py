@@ -1,7 +1,7 @@
 """`housingfe bench mpi`: strong scaling of the modal solve and of the harmonic sweep, 1 against 2 MPI ranks.
 
 The model: the box-free-frf scene (two forces, 819 lines of 4.88 Hz to 4 kHz, modal superposition with residual
-vectors on a basis to 6 kHz) on a Q3 hexahedral mesh graded towards the wall junctions, h = 13 mm: ~330 k DOFs
+vectors on a basis to 6 kHz) on a Q3 hexahedral mesh graded towards the wall junctions, h = 12.5 mm: 309 k DOFs
 (--quick: 30 mm, ~60 k).  Each run is `mpirun -n R python -m housingfe run box-free-frf ...` in a fresh process;
 the 1- and 2-rank runs alternate, ROUNDS rounds, and the table gives min / median / max of every phase with the
 1-minute load average before each run.  Phases (from harmonic.json): modal solve = inertia count + Krylov-Schur
@@ -27,7 +27,7 @@ from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 SCENE = "box-free-frf"
 MESH = ["mesh.degree=3", "mesh.grading=0.25", "output.pictures=false"]
-SIZE, QUICK_SIZE = 0.013, 0.030        # m
+SIZE, QUICK_SIZE = 0.0125, 0.030       # m: 309 108 and 59 952 DOFs
 RANKS = (1, 2)
 ROUNDS, QUICK_ROUNDS = 2, 1
 
