@@ -28,7 +28,7 @@ from pathlib import Path
 from housingfe.errors import SolverError
 
 # Page order; any other benchmark module found is appended after these.
-ORDER = ["modal", "mpi", "frf", "scenes", "source", "bearings", "radiation", "coupling", "runup"]
+ORDER = ["modal", "mpi", "frf", "direct", "scenes", "source", "bearings", "radiation", "coupling", "runup"]
 MAX_ROWS = 40           # a longer CSV shows its first rows and says how many more the file holds
 NOTES_MARK = re.compile(r"^<!--\s*notes:\s*([\w-]+)\s*-->\s*$", re.MULTILINE)
 

@@ -76,6 +76,15 @@ def _on_union(mats):
     return union.indptr.astype(np.int32), union.indices.astype(np.int32), datas
 
 
+def _upper_triangle(indptr, indices, datas):
+    """The entries with column >= row of a CSR pattern and of its data arrays (sorted rows stay sorted)."""
+    rows = np.repeat(np.arange(len(indptr) - 1, dtype=np.int32), np.diff(indptr))
+    keep = indices >= rows
+    counts = np.bincount(rows[keep], minlength=len(indptr) - 1)
+    upper_ptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int32)
+    return upper_ptr, indices[keep].astype(np.int32), [np.ascontiguousarray(d[keep]) for d in datas]
+
+
 def run(job_path: str | None, out) -> int:
     """Solve the job (job_path; None: read its path from stdin once the imports are done, so the parent can start
     the worker first and write the job meanwhile), streaming the solutions to the binary stream `out`."""
@@ -93,12 +102,20 @@ def run(job_path: str | None, out) -> int:
             job[f"{name}_indptr"], job[f"{name}_indices"] = job["K_indptr"], job["K_indices"]
     names = ["K", "M"] + [m for m in ("D", "C") if f"{m}_data" in job]
     indptr, indices, datas = _on_union([_csr(job, m) for m in names])
-    data = dict(zip(names, datas))
     loads = job["loads"]
     n = loads.shape[1]
     use_D, symmetric = bool(job["use_D"]), bool(job["symmetric"])
-    A = PETSc.Mat().createAIJ((n, n), csr=(indptr, indices, np.zeros(len(indices), complex)), comm=PETSc.COMM_SELF)
+    if symmetric:
+        # the upper triangle only, as SBAIJ: half the entries to recombine per line and to hand to MUMPS' LDL^T
+        # (which reads only the upper triangle anyway): 1.47 -> 1.3 s per line at 39 k DOFs
+        indptr, indices, datas = _upper_triangle(indptr, indices, datas)
+        A = PETSc.Mat().createSBAIJ((n, n), 1, csr=(indptr, indices, np.zeros(len(indices), complex)),
+                                    comm=PETSc.COMM_SELF)
+    else:
+        A = PETSc.Mat().createAIJ((n, n), csr=(indptr, indices, np.zeros(len(indices), complex)),
+                                  comm=PETSc.COMM_SELF)
     A.setOption(PETSc.Mat.Option.SYMMETRIC, symmetric)
+    data = dict(zip(names, datas))
     ksp = PETSc.KSP().create(PETSc.COMM_SELF)
     ksp.setOperators(A)
     ksp.setType("preonly")

@@ -1,0 +1,96 @@
+"""`housingfe bench direct`: the direct harmonic solver (non-proportional damping), complex worker against the real
+2x2 block form, per line.
+
+Model: box-free-frf on its default mesh (Q2 hexahedra, 38 997 DOFs), both load cases, eta per band.  The two forms
+solve the same LINES consecutive lines (4.88 Hz apart around 1.5 kHz), interleaved block, complex, block, complex, ...
+ROUNDS rounds each; wall time per line (the worker's start, the hand-over of the matrices and the ordering are
+inside: they are paid once per call) with min / median / max, and the largest relative difference of the two
+forms' responses (the same equations, so round-off only).
+"""
+from __future__ import annotations
+
+import os
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from housingfe.outputs import atomic_output_dir, format_table, write_csv
+
+LINES, QUICK_LINES = 20, 3
+ROUNDS, QUICK_ROUNDS = 2, 1
+F_START = 1469.0    # Hz: the lines measured in issue 16 (1469-1562 Hz)
+
+
+def main(out_dir: Path, quick: bool = False) -> None:
+    """Interleave the two forms, print the per-line table, write direct_bench.csv/.txt/.png."""
+    from mpi4py import MPI
+
+    from housingfe.fe.loads import assemble_load
+    from housingfe.response.forced import damping_model
+    from housingfe.response.observers import SurfaceObserver, responses
+    from housingfe.scene import build_model_from_scene, load_housing_scene
+    from housingfe.solvers import harmonic
+
+    scene, _ = load_housing_scene("box-free-frf")
+    model = build_model_from_scene(scene, MPI.COMM_WORLD)
+    spec = scene.analysis.harmonic
+    loads = [assemble_load(load, model.housing, model.V, model.bcs) for load in scene.loads]
+    observer = SurfaceObserver(model, spec.surface, [], loads)
+    damping = damping_model(scene.damping, model)
+    n_lines = QUICK_LINES if quick else LINES
+    freqs = F_START + spec.df * np.arange(n_lines)
+    times: dict[str, list] = {"block": [], "complex": []}
+    answers = {}
+    for rnd in range(QUICK_ROUNDS if quick else ROUNDS):
+        for method in ("block", "complex"):
+            load = os.getloadavg()[0]
+            t0 = time.perf_counter()
+            res = harmonic.direct(model.K, model.M, loads, freqs, damping, observer.reduce, method=method)
+            per_line = (time.perf_counter() - t0) / n_lines
+            times[method].append((per_line, load))
+            answers[method] = responses(res, observer, loads)
+            print(f"round {rnd + 1}  {method:8s} {per_line:.3f} s per line  load before {load:.2f}", flush=True)
+    difference = _max_relative_difference(answers["block"], answers["complex"])
+    header = ["form", "dofs", "lines", "per_line_min_s", "per_line_median_s", "per_line_max_s", "runs",
+              "max_load_before", "speedup_median"]
+    base = statistics.median(t for t, _ in times["block"])
+    rows = [[m, model.dofs, n_lines, min(t for t, _ in v), statistics.median(t for t, _ in v),
+             max(t for t, _ in v), len(v), max(ld for _, ld in v), base / statistics.median(t for t, _ in v)]
+            for m, v in times.items()]
+    note = f"largest relative difference of the responses, complex vs block: {difference:.1e}"
+    table = format_table(header, rows)
+    with atomic_output_dir(out_dir) as tmp:
+        write_csv(tmp / "direct_bench.csv", header, rows)
+        (tmp / "direct_bench.txt").write_text(table + "\n" + note + "\n")
+        _plot(tmp / "direct_bench.png", rows)
+    print(table)
+    print(note)
+    print(f"results: {out_dir}/")
+
+
+def _max_relative_difference(a: list, b: list) -> float:
+    """Largest relative difference of the surface <v^2> and of the receptances of two lists of LoadResponses."""
+    worst = 0.0
+    for ra, rb in zip(a, b):
+        for xa, xb in ((ra.mean_square_velocity, rb.mean_square_velocity), (ra.receptance, rb.receptance)):
+            worst = max(worst, float(np.max(np.abs(xa - xb)) / np.max(np.abs(xa))))
+    return worst
+
+
+def _plot(path: Path, rows: list) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 3.5))
+    med = [r[4] for r in rows]
+    spread = [[m - r[3] for m, r in zip(med, rows)], [r[5] - m for m, r in zip(med, rows)]]
+    ax.bar([r[0] for r in rows], med, yerr=spread, capsize=4)
+    ax.set_ylabel("wall time per line (s)")
+    ax.set_title(f"direct solver, {rows[0][1]} DOFs, both loads")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
