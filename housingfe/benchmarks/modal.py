@@ -277,8 +277,19 @@ def recompute_reference() -> None:
                         f"{', '.join(f'{1e3 * h:g}' for h in REFERENCE_SIZES)} mm: python -m "
                         f"housingfe.benchmarks.modal --reference (housingfe {commit}, 1 rank, {datetime.date.today()})",
         "case": {**REFERENCE, "sizes_m": list(REFERENCE_SIZES)}, "dofs": [r["dofs"] for r in runs],
+        "uncertainty": _uncertainty(discrete, f_inf, keep),
         "frequencies_hz": [round(x, 3) for x in f_inf[keep]], "rates": [round(x, 3) for x in rates[keep]],
         "discrete_hz": {f"{h:.3f}": r["frequencies_hz"][:n] for h, r in zip(REFERENCE_SIZES, runs)}}, indent=1))
+
+
+def _uncertainty(discrete: np.ndarray, f_inf: np.ndarray, keep: np.ndarray) -> str:
+    """The extrapolation against a rate-1 extrapolation of the two finest meshes, and the finest mesh's own
+    distance from the limit (both max over the kept modes, %)."""
+    h_mid, h_fine = REFERENCE_SIZES[1:]
+    rate_one = discrete[2] + (discrete[2] - discrete[1]) / (h_mid / h_fine - 1)
+    return (f"fitted rates against p = 1 fixed: {100 * np.nanmax(np.abs(f_inf / rate_one - 1)[keep]):.2f} % max; "
+            f"the {1e3 * h_fine:g} mm solution lies {100 * np.nanmin((discrete[2] / f_inf - 1)[keep]):.2f}-"
+            f"{100 * np.nanmax((discrete[2] / f_inf - 1)[keep]):.2f} % above the limit")
 
 
 def load_average() -> float:
