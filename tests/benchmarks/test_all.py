@@ -88,4 +88,6 @@ def test_quick_and_failed_runs_leave_the_docs_alone(tmp_path, monkeypatch):
 
 def test_bench_all_runs_every_other_benchmark_once():
     names = bench_all.benchmarks()
-    assert "all" not in names and names[:2] == ["modal", "frf"] and len(set(names)) == len(names)
+    # the modal benchmark leads the page (the headline comparison); every command appears exactly once
+    assert "all" not in names and names[0] == "modal" and len(set(names)) == len(names)
+    assert {"mpi", "frf", "direct"} <= set(names)
