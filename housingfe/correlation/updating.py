@@ -95,6 +95,10 @@ class UpdateSpec(_Strict):
     name: str = "update"
     parameters: list[ParameterSpec] = Field(min_length=1)
     targets: list[TargetSpec] = Field(min_length=1)
+    # scene -> overrides of every evaluation (search and confirmation), before the parameters: a parameter may set a
+    # key these introduce, e.g. ["regions.rim.name=steel", "regions.rim.youngs_modulus=2.1e11"] lets the rim's
+    # modulus be a parameter
+    scene_overrides: dict[str, list[str]] = {}
     search_overrides: dict[str, list[str]] = {}    # scene -> overrides during the search
     confirm_overrides: dict[str, list[str]] = {}   # scene -> overrides of the confirmation run
     mesh_correction: bool = True    # scale the search predictions by (confirm / search) at the start point
@@ -153,15 +157,21 @@ class SceneResult:
 def check_parameter_keys(spec: UpdateSpec) -> None:
     """InputError "<scene>: <key>: ..." for a parameter key that no scene of the spec defines (a parameter
     overrides an existing value; a misspelt key would otherwise add a new one)."""
-    from housingfe.scenefile import read_scene_dict
-
     scenes = {t.scene for t in spec.targets}
-    data = {s: read_scene_dict(s)[0] for s in scenes}
+    data = {s: _scene_data(spec, s) for s in scenes}
     for p in spec.parameters:
         for key in p.keys:
             if not any(_present(d, key) for d in data.values()):
                 raise InputError(f"{', '.join(sorted(scenes))}: {key}: unknown parameter key "
                                  f"(parameter {p.name!r}: no scene of the spec has it)")
+
+
+def _scene_data(spec: UpdateSpec, scene: str) -> dict:
+    """A scene's TOML data with the spec's scene_overrides for it applied."""
+    from housingfe.scenefile import apply_overrides, read_scene_dict
+
+    data, _ = read_scene_dict(scene)
+    return apply_overrides(data, spec.scene_overrides.get(scene, []), source=f"scene_overrides.{scene}")
 
 
 def _present(data: dict, key: str) -> bool:
@@ -179,8 +189,6 @@ class SceneEvaluator:
     def __init__(self, spec: UpdateSpec, comm=None, log: Callable[[str], None] | None = None, isolate: bool = True):
         from mpi4py import MPI
 
-        from housingfe.scenefile import read_scene_dict
-
         self.spec = spec
         self.comm = comm or MPI.COMM_WORLD
         self.log = log or (lambda s: None)
@@ -189,7 +197,7 @@ class SceneEvaluator:
         self.f_last: dict[str, float] = {}
         self.isolate, self.pool = isolate, None
         scenes = sorted({t.scene for t in spec.targets})
-        self.scene_data = {s: read_scene_dict(s)[0] for s in scenes}
+        self.scene_data = {s: _scene_data(spec, s) for s in scenes}
         self.measured = {}
         for t in spec.targets:
             if t.kind == "paired":
@@ -198,7 +206,9 @@ class SceneEvaluator:
                 self.measured[t.name] = read_measured_modes(t.measured)
 
     def overrides(self, scene: str, values: np.ndarray, extra: list[str]) -> list[str]:
-        out = list(extra)
+        """The --set overrides of one evaluation: the spec's scene_overrides, `extra` (search or confirmation
+        mesh), then the parameters."""
+        out = list(self.spec.scene_overrides.get(scene, [])) + list(extra)
         for p, v in zip(self.spec.parameters, values):
             for key in p.keys:
                 if _present(self.scene_data[scene], key):

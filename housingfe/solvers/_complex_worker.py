@@ -1,7 +1,8 @@
 """Complex-valued direct harmonic solve in its own process (complex PETSc build, one rank).
 
 Started by `housingfe.solvers.harmonic.direct` as `python -m housingfe.solvers._complex_worker -` (the job's path
-then comes on stdin, once the worker's imports are done) or `... job.npz`, with
+then comes on stdin, once the worker's imports are done, optionally followed by `first step`: this worker solves
+lines first, first + step, ... of the job, so that several workers share the lines) or `... job.npz`, with
 PETSC_DIR / SLEPC_DIR selecting the complex build (one process cannot hold both builds, see
 docs/forced-response.md).  Per line it factorises A = K_r + i K_i (n x n complex, MUMPS LDL^T when symmetric,
 LU otherwise) instead of the real 2n x 2n block form, and the sparsity pattern is the same on every line, so the
@@ -85,9 +86,10 @@ def _upper_triangle(indptr, indices, datas):
     return upper_ptr, indices[keep].astype(np.int32), [np.ascontiguousarray(d[keep]) for d in datas]
 
 
-def run(job_path: str | None, out) -> int:
-    """Solve the job (job_path; None: read its path from stdin once the imports are done, so the parent can start
-    the worker first and write the job meanwhile), streaming the solutions to the binary stream `out`."""
+def run(job_path: str | None, out, first: int = 0, step: int = 1) -> int:
+    """Solve lines first, first + step, ... of the job (job_path; None: read `path [first step]` from stdin once the
+    imports are done, so the parent can start the worker first and write the job meanwhile), streaming the
+    solutions to the binary stream `out`."""
     import scipy.sparse  # noqa: F401  (imported while the parent writes the job)
     from petsc4py import PETSc
 
@@ -95,7 +97,10 @@ def run(job_path: str | None, out) -> int:
         print("the complex PETSc build was not selected (PETSC_DIR/SLEPC_DIR)", file=sys.stderr)
         return 2
     if job_path is None:
-        job_path = sys.stdin.readline().strip()
+        words = sys.stdin.readline().split()
+        job_path = words[0]
+        if len(words) == 3:
+            first, step = int(words[1]), int(words[2])
     job = dict(np.load(job_path))
     for name in ("M", "D", "C"):   # a matrix sent without its pattern shares K's
         if f"{name}_data" in job and f"{name}_indptr" not in job:
@@ -128,7 +133,8 @@ def run(job_path: str | None, out) -> int:
     b, x = A.createVecs()
     values = np.empty(len(indices), complex)
     work = np.empty(len(indices))
-    for k, (w, eta) in enumerate(zip(job["omega"], job["eta"])):
+    for k in range(first, len(job["omega"]), step):
+        w, eta = job["omega"][k], job["eta"][k]
         # values = K + i (D or eta K) + i omega C - omega^2 M, in place (5 M entries at 39 k DOFs: temporaries cost)
         np.multiply(data["M"], -w * w, out=work)
         work += data["K"]

@@ -258,14 +258,17 @@ def solve_reduced(Kr, Mr, Cr, omega, eta, Fr) -> np.ndarray:
 
 # ----------------------------------------------------------------------------------------- direct
 def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | None = None, *,
-           method: str = "auto") -> HarmonicResult:
+           method: str = "auto", workers: int | None = None) -> HarmonicResult:
     """Direct solution per frequency (Hz) of (K_r + i K_i) u = f, K_r = K - omega^2 M, K_i = eta K (or the damping
     matrix D) + omega C; all load cases per factor.
 
     method: "complex" solves the n x n complex system in a worker process running the complex PETSc build
     (housingfe.solvers._complex_worker: MUMPS LDL^T, ordering and symbolic factorisation done once for all lines);
     "block" the real 2n x 2n block form in this process; "auto" (default): complex on one MPI rank when the complex
-    build is installed, block otherwise (the worker is a single process; the block form runs on every rank)."""
+    build is installed, block otherwise (the worker is a single process; the block form runs on every rank).
+    workers: complex worker processes sharing the lines (line k goes to worker k mod workers); default: one per
+    core this process may use (os.sched_getaffinity), at most one per line and at most 8.  The lines are
+    independent, so on a one-rank run the otherwise idle cores factorise other lines."""
     from housingfe.solvers import _complex_worker
 
     if method not in ("auto", "complex", "block"):
@@ -273,12 +276,21 @@ def direct(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.Mat | No
     if method == "auto":
         method = "complex" if K.getComm().getSize() == 1 and _complex_worker.available() else "block"
     if method == "complex":
-        return _direct_complex(K, M, loads, frequencies, damping, reduce, C)
+        return _direct_complex(K, M, loads, frequencies, damping, reduce, C, workers)
     return _direct_block(K, M, loads, frequencies, damping, reduce, C)
 
 
-def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None) -> HarmonicResult:
-    """`direct` through the complex worker (one rank): solutions stream back line by line and are reduced at once."""
+def default_direct_workers(n_lines: int) -> int:
+    """Complex workers for n_lines lines: one per usable core, at most one per line, at most 8."""
+    import os
+
+    return max(1, min(len(os.sched_getaffinity(0)), n_lines, 8))
+
+
+def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None, workers: int | None = None
+                    ) -> HarmonicResult:
+    """`direct` through complex workers (one rank): line k is solved by worker k mod workers; the solutions stream
+    back line by line, in order, and are reduced at once."""
     import os
     import subprocess
     import sys
@@ -299,11 +311,15 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None) 
         for w, f_hz in zip(omega, frequencies):
             _check_undamped_line(K, M, w * w, f_hz)
     n = K.getSize()[0]
+    n_workers = default_direct_workers(len(frequencies)) if workers is None else int(workers)
+    if n_workers < 1:
+        raise ValueError(f"direct: workers must be >= 1, got {workers}")
+    n_workers = min(n_workers, max(len(frequencies), 1))
     tmp = tempfile.TemporaryDirectory(prefix="housingfe-direct-")
-    err = open(os.path.join(tmp.name, "stderr.txt"), "w+")
-    # started first: its imports (~0.5 s) overlap with writing the job
-    proc = subprocess.Popen([sys.executable, "-m", "housingfe.solvers._complex_worker", "-"], stdin=subprocess.PIPE,
-                            stdout=subprocess.PIPE, stderr=err, env=_complex_worker.complex_env())
+    errs = [open(os.path.join(tmp.name, f"stderr{w}.txt"), "w+") for w in range(n_workers)]
+    # started first: their imports (~0.5 s) overlap with writing the job
+    procs = [subprocess.Popen([sys.executable, "-m", "housingfe.solvers._complex_worker", "-"], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, stderr=err, env=_complex_worker.complex_env()) for err in errs]
     job = {"loads": np.array([load.vector.getArray() for load in loads], dtype=float).reshape(len(loads), n),
            "omega": omega, "eta": np.broadcast_to(eta, omega.shape).copy(), "use_D": use_D, "symmetric": symmetric}
     blocks = [[] for _ in loads]
@@ -323,13 +339,15 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None) 
                     job.update({f"{name}_indptr": indptr, f"{name}_indices": indices})
         np.savez(os.path.join(tmp.name, "job.npz"), **job)
         del job
-        try:
-            proc.stdin.write((os.path.join(tmp.name, "job.npz") + "\n").encode())
-            proc.stdin.close()
-        except BrokenPipeError:   # the worker died at start: its stderr is reported below
-            pass
+        for w, proc in enumerate(procs):
+            try:
+                proc.stdin.write(f"{os.path.join(tmp.name, 'job.npz')} {w} {n_workers}\n".encode())
+                proc.stdin.close()
+            except BrokenPipeError:   # the worker died at start: its stderr is reported below
+                pass
         for k in range(len(frequencies)):
-            raw = proc.stdout.read(line_bytes)
+            # in line order, round robin: each worker is at most one line ahead of the reading
+            raw = procs[k % n_workers].stdout.read(line_bytes)
             if len(raw) < line_bytes:
                 break
             head = np.frombuffer(raw[:16], np.float64)
@@ -342,23 +360,30 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None) 
                 ui.setArray(sol[j].imag)
                 blocks[j].append(Block(reduce([ur, ui]), pair, np.array([k])))
     finally:
-        if proc.poll() is None and any(len(b) != len(frequencies) for b in blocks):
-            proc.kill()   # an exception here (in reduce, say): do not leave the worker running
-        proc.stdout.close()
-        code = proc.wait()
-        err.seek(0)
-        message = err.read().strip()
-        err.close()
+        incomplete = any(len(b) != len(frequencies) for b in blocks)
+        codes, messages = [], []
+        for proc, err in zip(procs, errs):
+            if proc.poll() is None and incomplete:
+                proc.kill()   # an exception here (in reduce, say) or a failed worker: leave none running
+            proc.stdout.close()
+            codes.append(proc.wait())
+            err.seek(0)
+            messages.append(err.read().strip())
+            err.close()
         tmp.cleanup()
-    if code == _complex_worker.SINGULAR_EXIT and message.startswith("SINGULAR"):
-        f_hz = frequencies[int(message.split()[1])]
-        raise SolverError(f"direct solver: singular system at {f_hz:.6g} Hz (undamped resonance?)")
-    if code != 0 or any(len(b) != len(frequencies) for b in blocks):
+    for code, message in zip(codes, messages):
+        if code == _complex_worker.SINGULAR_EXIT and message.startswith("SINGULAR"):
+            f_hz = frequencies[int(message.split()[1])]
+            raise SolverError(f"direct solver: singular system at {f_hz:.6g} Hz (undamped resonance?)")
+    # the worker that failed first, not the ones killed because of it (exit -9)
+    failed = sorted(((c, m) for c, m in zip(codes, messages) if c), key=lambda cm: cm[0] == -9)
+    if failed or any(len(b) != len(frequencies) for b in blocks):
+        code, message = failed[0] if failed else (0, "fewer lines than asked")
         tail = " | ".join(message.splitlines()[-5:])
         raise SolverError(f"direct solver: the complex worker failed (exit {code}): {tail}")
     return HarmonicResult(frequencies, blocks, "direct",
                           {"direct_s": time.perf_counter() - t0, "direct_factor_s": t_factor,
-                           "direct_factorisations": factorisations,
+                           "direct_factorisations": factorisations, "direct_workers": n_workers,
                            "direct_s_per_frequency": (time.perf_counter() - t0) / max(len(frequencies), 1)})
 
 

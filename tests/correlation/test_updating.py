@@ -117,6 +117,22 @@ def test_unknown_parameter_key_is_input_error(synthetic):
     assert "\n" not in str(exc.value)
 
 
+def test_scene_overrides_introduce_a_parameter_key(synthetic):
+    """A key no scene has (a region's modulus) is a parameter once the spec's scene_overrides introduce it; every
+    evaluation applies scene_overrides first, then the search/confirmation overrides, then the parameters."""
+    scene, ema, _, _ = synthetic
+    rim = ParameterSpec(name="E_rim", keys=["regions.rim.youngs_modulus"], lower=1e9, upper=3e11, start=2e11)
+    spec = _spec(scene, ema).model_copy(update={"parameters": [rim]})
+    with pytest.raises(InputError, match="regions.rim.youngs_modulus: unknown parameter key"):
+        check_parameter_keys(spec)
+    introduced = ["regions.rim.name=steel", "regions.rim.youngs_modulus=2.1e11"]
+    spec = spec.model_copy(update={"scene_overrides": {str(scene): introduced}})
+    check_parameter_keys(spec)
+    evaluator = SceneEvaluator(spec, isolate=False)
+    assert evaluator.overrides(str(scene), np.array([5e10]), ["mesh.size=0.1"]) == \
+        introduced + ["mesh.size=0.1", "regions.rim.youngs_modulus=50000000000.0"]
+
+
 def test_cli_no_paired_modes_is_one_line_error(synthetic, tmp_path, capsys):
     from housingfe.cli import main
 

@@ -1,6 +1,7 @@
 """The complex-worker direct solver (housingfe.solvers._complex_worker) against the real 2x2 block form in this
 process: same solutions to 1e-9 relative, for a hysteretic loss factor, a non-proportional damping matrix D and a
-non-symmetric viscous C (the LU path); a singular undamped line is reported as in the block form."""
+non-symmetric viscous C (the LU path), with one worker or several sharing the lines; a singular undamped line is
+reported as in the block form."""
 import numpy as np
 import pytest
 import scipy.sparse as sp
@@ -97,14 +98,17 @@ def test_undamped_eigenfrequency_is_singular(plate):
         harmonic.direct(model.K, model.M, loads, f_hit, undamped, lambda v: v, method="complex")
 
 
-def test_a_dense_sweep_equals_block_form(plate):
-    """Twenty lines 5 Hz apart on one symbolic factorisation: the answers stay those of the block form to 1e-9."""
+@pytest.mark.parametrize("workers", [1, 3])
+def test_a_dense_sweep_equals_block_form(plate, workers):
+    """Twenty lines 5 Hz apart on one symbolic factorisation per worker: the answers stay those of the block form to
+    1e-9, line by line in order, also when three workers share the lines (line k on worker k mod 3)."""
     model, loads = plate
     freqs = np.arange(1300.0, 1400.0, 5.0)
     damping = harmonic.Damping(lambda f: np.full(np.shape(f), 0.02))
     copies = lambda vecs: [v.copy() for v in vecs]   # noqa: E731
-    new = harmonic.direct(model.K, model.M, loads, freqs, damping, copies, method="complex")
+    new = harmonic.direct(model.K, model.M, loads, freqs, damping, copies, method="complex", workers=workers)
     old = harmonic.direct(model.K, model.M, loads, freqs, damping, copies, method="block")
     u_new, u_old = _solutions(new), _solutions(old)
     assert np.max(np.abs(u_new - u_old) / np.abs(u_old).max(axis=2, keepdims=True)) < 1e-9
-    assert new.timings["direct_factorisations"] == len(freqs)
+    assert new.timings["direct_factorisations"] == len(freqs) and new.timings["direct_workers"] == workers
+    assert [b.index[0] for b in new.blocks[0]] == list(range(len(freqs)))
