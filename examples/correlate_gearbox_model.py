@@ -16,9 +16,11 @@ Each variant changes one modelling choice of the reconstruction through the stag
                 shell model's plates meet at their mid-planes: every panel 8 mm larger)
     mesh        the scene's mesh / a finer one (discretisation, to separate it from the modelling)
 
-    .venv/bin/python examples/correlate_gearbox_model.py [--out DIR] [--only NAME ...] [--fit]
+    .venv/bin/python examples/correlate_gearbox_model.py [--small] [--out DIR] [--only NAME ...] [--fit]
 
-about 20-40 s per variant on one core; writes variants.csv and variants.md (atomically) into --out.
+about 10-25 s per variant on one core (--small: two variants on a coarse mesh, ~15 s); --fit adds the rim's
+stiffness fitted by `housingfe update`'s machinery (examples/correlate_gearbox_model.toml) for both readings of
+Appendix E (~15 min).  Writes variants.csv and variants.md (and rim_fits.json with --fit) atomically into --out.
 """
 from __future__ import annotations
 
@@ -42,6 +44,8 @@ BANDS_NO_MODE = (500.0, 800.0)
 SIGMA = 0.02          # relative: the thesis' shell model against a converged solid one
 
 # name -> (scene, overrides, geometry changes, what it tests)
+OUTPUTS = ("variants.csv", "variants.md")
+SMALL = ["mesh.elements_per_wavelength=3"]      # --small: a coarse mesh, the trend only
 MID_SURFACE = ["geometry.length=0.408", "geometry.width=0.145", "geometry.height=0.305"]
 VARIANTS = {
     "reconstructed": ("gearbox-model", [], {}, "solid 30 x 30 rim, feet, Appendix E as outer dimensions"),
@@ -97,15 +101,21 @@ def score(freqs: np.ndarray) -> dict:
 
 
 def main() -> None:
+    # %% which variants: all, --only some, or --small (two on a coarse mesh)
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", default="results/correlate-gearbox-model")
+    parser.add_argument("--small", action="store_true", help="reconstructed and no rim on a coarse mesh")
+    parser.add_argument("--out", default=None, help="write variants.csv, variants.md (and rim_fits.json)")
     parser.add_argument("--only", nargs="*", default=None, help="variant names (default: all)")
     parser.add_argument("--fit", action="store_true",
                         help="also fit the rim's stiffness (correlate_gearbox_model.toml) for both readings of "
                              "Appendix E, and score the fitted models (a few minutes)")
     args = parser.parse_args()
-    variants = {name: VARIANTS[name] for name in (args.only or VARIANTS)}
+    names = ["reconstructed", "no rim"] if args.small else (args.only or list(VARIANTS))
+    variants = {name: VARIANTS[name] for name in names}
+    if args.small:
+        variants = {k: (sc, o + SMALL, ch, w) for k, (sc, o, ch, w) in variants.items()}
     fits = {}
+    # %% the rim's stiffness fitted to the first three modes and the count (bounded least squares, update spec)
     if args.fit:
         # the rim stiffness fitted (examples/correlate_gearbox_model.toml) with each reading of Appendix E
         spec = load_update_spec(str(Path(__file__).with_name("correlate_gearbox_model.toml")))
@@ -119,6 +129,7 @@ def main() -> None:
                 "gearbox-model", dims + ["regions.rim.name=steel", f"regions.rim.youngs_modulus={E!r}",
                                          "mesh.elements_per_wavelength=9"], {},
                 f"rim E = {E / 1e9:.1f} GPa fitted (update spec), finer mesh")
+    # %% every variant solved and scored against the published numbers
     rows = []
     for name, (scene, overrides, changes, what) in variants.items():
         r = solve_variant(scene, overrides, changes)
@@ -129,6 +140,7 @@ def main() -> None:
                      "f42": round(s["f42"], 0), "bands_400_630_1000_1250_500_800": "/".join(map(str, s["bands"])),
                      "bands_right_of_6": s["bands_right"], "cost": round(s["cost"], 1)})
         print(" | ".join(f"{k} {v}" for k, v in rows[-1].items()), flush=True)
+    # %% the table (markdown) and the files
     head = ("| variant | DOFs | mass kg | modes < 4 kHz | f1 / f2 / f3 Hz | f42 Hz | bands 400/630/1000/1250 "
             "(1 each) · 500/800 (0) | cost |\n|---|---|---|---|---|---|---|---|\n")
     lines = [f"| thesis FEM | 1370 nodes | — | {PUBLISHED_COUNT} | "
@@ -138,6 +150,9 @@ def main() -> None:
         lines.append(f"| {r['variant']} | {r['dofs']} | {r['mass_kg']} | {r['modes_below_4k']} | "
                      f"{r['f1']} / {r['f2']} / {r['f3']} | {r['f42']:.0f} | {'/'.join(b[:4])} · {'/'.join(b[4:])} "
                      f"| {r['cost']} |")
+    print(head + "\n".join(lines))
+    if args.out is None:
+        return
     with atomic_output_dir(args.out) as tmp:
         write_csv(tmp / "variants.csv", list(rows[0]), [list(r.values()) for r in rows])
         (tmp / "variants.md").write_text(head + "\n".join(lines) + "\n")
