@@ -69,6 +69,11 @@ class TargetSpec(_Strict):
     threshold: float = Field(0.6, ge=0.0, le=1.0)     # paired: MAC threshold
     use_mac: bool = False                             # paired: add (1 - MAC) / sigma_mac residuals
     sigma_mac: PositiveFloat = 0.1
+    # paired: add (zeta_model / zeta_measured - 1) / sigma_damping for every paired mode with a measured modal
+    # damping ratio (UFF 55); zeta_model from the scene's [damping] (eta / 2, xi, or the modal strain energy of
+    # per-material loss factors), so damping keys can be fitted
+    use_damping: bool = False
+    sigma_damping: PositiveFloat = 0.2
 
     @model_validator(mode="after")
     def _check(self):
@@ -142,7 +147,8 @@ def resolve_measured_paths(spec: UpdateSpec, base) -> UpdateSpec:
 @dataclass
 class SceneResult:
     """Modes of one scene at one parameter set: elastic frequencies (Hz), rigid-body mode count, mass (kg, free
-    scenes), the elastic modes sampled on each paired target's measured channels (target name -> ModeSet).
+    scenes), the elastic modes sampled on each paired target's measured channels (target name -> ModeSet),
+    the viscous damping ratio of each elastic mode that the scene's [damping] gives (-).
     The FE model and basis are not kept: a search makes hundreds of them."""
 
     frequencies_hz: np.ndarray
@@ -152,6 +158,7 @@ class SceneResult:
     dofs: int
     seconds: float
     f_max: float = 0.0
+    damping_ratios: np.ndarray | None = None
 
 
 def check_parameter_keys(spec: UpdateSpec) -> None:
@@ -244,15 +251,16 @@ class SceneEvaluator:
         f_max = max(f_guess, self.f_last.get(scene, 0.0))
         need_mass = any(t.kind == "mass" and t.scene == scene for t in self.spec.targets)
         measured = {t.name: self.measured[t.name] for t in self.spec.targets if t.kind == "paired" and t.scene == scene}
+        need_damping = any(t.kind == "paired" and t.use_damping and t.scene == scene for t in self.spec.targets)
         args = (scene, self.overrides(scene, values, extra), n, f_max, need_mass, measured)
         if self.comm.size == 1 and self.isolate:
             if self.pool is None:
                 from housingfe.correlation.worker import Worker
 
                 self.pool = Worker(WORKER_TASKS, module=__name__)
-            result = self.pool.call("solve_scene", *args)
+            result = self.pool.call("solve_scene", *args, None, need_damping)
         else:
-            result = solve_scene(*args, comm=self.comm)
+            result = solve_scene(*args, comm=self.comm, need_damping=need_damping)
         self.f_last[scene] = result.f_max
         self.seconds.append(result.seconds)
         self.cache[key] = result
@@ -268,7 +276,7 @@ WORKER_TASKS = 20
 
 
 def solve_scene(scene: str, overrides: list[str], n: int, f_max: float, need_mass: bool, measured: dict,
-                comm=None) -> SceneResult:
+                comm=None, need_damping: bool = False) -> SceneResult:
     """Build a scene with overrides and solve at least n elastic modes (f_max raised until there are n);
     the mass (kg) from the rigid x-translation t^T M t if need_mass; the modes sampled on the channels of
     each measured ModeSet (name -> ModeSet)."""
@@ -297,7 +305,30 @@ def solve_scene(scene: str, overrides: list[str], n: int, f_max: float, need_mas
         y = t.duplicate()
         model.M.mult(t, y)
         mass = float(t.dot(y))
-    return SceneResult(freqs, basis.rigid_count, mass, sampled, model.dofs, time.perf_counter() - t0, f_max)
+    zeta = modal_damping_ratios(sc.damping, model, basis) if need_damping else None
+    return SceneResult(freqs, basis.rigid_count, mass, sampled, model.dofs, time.perf_counter() - t0, f_max, zeta)
+
+
+def modal_damping_ratios(spec, structure, basis) -> np.ndarray:
+    """Viscous damping ratio (-) of each elastic mode of a basis under a scene's DampingSpec: xi as given; a
+    loss factor eta(f) as eta / 2 at the mode's frequency (equal loss per cycle at resonance); per-material loss
+    factors (damping matrix D) by the modal strain energy, xi_k = phi_k^T D phi_k / (2 lambda_k) for
+    mass-normalised phi_k."""
+    from housingfe.response.forced import damping_model
+
+    damping = damping_model(spec, structure)
+    freqs = basis.frequencies_hz[basis.rigid_count:]
+    xi = damping.ratios(len(freqs))
+    if xi is not None:
+        return np.asarray(xi, float)
+    if damping.D is None:
+        return 0.5 * np.asarray(damping.hysteretic(freqs), float)
+    out = []
+    y = basis.vectors[0].duplicate()
+    for lam, x in zip(basis.eigenvalues[basis.rigid_count:], basis.vectors[basis.rigid_count:]):
+        damping.D.mult(x, y)
+        out.append(float(x.dot(y)) / (2.0 * lam))
+    return np.array(out)
 
 
 def _nearest_pair(freqs: np.ndarray, pair: list[float]) -> tuple[float, float]:
@@ -365,6 +396,8 @@ def evaluate_targets(evaluator: SceneEvaluator, values: np.ndarray, extra: dict[
                 res.append((comp_f[j] / fm_i - 1) / t.sigma)
                 if t.use_mac:
                     res.append((1 - m[i, j]) / t.sigma_mac)
+                if t.use_damping and meas.damping is not None and meas.damping[i] > 0:
+                    res.append((r.damping_ratios[j] / meas.damping[i] - 1) / t.sigma_damping)
             out.append(TargetValue(t.name, t.role, np.array(res), pairing, meas.frequencies_hz))
     return out
 
