@@ -1,5 +1,6 @@
 """`housingfe bench direct`: the direct harmonic solver (non-proportional damping), complex worker against the real
-2x2 block form, per line; both on one core, and the complex form once more with one worker per core.
+2x2 block form, per line; both on one core, then with every core each: the complex form with one worker per core
+and the block form on as many MPI ranks (a child `mpirun` of this module with --block-child).
 
 Model: box-free-frf on its default mesh (Q2 hexahedra, 38 997 DOFs), both load cases, eta per band.  The two forms
 solve the same LINES consecutive lines (4.88 Hz apart around 1.5 kHz), interleaved block, complex, block, complex, ...
@@ -46,11 +47,18 @@ def main(out_dir: Path, quick: bool = False) -> None:
     cores = harmonic.default_direct_workers(n_lines)
     if cores > 1:
         forms[f"complex x{cores} workers"] = ("complex", cores)
+    if cores > 1:
+        forms[f"block, {cores} MPI ranks"] = ("block-ranks", cores)
     times: dict[str, list] = {name: [] for name in forms}
     answers = {}
     for rnd in range(QUICK_ROUNDS if quick else ROUNDS):
         for method, (form, workers) in forms.items():
             load = os.getloadavg()[0]
+            if form == "block-ranks":
+                per_line, answers[method] = _block_on_ranks(workers, n_lines)
+                times[method].append((per_line, load))
+                print(f"round {rnd + 1}  {method:18s} {per_line:.3f} s per line  load before {load:.2f}", flush=True)
+                continue
             t0 = time.perf_counter()
             res = harmonic.direct(model.K, model.M, loads, freqs, damping, observer.reduce, method=form,
                                   workers=workers)
@@ -65,7 +73,7 @@ def main(out_dir: Path, quick: bool = False) -> None:
     rows = [[m, model.dofs, n_lines, min(t for t, _ in v), statistics.median(t for t, _ in v),
              max(t for t, _ in v), len(v), max(ld for _, ld in v), base / statistics.median(t for t, _ in v)]
             for m, v in times.items()]
-    note = f"largest relative difference of the responses, complex vs block: {difference:.1e}"
+    note = f"largest relative difference of the responses, every form vs block on one core: {difference:.1e}"
     table = format_table(header, rows)
     with atomic_output_dir(out_dir) as tmp:
         write_csv(tmp / "direct_bench.csv", header, rows)
@@ -76,11 +84,71 @@ def main(out_dir: Path, quick: bool = False) -> None:
     print(f"results: {out_dir}/")
 
 
+def _block_on_ranks(ranks: int, n_lines: int) -> tuple[float, list]:
+    """Wall time per line (s) of the block form on `ranks` MPI ranks, and its surface <v^2> per load: a child
+    `mpirun -n ranks python -m housingfe.benchmarks.direct --block-child N FILE` (model built there, the direct
+    call timed between barriers)."""
+    import subprocess
+    import sys
+    import tempfile
+
+    from housingfe.benchmarks._launch import mpi_environment, mpi_launcher
+
+    with tempfile.TemporaryDirectory(prefix="housingfe-bench-direct-") as tmp:
+        out = Path(tmp) / "block.npz"
+        cmd = mpi_launcher(ranks) + [sys.executable, "-m", "housingfe.benchmarks.direct", "--block-child",
+                                     str(n_lines), str(out)]
+        proc = subprocess.run(cmd, env=mpi_environment(), capture_output=True, text=True)
+        if proc.returncode != 0 or not out.exists():
+            raise RuntimeError(f"block form on {ranks} ranks failed (exit {proc.returncode}): {proc.stderr[-500:]}")
+        data = np.load(out)
+        return float(data["per_line"]), [_MeanSquare(v) for v in data["msv"]]
+
+
+class _MeanSquare:
+    """A LoadResponse stand-in carrying only the surface <v^2> (the child run returns no receptances)."""
+
+    def __init__(self, msv):
+        self.mean_square_velocity = msv
+        self.receptance = None
+
+
+def _block_child(n_lines: int, out: str) -> None:
+    """The block form on this process' MPI_COMM_WORLD; rank 0 writes per_line (s) and msv (loads x lines)."""
+    from mpi4py import MPI
+
+    from housingfe.fe.loads import assemble_load
+    from housingfe.response.forced import damping_model
+    from housingfe.response.observers import SurfaceObserver, responses
+    from housingfe.scene import build_model_from_scene, load_housing_scene
+    from housingfe.solvers import harmonic
+
+    comm = MPI.COMM_WORLD
+    scene, _ = load_housing_scene("box-free-frf")
+    model = build_model_from_scene(scene, comm)
+    spec = scene.analysis.harmonic
+    loads = [assemble_load(load, model.housing, model.V, model.bcs) for load in scene.loads]
+    observer = SurfaceObserver(model, spec.surface, [], loads)
+    damping = damping_model(scene.damping, model)
+    freqs = F_START + spec.df * np.arange(n_lines)
+    comm.barrier()
+    t0 = time.perf_counter()
+    res = harmonic.direct(model.K, model.M, loads, freqs, damping, observer.reduce, method="block")
+    answer = responses(res, observer, loads)
+    comm.barrier()
+    per_line = (time.perf_counter() - t0) / n_lines
+    if comm.rank == 0:
+        np.savez(out, per_line=per_line, msv=np.array([r.mean_square_velocity for r in answer]))
+
+
 def _max_relative_difference(a: list, b: list) -> float:
-    """Largest relative difference of the surface <v^2> and of the receptances of two lists of LoadResponses."""
+    """Largest relative difference of the surface <v^2> and of the receptances of two lists of LoadResponses
+    (receptances skipped where one side has none)."""
     worst = 0.0
     for ra, rb in zip(a, b):
         for xa, xb in ((ra.mean_square_velocity, rb.mean_square_velocity), (ra.receptance, rb.receptance)):
+            if xa is None or xb is None:
+                continue
             worst = max(worst, float(np.max(np.abs(xa - xb)) / np.max(np.abs(xa))))
     return worst
 
@@ -100,3 +168,13 @@ def _plot(path: Path, rows: list) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+if __name__ == "__main__":
+    import sys
+
+    if len(sys.argv) == 4 and sys.argv[1] == "--block-child":
+        _block_child(int(sys.argv[2]), sys.argv[3])
+    else:
+        raise SystemExit("usage: python -m housingfe.benchmarks.direct --block-child N_LINES OUT.npz "
+                         "(the benchmark itself: housingfe bench direct)")
