@@ -26,6 +26,9 @@ from housingfe.errors import SolverError
 RIGID_EIGENVALUE_RATIO = 1e-13
 # Kept for small dense models that have no matrix scale at hand (housingfe.drivetrain.interior): a frequency ratio.
 RIGID_FREQUENCY_RATIO = 1e-4
+# From this many DOFs on, method="auto" uses the block Krylov–Schur (housingfe.solvers.block_eigen): below,
+# MUMPS' single solves are cheap and SLEPc's Krylov–Schur needs fewer of them (bench modal).
+BLOCK_MIN_DOFS = 5000
 
 
 @dataclass
@@ -37,6 +40,7 @@ class ModalResult:
     expected_count: eigenvalues below (2 pi f_max)^2 by the inertia count.
     residuals: ||K x - lambda M x|| / ||K x|| (for rigid modes: / (sigma_max ||M x||)).
     eigenvalue_scale: max_i K_ii / M_ii (rad^2/s^2), the scale against which rigid modes are classified.
+    eigensolver: the method that produced the pairs ("block" or "slepc", see solve_modes).
     """
 
     eigenvalues: np.ndarray
@@ -46,6 +50,7 @@ class ModalResult:
     f_max: float
     timings: dict = field(default_factory=dict)
     eigenvalue_scale: float | None = None
+    eigensolver: str = "slepc"
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -129,15 +134,21 @@ def count_eigenvalues_below(K: PETSc.Mat, M: PETSc.Mat, sigma: float) -> int:
 
 def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = None,
                 tol: float = 1e-10, require_complete: bool = True, shift_hz: float | None = None,
-                ncv: int | None = None, purify: bool = False) -> ModalResult:
+                ncv: int | None = None, purify: bool = False, method: str = "auto") -> ModalResult:
     """All eigenpairs with frequency below f_max (Hz).
 
-    nev: number of eigenpairs to ask SLEPc for (default: the inertia count); asking for fewer makes the
+    nev: number of eigenpairs to ask for (default: the inertia count); asking for fewer makes the
     result incomplete, which raises SolverError when require_complete is True.
     shift_hz: shift of the spectral transformation (default: -1 % of f_max, i.e. below the rigid modes).
-    purify: SLEPc's eigenvector purification costs one extra solve per mode (2.4 s of a 10 s box run);
-    constrained rows are decoupled (1 on K's, 0 on M's diagonal), so it is off and residuals are reported.
+    method: "block" (housingfe.solvers.block_eigen: block Krylov–Schur, several right-hand sides per MUMPS
+    solve), "slepc" (SLEPc's Krylov–Schur) or "auto": block from BLOCK_MIN_DOFS DOFs on (where a block of
+    solves is cheaper than single ones), SLEPc below and whenever the block method fails.
+    ncv, purify: SLEPc only.  purify: SLEPc's eigenvector purification costs one extra solve per mode (2.4 s
+    of a 10 s box run); constrained rows are decoupled (1 on K's, 0 on M's diagonal), so it is off and
+    residuals are reported.
     """
+    if method not in EIGENSOLVERS and method != "auto":
+        raise ValueError(f"unknown eigensolver {method!r}: choose from auto, {', '.join(EIGENSOLVERS)}")
     sigma_max = (2 * math.pi * f_max) ** 2
     t0 = time.perf_counter()
     expected = count_eigenvalues_below(K, M, sigma_max)
@@ -146,7 +157,20 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     shift = -((2 * math.pi * (shift_hz if shift_hz is not None else 0.01 * f_max)) ** 2)
     requested = expected if nev is None else nev
     t0 = time.perf_counter()
-    pairs = _krylov_schur(K, M, shift, requested, ncv, tol, purify, sigma_max)
+    chosen = method if method != "auto" else ("block" if K.getSize()[0] >= BLOCK_MIN_DOFS else "slepc")
+    pairs = [] if requested == 0 else None
+    phases = {}
+    if chosen == "block" and pairs is None:
+        try:
+            pairs = _block_krylov_schur(K, M, shift, requested, tol, sigma_max, phases)
+        except SolverError:
+            if method == "block":
+                raise
+        if method == "auto" and pairs is not None and len(pairs) < requested:
+            pairs = None   # an eigenvalue missed: SLEPc below, with its retry for close pairs at f_max
+    if pairs is None:
+        chosen = "slepc"
+        pairs = _krylov_schur(K, M, shift, requested, ncv, tol, purify, sigma_max)
     if nev is None and len(pairs) < requested:
         # SLEPc's nev closest to the shift can miss one of a close pair near f_max (seen on the coupled test
         # gearbox: 62 of 63): ask again for a few more; the extras above f_max are dropped
@@ -157,11 +181,44 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     vectors = [p[1] for p in pairs]
     residuals = _normalise_and_residuals(K, M, values, vectors, sigma_max)
     result = ModalResult(values, vectors, expected, residuals, f_max,
-                         {"inertia_s": t_inertia, "eigensolve_s": t_solve}, eigenvalue_scale(K, M))
+                         {"inertia_s": t_inertia, "eigensolve_s": t_solve,
+                          **{f"eigensolve_{k}": v for k, v in phases.items()}}, eigenvalue_scale(K, M),
+                         eigensolver=chosen)
     if require_complete and not result.complete:
         raise SolverError(f"incomplete eigen-solution: {len(values)} eigenvalues returned, "
                           f"{expected} lie below f_max = {f_max:g} Hz (inertia count)")
     return result
+
+
+def _block_krylov_schur(K, M, shift: float, nev: int, tol: float, sigma_max: float,
+                        timings: dict | None = None) -> list:
+    """(eigenvalue, vector) pairs below sigma_max, ascending, by housingfe.solvers.block_eigen with a MUMPS
+    Cholesky of K - shift M.  Fewer than nev pairs when an eigenvalue was missed (the caller falls back).
+    `timings` (if given) receives the phases: factor_s, solve_s, mass_s, orthogonalise_s, restart_s."""
+    from housingfe.solvers.block_eigen import block_krylov_schur
+
+    P = K.copy()
+    P.axpy(-shift, M, structure=axpy_structure(P, M))
+    P.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    ksp = mumps_cholesky(P, "modal_shift_")
+    try:
+        t0 = time.perf_counter()
+        ksp.setUp()
+        t_factor = time.perf_counter() - t0
+        result = block_krylov_schur(ksp.getPC().getFactorMatrix(), M, shift, nev, tol=tol)
+        if timings is not None:
+            timings.update(factor_s=t_factor, **result.timings, block_solves=result.block_solves,
+                           restarts=result.restarts)
+    finally:
+        ksp.destroy()
+        P.destroy()
+    pairs = []
+    for j, lam in enumerate(result.eigenvalues):
+        if lam < sigma_max:
+            x = K.createVecRight()
+            x.getArray()[:] = result.vectors[:, j]
+            pairs.append((float(lam), x))
+    return pairs
 
 
 def _krylov_schur(K, M, shift: float, nev: int, ncv, tol: float, purify: bool, sigma_max: float,
@@ -214,6 +271,9 @@ def _krylov_schur(K, M, shift: float, nev: int, ncv, tol: float, purify: bool, s
         M_fast.destroy()
     pairs.sort(key=lambda p: p[0])
     return pairs[:keep]
+
+
+EIGENSOLVERS = {"block": _block_krylov_schur, "slepc": _krylov_schur}
 
 
 def _symmetric_block_copy(M: PETSc.Mat) -> PETSc.Mat:
