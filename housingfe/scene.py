@@ -66,6 +66,21 @@ class MeshSpec(_Strict):
     # converge at O(h) only (box, Q3: rates 0.7-1.4 per mode); < 1 puts the elements there.
     grading: float = Field(default=1.0, gt=0.0, le=1.0)
     allow_large: bool = False   # run even when the estimated memory exceeds what the machine has available
+    # "serendipity" (hex, degree 2: the 20-node brick) with integration "reduced" (2x2x2 Gauss points in the
+    # stiffness, the mass fully integrated) is CalculiX's / Abaqus' C3D20R: softer in bending than Q2/Q3 at
+    # the same DOFs; with 3 layers through the walls it reaches 0.86 % on the free box at 40 k DOFs (bench
+    # modal).  Modal analyses only: loads, sample points and couplings use Lagrange nodes.
+    family: Literal["lagrange", "serendipity"] = "lagrange"
+    integration: Literal["full", "reduced"] = "full"
+
+    @model_validator(mode="after")
+    def _element_family(self):
+        if self.family == "serendipity" and (self.element != "hex" or self.degree != 2):
+            raise ValueError("family: serendipity elements need element = \"hex\" and degree = 2")
+        if self.integration == "reduced" and self.family != "serendipity":
+            raise ValueError("integration: reduced integration needs family = \"serendipity\" (Lagrange bricks "
+                             "under-integrated have spurious zero-energy modes)")
+        return self
 
 
 class ModalSpec(_Strict):
@@ -323,6 +338,10 @@ class HousingScene(_Strict):
         names = [load.name for load in self.loads]
         if len(set(names)) != len(names):
             raise ValueError("loads: load case names must be unique")
+        if self.mesh.family != "lagrange" and (self.analysis.harmonic is not None or self.coupling is not None
+                                               or self.supports):
+            raise ValueError("mesh.family: serendipity elements support modal analyses of free housings only "
+                             "(loads, supports, sample points and couplings use Lagrange nodes)")
         return self
 
 

@@ -51,6 +51,10 @@ HOUSINGFE_CASES = [
     {"element": "hex", "degree": 3, "size": 0.025, "layers": 1, "grading": 0.3, "eigensolver": "slepc"},
     {"element": "hex", "degree": 3, "size": 0.025, "layers": 1, "grading": 0.3, "ranks": 2},
     {"element": "tet", "degree": 2, "size": 0.020, "layers": 1},
+    # the 20-node serendipity brick, reduced integration: CalculiX's C3D20R, on CalculiX's best mesh at 1 %
+    {"element": "hex", "degree": 2, "size": 0.030, "layers": 3, "family": "serendipity", "integration": "reduced"},
+    {"element": "hex", "degree": 2, "size": 0.030, "layers": 3, "family": "serendipity", "integration": "reduced",
+     "ranks": 2},
 ]
 # CalculiX's element and mesh choices that matter here (C3D20R: C3D20 is stiffer, 2.52 % vs 1.94 % at 15 mm):
 # the number of element layers through the 8 mm walls decides its error (mode 7, 1374 Hz, converges with the
@@ -78,7 +82,9 @@ def run_housingfe_case(case: dict) -> dict:
 
     overrides = [f"mesh.element=\"{case['element']}\"", f"mesh.degree={case['degree']}",
                  f"mesh.size={case['size']}", f"mesh.layers={case['layers']}",
-                 f"mesh.grading={case.get('grading', 1.0)}", f"analysis.modal.f_max={SOLVE_TO}"]
+                 f"mesh.grading={case.get('grading', 1.0)}", f"analysis.modal.f_max={SOLVE_TO}",
+                 f"mesh.family=\"{case.get('family', 'lagrange')}\"",
+                 f"mesh.integration=\"{case.get('integration', 'full')}\""]
     scene, _ = load_housing_scene("box-free", overrides)
     model = build_model_from_scene(scene, MPI.COMM_WORLD)
     result = modal.solve_modes(model.K, model.M, SOLVE_TO, method=case.get("eigensolver", "auto"))
@@ -211,6 +217,10 @@ def label(code: str, case: dict) -> str:
     graded = f" g{case['grading']:g}" if case.get("grading", 1.0) < 1.0 else ""
     if code == "calculix":
         return f"ccx {case['ccx_type']} h={case['size'] * 1e3:g}mm x{case['layers']}{graded}"
+    if case.get("family") == "serendipity":
+        order = "S2R" if case.get("integration") == "reduced" else "S2"
+        return f"{order} hex h={case['size'] * 1e3:g}mm x{case['layers']}{graded}" + (
+            f" {case['ranks']} ranks" if case.get("ranks", 1) > 1 else "")
     order = {2: "Q2" if case["element"] == "hex" else "P2", 3: "Q3" if case["element"] == "hex" else "P3",
              1: "Q1" if case["element"] == "hex" else "P1"}[case["degree"]]
     ranks = case.get("ranks", 1)
@@ -368,19 +378,28 @@ def main(out_dir: Path, quick: bool = False) -> None:
 
 def _speedup_at(rows: list, runs: dict, max_error_pct: float) -> str:
     """Fastest case (median wall) of each code reaching max error <= max_error_pct, the ratio of their medians
-    and the range of the per-round ratios."""
-    best = {}
-    for r in rows:
-        if r[10] <= max_error_pct and (r[0] not in best or r[4] < best[r[0]][4]):
-            best[r[0]] = r
-    if "housingfe" in best and "calculix" in best:
-        h, c = best["housingfe"], best["calculix"]
-        per_round = [tc / th for (th, _), (tc, _) in zip(runs[h[1]], runs[c[1]])]
-        spread = f" (per round {min(per_round):.1f}-{max(per_round):.1f}x)" if len(per_round) > 1 else ""
-        return (f"at <= {max_error_pct:g} % max error: housingfe {h[1]} {h[4]:.1f} s vs CalculiX {c[1]} "
-                f"{c[4]:.1f} s (medians) -> {c[4] / h[4]:.1f}x faster{spread}")
-    return f"at <= {max_error_pct:g} % max error: best per code: " + ", ".join(
-        f"{k}: {v[1]} {v[4]:.1f} s" for k, v in best.items())
+    and the range of the per-round ratios: housingfe on one rank, and on any number of ranks (CalculiX runs
+    with 2 threads, so the 2-rank row is the comparison at equal cores)."""
+    lines = []
+    for scope, keep in (("housingfe on 1 core", lambda r: " ranks" not in r[1]), ("housingfe on 2 ranks", None)):
+        best = {}
+        for r in rows:
+            if r[0] == "housingfe" and keep is not None and not keep(r):
+                continue
+            if r[10] <= max_error_pct and (r[0] not in best or r[4] < best[r[0]][4]):
+                best[r[0]] = r
+        if "housingfe" in best and "calculix" in best:
+            h, c = best["housingfe"], best["calculix"]
+            per_round = [tc / th for (th, _), (tc, _) in zip(runs[h[1]], runs[c[1]])]
+            spread = f" (per round {min(per_round):.1f}-{max(per_round):.1f}x)" if len(per_round) > 1 else ""
+            lines.append(f"at <= {max_error_pct:g} % max error, {scope}: housingfe {h[1]} {h[4]:.1f} s vs CalculiX "
+                         f"{c[1]} {c[4]:.1f} s (medians) -> {c[4] / h[4]:.1f}x faster{spread}")
+        else:
+            lines.append(f"at <= {max_error_pct:g} % max error, {scope}: best per code: " + ", ".join(
+                f"{k}: {v[1]} {v[4]:.1f} s" for k, v in best.items()))
+        if keep is None:
+            break
+    return "\n".join(lines)
 
 
 def _plot(path: Path, rows: list) -> None:

@@ -43,6 +43,7 @@ class HousingModel:
     materials: object = None
     scene: object = None
     element_degree: int = 2
+    reduced_integration: bool = False
 
     # ----------------------------------------------------------------------- the Structure protocol
     C = None               # no viscous damping matrix on the bare housing
@@ -94,7 +95,8 @@ class HousingModel:
         eta = self.materials.eta
         if self.V.mesh.comm.allreduce(float(np.abs(eta.x.array).max(initial=0.0)), op=MPI.MAX) == 0.0:
             return None
-        D = assemble_matrix(stiffness_form(self.V, self.materials, weight=eta), bcs=self.bcs, diagonal=0.0)
+        D = assemble_matrix(stiffness_form(self.V, self.materials, weight=eta, reduced=self.reduced_integration),
+                            bcs=self.bcs, diagonal=0.0)
         D.assemble()
         return D
 
@@ -128,14 +130,15 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
         raise InputError(f"mesh: element quality {housing.quality['min']:.3f} < {MIN_ELEMENT_QUALITY} "
                          f"({housing.quality['measure']}); change mesh.size or mesh.element")
     t0 = time.perf_counter()
-    V = elasticity.displacement_space(housing.mesh, mesh.degree)
+    V = elasticity.displacement_space(housing.mesh, mesh.degree, mesh.family)
     materials = material_field(regions, housing, material)
     bcs = boundary_conditions(supports, geometry, housing, V)
-    K, M = elasticity.assemble_stiffness_mass(V, materials, bcs, foundation_forms(supports, housing, V))
+    reduced = mesh.integration == "reduced"
+    K, M = elasticity.assemble_stiffness_mass(V, materials, bcs, foundation_forms(supports, housing, V), reduced)
     timings = {"mesh_s": housing.mesh_time_s, "assembly_s": time.perf_counter() - t0}
     free = not bcs and not any(s.kind == "elastic" for s in supports)
     return HousingModel(housing, material, V, bcs, K, M, 6 if free else 0, timings, materials,
-                        element_degree=mesh.degree)
+                        element_degree=mesh.degree, reduced_integration=reduced)
 
 
 def available_memory_bytes() -> tuple[int, int]:

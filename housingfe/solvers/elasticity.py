@@ -15,9 +15,12 @@ from petsc4py import PETSc
 from housingfe.materials import Material
 
 
-def displacement_space(mesh, degree: int = 2):
-    """Vector Lagrange space of the given polynomial degree for the displacement (m)."""
-    return fem.VectorFunctionSpace(mesh, ("Lagrange", degree))
+FAMILIES = {"lagrange": "Lagrange", "serendipity": "S"}
+
+
+def displacement_space(mesh, degree: int = 2, family: str = "lagrange"):
+    """Vector space of the given polynomial degree and family (lagrange, serendipity) for the displacement (m)."""
+    return fem.VectorFunctionSpace(mesh, (FAMILIES[family], degree))
 
 
 class MaterialField:
@@ -49,22 +52,26 @@ def _stress(u, lam, mu):
     return 2.0 * mu * eps + lam * ufl.tr(eps) * ufl.Identity(len(u))
 
 
-def volume_measure(V):
+def volume_measure(V, reduced: bool = False):
     """dx with full Gauss integration on hexahedra: (p+1)^3 points for Q_p, exact for K and M on brick
     (parallelepiped) cells.  UFL's estimate adds degrees for the trilinear geometry map and picks (p+2)^3:
     the same matrices to 3e-15 on the box meshes at 2.2x the assembly time (Q3, 40 mm: 1.58 -> 0.72 s for K).
-    Simplices keep UFL's estimate, which is exact there (affine cells)."""
+    Simplices keep UFL's estimate, which is exact there (affine cells).  reduced: p^3 points (2x2x2 for the
+    20-node brick, C3D20R's rule)."""
+    if reduced:
+        return ufl.dx(metadata={"quadrature_degree": 2 * V.ufl_element().degree() - 2})
     if V.mesh.topology.cell_type == CellType.hexahedron:
         return ufl.dx(metadata={"quadrature_degree": 2 * V.ufl_element().degree()})
     return ufl.dx
 
 
-def stiffness_form(V, materials: MaterialField, weight=None):
+def stiffness_form(V, materials: MaterialField, weight=None, reduced: bool = False):
     """Bilinear form of the elastic strain energy, K (N/m); `weight` (e.g. the loss factor field)
-    multiplies the integrand, giving the hysteretic damping matrix for weight = eta."""
+    multiplies the integrand, giving the hysteretic damping matrix for weight = eta.  reduced: reduced
+    Gauss integration (volume_measure)."""
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     integrand = ufl.inner(_stress(u, materials.lam, materials.mu), ufl.sym(ufl.grad(v)))
-    return fem.form((integrand if weight is None else weight * integrand) * volume_measure(V))
+    return fem.form((integrand if weight is None else weight * integrand) * volume_measure(V, reduced))
 
 
 def mass_form(V, materials: MaterialField):
@@ -98,12 +105,12 @@ def clamp_bc(V, facets: np.ndarray, components: tuple[int, ...] | None = None) -
     return bcs
 
 
-def assemble_stiffness_mass(V, materials: MaterialField, bcs: list, extra_stiffness: list = ()
-                            ) -> tuple[PETSc.Mat, PETSc.Mat]:
+def assemble_stiffness_mass(V, materials: MaterialField, bcs: list, extra_stiffness: list = (),
+                            reduced: bool = False) -> tuple[PETSc.Mat, PETSc.Mat]:
     """Assemble K (plus any extra stiffness forms, e.g. foundations) and M.  Constrained rows/columns get 1
     on K's diagonal and 0 on M's, so their eigenvalues go to infinity and never enter the spectrum of
-    interest."""
-    K = assemble_matrix(stiffness_form(V, materials), bcs=bcs, diagonal=1.0)
+    interest.  reduced: reduced integration of K (M stays fully integrated)."""
+    K = assemble_matrix(stiffness_form(V, materials, reduced=reduced), bcs=bcs, diagonal=1.0)
     K.assemble()
     for form in extra_stiffness:
         Ke = assemble_matrix(form, bcs=bcs, diagonal=0.0)
@@ -118,22 +125,15 @@ def assemble_stiffness_mass(V, materials: MaterialField, bcs: list, extra_stiffn
 
 def rigid_body_vectors(V) -> list[PETSc.Vec]:
     """The six rigid-body fields: translations x, y, z and rotations about the x, y, z axes through the
-    origin (m per unit translation / rad)."""
-    from dolfinx import la
-
-    index_map, bs = V.dofmap.index_map, V.dofmap.index_map_bs
-    vectors = [la.create_petsc_vector(index_map, bs) for _ in range(6)]
-    x = V.tabulate_dof_coordinates()
-    n = index_map.size_local + index_map.num_ghosts
-    x = x[:n]
-    for i, vec in enumerate(vectors):
-        with vec.localForm() as local:
-            a = np.zeros((n, 3))
-            if i < 3:
-                a[:, i] = 1.0
-            else:
-                axis = np.zeros(3)
-                axis[i - 3] = 1.0
-                a[:] = np.cross(axis, x)
-            local.array[:] = a.reshape(-1)
+    origin (m per unit translation / rad), interpolated into V (exact: they are linear; any element family)."""
+    vectors = []
+    for i in range(6):
+        u = fem.Function(V)
+        if i < 3:
+            u.interpolate(lambda x, i=i: np.vstack([np.full(x.shape[1], 1.0 if c == i else 0.0) for c in range(3)]))
+        else:
+            axis = np.zeros(3)
+            axis[i - 3] = 1.0
+            u.interpolate(lambda x, axis=axis: np.cross(axis, x.T).T)
+        vectors.append(u.vector.copy())
     return vectors
