@@ -49,7 +49,8 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from housingfe.benchmarks import _dispatch as bench
 
-    bench.main(args.which, out_dir=args.out, quick=args.quick)
+    only = [n for n in (args.only or "").split(",") if n]
+    bench.main(args.which, out_dir=args.out, quick=args.quick, only=only or None)
     return 0
 
 
@@ -132,6 +133,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("which", help=f"which benchmark: {', '.join(available())}")
     p.add_argument("--out", default=None, help="result folder (default results/bench-<which>)")
     p.add_argument("--quick", action="store_true", help="small subset, for a smoke run")
+    p.add_argument("--only", default=None, metavar="NAMES",
+                   help="with `all`: re-run only these benchmarks (comma-separated) and replace their sections "
+                        "of docs/benchmarks.md")
     p.set_defaults(func=_cmd_bench)
 
     p = sub.add_parser("mesh-picture", help="PNG of a scene's mesh coloured by feature (for the docs)")

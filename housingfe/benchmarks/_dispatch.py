@@ -13,9 +13,15 @@ def available() -> list[str]:
     return sorted(m.name for m in pkgutil.iter_modules([str(Path(__file__).parent)]) if not m.name.startswith("_"))
 
 
-def main(which: str, out_dir: str | None = None, quick: bool = False) -> None:
-    """Run one benchmark; results go to out_dir (default results/bench-<which>)."""
+def main(which: str, out_dir: str | None = None, quick: bool = False, only: list[str] | None = None) -> None:
+    """Run one benchmark; results go to out_dir (default results/bench-<which>).  only: for `all`, the subset to
+    re-run (their sections of docs/benchmarks.md are replaced)."""
     if which not in available():
         raise InputError(f"bench: unknown benchmark {which!r} (available: {', '.join(available())})")
     module = importlib.import_module(f"housingfe.benchmarks.{which}")
+    if only:
+        if which != "all":
+            raise InputError("bench: --only applies to `housingfe bench all`")
+        module.main(Path(out_dir or f"results/bench-{which}"), quick, only=only)
+        return
     module.main(Path(out_dir or f"results/bench-{which}"), quick)
