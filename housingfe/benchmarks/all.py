@@ -208,7 +208,7 @@ def update_sections(page: Path, results: list[dict], info: dict, notes: str) -> 
     for r in results:
         note = (f"*Re-run alone by `housingfe bench all --only {','.join(x['name'] for x in results)}` on {date} "
                 f"UTC: {r['wall_s']:.1f} s, peak {r['peak_gb']:.2f} GB, load {r['load_before']:.2f} → "
-                f"{r['load_after']:.2f}, git {info.get('git commit', '?')}; the header's tables are from the last "
+                f"{r['load_after']:.2f}, git {info.get('git', '?')}; the header's tables are from the last "
                 "full run.*")
         sections[r["name"]] = "\n".join(render_section(r, blocks, note)).strip("\n")
     line = f"Sections re-run alone since: {', '.join(r['name'] for r in results)} on {date} UTC (`--only`)."
