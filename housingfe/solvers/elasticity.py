@@ -14,7 +14,6 @@ from petsc4py import PETSc
 
 from housingfe.materials import Material
 
-
 FAMILIES = {"lagrange": "Lagrange", "serendipity": "S"}
 
 
