@@ -298,6 +298,7 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None, 
 
     from housingfe.solvers import _complex_worker
 
+    HEAD = _complex_worker.HEAD_BYTES
     if K.getComm().getSize() != 1:
         raise SolverError("direct solver: the complex worker runs on one MPI rank; use method='block' in parallel")
     t0 = time.perf_counter()
@@ -321,12 +322,14 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None, 
     procs = [subprocess.Popen([sys.executable, "-m", "housingfe.solvers._complex_worker", "-"], stdin=subprocess.PIPE,
                               stdout=subprocess.PIPE, stderr=err, env=_complex_worker.complex_env()) for err in errs]
     job = {"loads": np.array([load.vector.getArray() for load in loads], dtype=float).reshape(len(loads), n),
-           "omega": omega, "eta": np.broadcast_to(eta, omega.shape).copy(), "use_D": use_D, "symmetric": symmetric}
+           "omega": omega, "eta": np.broadcast_to(eta, omega.shape).copy(), "use_D": use_D, "symmetric": symmetric,
+           "block_size": K.getBlockSize()}
     blocks = [[] for _ in loads]
     pair = np.array([[1.0], [1j]])
     t_factor = 0.0
-    line_bytes = 16 + 16 * len(loads) * n
+    line_bytes = HEAD + 16 * len(loads) * n
     factorisations = 0
+    backward_error = 0.0
     try:
         K_pattern = None
         for name, A in (("K", K), ("M", M), ("D", damping.D if use_D else None), ("C", C)):
@@ -350,10 +353,11 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None, 
             raw = procs[k % n_workers].stdout.read(line_bytes)
             if len(raw) < line_bytes:
                 break
-            head = np.frombuffer(raw[:16], np.float64)
+            head = np.frombuffer(raw[:HEAD], np.float64)
             t_factor += float(head[0])
             factorisations += int(head[1])
-            sol = np.frombuffer(raw[16:], np.complex128).reshape(len(loads), n)
+            backward_error = max(backward_error, float(head[2]))
+            sol = np.frombuffer(raw[HEAD:], np.complex128).reshape(len(loads), n)
             for j in range(len(loads)):
                 ur, ui = K.createVecRight(), K.createVecRight()
                 ur.setArray(sol[j].real)
@@ -384,6 +388,7 @@ def _direct_complex(K, M, loads, frequencies, damping: Damping, reduce, C=None, 
     return HarmonicResult(frequencies, blocks, "direct",
                           {"direct_s": time.perf_counter() - t0, "direct_factor_s": t_factor,
                            "direct_factorisations": factorisations, "direct_workers": n_workers,
+                           "direct_backward_error": backward_error,
                            "direct_s_per_frequency": (time.perf_counter() - t0) / max(len(frequencies), 1)})
 
 

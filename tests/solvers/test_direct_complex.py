@@ -112,3 +112,39 @@ def test_a_dense_sweep_equals_block_form(plate, workers):
     assert np.max(np.abs(u_new - u_old) / np.abs(u_old).max(axis=2, keepdims=True)) < 1e-9
     assert new.timings["direct_factorisations"] == len(freqs) and new.timings["direct_workers"] == workers
     assert [b.index[0] for b in new.blocks[0]] == list(range(len(freqs)))
+
+
+def test_backward_error_is_reported_and_a_poor_line_is_refactorised_with_scaling(plate, tmp_path):
+    """The worker checks each line's normwise backward error: the plate's lines are at round-off (< 1e-13) without
+    MUMPS' scaling; a line above the tolerance (forced here: tolerance 0) is factorised again with scaling, and the
+    answer is the same."""
+    import subprocess
+    import sys
+
+    model, loads = plate
+    damping = harmonic.Damping(lambda f: np.full(np.shape(f), 0.02))
+    copies = lambda vecs: [v.copy() for v in vecs]   # noqa: E731
+    res = harmonic.direct(model.K, model.M, loads, FREQS, damping, copies, method="complex", workers=1)
+    assert 0 < res.timings["direct_backward_error"] < 1e-13
+    assert res.timings["direct_factorisations"] == len(FREQS)
+    n = model.K.getSize()[0]
+    job = {"loads": np.array([ld.vector.getArray() for ld in loads]), "omega": 2 * np.pi * FREQS,
+           "eta": np.full(len(FREQS), 0.02), "use_D": False, "symmetric": True, "block_size": 3}
+    for name, A in (("K", model.K), ("M", model.M)):
+        indptr, indices, data = A.getValuesCSR()
+        job.update({f"{name}_indptr": indptr, f"{name}_indices": indices, f"{name}_data": data})
+    np.savez(tmp_path / "job.npz", **job)
+    driver = ("import sys; from housingfe.solvers import _complex_worker as w; w.BACKWARD_ERROR_TOL = 0.0; "
+              f"raise SystemExit(w.run({str(tmp_path / 'job.npz')!r}, sys.stdout.buffer))")
+    out = subprocess.run([sys.executable, "-c", driver], capture_output=True, env=_complex_worker.complex_env(),
+                         check=True).stdout
+    line_bytes = _complex_worker.HEAD_BYTES + 16 * len(loads) * n
+    assert len(out) == len(FREQS) * line_bytes
+    u_ref = _solutions(res)
+    for k in range(len(FREQS)):
+        raw = out[k * line_bytes:(k + 1) * line_bytes]
+        head = np.frombuffer(raw[:_complex_worker.HEAD_BYTES])
+        assert head[1] == (2 if k == 0 else 1)   # scaling stays on once switched on
+        assert head[2] < 1e-13
+        sol = np.frombuffer(raw[_complex_worker.HEAD_BYTES:], np.complex128).reshape(len(loads), n)
+        assert np.abs(sol - u_ref[:, k]).max() < 1e-9 * np.abs(u_ref[:, k]).max()
