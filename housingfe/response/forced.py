@@ -125,12 +125,14 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
         t1 = time.perf_counter()
         if solver == "modal":
             f_basis = spec.modal_basis_factor * spec.f_max
-            modes = modal.solve_modes(K, M, f_basis)
+            # the residual vectors reuse the eigensolve's factorisation of K - shift M
+            modes = modal.solve_modes(K, M, f_basis, keep_solver=spec.residual)
             timings["modal_eigensolve_s"] = time.perf_counter() - t1
             facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
                          rigid_modes=modes.rigid_count, basis_f_max_hz=f_basis)
             result = harmonic.modal_superposition(K, M, modes, loads, freqs, damping,
                                                   observer.reduce, residual=spec.residual)
+            modes.release_solver()
             if spec.solver == "both" and spec.residual:
                 plain = harmonic.modal_superposition(K, M, modes, loads, freqs, damping,
                                                      observer.reduce, residual=False)
@@ -139,11 +141,12 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
         elif solver == "projected":
             f_basis = spec.modal_basis_factor * spec.f_max
             K_sym = K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
-            modes = modal.solve_modes(K_sym, M, f_basis)
+            modes = modal.solve_modes(K_sym, M, f_basis, keep_solver=True)
             timings["modal_eigensolve_s"] = time.perf_counter() - t1
             facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
                          rigid_modes=modes.rigid_count, basis_f_max_hz=f_basis)
             result = harmonic.projected(K, M, modes, loads, freqs, damping, observer.reduce, C=C, K_sym=K_sym)
+            modes.release_solver()
             name = "projected"
         else:
             result = harmonic.direct(K, M, loads, freqs, damping, observer.reduce, C=C)

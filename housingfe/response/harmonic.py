@@ -214,12 +214,18 @@ def harmonic_response(structure_or_basis, loads, damping, frequencies, *, surfac
     every = np.arange(len(f))
     if name in ("modal", "projected"):
         K_sym = K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
-        if basis is None:
-            basis = modal.solve_modes(K_sym, M, basis_factor * f.max())
-        if name == "modal":
-            res = harmonic.modal_superposition(K, M, basis, loads, f, damping, observer.reduce, residual=residual)
-        else:
-            res = harmonic.projected(K, M, basis, loads, f, damping, observer.reduce, C=C, K_sym=K_sym)
+        own_basis = basis is None
+        if own_basis:   # the residual vectors reuse the eigensolve's factorisation of K - shift M
+            basis = modal.solve_modes(K_sym, M, basis_factor * f.max(), keep_solver=True)
+        try:
+            if name == "modal":
+                res = harmonic.modal_superposition(K, M, basis, loads, f, damping, observer.reduce,
+                                                   residual=residual)
+            else:
+                res = harmonic.projected(K, M, basis, loads, f, damping, observer.reduce, C=C, K_sym=K_sym)
+        finally:
+            if own_basis:
+                basis.release_solver()
         # every load case shares the reduced basis: the coherent sum is the sum of the amplitude-weighted
         # coefficients
         reduced = res.blocks[0][0].reduced

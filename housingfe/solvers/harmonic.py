@@ -98,8 +98,7 @@ def modal_superposition(K, M, modal_result, loads, frequencies, damping: Damping
     denominators = modal_denominators(lam_e, omega, eta, xi, eta_modal)
     _check_not_singular(denominators, lam_e, frequencies)
 
-    shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
-    ksp = _factor(_shifted(K, M, shift), "residual_") if residual else None
+    ksp, shift, own = _residual_solver(K, M, modal_result, lam_e, shift, "residual_") if residual else (None, 0, False)
     every = np.arange(len(omega))
     shared = list(rigid) + list(elastic)
     residuals = [_residual_vector(ksp, M, load.vector, rigid, elastic, lam_e, shift) for load in loads] if residual else []
@@ -117,7 +116,7 @@ def modal_superposition(K, M, modal_result, loads, frequencies, damping: Damping
             c[len(shared) + j] = damp[0]
         blocks.append([Block(reduced, c, every)])
         kept.append(shared + residuals)
-    if ksp is not None:
+    if own:
         ksp.destroy()
     return HarmonicResult(np.asarray(frequencies, float), blocks, "modal+residual" if residual else "modal",
                           {"modal_superposition_s": time.perf_counter() - t0}, modal_vectors=kept)
@@ -134,6 +133,17 @@ def modal_denominators(lam_e: np.ndarray, omega: np.ndarray, eta: np.ndarray, xi
         w_n = np.sqrt(lam_e)
         return lam_e[:, None] - omega[None, :] ** 2 + 2j * xi[:, None] * w_n[:, None] * omega[None, :]
     return lam_e[:, None] * (1 + 1j * np.asarray(eta)[None, :]) - omega[None, :] ** 2
+
+
+def _residual_solver(K, M, modal_result, lam_e: np.ndarray, shift: float | None, prefix: str):
+    """(solver of K - shift M, shift, whether the caller destroys it): the eigensolve's own factorisation when
+    modal_result kept it for these K and M (solve_modes(keep_solver=True)) and no other shift is asked for, else
+    a new one at `shift` (default: -(1 % of the highest basis frequency)^2, rad^2/s^2)."""
+    kept = getattr(modal_result, "shifted_solver", None)
+    if shift is None and kept is not None and kept.matches(K, M):
+        return kept, kept.shift, False
+    shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
+    return _factor(_shifted(K, M, shift), prefix), shift, True
 
 
 def _residual_vector(ksp, M, f, rigid, elastic, lam_e, shift) -> PETSc.Vec:
@@ -201,8 +211,7 @@ def ritz_basis(K_sym, M, modal_result, load_vectors, *, shift: float | None = No
     n_rigid = modal_result.rigid_count
     phis = list(modal_result.vectors)
     lam_e = lam[n_rigid:]
-    shift = shift if shift is not None else -(0.01 * math.sqrt(max(lam_e.max(initial=1.0), 1.0))) ** 2
-    ksp = _factor(_shifted(K_sym, M, shift), "projected_")
+    ksp, shift, own = _residual_solver(K_sym, M, modal_result, lam_e, shift, "projected_")
     basis = list(phis)
     for f in load_vectors:
         r = _residual_vector(ksp, M, f, phis[:n_rigid], phis[n_rigid:], lam_e, shift)
@@ -214,7 +223,8 @@ def ritz_basis(K_sym, M, modal_result, load_vectors, *, shift: float | None = No
         if norm > 1e-12 * math.sqrt(max(f.norm(), 1e-300)):
             r.scale(1.0 / norm)
             basis.append(r)
-    ksp.destroy()
+    if own:
+        ksp.destroy()
     return basis
 
 

@@ -41,6 +41,8 @@ class ModalResult:
     residuals: ||K x - lambda M x|| / ||K x|| (for rigid modes: / (sigma_max ||M x||)).
     eigenvalue_scale: max_i K_ii / M_ii (rad^2/s^2), the scale against which rigid modes are classified.
     eigensolver: the method that produced the pairs ("block" or "slepc", see solve_modes).
+    shifted_solver: with solve_modes(keep_solver=True), the eigensolve's factorisation of K - shift M (else
+    None), for the residual vectors of a modal sweep; release_solver() frees it.
     """
 
     eigenvalues: np.ndarray
@@ -51,6 +53,7 @@ class ModalResult:
     timings: dict = field(default_factory=dict)
     eigenvalue_scale: float | None = None
     eigensolver: str = "slepc"
+    shifted_solver: ShiftedSolver | None = None
 
     @property
     def frequencies_hz(self) -> np.ndarray:
@@ -69,6 +72,38 @@ class ModalResult:
     def complete(self) -> bool:
         """True if every eigenvalue below f_max (by the inertia count) was returned."""
         return len(self.eigenvalues) == self.expected_count
+
+    def release_solver(self) -> None:
+        """Free the kept factorisation (a no-op without one)."""
+        if self.shifted_solver is not None:
+            self.shifted_solver.destroy()
+            self.shifted_solver = None
+
+
+@dataclass
+class ShiftedSolver:
+    """The eigensolve's MUMPS factorisation of K - shift M (shift in rad^2/s^2), kept for later solves with the
+    same matrices: the residual vectors of a modal sweep need exactly that factorisation, and a second one costs
+    as much as the first (10 s of a 13 s sweep at 309 k DOFs).  It serves only the K and M it was built from
+    (matches())."""
+
+    ksp: PETSc.KSP
+    matrix: PETSc.Mat
+    shift: float
+    k_handle: int
+    m_handle: int
+
+    def matches(self, K: PETSc.Mat, M: PETSc.Mat) -> bool:
+        """True for the very matrices (PETSc objects) of the eigensolve."""
+        return K.handle == self.k_handle and M.handle == self.m_handle
+
+    def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
+        """x = (K - shift M)^-1 b."""
+        self.ksp.solve(b, x)
+
+    def destroy(self) -> None:
+        self.ksp.destroy()
+        self.matrix.destroy()
 
 
 def mumps_cholesky(A: PETSc.Mat, prefix: str, inertia: bool = False) -> PETSc.KSP:
@@ -142,7 +177,8 @@ def _inertia_factor(K: PETSc.Mat, M: PETSc.Mat, sigma: float) -> tuple[int, PETS
 
 def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = None,
                 tol: float = 1e-10, require_complete: bool = True, shift_hz: float | None = None,
-                ncv: int | None = None, purify: bool = False, method: str = "auto") -> ModalResult:
+                ncv: int | None = None, purify: bool = False, method: str = "auto",
+                keep_solver: bool = False) -> ModalResult:
     """All eigenpairs with frequency below f_max (Hz).
 
     nev: number of eigenpairs to ask for (default: the inertia count); asking for fewer makes the
@@ -154,6 +190,8 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     ncv, purify: SLEPc only.  purify: SLEPc's eigenvector purification costs one extra solve per mode (2.4 s
     of a 10 s box run); constrained rows are decoupled (1 on K's, 0 on M's diagonal), so it is off and
     residuals are reported.
+    keep_solver: keep the block method's factorisation of K - shift M in result.shifted_solver (the SLEPc path
+    keeps none); the caller frees it with result.release_solver().
     """
     if method not in EIGENSOLVERS and method != "auto":
         raise ValueError(f"unknown eigensolver {method!r}: choose from auto, {', '.join(EIGENSOLVERS)}")
@@ -175,19 +213,24 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     requested = expected if nev is None else nev
     t0 = time.perf_counter()
     pairs = [] if requested == 0 else None
-    phases = {}
+    phases, kept = {}, []
     if chosen == "block" and pairs is None:
         reuse = None if inertia_ksp is None else (inertia_ksp, inertia_mat, sigma_max)
         try:
-            pairs = _block_krylov_schur(K, M, shift, requested, tol, sigma_max, phases, reuse=reuse)
+            pairs = _block_krylov_schur(K, M, shift, requested, tol, sigma_max, phases, reuse=reuse,
+                                        keep=kept if keep_solver else None)
         except SolverError:
             if method == "block":
                 raise
         if method == "auto" and pairs is not None and len(pairs) < requested:
             pairs = None   # an eigenvalue missed: SLEPc below, with its retry for close pairs at f_max
-    if inertia_ksp is not None:
+    if inertia_ksp is not None and not (kept and kept[0].ksp is inertia_ksp):
         inertia_ksp.destroy()
         inertia_mat.destroy()
+    if pairs is None:
+        for solver in kept:
+            solver.destroy()
+        kept = []
     if pairs is None:
         chosen = "slepc"
         pairs = _krylov_schur(K, M, shift, requested, ncv, tol, purify, sigma_max)
@@ -203,20 +246,22 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     result = ModalResult(values, vectors, expected, residuals, f_max,
                          {"inertia_s": t_inertia, "eigensolve_s": t_solve,
                           **{f"eigensolve_{k}": v for k, v in phases.items()}}, eigenvalue_scale(K, M),
-                         eigensolver=chosen)
+                         eigensolver=chosen, shifted_solver=kept[0] if kept else None)
     if require_complete and not result.complete:
+        result.release_solver()
         raise SolverError(f"incomplete eigen-solution: {len(values)} eigenvalues returned, "
                           f"{expected} lie below f_max = {f_max:g} Hz (inertia count)")
     return result
 
 
 def _block_krylov_schur(K, M, shift: float, nev: int, tol: float, sigma_max: float,
-                        timings: dict | None = None, reuse: tuple | None = None) -> list:
+                        timings: dict | None = None, reuse: tuple | None = None, keep: list | None = None) -> list:
     """(eigenvalue, vector) pairs below sigma_max, ascending, by housingfe.solvers.block_eigen with a MUMPS
     Cholesky of K - shift M.  Fewer than nev pairs when an eigenvalue was missed (the caller falls back).
     `timings` (if given) receives the phases: factor_s, solve_s, mass_s, orthogonalise_s, restart_s.
     reuse: (solver, its matrix K - sigma M, sigma) of the inertia count (K - sigma M has K's pattern): its matrix
-    becomes K - shift M and is refactorised numerically (the caller keeps and destroys both)."""
+    becomes K - shift M and is refactorised numerically (the caller keeps and destroys both).
+    keep: a list that receives the factorisation as a ShiftedSolver (then not destroyed here)."""
     from housingfe.solvers.block_eigen import block_krylov_schur
 
     if reuse is not None:
@@ -239,8 +284,13 @@ def _block_krylov_schur(K, M, shift: float, nev: int, tol: float, sigma_max: flo
         if timings is not None:
             timings.update(factor_s=t_factor, **result.timings, block_solves=result.block_solves,
                            restarts=result.restarts)
+    except BaseException:
+        keep = None
+        raise
     finally:
-        if reuse is None:
+        if keep is not None:
+            keep.append(ShiftedSolver(ksp, P, shift, K.handle, M.handle))
+        elif reuse is None:
             ksp.destroy()
             P.destroy()
     pairs = []
@@ -426,7 +476,7 @@ class ModalBasis(ModalResult):
         import dataclasses
 
         return ModalResult(**{f.name: getattr(self, f.name) for f in dataclasses.fields(ModalResult)
-                              if f.name != "vectors"},
+                              if f.name not in ("vectors", "shifted_solver")},
                            vectors=[self.structure.to_housing(x) for x in self.vectors])
 
 

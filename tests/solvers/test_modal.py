@@ -137,3 +137,43 @@ def test_simply_supported_plate_harmonic_basis_counts_rigid_modes(comm):
     assert forced.facts["basis_f_max_hz"] == pytest.approx(3.7)
     assert forced.facts["rigid_modes"] == 3
     assert forced.facts["modes_in_basis"] == 1
+
+
+def test_residual_vectors_reuse_the_eigensolve_factorisation(coarse_box_model):
+    """solve_modes(keep_solver=True) hands its factorisation of K - shift M to the modal sweep's residual vectors:
+    the same vectors as a new factorisation at that shift, only for the matrices it was built from, and freed."""
+    from types import SimpleNamespace
+
+    from housingfe.solvers import harmonic
+
+    K, M = coarse_box_model.K, coarse_box_model.M
+    kept = modal.solve_modes(K, M, 2500.0, method="block", keep_solver=True)
+    plain = modal.solve_modes(K, M, 2500.0, method="block")
+    solver = kept.shifted_solver
+    assert plain.shifted_solver is None and solver is not None
+    assert solver.shift < 0 and solver.matches(K, M)
+    other = K.copy()
+    assert not solver.matches(other, M)
+    other.destroy()
+    f = K.createVecRight()
+    start, end = f.getOwnershipRange()
+    f.getArray()[:] = np.random.default_rng(1).standard_normal(K.getSize()[0])[start:end]
+    loads = [SimpleNamespace(vector=f)]
+    copies = lambda vecs: [v.copy() for v in vecs]   # noqa: E731
+    damping = harmonic.Damping(lambda fr: np.full(np.shape(fr), 0.02))
+    freqs = np.array([300.0, 1200.0])
+    reused = harmonic.modal_superposition(K, M, kept, loads, freqs, damping, copies)
+    fresh = harmonic.modal_superposition(K, M, plain, loads, freqs, damping, copies, shift=solver.shift)
+    r_reused = reused.blocks[0][0].reduced[-1].getArray()
+    r_fresh = fresh.blocks[0][0].reduced[-1].getArray()
+    scale = max(comm_max(np.abs(r_fresh), K), 1e-300)
+    assert comm_max(np.abs(r_reused - r_fresh), K) < 1e-9 * scale
+    assert comm_max(np.abs(r_fresh), K) > 0
+    kept.release_solver()
+    assert kept.shifted_solver is None
+
+
+def comm_max(values: np.ndarray, A) -> float:
+    from mpi4py import MPI
+
+    return A.getComm().tompi4py().allreduce(float(values.max(initial=0.0)), op=MPI.MAX)
