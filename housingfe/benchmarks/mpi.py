@@ -29,7 +29,7 @@ SCENE = "box-free-frf"
 MESH = ["mesh.degree=3", "mesh.grading=0.25", "output.pictures=false"]
 SIZE, QUICK_SIZE = 0.0125, 0.030       # m: 309 108 and 59 952 DOFs
 RANKS = (1, 2)
-ROUNDS, QUICK_ROUNDS = 2, 1
+ROUNDS, QUICK_ROUNDS = 3, 1
 
 _CHILD = """
 import resource, sys
