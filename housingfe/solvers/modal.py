@@ -134,12 +134,17 @@ def axpy_structure(Y: PETSc.Mat, X: PETSc.Mat):
 
 
 def _same_pattern(Y: PETSc.Mat, X: PETSc.Mat) -> bool:
-    """Equal local sparsity patterns.  The row/column indices alone (MatGetRowIJ, no copy of the values: 0.015
-    vs 0.77 s at 13 M nonzeros); matrix types without it (parallel AIJ) compare their CSR arrays."""
-    if Y.getType() == X.getType() and Y.getType() in ("seqaij", "seqbaij", "seqsbaij"):
-        ia, ja = Y.getRowIJ()
-        ib, jb = X.getRowIJ()
-        return bool(np.array_equal(ia, ib) and np.array_equal(ja, jb))
+    """Equal local sparsity patterns, by the row/column indices alone (MatGetRowIJ: no copy of the values;
+    0.015 vs 0.77 s at 13 M nonzeros on one rank).  Parallel AIJ answers it too (local rows, global columns),
+    cheaper than the CSR arrays with their values; types without it compare their CSR arrays."""
+    if Y.getType() == X.getType():
+        try:
+            ia, ja = Y.getRowIJ()
+            ib, jb = X.getRowIJ()
+        except PETSc.Error:
+            ia = None
+        if ia is not None and ib is not None:
+            return bool(np.array_equal(ia, ib) and np.array_equal(ja, jb))
     ia, ja, _ = Y.getValuesCSR()
     ib, jb, _ = X.getValuesCSR()
     return bool(np.array_equal(ia, ib) and np.array_equal(ja, jb))
@@ -153,16 +158,17 @@ def _mpi_min():
 
 def count_eigenvalues_below(K: PETSc.Mat, M: PETSc.Mat, sigma: float) -> int:
     """Number of eigenvalues of K x = lambda M x below sigma (rad^2/s^2), by the inertia of K - sigma M."""
-    count, ksp, A = _inertia_factor(K, M, sigma)
+    count, ksp, A = _inertia_factor(K, M, sigma, axpy_structure(K, M))
     ksp.destroy()
     A.destroy()
     return count
 
 
-def _inertia_factor(K: PETSc.Mat, M: PETSc.Mat, sigma: float) -> tuple[int, PETSc.KSP, PETSc.Mat]:
-    """(eigenvalues below sigma, the factorised solver of A = K - sigma M, A): the caller destroys both."""
+def _inertia_factor(K: PETSc.Mat, M: PETSc.Mat, sigma: float, structure) -> tuple[int, PETSc.KSP, PETSc.Mat]:
+    """(eigenvalues below sigma, the factorised solver of A = K - sigma M, A): the caller destroys both.
+    structure: axpy_structure(K, M)."""
     A = K.copy()
-    A.axpy(-sigma, M, structure=axpy_structure(A, M))
+    A.axpy(-sigma, M, structure=structure)
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     ksp = mumps_cholesky(A, "inertia_", inertia=True)
     ksp.setUp()
@@ -198,8 +204,11 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     sigma_max = (2 * math.pi * f_max) ** 2
     chosen = method if method != "auto" else ("block" if K.getSize()[0] >= BLOCK_MIN_DOFS else "slepc")
     t0 = time.perf_counter()
-    expected, inertia_ksp, inertia_mat = _inertia_factor(K, M, sigma_max)
-    shared_pattern = axpy_structure(K, M) == PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+    # one pattern comparison for the three K - s M below (each one copied the CSR arrays on 2 ranks: 0.2-1.4 s
+    # at 309 k DOFs)
+    structure = axpy_structure(K, M)
+    shared_pattern = structure == PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+    expected, inertia_ksp, inertia_mat = _inertia_factor(K, M, sigma_max, structure)
     if not (chosen == "block" and K.getComm().getSize() == 1 and shared_pattern):
         # the block method on one rank refactorises this solver at its shift, reusing the ordering and symbolic
         # analysis (0.2-0.3 s at 40 k DOFs); in parallel the inertia's options (no ScaLAPACK root) would slow it,
@@ -218,7 +227,7 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
         reuse = None if inertia_ksp is None else (inertia_ksp, inertia_mat, sigma_max)
         try:
             pairs = _block_krylov_schur(K, M, shift, requested, tol, sigma_max, phases, reuse=reuse,
-                                        keep=kept if keep_solver else None)
+                                        keep=kept if keep_solver else None, structure=structure)
         except SolverError:
             if method == "block":
                 raise
@@ -233,12 +242,12 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
         kept = []
     if pairs is None:
         chosen = "slepc"
-        pairs = _krylov_schur(K, M, shift, requested, ncv, tol, purify, sigma_max)
+        pairs = _krylov_schur(K, M, shift, requested, ncv, tol, purify, sigma_max, structure=structure)
     if nev is None and len(pairs) < requested:
         # SLEPc's nev closest to the shift can miss one of a close pair near f_max (seen on the coupled test
         # gearbox: 62 of 63): ask again for a few more; the extras above f_max are dropped
         pairs = _krylov_schur(K, M, shift, requested + max(2, requested // 20), ncv, tol, purify, sigma_max,
-                              keep=requested)
+                              keep=requested, structure=structure)
     t_solve = time.perf_counter() - t0
     values = np.array([p[0] for p in pairs])
     vectors = [p[1] for p in pairs]
@@ -255,25 +264,28 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
 
 
 def _block_krylov_schur(K, M, shift: float, nev: int, tol: float, sigma_max: float,
-                        timings: dict | None = None, reuse: tuple | None = None, keep: list | None = None) -> list:
+                        timings: dict | None = None, reuse: tuple | None = None, keep: list | None = None,
+                        structure=None) -> list:
     """(eigenvalue, vector) pairs below sigma_max, ascending, by housingfe.solvers.block_eigen with a MUMPS
     Cholesky of K - shift M.  Fewer than nev pairs when an eigenvalue was missed (the caller falls back).
     `timings` (if given) receives the phases: factor_s, solve_s, mass_s, orthogonalise_s, restart_s.
     reuse: (solver, its matrix K - sigma M, sigma) of the inertia count (K - sigma M has K's pattern): its matrix
     becomes K - shift M and is refactorised numerically (the caller keeps and destroys both).
-    keep: a list that receives the factorisation as a ShiftedSolver (then not destroyed here)."""
+    keep: a list that receives the factorisation as a ShiftedSolver (then not destroyed here).
+    structure: axpy_structure(K, M) when the caller has it."""
     from housingfe.solvers.block_eigen import block_krylov_schur
 
+    structure = axpy_structure(K, M) if structure is None else structure
     if reuse is not None:
         ksp, P, _ = reuse
         # K's values into P (its pattern), then the shift: bitwise the matrix of the path below (moving P by
         # (sigma - shift) M instead perturbs K by round-off, which on a thin plate moves eigenvalues by 3e-8)
         K.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        P.axpy(-shift, M, structure=axpy_structure(P, M))
+        P.axpy(-shift, M, structure=structure)
         ksp.setOperators(P)   # same pattern: only the numerical factorisation is redone
     else:
         P = K.copy()
-        P.axpy(-shift, M, structure=axpy_structure(P, M))
+        P.axpy(-shift, M, structure=structure)
         P.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         ksp = mumps_cholesky(P, "modal_shift_")
     try:
@@ -303,7 +315,7 @@ def _block_krylov_schur(K, M, shift: float, nev: int, tol: float, sigma_max: flo
 
 
 def _krylov_schur(K, M, shift: float, nev: int, ncv, tol: float, purify: bool, sigma_max: float,
-                  keep: int | None = None) -> list:
+                  keep: int | None = None, structure=None) -> list:
     """(eigenvalue, vector) pairs below sigma_max (at most `keep`, default nev), ascending: Krylov-Schur with
     shift-and-invert (MUMPS Cholesky of K - shift M) about `shift` (rad^2/s^2).
 
@@ -314,7 +326,7 @@ def _krylov_schur(K, M, shift: float, nev: int, ncv, tol: float, purify: bool, s
     keep = nev if keep is None else keep
     M_fast = _symmetric_block_copy(M)
     P = K.copy()
-    P.axpy(-shift, M, structure=axpy_structure(P, M))
+    P.axpy(-shift, M, structure=axpy_structure(K, M) if structure is None else structure)
     P.setOption(PETSc.Mat.Option.SYMMETRIC, True)
     eps = SLEPc.EPS().create(K.getComm())
     eps.setOperators(K, M_fast)

@@ -177,3 +177,44 @@ def comm_max(values: np.ndarray, A) -> float:
     from mpi4py import MPI
 
     return A.getComm().tompi4py().allreduce(float(values.max(initial=0.0)), op=MPI.MAX)
+
+
+def _with_extra_slot(A):
+    """A copy of A with one more stored entry (an explicit 0.0 outside A's pattern in each rank's first row):
+    the same operator, another sparsity pattern."""
+    from petsc4py import PETSc
+
+    ia, ja, va = A.getValuesCSR()
+    start, _ = A.getOwnershipRange()
+    row = ja[ia[0]:ia[1]]
+    free = next(c for c in range(A.getSize()[1]) if c not in set(row.tolist()))
+    at = ia[0] + int(np.searchsorted(row, free))
+    ja = np.insert(ja, at, free)
+    va = np.insert(va, at, 0.0)
+    ia = ia.copy()
+    ia[1:] += 1
+    B = PETSc.Mat().createAIJ(A.getSizes(), csr=(ia, ja, va), comm=A.getComm())
+    B.setBlockSizes(*A.getBlockSizes())
+    assert B.getInfo()["nz_used"] == A.getInfo()["nz_used"] + A.getComm().getSize()   # one per rank
+    return B
+
+
+def test_matrices_of_different_patterns_give_the_same_modes(comm):
+    """K - s M is formed with PETSc's fast same-pattern update only when K and M share their pattern (on one rank
+    and in parallel): the same update on another pattern would silently give a wrong matrix."""
+    from petsc4py import PETSc
+
+    scene = load_scene("nafems-fv12")
+    model = build_model_from_scene(scene, comm)
+    K, M = model.K, model.M
+    M_other = _with_extra_slot(M)
+    assert modal.axpy_structure(K, M) == PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+    assert modal.axpy_structure(K, M_other) == PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+    f_max = scene.analysis.modal.f_max
+    for method in ("block", "slepc"):
+        same = modal.solve_modes(K, M, f_max, method=method)
+        other = modal.solve_modes(K, M_other, f_max, method=method)
+        assert len(other.eigenvalues) == len(same.eigenvalues) == same.expected_count
+        elastic = slice(6, None)
+        np.testing.assert_allclose(other.frequencies_hz[elastic], same.frequencies_hz[elastic], rtol=1e-8)
+    M_other.destroy()
