@@ -12,6 +12,7 @@ extras="${HOUSINGFE_EXTRAS:-test}"
 debian_packages=(
   python3-dolfinx-real python3-dolfinx-complex python3-petsc4py python3-slepc4py
   python3-gmsh python3-meshio python3-venv python3-dev
+  python3-cffi                  # housingfe.solvers.mumps calls MUMPS directly (also a dependency of FFCx)
   libopenblas0-pthread          # MUMPS is ~2x slower on the reference BLAS (STACK-NOTES)
   openmpi-bin                   # mpirun for multi-rank runs
   calculix-ccx                  # peer solver for `housingfe bench modal`

@@ -116,9 +116,9 @@ def _dense(a: np.ndarray, rows: int, comm) -> PETSc.Mat:
 
 
 class _Operators:
-    """S X = (K - sigma M)^-1 M X through a factor's matSolve, M-products, reductions, and their timers."""
+    """S X = (K - sigma M)^-1 M X through a factor (solve_block or matSolve), M-products, reductions, and their timers."""
 
-    def __init__(self, factor: PETSc.Mat, M: PETSc.Mat):
+    def __init__(self, factor, M: PETSc.Mat):
         self.factor = factor
         self.mass_products = MassProducts(M)
         self.comm = M.getComm()
@@ -128,12 +128,15 @@ class _Operators:
 
     def solve(self, B: np.ndarray) -> np.ndarray:
         t = time.perf_counter()
-        D = _dense(B, self.rows, self.comm)
-        X = D.duplicate()
-        self.factor.matSolve(D, X)
-        out = np.array(X.getDenseArray())
-        X.destroy()
-        D.destroy()
+        if hasattr(self.factor, "solve_block"):
+            out = self.factor.solve_block(B)
+        else:
+            D = _dense(B, self.rows, self.comm)
+            X = D.duplicate()
+            self.factor.matSolve(D, X)
+            out = np.array(X.getDenseArray())
+            X.destroy()
+            D.destroy()
         self.timings["solve_s"] += time.perf_counter() - t
         return out
 
@@ -174,11 +177,11 @@ def default_max_basis(nev: int, block: int) -> int:
     return block * -(-size // block)
 
 
-def block_krylov_schur(factor: PETSc.Mat, M: PETSc.Mat, shift: float, nev: int, *, block: int | None = None,
+def block_krylov_schur(factor, M: PETSc.Mat, shift: float, nev: int, *, block: int | None = None,
                        max_basis: int | None = None, tol: float = 1e-10, max_restarts: int = 200,
                        seed: int = 0) -> BlockEigenResult:
-    """The nev eigenpairs of K x = lambda M x closest above `shift` (rad^2/s^2), given `factor`, a MUMPS
-    factor of K - shift M (a PETSc factored Mat).  Eigenvectors M-orthonormal.  SolverError if it does not
+    """The nev eigenpairs of K x = lambda M x closest above `shift` (rad^2/s^2), given `factor`, a
+    factorisation of K - shift M: an LDL^T of housingfe.solvers.mumps (solve_block) or a PETSc factored Mat.  Eigenvectors M-orthonormal.  SolverError if it does not
     converge within max_restarts or the basis degenerates (then use SLEPc's Krylov–Schur)."""
     ops = _Operators(factor, M)
     try:

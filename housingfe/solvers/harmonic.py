@@ -486,7 +486,7 @@ def _shifted(K, M, shift: float) -> PETSc.Mat:
 
 
 def _factor(A: PETSc.Mat, prefix: str, lu: bool = False) -> PETSc.KSP:
-    from housingfe.solvers.modal import mumps_cholesky
+    from housingfe.solvers.mumps import mumps_cholesky
 
     ksp = mumps_cholesky(A, prefix)
     if lu:   # non-symmetric bearing stiffness or fluid-film damping

@@ -17,6 +17,7 @@ from petsc4py import PETSc
 from slepc4py import SLEPc
 
 from housingfe.errors import SolverError
+from housingfe.solvers import mumps
 
 # Rigid-body (mechanism) modes are classified against the scale of the matrices, not against f_max: the
 # computed zero eigenvalues are round-off, |lambda| ~ 1e-17..1e-16 of lambda_scale = max_i K_ii / M_ii (an
@@ -87,7 +88,7 @@ class ShiftedSolver:
     as much as the first (10 s of a 13 s sweep at 309 k DOFs).  It serves only the K and M it was built from
     (matches())."""
 
-    ksp: PETSc.KSP
+    factor: object          # housingfe.solvers.mumps.DirectLDLT or PetscLDLT, factorised at the shift
     matrix: PETSc.Mat
     shift: float
     k_handle: int
@@ -99,36 +100,11 @@ class ShiftedSolver:
 
     def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
         """x = (K - shift M)^-1 b."""
-        self.ksp.solve(b, x)
+        self.factor.solve(b, x)
 
     def destroy(self) -> None:
-        self.ksp.destroy()
+        self.factor.destroy()
         self.matrix.destroy()
-
-
-def mumps_cholesky(A: PETSc.Mat, prefix: str, inertia: bool = False, count_only: bool = False) -> PETSc.KSP:
-    """A direct solver for a symmetric A: MUMPS LDL^T (Cholesky when A is positive definite).  With
-    `inertia`, the factor can report its inertia (no ScaLAPACK root, null-pivot detection on).  With
-    `count_only` it can do nothing else: MUMPS discards the factors as it goes (ICNTL(31) = 1), which cannot
-    solve but touches less memory (309 k DOFs, 2 ranks, fresh process: 6.2 instead of 9.2 s, 2.9 instead of
-    3.6 GB per rank)."""
-    ksp = PETSc.KSP().create(A.getComm())
-    ksp.setOptionsPrefix(prefix)
-    ksp.setOperators(A)
-    ksp.setType("preonly")
-    pc = ksp.getPC()
-    pc.setType("cholesky")
-    pc.setFactorSolverType("mumps")
-    if inertia:
-        opts = PETSc.Options()
-        opts[f"{prefix}mat_mumps_icntl_13"] = 1   # no ScaLAPACK root: required for the inertia in parallel
-        opts[f"{prefix}mat_mumps_icntl_24"] = 1   # null-pivot detection: MatGetInertia requires it
-    ksp.setFromOptions()
-    if count_only:
-        # on this factor, not in the options database: a later solver under the same prefix must keep its factors
-        pc.setFactorSetUpSolverType()
-        pc.getFactorMatrix().setMumpsIcntl(31, 1)
-    return ksp
 
 
 def axpy_structure(Y: PETSc.Mat, X: PETSc.Mat):
@@ -163,37 +139,39 @@ def _mpi_min():
     return MPI.MIN
 
 
-def count_eigenvalues_below(K: PETSc.Mat, M: PETSc.Mat, sigma: float) -> int:
+def count_eigenvalues_below(K: PETSc.Mat, M: PETSc.Mat, sigma: float, backend: str = "auto") -> int:
     """Number of eigenvalues of K x = lambda M x below sigma (rad^2/s^2), by the inertia of K - sigma M."""
-    count, ksp, A = _inertia_factor(K, M, sigma, axpy_structure(K, M), count_only=True)
-    ksp.destroy()
-    A.destroy()
-    return count
+    A = _shifted_matrix(K, M, sigma, axpy_structure(K, M))
+    factor = mumps.ldlt(A, backend, count_only=True)
+    try:
+        return _count_below(factor, A)
+    finally:
+        factor.destroy()
+        A.destroy()
 
 
-def _inertia_factor(K: PETSc.Mat, M: PETSc.Mat, sigma: float, structure,
-                    count_only: bool = False) -> tuple[int, PETSc.KSP, PETSc.Mat]:
-    """(eigenvalues below sigma, the factorised solver of A = K - sigma M, A): the caller destroys both.
-    structure: axpy_structure(K, M).  count_only: the solver cannot solve (its factors are discarded), nor be
-    refactorised into one that can."""
+def _shifted_matrix(K: PETSc.Mat, M: PETSc.Mat, sigma: float, structure) -> PETSc.Mat:
+    """A new K - sigma M, marked symmetric.  structure: axpy_structure(K, M)."""
     A = K.copy()
     A.axpy(-sigma, M, structure=structure)
     A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-    ksp = mumps_cholesky(A, "inertia_", inertia=True, count_only=count_only)
-    ksp.setUp()
-    nneg, nzero, npos = ksp.getPC().getFactorMatrix().getInertia()
-    if nzero:
-        ksp.destroy()
-        A.destroy()
+    return A
+
+
+def _count_below(factor, A: PETSc.Mat) -> int:
+    """Negative pivots of the LDL^T of A = K - sigma M (factor: housingfe.solvers.mumps, analysed on A)."""
+    factor.factorise(A)
+    negative, null = factor.inertia()
+    if null:
         raise SolverError("K - sigma M is singular at f_max (an eigenvalue sits exactly at f_max); "
                           "move f_max slightly")
-    return int(nneg), ksp, A
+    return negative
 
 
 def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = None,
                 tol: float = 1e-10, require_complete: bool = True, shift_hz: float | None = None,
                 ncv: int | None = None, purify: bool = False, method: str = "auto",
-                keep_solver: bool = False) -> ModalResult:
+                keep_solver: bool = False, backend: str = "auto") -> ModalResult:
     """All eigenpairs with frequency below f_max (Hz).
 
     nev: number of eigenpairs to ask for (default: the inertia count); asking for fewer makes the
@@ -207,25 +185,32 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     residuals are reported.
     keep_solver: keep the block method's factorisation of K - shift M in result.shifted_solver (the SLEPc path
     keeps none); the caller frees it with result.release_solver().
+    backend: how the inertia count and the block method call MUMPS (housingfe.solvers.mumps.ldlt): "auto",
+    "direct" or "petsc".
     """
     if method not in EIGENSOLVERS and method != "auto":
         raise ValueError(f"unknown eigensolver {method!r}: choose from auto, {', '.join(EIGENSOLVERS)}")
     sigma_max = (2 * math.pi * f_max) ** 2
     chosen = method if method != "auto" else ("block" if K.getSize()[0] >= BLOCK_MIN_DOFS else "slepc")
     t0 = time.perf_counter()
-    # one pattern comparison for the three K - s M below (each one copied the CSR arrays on 2 ranks: 0.2-1.4 s
+    # one pattern comparison for every K - s M below (each one copied the CSR arrays on 2 ranks: 0.2-1.4 s
     # at 309 k DOFs)
     structure = axpy_structure(K, M)
-    shared_pattern = structure == PETSc.Mat.Structure.SAME_NONZERO_PATTERN
-    reusable = chosen == "block" and K.getComm().getSize() == 1 and shared_pattern
-    expected, inertia_ksp, inertia_mat = _inertia_factor(K, M, sigma_max, structure, count_only=not reusable)
-    if not reusable:
-        # the block method on one rank refactorises this solver at its shift, reusing the ordering and symbolic
-        # analysis (0.2-0.3 s at 40 k DOFs); in parallel the inertia's options (no ScaLAPACK root) would slow it,
-        # and K - shift M must have K's pattern to be written over K - sigma M
-        inertia_ksp.destroy()
-        inertia_mat.destroy()
-        inertia_ksp = inertia_mat = None
+    A = _shifted_matrix(K, M, sigma_max, structure)
+    # the block method: one analysis for the count and the factorisation at the shift (0.2-0.3 s at 40 k DOFs
+    # on one rank; on two at 309 k DOFs, count and shift factorisation 14-16 s either way, but the factorisation
+    # at the shift 5.0-5.3 s instead of 7.4-8.1 s); a count alone discards its factors as it goes
+    reuse_analysis = chosen == "block"
+    factor = mumps.ldlt(A, backend, count_only=not reuse_analysis)
+    try:
+        expected = _count_below(factor, A)
+    except BaseException:
+        factor.destroy()
+        A.destroy()
+        raise
+    if not reuse_analysis:
+        factor.destroy()
+        factor = None
     t_inertia = time.perf_counter() - t0
 
     shift = -((2 * math.pi * (shift_hz if shift_hz is not None else 0.01 * f_max)) ** 2)
@@ -234,22 +219,19 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     pairs = [] if requested == 0 else None
     phases, kept = {}, []
     if chosen == "block" and pairs is None:
-        reuse = None if inertia_ksp is None else (inertia_ksp, inertia_mat, sigma_max)
         try:
-            pairs = _block_krylov_schur(K, M, shift, requested, tol, sigma_max, phases, reuse=reuse,
-                                        keep=kept if keep_solver else None, structure=structure)
+            factor, A = _factorise_at(K, M, shift, factor, A, structure, backend, phases)
+            pairs = _block_krylov_schur(factor, M, shift, requested, tol, sigma_max, phases)
         except SolverError:
             if method == "block":
+                _destroy(factor, A)
                 raise
         if method == "auto" and pairs is not None and len(pairs) < requested:
             pairs = None   # an eigenvalue missed: SLEPc below, with its retry for close pairs at f_max
-    if inertia_ksp is not None and not (kept and kept[0].ksp is inertia_ksp):
-        inertia_ksp.destroy()
-        inertia_mat.destroy()
-    if pairs is None:
-        for solver in kept:
-            solver.destroy()
-        kept = []
+    if keep_solver and pairs is not None and chosen == "block" and requested:
+        kept.append(ShiftedSolver(factor, A, shift, K.handle, M.handle))
+    else:
+        _destroy(factor, A)
     if pairs is None:
         chosen = "slepc"
         pairs = _krylov_schur(K, M, shift, requested, ncv, tol, purify, sigma_max, structure=structure)
@@ -273,52 +255,48 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     return result
 
 
-def _block_krylov_schur(K, M, shift: float, nev: int, tol: float, sigma_max: float,
-                        timings: dict | None = None, reuse: tuple | None = None, keep: list | None = None,
-                        structure=None) -> list:
-    """(eigenvalue, vector) pairs below sigma_max, ascending, by housingfe.solvers.block_eigen with a MUMPS
-    Cholesky of K - shift M.  Fewer than nev pairs when an eigenvalue was missed (the caller falls back).
-    `timings` (if given) receives the phases: factor_s, solve_s, mass_s, orthogonalise_s, restart_s.
-    reuse: (solver, its matrix K - sigma M, sigma) of the inertia count (K - sigma M has K's pattern): its matrix
-    becomes K - shift M and is refactorised numerically (the caller keeps and destroys both).
-    keep: a list that receives the factorisation as a ShiftedSolver (then not destroyed here).
-    structure: axpy_structure(K, M) when the caller has it."""
+def _factorise_at(K, M, shift: float, factor, A: PETSc.Mat, structure, backend: str, timings: dict):
+    """(factor, A) with A = K - shift M factorised.  When K and M share their pattern, A (K - sigma M) is
+    overwritten in place (its memory is already touched) and the count's analysis, if given as `factor`, is
+    reused; K - shift M is written bitwise as K.copy() - shift M (moving A by (sigma - shift) M instead perturbs
+    K by round-off, which on a thin plate moves eigenvalues by 3e-8).  Otherwise A's pattern is K's and M's
+    union: a new matrix and analysis."""
+    t0 = time.perf_counter()
+    if structure == PETSc.Mat.Structure.SAME_NONZERO_PATTERN:
+        K.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        A.axpy(-shift, M, structure=structure)
+    else:
+        _destroy(factor, A)
+        A = _shifted_matrix(K, M, shift, structure)
+        factor = None
+    if factor is None:
+        factor = mumps.ldlt(A, backend)
+    factor.factorise(A)
+    timings["factor_s"] = time.perf_counter() - t0
+    return factor, A
+
+
+def _destroy(factor, A: PETSc.Mat) -> None:
+    if factor is not None:
+        factor.destroy()
+    A.destroy()
+
+
+def _block_krylov_schur(factor, M, shift: float, nev: int, tol: float, sigma_max: float,
+                        timings: dict | None = None) -> list:
+    """(eigenvalue, vector) pairs below sigma_max, ascending, by housingfe.solvers.block_eigen with `factor`, an
+    LDL^T of K - shift M (housingfe.solvers.mumps).  Fewer than nev pairs when an eigenvalue was missed (the
+    caller falls back).  `timings` (if given) receives the phases: solve_s, mass_s, orthogonalise_s, restart_s,
+    block_solves, restarts."""
     from housingfe.solvers.block_eigen import block_krylov_schur
 
-    structure = axpy_structure(K, M) if structure is None else structure
-    if reuse is not None:
-        ksp, P, _ = reuse
-        # K's values into P (its pattern), then the shift: bitwise the matrix of the path below (moving P by
-        # (sigma - shift) M instead perturbs K by round-off, which on a thin plate moves eigenvalues by 3e-8)
-        K.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        P.axpy(-shift, M, structure=structure)
-        ksp.setOperators(P)   # same pattern: only the numerical factorisation is redone
-    else:
-        P = K.copy()
-        P.axpy(-shift, M, structure=structure)
-        P.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        ksp = mumps_cholesky(P, "modal_shift_")
-    try:
-        t0 = time.perf_counter()
-        ksp.setUp()
-        t_factor = time.perf_counter() - t0
-        result = block_krylov_schur(ksp.getPC().getFactorMatrix(), M, shift, nev, tol=tol)
-        if timings is not None:
-            timings.update(factor_s=t_factor, **result.timings, block_solves=result.block_solves,
-                           restarts=result.restarts)
-    except BaseException:
-        keep = None
-        raise
-    finally:
-        if keep is not None:
-            keep.append(ShiftedSolver(ksp, P, shift, K.handle, M.handle))
-        elif reuse is None:
-            ksp.destroy()
-            P.destroy()
+    result = block_krylov_schur(factor, M, shift, nev, tol=tol)
+    if timings is not None:
+        timings.update(**result.timings, block_solves=result.block_solves, restarts=result.restarts)
     pairs = []
     for j, lam in enumerate(result.eigenvalues):
         if lam < sigma_max:
-            x = K.createVecRight()
+            x = M.createVecRight()
             x.getArray()[:] = result.vectors[:, j]
             pairs.append((float(lam), x))
     return pairs

@@ -8,7 +8,7 @@ from petsc4py import PETSc
 
 from housingfe.errors import SolverError
 from housingfe.scene import build_model_from_scene
-from housingfe.solvers import block_eigen, modal
+from housingfe.solvers import block_eigen, modal, mumps
 from tests.conftest import load_scene
 
 
@@ -106,7 +106,7 @@ def test_too_small_a_model_is_refused_by_block_and_solved_by_auto(comm):
     assert n < modal.BLOCK_MIN_DOFS
     P = model.K.copy()
     P.axpy(1.0, model.M)
-    ksp = modal.mumps_cholesky(P, "small_")
+    ksp = mumps.mumps_cholesky(P, "small_")
     ksp.setUp()
     with pytest.raises(SolverError, match=f"basis of {n + 8} vectors for {n} DOFs"):
         block_eigen.block_krylov_schur(ksp.getPC().getFactorMatrix(), model.M, -1.0, 10, max_basis=n)

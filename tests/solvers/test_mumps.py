@@ -1,0 +1,119 @@
+"""housingfe.solvers.mumps: MUMPS' LDL^T called directly (cffi) and through PETSc give the same inertia, solve
+A X = B to round-off (checked against A itself), and the modal solve is the same with either back-end.  Run on
+1 rank by `make test`; `mpirun -n 2 python -m pytest tests/solvers/test_mumps.py` checks the distributed path."""
+import math
+
+import numpy as np
+import pytest
+
+from housingfe.errors import SolverError
+from housingfe.solvers import modal, mumps
+
+BACKENDS = ["direct", "petsc"]
+
+
+@pytest.fixture(scope="module")
+def shifted(coarse_box_model):
+    """K - sigma M of the coarse box at 1.5 kHz: indefinite, a dozen negative pivots."""
+    K, M = coarse_box_model.K, coarse_box_model.M
+    sigma = (2 * math.pi * 1500.0) ** 2
+    A = modal._shifted_matrix(K, M, sigma, modal.axpy_structure(K, M))
+    yield A
+    A.destroy()
+
+
+def _residual(A, B: np.ndarray, X: np.ndarray) -> float:
+    """max_j ||A x_j - b_j|| / ||b_j|| over the ranks."""
+    from mpi4py import MPI
+
+    worst = 0.0
+    x, y = A.createVecRight(), A.createVecLeft()
+    for j in range(B.shape[1]):
+        x.getArray()[:] = X[:, j]
+        A.mult(x, y)
+        r = A.getComm().tompi4py().allreduce(float(np.sum((y.getArray() - B[:, j]) ** 2)), op=MPI.SUM)
+        b = A.getComm().tompi4py().allreduce(float(np.sum(B[:, j] ** 2)), op=MPI.SUM)
+        worst = max(worst, math.sqrt(r / b))
+    return worst
+
+
+def test_the_direct_binding_is_available_here():
+    """The stack (Debian's MUMPS 5.5, cffi) carries it: without it every modal solve would fall back silently."""
+    assert mumps.available()
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_block_solves_satisfy_the_equations(shifted, backend):
+    """X = A^-1 B for an indefinite A: ||A X - B|| / ||B|| at round-off, on any number of ranks (the distributed
+    solution is moved back to PETSc's rows); a wrong triangle or row map gives O(1)."""
+    factor = mumps.ldlt(shifted, backend)
+    try:
+        factor.factorise(shifted)
+        start, end = shifted.getOwnershipRange()
+        B = np.random.default_rng(3).standard_normal((shifted.getSize()[0], 5))[start:end]
+        X = factor.solve_block(B)
+        assert X.shape == B.shape
+        assert _residual(shifted, B, X) < 1e-8
+        b, x = shifted.createVecRight(), shifted.createVecRight()
+        b.getArray()[:] = B[:, 0]
+        factor.solve(b, x)
+        assert np.allclose(x.getArray(), X[:, 0], rtol=0, atol=1e-12 * np.abs(X[:, 0]).max())
+    finally:
+        factor.destroy()
+
+
+def test_both_backends_count_the_same_eigenvalues(coarse_box_model):
+    """The inertia of K - sigma M by either back-end equals the number of eigenvalues below sigma found by the
+    eigensolver (count_eigenvalues_below's own check on one rank is against dense eigenvalues)."""
+    K, M = coarse_box_model.K, coarse_box_model.M
+    result = modal.solve_modes(K, M, 2500.0, method="slepc")
+    for f_hz in (700.0, 1500.0, 2200.0):
+        sigma = (2 * math.pi * f_hz) ** 2
+        expected = int(np.sum(result.eigenvalues < sigma))
+        assert [modal.count_eigenvalues_below(K, M, sigma, backend=b) for b in BACKENDS] == [expected] * 2
+
+
+def test_the_modal_solve_is_the_same_with_either_backend(coarse_box_model):
+    """The block eigensolver on a direct or a PETSc factorisation: the same eigenvalues to 1e-10, and the kept
+    factorisation solves for the sweep's residual vectors either way."""
+    K, M = coarse_box_model.K, coarse_box_model.M
+    runs = {b: modal.solve_modes(K, M, 2500.0, method="block", backend=b, keep_solver=True) for b in BACKENDS}
+    direct, petsc = runs["direct"], runs["petsc"]
+    assert isinstance(direct.shifted_solver.factor, mumps.DirectLDLT)
+    assert isinstance(petsc.shifted_solver.factor, mumps.PetscLDLT)
+    assert direct.complete and petsc.complete and len(direct.eigenvalues) == len(petsc.eigenvalues)
+    scale = direct.eigenvalues.max()
+    np.testing.assert_allclose(direct.eigenvalues, petsc.eigenvalues, rtol=0, atol=1e-10 * scale)
+    b = K.createVecRight()
+    b.getArray()[:] = 1.0
+    x = [K.createVecRight() for _ in BACKENDS]
+    for run, xi in zip(runs.values(), x):
+        run.shifted_solver.solve(b, xi)
+        run.release_solver()
+    assert np.allclose(x[0].getArray(), x[1].getArray(), rtol=1e-9, atol=0)
+
+
+def test_a_matrix_of_another_pattern_is_refused(shifted):
+    from petsc4py import PETSc
+
+    factor = mumps.ldlt(shifted, "direct")
+    other = shifted.duplicate(copy=True)
+    other.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)
+    start, end = other.getOwnershipRange()
+    n = other.getSize()[0]
+    far = (start + n // 2) % n
+    other.setValue(start, far, 0.0, addv=True)
+    other.setValue(far, start, 0.0, addv=True)
+    other.assemble()
+    try:
+        assert other.getInfo()["nz_used"] > shifted.getInfo()["nz_used"]
+        with pytest.raises(SolverError, match="sparsity pattern"):
+            factor.factorise(other)
+    finally:
+        factor.destroy()
+        other.destroy()
+
+
+def test_unknown_backend_is_named(shifted):
+    with pytest.raises(ValueError, match="unknown MUMPS back-end 'umfpack'"):
+        mumps.ldlt(shifted, "umfpack")
