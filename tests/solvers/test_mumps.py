@@ -1,6 +1,6 @@
 """housingfe.solvers.mumps: MUMPS' LDL^T called directly (cffi) and through PETSc give the same inertia, solve
-A X = B to round-off (checked against A itself), and the modal solve is the same with either back-end.  Run on
-1 rank by `make test`; `mpirun -n 2 python -m pytest tests/solvers/test_mumps.py` checks the distributed path."""
+A X = B to round-off (checked against A itself), and the modal solve is the same with either back-end.  `make test`
+runs them on one rank and, through the last test, on two (the distributed path)."""
 import math
 
 import numpy as np
@@ -131,3 +131,25 @@ def test_auto_calls_mumps_directly_only_in_parallel(shifted):
         assert isinstance(factor, mumps.DirectLDLT) == (shifted.getComm().getSize() > 1)
     finally:
         factor.destroy()
+
+
+@pytest.mark.mpi
+def test_the_tests_above_pass_on_two_ranks(comm):
+    """The distributed path (MUMPS' solution rows moved back to PETSc's, the collective pattern check) runs in
+    `make test` too: this file's other tests under `mpirun -n 2`."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    if comm.size > 1 or not shutil.which("mpirun"):
+        pytest.skip("runs from a one-rank session with mpirun installed")
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    proc = subprocess.run([shutil.which("mpirun"), "-n", "2", sys.executable, "-m", "pytest", "-q", "-p",
+                           "no:cacheprovider", "-k", "not two_ranks", str(Path(__file__))],
+                          capture_output=True, text=True, env=env, timeout=600, cwd=root)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
+    assert proc.stdout.count(" passed") == 2      # one summary line per rank
