@@ -56,8 +56,8 @@ def test_block_solves_satisfy_the_equations(shifted, backend):
         assert _residual(shifted, B, X) < 1e-8
         b, x = shifted.createVecRight(), shifted.createVecRight()
         b.getArray()[:] = B[:, 0]
-        factor.solve(b, x)
-        assert np.allclose(x.getArray(), X[:, 0], rtol=0, atol=1e-12 * np.abs(X[:, 0]).max())
+        factor.solve(b, x)      # one right-hand side: MUMPS blocks its solve otherwise, so round-off differs
+        assert _residual(shifted, B[:, :1], x.getArray()[:, None]) < 1e-8
     finally:
         factor.destroy()
 
