@@ -14,7 +14,9 @@ CholQR2); after every block (once p >= nev + b), Rayleigh–Ritz on H[:p, :p] (S
 symmetric up to round-off); stop when the nev largest Ritz values theta have residual norms ||H[p:, :p] u|| / |theta|
 below tol (SLEPc's relative criterion on the transformed problem); with a full basis, restart with the `keep` best Ritz
 vectors and the last block, whose relation H = [diag(theta); H[p:, :p] U] keeps the expansion going.
-lambda = sigma + 1 / theta.  The same answer on any number of MPI ranks: vectors are distributed by rows,
+lambda = sigma + 1 / theta.  With side="below" (sigma above the wanted eigenvalues, e.g. sigma_max of the inertia
+count) the most negative theta are wanted instead, and the estimates are scaled to residuals of K x = lambda M x
+(BELOW_RIGID_FLOOR).  The same answer on any number of MPI ranks: vectors are distributed by rows,
 the small projected matrices are reduced over the ranks and solved redundantly.
 """
 from __future__ import annotations
@@ -177,21 +179,36 @@ def default_max_basis(nev: int, block: int) -> int:
     return block * -(-size // block)
 
 
-def block_krylov_schur(factor, M: PETSc.Mat, shift: float, nev: int, *, block: int | None = None,
-                       max_basis: int | None = None, tol: float = 1e-10, max_restarts: int = 200,
-                       seed: int = 0) -> BlockEigenResult:
-    """The nev eigenpairs of K x = lambda M x closest above `shift` (rad^2/s^2), given `factor`, a
-    factorisation of K - shift M: an LDL^T of housingfe.solvers.mumps (solve_block) or a PETSc factored Mat.  Eigenvectors M-orthonormal.  SolverError if it does not
-    converge within max_restarts or the basis degenerates (then use SLEPc's Krylov–Schur)."""
+SIDES = ("above", "below")
+
+
+def block_krylov_schur(factor, M: PETSc.Mat, shift: float, nev: int, *, side: str = "above",
+                       block: int | None = None, max_basis: int | None = None, tol: float = 1e-10,
+                       max_restarts: int = 200, seed: int = 0) -> BlockEigenResult:
+    """The nev eigenpairs of K x = lambda M x closest to `shift` (rad^2/s^2) on one side of it, given `factor`,
+    a factorisation of K - shift M: an LDL^T of housingfe.solvers.mumps (solve_block) or a PETSc factored Mat.
+
+    side="above": the nev closest above the shift (a shift below the spectrum: the lowest nev).
+    side="below": the nev closest below the shift, i.e. the most negative theta = 1 / (lambda - shift); with nev
+    the inertia count of K - shift M, every eigenpair below the shift, so the count's own factorisation serves
+    the eigensolve.  Eigenvalues ascending, eigenvectors M-orthonormal.  SolverError if it does not converge
+    within max_restarts or the basis degenerates (then use SLEPc's Krylov–Schur)."""
+    if side not in SIDES:
+        raise ValueError(f"side must be one of {SIDES}, not {side!r}")
     ops = _Operators(factor, M)
     try:
-        return _iterate(ops, shift, nev, block or default_block(nev), max_basis, tol, max_restarts, seed)
+        result = _iterate(ops, shift, nev, block or default_block(nev), max_basis, tol, max_restarts, seed,
+                          side == "below")
     finally:
         ops.mass_products.destroy()
+    order = np.argsort(result.eigenvalues, kind="stable")
+    result.eigenvalues, result.vectors = result.eigenvalues[order], result.vectors[:, order]
+    result.residual_estimates = result.residual_estimates[order]
+    return result
 
 
 def _iterate(ops: _Operators, shift: float, nev: int, b: int, max_basis: int | None, tol: float,
-             max_restarts: int, seed: int) -> BlockEigenResult:
+             max_restarts: int, seed: int, below: bool) -> BlockEigenResult:
     pmax = max_basis or default_max_basis(nev, b)
     if pmax + b > ops.rows:
         raise SolverError(f"block Krylov–Schur: basis of {pmax + b} vectors for {ops.rows} DOFs")
@@ -230,11 +247,11 @@ def _iterate(ops: _Operators, shift: float, nev: int, b: int, max_basis: int | N
                 # the Krylov–Schur relation holds after every block, so convergence is checked after every
                 # block (a p x p eigenproblem, ~1 ms), not only with a full basis: a run no longer pays a whole
                 # restart cycle (7 block solves at 63 eigenpairs) when its last Ritz values pass tol mid-cycle
-                theta, U, coupling, estimates = _ritz(H, p, b)
+                theta, U, coupling, estimates = _ritz(H, p, b, below, shift)
                 if np.all(estimates[:nev] < tol):
                     return BlockEigenResult(shift + 1.0 / theta[:nev], V[:, :p] @ U[:, :nev], estimates[:nev],
                                             restart, solves, b, dict(ops.timings))
-        theta, U, coupling, estimates = _ritz(H, p, b)
+        theta, U, coupling, estimates = _ritz(H, p, b, below, shift)
         if np.all(estimates[:nev] < tol):
             X = V[:, :p] @ U[:, :nev]
             return BlockEigenResult(shift + 1.0 / theta[:nev], X, estimates[:nev], restart, solves, b,
@@ -253,14 +270,27 @@ def _iterate(ops: _Operators, shift: float, nev: int, b: int, max_basis: int | N
                       f"after {max_restarts} restarts")
 
 
-def _ritz(H: np.ndarray, p: int, b: int):
-    """Ritz values theta (largest first: eigenvalues closest above the shift), vectors U of the projected
-    H[:p, :p], the last block row's coupling H[p:p+b, :p] U and the relative residual estimates |coupling| / |theta|."""
+# With the shift above the wanted eigenvalues (side="below"), a residual of the transformed problem maps to one of
+# K x = lambda M x enlarged by |lambda - shift| / lambda: sigma_max / lambda_1 = 46 on the box's lowest elastic mode.
+# The estimates are scaled by it, so the modes meet the same residual as with a shift below zero; the rigid modes
+# (lambda ~ 0) are held to 1 / BELOW_RIGID_FLOOR of the tolerance instead.
+BELOW_RIGID_FLOOR = 1e-2
+
+
+def _ritz(H: np.ndarray, p: int, b: int, below: bool = False, shift: float = 0.0):
+    """Ritz values theta, wanted first (largest: eigenvalues closest above the shift; with `below`, most negative:
+    closest below it), vectors U of the projected H[:p, :p], the last block row's coupling H[p:p+b, :p] U and
+    the relative residual estimates |coupling| / |theta| (with `below`, scaled as said at BELOW_RIGID_FLOOR)."""
     T = H[:p, :p]
     theta, U = np.linalg.eigh((T + T.T) / 2)
-    theta, U = theta[::-1], U[:, ::-1]
+    if not below:
+        theta, U = theta[::-1], U[:, ::-1]
     coupling = H[p:p + b, :p] @ U
-    return theta, U, coupling, np.linalg.norm(coupling, axis=0) / np.abs(theta)
+    estimates = np.linalg.norm(coupling, axis=0) / np.abs(theta)
+    if below:
+        lam = shift + 1.0 / theta
+        estimates = estimates / (np.abs(theta) * np.maximum(lam, BELOW_RIGID_FLOOR * abs(shift)))
+    return theta, U, coupling, estimates
 
 
 def _global_row_range(ops: _Operators) -> tuple[int, int]:
