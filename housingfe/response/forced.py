@@ -126,7 +126,8 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
         if solver == "modal":
             f_basis = spec.modal_basis_factor * spec.f_max
             # the residual vectors reuse the eigensolve's factorisation of K - shift M
-            modes = modal.solve_modes(K, M, f_basis, keep_solver=spec.residual)
+            modes = modal.solve_modes(K, M, f_basis, keep_solver=spec.residual,
+                                      null_space=modal.known_null_space(structure))
             timings["modal_eigensolve_s"] = time.perf_counter() - t1
             facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
                          rigid_modes=modes.rigid_count, basis_f_max_hz=f_basis)
@@ -141,7 +142,8 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
         elif solver == "projected":
             f_basis = spec.modal_basis_factor * spec.f_max
             K_sym = K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
-            modes = modal.solve_modes(K_sym, M, f_basis, keep_solver=True)
+            modes = modal.solve_modes(K_sym, M, f_basis, keep_solver=True,
+                                      null_space=modal.known_null_space(structure))
             timings["modal_eigensolve_s"] = time.perf_counter() - t1
             facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
                          rigid_modes=modes.rigid_count, basis_f_max_hz=f_basis)

@@ -216,7 +216,8 @@ def harmonic_response(structure_or_basis, loads, damping, frequencies, *, surfac
         K_sym = K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
         own_basis = basis is None
         if own_basis:   # the residual vectors reuse the eigensolve's factorisation of K - shift M
-            basis = modal.solve_modes(K_sym, M, basis_factor * f.max(), keep_solver=True)
+            basis = modal.solve_modes(K_sym, M, basis_factor * f.max(), keep_solver=True,
+                                      null_space=modal.known_null_space(structure))
         try:
             if name == "modal":
                 res = harmonic.modal_superposition(K, M, basis, loads, f, damping, observer.reduce,

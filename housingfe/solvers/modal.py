@@ -9,7 +9,8 @@ housingfe.solvers.block_eigen runs on that same LDL^T of K - sigma_max M: the wa
 negative theta = 1 / (lambda - sigma_max), so one factorisation serves the count and the eigensolve, and the
 eigenvalues are the Rayleigh quotients of the vectors.  Otherwise (a caller's shift or nev, a kept solver for
 residual vectors, small models, SLEPc's Krylov–Schur) the operator is factorised again at a shift just below zero,
-positive definite even for free-free structures.
+positive definite even for free-free structures.  A free structure's rigid-body motions are known exactly
+(null_space, known_null_space): the block method returns them as the zero modes and seeks only the others.
 """
 from __future__ import annotations
 
@@ -176,7 +177,8 @@ def _count_below(factor, A: PETSc.Mat) -> int:
 def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = None,
                 tol: float = 1e-10, require_complete: bool = True, shift_hz: float | None = None,
                 ncv: int | None = None, purify: bool = False, method: str = "auto",
-                keep_solver: bool = False, backend: str = "auto") -> ModalResult:
+                keep_solver: bool = False, backend: str = "auto",
+                null_space: list | None = None) -> ModalResult:
     """All eigenpairs with frequency below f_max (Hz).
 
     nev: number of eigenpairs to ask for (default: the inertia count); asking for fewer makes the
@@ -192,6 +194,10 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     keeps none); the caller frees it with result.release_solver().
     backend: how the inertia count and the block method call MUMPS (housingfe.solvers.mumps.ldlt): "auto",
     "direct" or "petsc".
+    null_space: PETSc Vecs known to lie in K's null space, e.g. a free structure's six rigid-body motions
+    (Structure.rigid_body_vectors()).  The block method returns them (M-orthonormalised) as the zero modes and
+    seeks only the other eigenpairs, in their M-orthogonal complement (S2R box: 27 -> 20 block solves, with
+    default_max_basis); vectors that are not null to round-off (null_space_basis) are not used.
     """
     if method not in EIGENSOLVERS and method != "auto":
         raise ValueError(f"unknown eigensolver {method!r}: choose from auto, {', '.join(EIGENSOLVERS)}")
@@ -234,8 +240,12 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
                 shift, phases["factor_s"] = sigma_max, 0.0
             else:
                 factor, A = _factorise_at(K, M, shift, factor, A, structure, backend, phases)
-            pairs = _block_krylov_schur(factor, M, shift, requested, tol, sigma_max, phases,
-                                        side="below" if one_factor else "above")
+            null = null_space_basis(K, M, null_space) if null_space else None
+            known = [] if null is None else _zero_pairs(M, null, requested)
+            phases["deflated"] = len(known)
+            pairs = known + (_block_krylov_schur(factor, M, shift, requested - len(known), tol, sigma_max, phases,
+                                                 side="below" if one_factor else "above", deflate=null)
+                             if requested > len(known) else [])
         except SolverError:
             if method == "block":
                 _destroy(factor, A)
@@ -248,6 +258,7 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
         _destroy(factor, A)
     if pairs is None:
         chosen = "slepc"
+        phases.pop("deflated", None)   # SLEPc finds the rigid modes itself
         pairs = _krylov_schur(K, M, shift, requested, ncv, tol, purify, sigma_max, structure=structure)
     if nev is None and len(pairs) < requested:
         # SLEPc's nev closest to the shift can miss one of a close pair near f_max (seen on the coupled test
@@ -299,15 +310,46 @@ def _destroy(factor, A: PETSc.Mat) -> None:
     A.destroy()
 
 
+def null_space_basis(K: PETSc.Mat, M: PETSc.Mat, vectors: list) -> np.ndarray | None:
+    """The vectors (PETSc Vecs in K's layout) as an M-orthonormal basis (local rows x r), or None when one of
+    them is not null to round-off: ||K r|| > RIGID_EIGENVALUE_RATIO eigenvalue_scale ||M r|| (the test that
+    classifies a computed eigenvalue as zero; the box's rigid motions: ~1e-17) or they are linearly dependent."""
+    X = _dense_columns(K, vectors)
+    KX, MX = K.matMult(X), M.matMult(X)
+    x, kx, mx = X.getDenseArray().copy(), KX.getDenseArray(), MX.getDenseArray()
+    comm = K.getComm().tompi4py()
+    norms = comm.allreduce(np.stack([np.einsum("ij,ij->j", kx, kx), np.einsum("ij,ij->j", mx, mx)]))
+    gram = comm.allreduce(x.T @ mx)
+    for A in (X, KX, MX):
+        A.destroy()
+    if np.any(np.sqrt(norms[0]) > RIGID_EIGENVALUE_RATIO * eigenvalue_scale(K, M) * np.sqrt(norms[1])):
+        return None
+    try:
+        L = np.linalg.cholesky((gram + gram.T) / 2)
+    except np.linalg.LinAlgError:
+        return None
+    return x @ np.linalg.inv(L.T)
+
+
+def _zero_pairs(M: PETSc.Mat, basis: np.ndarray, nev: int) -> list:
+    """(0, vector) pairs of the first min(nev, r) columns of an M-orthonormal null-space basis."""
+    pairs = []
+    for j in range(min(nev, basis.shape[1])):
+        x = M.createVecRight()
+        x.getArray()[:] = basis[:, j]
+        pairs.append((0.0, x))
+    return pairs
+
+
 def _block_krylov_schur(factor, M, shift: float, nev: int, tol: float, sigma_max: float,
-                        timings: dict | None = None, side: str = "above") -> list:
+                        timings: dict | None = None, side: str = "above", deflate: np.ndarray | None = None) -> list:
     """(eigenvalue, vector) pairs below sigma_max, ascending, by housingfe.solvers.block_eigen with `factor`, an
     LDL^T of K - shift M (housingfe.solvers.mumps), the nev closest to the shift on `side` of it.  Fewer than nev
     pairs when an eigenvalue was missed (the caller falls back).  `timings` (if given) receives the phases:
     solve_s, mass_s, orthogonalise_s, restart_s, block_solves, restarts."""
     from housingfe.solvers.block_eigen import block_krylov_schur
 
-    result = block_krylov_schur(factor, M, shift, nev, side=side, tol=tol)
+    result = block_krylov_schur(factor, M, shift, nev, side=side, tol=tol, deflate=deflate)
     if timings is not None:
         timings.update(**result.timings, block_solves=result.block_solves, restarts=result.restarts)
     pairs = []
@@ -501,6 +543,14 @@ class ModalBasis(ModalResult):
                            vectors=[self.structure.to_housing(x) for x in self.vectors])
 
 
+def known_null_space(structure) -> list | None:
+    """A free structure's six rigid-body motions (PETSc Vecs), known exactly: the null_space of solve_modes, so
+    the eigensolve seeks only the other modes (solve_modes checks that they are null vectors of the K it gets).
+    None when the structure is not free (expected_zero_modes < 6 or unknown) or cannot give them."""
+    free = (structure.expected_zero_modes or 0) >= 6 and hasattr(structure, "rigid_body_vectors")
+    return structure.rigid_body_vectors() if free else None
+
+
 def modes(structure, f_max: float, *, tol: float = 1e-10, check: bool = True) -> ModalBasis:
     """All modes of a structure (housingfe.fe.structure.Structure: K, M, expected_zero_modes) below f_max (Hz),
     complete by the inertia count (solve_modes; SolverError if not).  Eigenvalues in rad^2/s^2, vectors
@@ -511,7 +561,7 @@ def modes(structure, f_max: float, *, tol: float = 1e-10, check: bool = True) ->
     import dataclasses
 
     K = structure.K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
-    result = solve_modes(K, structure.M, f_max, tol=tol)
+    result = solve_modes(K, structure.M, f_max, tol=tol, null_space=known_null_space(structure))
     basis = ModalBasis(**{f.name: getattr(result, f.name) for f in dataclasses.fields(ModalResult)},
                        structure=structure)
     if check:

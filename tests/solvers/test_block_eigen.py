@@ -106,6 +106,44 @@ def test_default_block_solve_uses_the_counts_factorisation_and_keeps_the_residua
     assert np.max(one.residuals[k:]) < 1e-8 and np.max(two.residuals[k:]) < 1e-8
 
 
+def test_rigid_body_motions_deflated_give_the_same_elastic_modes_with_fewer_solves(coarse_box_model):
+    """The free box with its six exact rigid-body motions as null_space: they come back as the six zero modes
+    (M-orthonormal, residuals no larger than the solved rigid modes'), the elastic eigenvalues equal the undeflated solve's to 1e-10 with
+    residuals < 1e-8 and M-orthogonal to the rigid motions, with fewer block solves."""
+    model = coarse_box_model
+    K, M = model.K, model.M
+    plain = modal.solve_modes(K, M, 2500.0, method="block")
+    deflated = modal.solve_modes(K, M, 2500.0, method="block", null_space=model.rigid_body_vectors())
+    assert deflated.timings["eigensolve_deflated"] == 6 and plain.timings["eigensolve_deflated"] == 0
+    assert deflated.rigid_count == plain.rigid_count == 6 and deflated.complete
+    assert np.allclose(deflated.eigenvalues[6:], plain.eigenvalues[6:], rtol=1e-10, atol=0)
+    assert np.max(deflated.residuals[:6]) <= np.max(plain.residuals[:6]) and np.max(deflated.residuals[6:]) < 1e-8
+    X = deflated.vectors
+    G = np.array([[X[i].dot(modal._mult(M, X[j])) for j in range(len(X))] for i in range(len(X))])
+    assert np.allclose(G, np.eye(len(X)), atol=1e-8)
+    assert deflated.timings["eigensolve_block_solves"] < plain.timings["eigensolve_block_solves"]
+
+
+def test_vectors_that_are_not_null_are_not_deflated(coarse_box_model):
+    """A null_space that K does not annihilate (a rigid motion plus a bending-like perturbation) is refused by
+    null_space_basis and the solve is the undeflated one: deflating it would drop a wrong vector's direction."""
+    model = coarse_box_model
+    K, M = model.K, model.M
+    vectors = model.rigid_body_vectors()
+    bent = vectors[0].copy()
+    bent.getArray()[::7] += 1e-6
+    assert modal.null_space_basis(K, M, vectors) is not None
+    assert modal.null_space_basis(K, M, vectors[:5] + [bent]) is None
+    result = modal.solve_modes(K, M, 2500.0, method="block", null_space=vectors[:5] + [bent])
+    assert result.timings["eigensolve_deflated"] == 0 and result.rigid_count == 6 and result.complete
+
+
+def test_modes_of_a_free_structure_deflate_its_rigid_motions(coarse_box_model):
+    """modal.modes passes a free structure's rigid-body motions (expected_zero_modes 6) to the eigensolve."""
+    basis = modal.modes(coarse_box_model, 2500.0)
+    assert basis.timings["eigensolve_deflated"] == 6 and basis.rigid_count == 6 and basis.complete
+
+
 def test_double_eigenvalue_is_resolved_as_a_pair(comm):
     """NAFEMS FV12's 4.233 Hz pair (square plate, symmetric mesh): both members found, equal to 1e-8 and
     M-orthogonal — a block method must not lose one of a multiple eigenvalue."""
