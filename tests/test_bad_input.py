@@ -461,7 +461,7 @@ def test_bad_source_scene_is_rejected(change, needles, tmp_path, capsys):
 
 
 # ---------------------------------------------------------------- housingfe bearing
-BEARING_CASES = [
+COMMAND_CASES = [
     ("bearing-unknown-designation", ["bearing", "SKF 99999", "--load", "1000", "0", "0", "0", "0"], ["99999"]),
     ("bearing-load-not-a-number", ["bearing", "SKF 6312", "--load", "1e4", "x", "0", "0", "0"], ["--load"]),
     ("bearing-load-too-few", ["bearing", "SKF 6312", "--load", "1e4", "0"], ["--load"]),
@@ -470,11 +470,15 @@ BEARING_CASES = [
     ("bearing-unknown-option", ["bearing", "SKF 6312", "--load", "1e4", "0", "0", "0", "0", "--speed", "3"],
      ["--speed"]),
     ("bearing-nan-load", ["bearing", "SKF 6312", "--load", "nan", "0", "0", "0", "0"], ["load"]),
+    ("bench-unknown", ["bench", "modall"], ["modall"]),
+    ("bench-only-not-all", ["bench", "modal", "--only", "mpi"], ["--only"]),
+    ("bench-notes-not-all", ["bench", "modal", "--notes"], ["--notes"]),
+    ("bench-notes-with-only", ["bench", "all", "--notes", "--only", "modal"], ["--notes"]),
 ]
 
 
-@pytest.mark.parametrize("argv, needles", [c[1:] for c in BEARING_CASES], ids=[c[0] for c in BEARING_CASES])
-def test_bad_bearing_command_is_rejected(argv, needles, tmp_path, capsys):
+@pytest.mark.parametrize("argv, needles", [c[1:] for c in COMMAND_CASES], ids=[c[0] for c in COMMAND_CASES])
+def test_bad_bearing_or_bench_command_is_rejected(argv, needles, tmp_path, capsys):
     code, err = _run_cli(argv, capsys)
     assert code == 2, (code, err)
     assert "Traceback" not in err, err
@@ -558,7 +562,7 @@ def test_console_script_end_to_end(args, tmp_path):
 
 
 CORPUS_SIZE = (len(SCENE_CASES) + len(MESH_CASES) + 1 + len(SET_CASES) + 2 * len(FILE_CASE_NAMES) + 1
-               + len(SOURCE_CASES) + len(BEARING_CASES) + 5)
+               + len(SOURCE_CASES) + len(COMMAND_CASES) + 5)
 
 
 def test_corpus_is_at_least_fifty_cases():

@@ -13,12 +13,19 @@ def available() -> list[str]:
     return sorted(m.name for m in pkgutil.iter_modules([str(Path(__file__).parent)]) if not m.name.startswith("_"))
 
 
-def main(which: str, out_dir: str | None = None, quick: bool = False, only: list[str] | None = None) -> None:
+def main(which: str, out_dir: str | None = None, quick: bool = False, only: list[str] | None = None,
+         notes_only: bool = False) -> None:
     """Run one benchmark; results go to out_dir (default results/bench-<which>).  only: for `all`, the subset to
-    re-run (their sections of docs/benchmarks.md are replaced)."""
+    re-run (their sections of docs/benchmarks.md are replaced).  notes_only: for `all`, run nothing and refresh the
+    page's hand-written notes from docs/benchmarks-notes.md."""
     if which not in available():
         raise InputError(f"bench: unknown benchmark {which!r} (available: {', '.join(available())})")
     module = importlib.import_module(f"housingfe.benchmarks.{which}")
+    if notes_only:
+        if which != "all" or only or quick:
+            raise InputError("bench: --notes applies to `housingfe bench all` alone (no --only, no --quick)")
+        module.main(Path(out_dir or f"results/bench-{which}"), notes_only=True)
+        return
     if only:
         if which != "all":
             raise InputError("bench: --only applies to `housingfe bench all`")
