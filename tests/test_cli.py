@@ -91,3 +91,17 @@ def test_run_writes_complete_folder_and_mpi_agrees(tmp_path):
     assert len(f1) == len(f2)
     assert max(abs(a - b) / a for a, b in zip(f1, f2)) < 1e-8
     assert Path(two / "modes.xdmf").exists()
+
+
+@pytest.mark.parametrize("env, expected", [({}, "ob1"), ({"OMPI_MCA_pml": "cm"}, "cm"),
+                                           ({"OMPI_COMM_WORLD_SIZE": "2"}, None), ({"SLURM_PROCID": "0"}, None)])
+def test_a_process_without_launcher_gets_the_shared_memory_mpi_layer(env, expected):
+    """A plain process (Open MPI singleton) gets OMPI_MCA_pml=ob1 (UCX's probe costs 0.2 s of MPI_Init and on one
+    host ob1 is what Open MPI falls back to anyway); a user's choice and a process started by mpirun or srun are
+    left alone."""
+    base = {k: v for k, v in os.environ.items()
+            if k not in ("OMPI_MCA_pml", "OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "SLURM_PROCID")}
+    proc = subprocess.run([sys.executable, "-c", "import os, housingfe; print(os.environ.get('OMPI_MCA_pml'))"],
+                          capture_output=True, text=True, env={**base, **env}, timeout=60)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == str(expected)
