@@ -70,7 +70,7 @@ def _cmd_mesh_picture(args: argparse.Namespace) -> int:
         scene, _ = load_housing_scene(name)
         size = element_size(scene.mesh, scene.geometry, scene.analysis.f_max, scene.material.resolve())
         hm = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, MPI.COMM_SELF,
-                        grading=scene.mesh.grading)
+                        grading=scene.mesh.grading, layer_size=scene.mesh.layer_size)
         label = f"{scene.scene.name}: {hm.mesh.topology.index_map(3).size_global} {hm.element} cells, " \
                 f"h = {size * 1e3:.1f} mm"
         mesh_picture(hm, out / f"{name}-mesh.png", label)

@@ -181,6 +181,7 @@ SCENE_CASES = [
     ("mesh-bad-degree", _set("mesh.degree", 5), ["mesh.degree"]),
     ("mesh-bad-element", _set("mesh.element", "prism"), ["mesh.element"]),
     ("mesh-zero-layers", _set("mesh.layers", 0), ["mesh.layers"]),
+    ("mesh-negative-layer-size", _set("mesh.layer_size", -0.004), ["mesh.layer_size"]),
     ("mesh-unknown", _set("mesh.order", 2), ["mesh.order", "unknown key"]),
     ("mesh-negative-size", _set("mesh.size", -0.01), ["mesh.size"]),
     ("mesh-grading-above-one", _set("mesh.grading", 1.5), ["mesh.grading"]),

@@ -125,7 +125,8 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
     regions = dict(regions or {})
     size = element_size(mesh, geometry, f_max, material)
     check_model_size(geometry, mesh, size, comm)
-    housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm, grading=mesh.grading)
+    housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm, grading=mesh.grading,
+                         layer_size=mesh.layer_size)
     if housing.quality["min"] < MIN_ELEMENT_QUALITY:
         raise InputError(f"mesh: element quality {housing.quality['min']:.3f} < {MIN_ELEMENT_QUALITY} "
                          f"({housing.quality['measure']}); change mesh.size or mesh.element")
@@ -161,7 +162,7 @@ def check_model_size(geometry, mesh, size: float, comm) -> dict:
     the element size, its key, and the geometry's largest dimension.  Returns the estimate."""
     from housingfe.geometry.mesh import estimate_dofs
 
-    dofs = estimate_dofs(geometry, mesh.element, mesh.degree, size, mesh.layers)
+    dofs = estimate_dofs(geometry, mesh.element, mesh.degree, size, mesh.layers, mesh.layer_size)
     need = MEMORY_BASE_BYTES * comm.size + MEMORY_PER_DOF_BYTES * dofs
     available, total = comm.bcast(available_memory_bytes() if comm.rank == 0 else None, root=0)
     estimate = {"dofs": dofs, "memory_bytes": need, "available_bytes": available, "total_bytes": total}

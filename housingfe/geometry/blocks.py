@@ -181,25 +181,31 @@ def cells_where(grid, predicate: Callable[[float, float, float], str | None]) ->
     return cells
 
 
-def divisions(length: float, size: float, thin: Sequence[float], layers: int) -> int:
+def divisions(length: float, size: float, thin: Sequence[float], layers: int,
+              layer_size: float | None = None) -> int:
     """Number of elements along an edge of `length` (m) for target element size `size` (m); edges no longer
-    than a wall thickness get at least `layers` elements.  A length that is a whole multiple of the size up to
+    than a wall thickness get at least `layers` elements, and with `layer_size` (m) at least
+    ceil(length / layer_size): elements of about that length through every wall, so a thicker wall (the box's
+    15 mm flange against its 8 mm walls) gets more layers.  A length that is a whole multiple of the size up to
     round-off gets exactly that many (slack 1e-6 of a division; the built-in kernel's lengths are exact, OCC's
     bounding boxes, used before 2026-11-25, carried ~1e-7 m per side and so gave one division more there).
     The 1 um slack on the thin test: edges are compared with the thicknesses of the model they came from."""
     if length <= max(thin, default=0.0) + 1e-6:
-        return max(layers, math.ceil(length / size - 1e-6))
+        through = math.ceil(length / layer_size - 1e-6) if layer_size else 1
+        return max(layers, through, math.ceil(length / size - 1e-6))
     return max(1, math.ceil(length / size - 1e-6))
 
 
 def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int,
-                     grading: float = 1.0) -> dict[str, dict[str, int]]:
+                     grading: float = 1.0, layer_size: float | None = None) -> dict[str, dict[str, int]]:
     """Create the blocks in the current gmsh model as one conforming solid (hexahedra: grid cells sharing their
     faces in gmsh's built-in kernel; tetrahedra: OCC boxes with the bores cut, fragmented), define physical
     groups (volumes per feature, surfaces per classifier name) and mesh.
 
     element: "hex" (transfinite, recombined hexahedra) or "tet".  size: target element size (m).
     grading: hex only, end-to-middle element length ratio along block edges longer than a wall (1 = uniform).
+    layers, layer_size: hex only, elements through every wall: at least `layers`, and at least
+    ceil(thickness / layer_size) where layer_size (m) is given (`divisions`).
     Returns {"cells": {name: tag}, "facets": {name: [tags]}} of the physical groups (a surface name may
     cover several facet tag values).
     Runs on the calling rank only; the caller owns gmsh initialise/finalise.
@@ -227,7 +233,7 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int,
 
     _set_mesh_options(element)
     if element == "hex":
-        _make_transfinite(model, size, layers, grading)
+        _make_transfinite(model, size, layers, grading, layer_size)
     else:
         gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
         gmsh.option.setNumber("Mesh.MeshSizeMax", size)
@@ -507,7 +513,8 @@ def _set_mesh_options(element: str) -> None:
     gmsh.option.setNumber("Mesh.RandomFactor", 1e-9)
 
 
-def _make_transfinite(model: BlockModel, size: float, layers: int, grading: float = 1.0) -> None:
+def _make_transfinite(model: BlockModel, size: float, layers: int, grading: float = 1.0,
+                      layer_size: float | None = None) -> None:
     """Structured divisions on every curve; with grading < 1, a symmetric "Bump" distribution (finer at both
     ends, where the block meets its neighbours) on curves longer than a wall with at least two divisions.  The
     bump is symmetric, so opposite edges of a block agree whatever their orientation."""
@@ -518,7 +525,7 @@ def _make_transfinite(model: BlockModel, size: float, layers: int, grading: floa
     for _, curve in gmsh.model.getEntities(1):
         xmin, ymin, zmin, xmax, ymax, zmax = gmsh.model.getBoundingBox(1, curve)
         length = max(xmax - xmin, ymax - ymin, zmax - zmin)
-        n = divisions(length, size, model.thin_dimensions, layers)
+        n = divisions(length, size, model.thin_dimensions, layers, layer_size)
         if grading < 1.0 and n >= 2 and length > thickest + 1e-6:
             mesh.setTransfiniteCurve(curve, n + 1, "Bump", grading)
         else:

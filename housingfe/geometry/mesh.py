@@ -64,7 +64,8 @@ def bending_wavelength(frequency: float, thickness: float, youngs_modulus: float
 DOFS_PER_GRID_CELL = {"hex": 37.0, "tet": 40.0}
 
 
-def estimate_dofs(geometry, element: str, degree: int, size: float, layers: int) -> int:
+def estimate_dofs(geometry, element: str, degree: int, size: float, layers: int,
+                  layer_size: float | None = None) -> int:
     """Displacement DOFs (3 per node) of the mesh `build_mesh` would make, estimated from the block model
     without meshing: every grid cell gets the structured divisions of its edges (size in m, `layers` through
     wall thicknesses), times DOFS_PER_GRID_CELL scaled by degree^2 (degree + 1) / 12: the cells are mostly one
@@ -76,16 +77,18 @@ def estimate_dofs(geometry, element: str, degree: int, size: float, layers: int)
     steps = [np.diff(g) for g in model.grid]
     cells = 0
     for i, j, k in model.cells:
-        cells += math.prod(divisions(float(d), size, model.thin_dimensions, layers)
+        cells += math.prod(divisions(float(d), size, model.thin_dimensions, layers, layer_size)
                            for d in (steps[0][i], steps[1][j], steps[2][k]))
     return int(round(DOFS_PER_GRID_CELL[element] * degree ** 2 * (degree + 1) / 12 * cells))
 
 
-def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: float = 1.0) -> HousingMesh:
+def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: float = 1.0,
+               layer_size: float | None = None) -> HousingMesh:
     """Build the gmsh model on rank 0, mesh it and distribute it as a dolfinx mesh.
 
     element: "hex" (structured quadratic-ready hexahedra) or "tet"; size: element size (m);
-    layers: elements through a wall thickness (hex meshes).
+    layers: elements through a wall thickness (hex meshes); layer_size (m): with it, at least
+    ceil(thickness / layer_size) elements through each wall (hex meshes, `blocks.divisions`).
     """
     import gmsh
     from dolfinx.io import gmshio
@@ -98,7 +101,7 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
         try:
             gmsh.option.setNumber("General.Terminal", 0)
             gmsh.model.add("housing")
-            groups = build_gmsh_model(model, element, size, layers, grading)
+            groups = build_gmsh_model(model, element, size, layers, grading, layer_size)
         except Exception:
             gmsh.finalize()
             raise

@@ -45,6 +45,21 @@ def test_free_box_below_one_percent_with_three_layers(comm):
     assert np.abs(stiff / reference - 1).max() > 2 * error.max()
 
 
+def test_free_box_below_one_percent_with_layers_from_the_wall_thickness(comm):
+    """mesh.layer_size = 4 mm gives 2 layers through the 8 mm walls and 4 through the 15 mm flange, whose root
+    carries the worst modes (6-8): with grading towards the junctions, below 1 % on 20 % fewer DOFs than 3 layers
+    everywhere (measured 0.92 % at 31 926 DOFs; 2 layers everywhere, 23 646 DOFs, is 1.42 %)."""
+    from housingfe.benchmarks.modal import load_reference
+
+    reference, _ = load_reference()
+    over = ["mesh.size=0.03", "mesh.layer_size=0.004", "mesh.grading=0.5", "analysis.modal.f_max=4320.0"]
+    model = build_model_from_scene(load_scene("box-free", *over, *S2R), comm)
+    assert model.dofs == 31926
+    result = modal.solve_modes(model.K, model.M, 4320.0)
+    f = result.frequencies_hz[result.rigid_count:][:len(reference)]
+    assert np.abs(f / reference - 1).max() < 0.01
+
+
 @pytest.mark.parametrize("overrides, message", [
     (['mesh.family="serendipity"', "mesh.degree=3"], 'element = "hex" and degree = 2'),
     (['mesh.integration="reduced"', "mesh.degree=2"], "reduced integration needs family"),
