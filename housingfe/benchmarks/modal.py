@@ -63,9 +63,11 @@ HOUSINGFE_CASES = [
     {"element": "hex", "degree": 2, "size": 0.030, "layers": 1, "layer_size": 0.004, "grading": 0.5,
      "family": "serendipity", "integration": "reduced", "ranks": 2},
 ]
-# CalculiX's element and mesh choices that matter here (C3D20R: C3D20 is stiffer, 2.52 % vs 1.94 % at 15 mm):
-# the number of element layers through the 8 mm walls decides its error (mode 7, 1374 Hz, converges with the
-# layers, not with the in-plane size): 1 layer stalls at 1.7 % even at 10 mm, 3 layers reach 0.86 % at 30 mm.
+# CalculiX's element and mesh choices that matter here (C3D20R: C3D20 is stiffer, 2.52 % vs 1.94 % at 15 mm;
+# C3D8I is far worse per DOF, 2.46 % at 54 k DOFs): the element layers through the walls decide its error, above
+# all those through the 15 mm flange (elastic modes 6-8 at the flange root converge with the layers, not with the
+# in-plane size): 1 layer stalls at 1.7 % even at 10 mm, 3 layers reach 0.86 % at 30 mm, 2 in the walls and 4 in
+# the flange (layer_size 4 mm) 0.96 % on 32 k DOFs (benchmarks/experiments/same_mesh).
 CALCULIX_CASES = [
     {"element": "hex", "ccx_type": "C3D20R", "size": 0.0234, "layers": 1},
     {"element": "hex", "ccx_type": "C3D20R", "size": 0.015, "layers": 1},
