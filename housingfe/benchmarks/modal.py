@@ -136,8 +136,9 @@ def write_calculix_deck(case: dict, path: Path) -> tuple[int, int]:
         gmsh.model.add("ccx")
         build_gmsh_model(block_model_for(scene.geometry), case["element"], case["size"], case["layers"],
                          case.get("grading", 1.0), case.get("layer_size"))
-        gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 1)  # 20-node hexes (C3D20/C3D20R)
-        gmsh.model.mesh.setOrder(2)
+        if not case["ccx_type"].startswith("C3D8"):                  # C3D8, C3D8R, C3D8I: linear bricks
+            gmsh.option.setNumber("Mesh.SecondOrderIncomplete", 1)  # 20-node hexes (C3D20/C3D20R)
+            gmsh.model.mesh.setOrder(2)
         raw = path.with_suffix(".gmsh.inp")
         gmsh.write(str(raw))
     finally:
