@@ -150,7 +150,9 @@ def write_calculix_deck(case: dict, path: Path) -> tuple[int, int]:
         f"{m.youngs_modulus:.6e},{m.poisson_ratio}\n*DENSITY\n{m.density}\n"
         "*SOLID SECTION,ELSET=EALL,MATERIAL=STEEL\n"
         f"*STEP\n*FREQUENCY,SOLVER=SPOOLES\n60,0.,{SOLVE_TO}\n*END STEP\n"))
-    return nodes.count("\n") - 1, elements.count("\n") - elements.count("*")
+    # gmsh continues a 20-node element's row on a second line after a trailing comma: count the rows' ends
+    rows = [line for line in elements.splitlines() if line.strip() and not line.startswith("*")]
+    return nodes.count("\n") - 1, sum(1 for line in rows if not line.rstrip().endswith(","))
 
 
 def _volume_part_of_inp(text: str, ccx_type: str) -> tuple[str, str]:
