@@ -23,8 +23,8 @@ from housingfe.benchmarks.modal import load_reference, run_housingfe_case
 LAYERS_BY_THICKNESS: dict[float, int] = {}   # m -> element layers
 
 
-def divisions(length: float, size: float, thin, layers: int) -> int:
-    """`blocks.divisions` with a layer count per wall thickness."""
+def divisions(length: float, size: float, thin, layers: int, layer_size=None) -> int:
+    """`blocks.divisions` with a layer count per wall thickness (mesh.layer_size is not used here)."""
     for thickness, n in LAYERS_BY_THICKNESS.items():
         if abs(length - thickness) < 1e-6:
             return max(n, math.ceil(length / size - 1e-6))
