@@ -174,6 +174,10 @@ def main(argv: list[str] | None = None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+    finally:
+        from housingfe import outputs
+
+        outputs.release_all()     # output places reserved by a command that stopped before writing
 
 
 if __name__ == "__main__":

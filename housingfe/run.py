@@ -50,6 +50,7 @@ def run_housing_scene(name_or_path: str, out_dir: str | None = None, overrides: 
     scene, path = load_housing_scene(name_or_path, overrides)
     comm = MPI.COMM_WORLD
     out = Path(out_dir or f"results/{scene.scene.name}")
+    outputs.reserve_output(out, comm, inputs=[path])   # a bad or busy output place stops here, before the mesh
     try:
         return _run(scene, out, comm, t_start)
     except InputError as exc:

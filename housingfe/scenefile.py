@@ -8,7 +8,7 @@ import tomllib
 from pathlib import Path
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
 
 from housingfe.errors import InputError
 
@@ -19,10 +19,31 @@ class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
 
 
+def scene_name_problem(name) -> str | None:
+    """Why `name` cannot be a scene name, or None.  The name is the default result folder results/<name>: it must
+    be one plain folder name, so that an empty or path-like name can never make results/ itself, or a place
+    outside it, the output (issue 27)."""
+    if not isinstance(name, str):
+        return f"{name!r} is not a string"
+    if not name.strip() or name in (".", "..") or name.startswith(".") or any(c in name for c in "/\\") \
+            or any(ord(c) < 32 for c in name):
+        return (f"{name!r} cannot name the result folder results/<name>: give a non-empty name without '/', "
+                "'\\', control characters or a leading '.'")
+    return None
+
+
 class SceneInfo(_Strict):
     name: str
     kind: Literal["housing", "source", "runup"]
     description: str = ""
+
+    @field_validator("name")
+    @classmethod
+    def _plain_folder_name(cls, name: str) -> str:
+        problem = scene_name_problem(name)
+        if problem is not None:
+            raise ValueError(problem)
+        return name
 
 
 def builtin_scenes() -> dict[str, str]:

@@ -6,6 +6,7 @@ import pkgutil
 from pathlib import Path
 
 from housingfe.errors import InputError
+from housingfe.outputs import reserve_output
 
 
 def available() -> list[str]:
@@ -31,4 +32,7 @@ def main(which: str, out_dir: str | None = None, quick: bool = False, only: list
             raise InputError("bench: --only applies to `housingfe bench all`")
         module.main(Path(out_dir or f"results/bench-{which}"), quick, only=only)
         return
-    module.main(Path(out_dir or f"results/bench-{which}"), quick)
+    out = Path(out_dir or f"results/bench-{which}")
+    if which != "all":      # `all` writes a folder of result folders (each checked by its own run)
+        reserve_output(out)     # a bad or busy output place stops here, before the rounds
+    module.main(out, quick)

@@ -36,9 +36,12 @@ def register_cli(subparsers) -> None:
 
 def _cmd_update(args: argparse.Namespace) -> int:
     from housingfe.correlation.updating import load_update_spec, run_update
+    from housingfe.outputs import reserve_output
 
     spec = load_update_spec(args.spec)
-    run_update(spec, args.out or f"results/update-{spec.name}")
+    out = args.out or f"results/update-{spec.name}"
+    reserve_output(out, inputs=[args.spec])     # before the 30-40 min of fitting
+    run_update(spec, out)
     return 0
 
 
@@ -52,11 +55,15 @@ def _cmd_correlate(args: argparse.Namespace) -> int:
     from mpi4py import MPI
 
     from housingfe.correlation import uff
+    from housingfe.outputs import reserve_output
     from housingfe.scene import build_model_from_scene, load_housing_scene
     from housingfe.solvers.modal import modes
 
     measured = uff.read_measured_modes(args.measured) if args.measured else None
-    scene, _ = load_housing_scene(args.scene, args.set or [])
+    scene, scene_path = load_housing_scene(args.scene, args.set or [])
+    if measured is not None:     # the folder written at the end: checked and locked before the solve
+        reserve_output(args.out or f"results/correlate-{Path(args.scene).stem}", MPI.COMM_WORLD,
+                       inputs=[scene_path, args.measured])
     f_max = args.f_max or (1.25 * float(measured.frequencies_hz.max()) if measured is not None
                            else scene.analysis.f_max)
     model = build_model_from_scene(scene, MPI.COMM_WORLD)

@@ -190,6 +190,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     scene, path = load_runup_scene(name_or_path, overrides)
     comm = MPI.COMM_WORLD
     out = Path(out_dir or f"results/{scene.scene.name}")
+    outputs.reserve_output(out, comm, inputs=[path])   # a bad or busy output place stops here, before any work
     spec = scene.runup
     housing_scene, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
     try:

@@ -15,7 +15,7 @@ import importlib
 from pathlib import Path
 
 from housingfe.errors import InputError
-from housingfe.scenefile import read_scene_dict
+from housingfe.scenefile import read_scene_dict, scene_name_problem
 
 MODELS = {
     "roosmalen": "housingfe.source.roosmalen",
@@ -44,7 +44,7 @@ def load_scene(name_or_path: str) -> tuple[dict, Path]:
 
 def run(name_or_path: str, out: str | None = None) -> Path:
     """Run a source scene and return the result folder."""
-    from housingfe.outputs import atomic_output_dir
+    from housingfe.outputs import atomic_output_dir, reserve_output
 
     scene, path = load_scene(name_or_path)
     model = scene["source"]["model"]
@@ -54,8 +54,12 @@ def run(name_or_path: str, out: str | None = None) -> Path:
         if exc.name == MODELS[model]:
             raise InputError(f"{path}: source.model: {model!r} is not available in this installation") from None
         raise
-    name = scene["scene"].get("name") or path.stem
+    name = scene["scene"].get("name", path.stem)
+    problem = scene_name_problem(name)
+    if problem is not None:
+        raise InputError(f"{path}: scene.name: {problem}")
     out_dir = Path(out) if out else Path("results") / name
+    reserve_output(out_dir, inputs=[path])
     with atomic_output_dir(out_dir) as tmp:
         module.run_scene(scene, str(path), tmp)
     print(f"results in {out_dir}")

@@ -210,12 +210,14 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
     from housingfe.scene import build_model_from_scene, load_housing_scene
 
     t_start = time.perf_counter()
-    scene, _ = load_housing_scene(scene_name, list(overrides))
+    scene, scene_path = load_housing_scene(scene_name, list(overrides))
     if scene.coupling is None or scene.analysis.harmonic is None or not scene.analysis.harmonic.angular_velocity_node:
         raise InputError(f"{scene_name}: bearing-variants needs a scene with [coupling], [analysis.harmonic] and "
                          "analysis.harmonic.angular_velocity_node")
     configs = list(configs or [*configurations(), THESIS_SELF_ALIGNING, APPENDIX_C_MOMENTS])
     comm = MPI.COMM_WORLD
+    out = Path(out_dir or f"results/bearing-variants-{scene.scene.name}")
+    outputs.reserve_output(out, comm, inputs=[scene_path])     # before the model is built
     model = build_model_from_scene(scene, comm)
     t_model = time.perf_counter() - t_start
     spec = scene.analysis.harmonic
@@ -235,7 +237,6 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
         if comm.rank == 0:
             print(f"{name:20s} {solver:15s} {time.perf_counter() - t0:6.1f} s", flush=True)
     summary = differences(results, "ball" if "ball" in results else configs[0])
-    out = Path(out_dir or f"results/bearing-variants-{scene.scene.name}")
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
             write_outputs(tmp, results, summary, scene, model, t_model)

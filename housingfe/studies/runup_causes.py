@@ -84,10 +84,12 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
     from housingfe.scene import load_housing_scene
 
     t0 = time.perf_counter()
-    scene, _ = load_runup_scene(scene_name, list(overrides))
+    scene, scene_path = load_runup_scene(scene_name, list(overrides))
     spec = scene.runup
     torque = max(spec.torques_nm)
     comm = MPI.COMM_WORLD
+    out = Path(out_dir or f"results/runup-causes-{scene.scene.name}")
+    outputs.reserve_output(out, comm, inputs=[scene_path])     # before the model is built
     housing_scene, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
     model = housing_model_for(housing_scene, spec.f_max_hz, comm)
     dt = drivetrain_of(scene.drivetrain, torque)
@@ -129,7 +131,6 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
     bands = third_octave_bands(125.0, 630.0)
     counts = {int(c): int(np.sum((freqs >= lo) & (freqs < hi)))
               for c, lo, hi in zip(bands.nominal, bands.lower, bands.upper)}
-    out = Path(out_dir or f"results/runup-causes-{scene.scene.name}")
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
             outputs.write_csv(tmp / "causes.csv", COLUMNS, ([r[c] for c in COLUMNS] for r in rows))

@@ -34,11 +34,13 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.errors import InputError, SolverError
+from housingfe.outputs import atomic_output_dir, reserve_output
 from housingfe.scene import load_housing_scene
 from housingfe.scenefile import builtin_scenes
 from housingfe.verification.published import THESIS, row, thesis, thesis_source
 
 RESULTS = Path("results")
+OWN_FILES = ("validate.csv", "validate.md")     # what --out holds (besides housingfe.outputs.MARKER)
 PACKAGE = Path(__file__).resolve().parent.parent   # the housingfe package (this file is in verification/)
 STAMP = ".validate-key"
 # the bearing-variant study (thesis Sec. 5.8, Fig. 5.18) and the configurations it needs
@@ -82,6 +84,12 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     writing the table when a computation failed."""
     t0 = time.perf_counter()
     results = Path(results_dir) if results_dir is not None else RESULTS
+    if results.resolve() == Path(out_dir).resolve() or Path(out_dir).resolve() in results.resolve().parents:
+        raise InputError(f"{out_dir}: --out: holds the FE result cache {results}/ (--results); give a folder of "
+                         f"its own, e.g. {results}/validate")
+    # checked and locked before minutes of computation; validate.csv and validate.md alone are an older
+    # validate's output (written before result folders carried a marker)
+    reserve_output(out_dir, own_files=OWN_FILES)
     names = scenes or default_scenes(quick)
     rows: list[dict] = []
     failures: list[str] = []
@@ -473,18 +481,19 @@ def format_rows(rows: list[dict]) -> str:
 
 def write_outputs(rows: list[dict], out_dir: Path, json_path) -> None:
     """validate.csv and validate.md in out_dir; the list of rows as JSON in json_path.  In the CSV an empty
-    `ours` is a published number we do not reproduce (see `note`)."""
-    out_dir.mkdir(parents=True, exist_ok=True)
-    with open(out_dir / "validate.csv", "w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(COLUMNS)
+    `ours` is a published number we do not reproduce (see `note`).  out_dir is written atomically (a result
+    folder: housingfe.outputs)."""
+    with atomic_output_dir(out_dir) as tmp:
+        with open(tmp / "validate.csv", "w", newline="") as fh:
+            writer = csv.writer(fh)
+            writer.writerow(COLUMNS)
+            for r in rows:
+                writer.writerow([r["scene"], r["quantity"], _csv(r["ours"]), _csv(r["published"]),
+                                 r.get("difference", ""), r["unit"], r["source"], r.get("note", "")])
+        lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
         for r in rows:
-            writer.writerow([r["scene"], r["quantity"], _csv(r["ours"]), _csv(r["published"]), r.get("difference", ""),
-                             r["unit"], r["source"], r.get("note", "")])
-    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
-    for r in rows:
-        lines.append("| " + " | ".join(c.replace("|", "/") for c in _cells(r)) + " |")
-    (out_dir / "validate.md").write_text("\n".join(lines) + "\n")
+            lines.append("| " + " | ".join(c.replace("|", "/") for c in _cells(r)) + " |")
+        (tmp / "validate.md").write_text("\n".join(lines) + "\n")
     if json_path:
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
         keys = ("scene", "quantity", "ours", "published", "unit", "source", "note")
