@@ -81,8 +81,10 @@ def check_output_place(out_dir: str | os.PathLike, inputs: Iterable[str | os.Pat
         raise InputError("output folder: empty path")
     out = Path(out_dir)
     real = out.resolve()
-    protected = [(Path.cwd().resolve(), "the working folder"), (Path.home().resolve(), "your home folder"),
+    protected = [(Path.cwd().resolve(), "the working folder"),
                  (Path(__file__).resolve().parent.parent, "the folder of housingfe's own sources")]
+    with contextlib.suppress(RuntimeError, KeyError):     # no home folder known: nothing to protect there
+        protected.append((Path.home().resolve(), "your home folder"))
     protected += [(Path(p).resolve(), f"the input file {p}") for p in inputs]
     for path, label in protected:
         if real == path or real in path.parents:
@@ -200,13 +202,25 @@ def _pid_alive(pid: int) -> bool:
 
 def _remove_stale(parent: Path, name: str) -> None:
     """Remove `.<name>.tmp-PID` / `.<name>.old-PID` folders left by killed runs (the caller holds the lock, so
-    no housingfe run of this version writes them; a folder of a live PID other than ours is left alone)."""
+    no housingfe run of this version writes them; a folder of a live PID other than ours is left alone).  If
+    the run was killed between its two renames (no folder under the name), the newest complete result among
+    them is renamed in first: a new one that holds MARKER, else the old one set aside."""
+    stale = []
     for kind in ("tmp", "old"):
         for path in parent.glob(f".{glob.escape(name)}.{kind}-*"):
             pid = path.name.rsplit("-", 1)[-1]
             if pid.isdigit() and (int(pid) == os.getpid() or not _pid_alive(int(pid))) and path.is_dir() \
                     and not path.is_symlink():
-                _remove_tree(path)
+                stale.append(path)
+    out = parent / name
+    if stale and not os.path.lexists(out):
+        complete = [p for p in stale if ".tmp-" in p.name and (p / MARKER).is_file()] + \
+                   [p for p in stale if ".old-" in p.name]
+        if complete:
+            os.rename(complete[0], out)
+            stale.remove(complete[0])
+    for path in stale:
+        _remove_tree(path)
 
 
 def _remove_tree(path: Path) -> None:

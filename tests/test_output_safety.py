@@ -294,6 +294,23 @@ def test_stale_temporary_folder_of_a_killed_run_is_removed_by_the_next_run(tmp_p
     assert (tmp_path / "res" / "modes.json").is_file()
 
 
+def test_a_run_killed_between_its_two_renames_is_recovered_by_the_next_run(tmp_path):
+    """The instant between `old -> .old-PID` and `.tmp-PID -> name`: no folder under the name, both results
+    complete beside it.  The next run into the place first puts the new one (it has the marker) in place; if
+    that run then fails before writing, the user still has the newest complete result."""
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    for kind, tag in (("old", "old"), ("tmp", "new")):
+        folder = tmp_path / f".res.{kind}-{dead.pid}"
+        folder.mkdir()
+        (folder / "f.txt").write_text(tag)
+        (folder / outputs.MARKER).write_text("{}")
+    outputs.reserve_output(tmp_path / "res")
+    outputs.release_output(tmp_path / "res")
+    assert (tmp_path / "res" / "f.txt").read_text() == "new"
+    assert hidden(tmp_path) == []
+
+
 def test_second_run_into_a_busy_place_is_refused_naming_the_holder(work):
     """Before issue 27 both runs reported success and one result was silently discarded."""
     holder = _helper(work, "busy", 3, "first", sleep=60, wait=False)

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.outputs import format_table, write_csv
+from housingfe.outputs import atomic_output_dir, format_table, write_csv
 from housingfe.source import dynamics as dyn
 from housingfe.source.roosmalen import OperatingPoint, build, parse
 
@@ -130,25 +130,25 @@ def main(out_dir: Path, quick: bool) -> None:
     import matplotlib.pyplot as plt
 
     out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
     rows = stiffness_rows(quick) + dynamics_rows(quick) + other_rows(quick)
     header = ["case", "wall_s", "error", "note"]
     table = [[r["case"], float(r["wall_s"]), float(r["error"]), r.get("note", "")] for r in rows]
     print(format_table(header, table, floatfmt="{:.3g}"))
-    write_csv(out_dir / "bench_source.csv", header, table)
-    fig, ax = plt.subplots(figsize=(8, 5))
-    for label, key in (("stiffness curve", "stiffness curve"), ("harmonic balance", "harmonic balance"),
-                       ("time integration", "time integration"), ("run-up", "run-up")):
-        sel = [r for r in rows if key in r["case"]]
-        if sel:
-            ax.loglog([r["wall_s"] for r in sel], [max(r["error"], 1e-16) for r in sel], "o-", label=label)
-    ax.set_xlabel("wall time [s]")
-    ax.set_ylabel("error (relative; run-up in dB)")
-    ax.set_title("housingfe bench source: van Roosmalen gear set A, 2000 N m")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out_dir / "bench_source.png", dpi=120)
-    plt.close(fig)
+    with atomic_output_dir(out_dir) as tmp:     # a result folder (docs/outputs.md)
+        write_csv(tmp / "bench_source.csv", header, table)
+        fig, ax = plt.subplots(figsize=(8, 5))
+        for label, key in (("stiffness curve", "stiffness curve"), ("harmonic balance", "harmonic balance"),
+                           ("time integration", "time integration"), ("run-up", "run-up")):
+            sel = [r for r in rows if key in r["case"]]
+            if sel:
+                ax.loglog([r["wall_s"] for r in sel], [max(r["error"], 1e-16) for r in sel], "o-", label=label)
+        ax.set_xlabel("wall time [s]")
+        ax.set_ylabel("error (relative; run-up in dB)")
+        ax.set_title("housingfe bench source: van Roosmalen gear set A, 2000 N m")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(tmp / "bench_source.png", dpi=120)
+        plt.close(fig)
 
 
 if __name__ == "__main__":
