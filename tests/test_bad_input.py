@@ -4,7 +4,9 @@ one line on stderr that names the offending key (or argument, or file), no trace
 Scenes are written as TOML into tmp_path and run in-process through `housingfe.cli.main` (a subprocess per case
 would cost seconds of imports each); a few cases run the console script end to end.  Almost every case is
 rejected by the scene check before any meshing; the few that need the mesh (a load point off its surface) use
-a coarse linear mesh.  `CORPUS_SIZE` counts the cases (hypothesis examples not included).
+a coarse linear mesh.  `CORPUS_SIZE` counts the cases (hypothesis examples not included).  Bad output places
+(`--out` onto a folder of the user's, `.`, a file, a read-only or busy place; path-like scene names) and killed
+runs are the corpus of tests/test_output_safety.py.
 """
 from __future__ import annotations
 

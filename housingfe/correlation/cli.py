@@ -35,12 +35,14 @@ def register_cli(subparsers) -> None:
 
 
 def _cmd_update(args: argparse.Namespace) -> int:
+    from mpi4py import MPI
+
     from housingfe.correlation.updating import load_update_spec, run_update
     from housingfe.outputs import reserve_output
 
     spec = load_update_spec(args.spec)
     out = args.out or f"results/update-{spec.name}"
-    reserve_output(out, inputs=[args.spec])     # before the 30-40 min of fitting
+    reserve_output(out, MPI.COMM_WORLD, inputs=[args.spec])     # before the 30-40 min of fitting
     run_update(spec, out)
     return 0
 
