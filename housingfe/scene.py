@@ -126,7 +126,7 @@ class LoadSpec(_Strict):
     point: Optional[list[float]] = Field(None, min_length=3, max_length=3)
     direction: Optional[list[float]] = Field(None, min_length=3, max_length=3)
     radius: PositiveFloat = 0.005
-    amplitude: float = 1.0
+    amplitude: float = Field(1.0, json_schema_extra={"unit": "N, N m or Pa (by kind)"})
     spectrum: Optional[Spectrum] = None
 
     @model_validator(mode="after")
@@ -175,7 +175,7 @@ class ResponsePointSpec(_Strict):
     point: list[float] = Field(min_length=3, max_length=3)
     direction: Optional[list[float] | Literal["normal"]] = None
     surface: Optional[str] = None
-    tolerance: Optional[PositiveFloat] = None
+    tolerance: Optional[PositiveFloat] = Field(None, json_schema_extra={"unit": "m"})
 
     @model_validator(mode="after")
     def _check(self):
