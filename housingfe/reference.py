@@ -67,7 +67,7 @@ def _field_comments(cls) -> dict[str, str]:
                 continue
             match = re.match(r"^    (\w+)\s*:", line)
             if match:
-                after = line.split("#", 1)[1].strip() if "  # " in line else ""
+                after = line.split("  # ", 1)[1].strip() if "  # " in line else ""
                 text = " ".join(pending + ([after] if after else []))
                 if text:
                     out[match.group(1)] = text

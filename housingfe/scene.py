@@ -90,8 +90,8 @@ class MeshSpec(_Strict):
 class ModalSpec(_Strict):
     """Eigenmodes: all modes below f_max (Hz), proven complete by an inertia count."""
 
-    f_max: PositiveFloat
-    tolerance: PositiveFloat = 1e-10
+    f_max: PositiveFloat  # every mode below this frequency
+    tolerance: PositiveFloat = 1e-10  # relative eigen-residual the solver must reach
 
 
 class Spectrum(_Strict):

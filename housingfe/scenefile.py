@@ -20,9 +20,9 @@ class _Strict(BaseModel):
 
 
 class SceneInfo(_Strict):
-    name: str
-    kind: Literal["housing", "source", "runup"]
-    description: str = ""
+    name: str  # names the result folder (results/<name> unless --out is given) and the reports
+    kind: Literal["housing", "source", "runup"]  # which schema the rest of the file follows
+    description: str = ""  # one line, shown by `housingfe scenes`
 
 
 def builtin_scenes() -> dict[str, str]:
