@@ -114,7 +114,7 @@ def _type_text(ann) -> str:
         meta = []
         for m in args[1:]:
             meta += _constraints(getattr(m, "metadata", [m]))
-        return f"{base} {' '.join(meta)}".strip()
+        return f"{base} {', '.join(meta)}".strip()
     if origin is typing.Literal:
         return "one of " + ", ".join(f'"{a}"' if isinstance(a, str) else str(a) for a in args)
     if origin in (list, tuple):
@@ -192,16 +192,22 @@ def _default_text(field) -> str:
 
 def _range_text(field) -> str:
     parts = _constraints(field.metadata)
+    lo = next((m.min_length for m in field.metadata if getattr(m, "min_length", None) is not None), None)
+    hi = next((m.max_length for m in field.metadata if getattr(m, "max_length", None) is not None), None)
+    if lo is not None or hi is not None:
+        what = "characters" if _strip_optional(field.annotation)[0] is str else "entries"
+        if lo == hi:
+            parts.append(f"exactly {lo} {what}")
+        elif lo == 1 and hi is None:
+            parts.append("not empty")
+        else:
+            parts += ([f"at least {lo} {what}"] if lo is not None else []) + \
+                     ([f"at most {hi} {what}"] if hi is not None else [])
     for m in field.metadata:
-        lo, hi = getattr(m, "min_length", None), getattr(m, "max_length", None)
-        if lo is not None:
-            parts.append(f"at least {lo} entries" if hi is None else "")
-        if hi is not None:
-            parts.append(f"{lo} entries" if lo == hi else f"at most {hi} entries")
         pattern = getattr(m, "pattern", None)
         if pattern:
             parts.append(f"matches `{pattern}`")
-    return ", ".join(p for p in parts if p)
+    return ", ".join(parts)
 
 
 def _cell(text: str) -> str:

@@ -27,11 +27,11 @@ from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table
 class MaterialSpec(_Strict):
     """A library material by name, with optional overrides of its values."""
 
-    name: str = "steel"
+    name: str = "steel"  # a material of the library (see Materials); the keys below override its values
     youngs_modulus: Optional[PositiveFloat] = None
-    poisson_ratio: Optional[float] = None
+    poisson_ratio: Optional[float] = None  # in (-1, 0.5)
     density: Optional[PositiveFloat] = None
-    loss_factor: Optional[float] = Field(None, ge=0.0, lt=1.0)
+    loss_factor: Optional[float] = Field(None, ge=0.0, lt=1.0)  # hysteretic eta of this material
 
     @model_validator(mode="after")
     def _check(self):
@@ -99,7 +99,8 @@ class Spectrum(_Strict):
     in log-frequency, held constant outside the table."""
 
     frequencies: list[PositiveFloat] = Field(min_length=1)
-    values: list[float] = Field(min_length=1)
+    values: list[float] = Field(min_length=1, json_schema_extra={"unit": "of what it scales (load: N, N m, Pa; "
+                                                                         "loss factor: -)"})
 
     @model_validator(mode="after")
     def _check(self):
