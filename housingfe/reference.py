@@ -442,10 +442,11 @@ def write_reference(out_dir: Path, pictures: bool = True) -> list[Path]:
 
 
 # ------------------------------------------------------------------------------------------------ describe
-def describe(name_or_path: str, overrides: list[str] | None = None) -> str:
+def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: float | None = None) -> str:
     """What a housing scene builds, without meshing or solving: geometry kind and dimensions, bounding box,
     named surfaces (area, normals, features), points, bores, supports, loads, analyses, and the mesh (element
-    size and the rule that set it, estimated DOFs and memory)."""
+    size and the rule that set it, estimated DOFs and memory).  mesh_f_max (Hz): the frequency the mesh is made for,
+    when another scene (a run-up) meshes this housing for its own range; default the scene's analyses."""
     from housingfe.fe.model import MEMORY_BASE_BYTES, MEMORY_PER_DOF_BYTES, element_size
     from housingfe.geometry.mesh import estimate_dofs
     from housingfe.geometry.registry import block_model_for
@@ -456,8 +457,17 @@ def describe(name_or_path: str, overrides: list[str] | None = None) -> str:
 
     data, path = read_scene_dict(name_or_path)
     kind = data.get("scene", {}).get("kind", "housing") if isinstance(data.get("scene"), dict) else "housing"
+    if kind == "runup":
+        # a run-up scene's housing is a housing scene with overrides: describe that
+        from housingfe.runup.scene import load_runup_scene
+
+        runup, path = load_runup_scene(name_or_path, overrides)
+        return (f"run-up scene {runup.scene.name} ({path}); its housing is the scene {runup.housing.scene}"
+                + (f" with --set {' --set '.join(runup.housing.set)}" if runup.housing.set else "")
+                + f", meshed for the run-up's highest line runup.f_max_hz = {runup.runup.f_max_hz:g} Hz:\n"
+                + describe(runup.housing.scene, runup.housing.set, mesh_f_max=runup.runup.f_max_hz))
     if kind != "housing":
-        raise InputError(f"{path}: scene.kind: describe knows housing scenes; this is a {kind} scene")
+        raise InputError(f"{path}: scene.kind: describe knows housing and run-up scenes; this is a {kind} scene")
     scene, path = load_housing_scene(name_or_path, overrides)
     g = scene.geometry
     model = block_model_for(g)
@@ -512,9 +522,10 @@ def describe(name_or_path: str, overrides: list[str] | None = None) -> str:
                       else ""))
     m = scene.mesh
     material = scene.material.resolve()
-    size = element_size(m, g, a.f_max, material)
+    f_mesh = a.f_max if mesh_f_max is None else mesh_f_max
+    size = element_size(m, g, f_mesh, material)
     rule = "mesh.size" if m.size is not None else (
-        f"bending wavelength of the thinnest wall ({g.min_thickness * 1e3:g} mm) at {a.f_max:g} Hz / "
+        f"bending wavelength of the thinnest wall ({g.min_thickness * 1e3:g} mm) at {f_mesh:g} Hz / "
         f"mesh.elements_per_wavelength = {m.elements_per_wavelength:g}")
     dofs = estimate_dofs(g, m.element, m.degree, size, m.layers, m.layer_size)
     memory = MEMORY_BASE_BYTES + MEMORY_PER_DOF_BYTES * dofs

@@ -127,3 +127,9 @@ def test_describe_of_a_bad_scene_is_one_line(tmp_path):
                           check=False)
     assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
     assert "geometry.length" in proc.stderr and "geometry.flange_width" in proc.stderr
+
+
+def test_describe_runup_scene_describes_its_housing():
+    text = describe("test-gearbox-runup")
+    assert "its housing is the scene test-gearbox" in text and "runup.f_max_hz = 4000 Hz" in text
+    assert 'geometry kind "gearbox"' in text and "bore_pinion" in text and "at 4000 Hz" in text
