@@ -17,6 +17,7 @@ _EXTENSIONS = (
     "housingfe.bearings.cli",
     "housingfe.correlation.cli",
     "housingfe.radiation",
+    "housingfe.reference",
     "housingfe.source.cli",
     "housingfe.studies.bearing_variants",
     "housingfe.studies.runup_causes",

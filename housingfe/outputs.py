@@ -353,12 +353,40 @@ def write_csv(path: Path, header: Sequence[str], rows: Iterable[Sequence]) -> No
             writer.writerow(row)
 
 
-def format_table(header: Sequence[str], rows: Sequence[Sequence], floatfmt: str = "{:.4g}") -> str:
-    """A plain-text table with aligned columns (for terminals and summary.txt)."""
+TERMINAL_WIDTH = 120   # the widest table a terminal is shown (the CSV / Markdown files keep every column whole)
+
+
+def format_table(header: Sequence[str], rows: Sequence[Sequence], floatfmt: str = "{:.4g}",
+                 width: int | None = TERMINAL_WIDTH) -> str:
+    """A plain-text table with aligned columns (for terminals and summary.txt), at most `width` characters wide
+    (None: any width).  A wider table is split into blocks of columns, each repeating the first column; a text
+    column still too wide for one block is shortened with "…" (the full text belongs in the CSV beside it)."""
     cells = [[str(h) for h in header]]
     for row in rows:
         cells.append([floatfmt.format(v) if isinstance(v, float) else str(v) for v in row])
     widths = [max(len(r[i]) for r in cells) for i in range(len(header))]
+    if width is None or sum(widths) + 2 * (len(widths) - 1) <= width or len(widths) < 2:
+        return _aligned(cells, widths)
+    # every column must fit beside the first one: shorten the first, then each other, to half the width
+    limit = width // 2 - 1
+    for i in range(len(widths)):
+        if widths[i] > limit:
+            for r in cells:
+                if len(r[i]) > limit:
+                    r[i] = r[i][:limit - 1] + "…"
+            widths[i] = limit
+    blocks, current = [], []
+    for i in range(1, len(widths)):
+        if current and widths[0] + sum(widths[j] + 2 for j in current + [i]) > width:
+            blocks.append(current)
+            current = []
+        current.append(i)
+    blocks.append(current)
+    return "\n\n".join(_aligned([[r[0]] + [r[j] for j in block] for r in cells],
+                                 [widths[0]] + [widths[j] for j in block]) for block in blocks)
+
+
+def _aligned(cells: list[list[str]], widths: list[int]) -> str:
     lines = ["  ".join(c.rjust(w) for c, w in zip(r, widths)) for r in cells]
     lines.insert(1, "  ".join("-" * w for w in widths))
     return "\n".join(lines)

@@ -27,11 +27,11 @@ from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table
 class MaterialSpec(_Strict):
     """A library material by name, with optional overrides of its values."""
 
-    name: str = "steel"
+    name: str = "steel"  # a material of the library (see Materials); the keys below override its values
     youngs_modulus: Optional[PositiveFloat] = None
-    poisson_ratio: Optional[float] = None
+    poisson_ratio: Optional[float] = None  # in (-1, 0.5)
     density: Optional[PositiveFloat] = None
-    loss_factor: Optional[float] = Field(None, ge=0.0, lt=1.0)
+    loss_factor: Optional[float] = Field(None, ge=0.0, lt=1.0)  # hysteretic eta of this material
 
     @model_validator(mode="after")
     def _check(self):
@@ -90,8 +90,8 @@ class MeshSpec(_Strict):
 class ModalSpec(_Strict):
     """Eigenmodes: all modes below f_max (Hz), proven complete by an inertia count."""
 
-    f_max: PositiveFloat
-    tolerance: PositiveFloat = 1e-10
+    f_max: PositiveFloat  # every mode below this frequency
+    tolerance: PositiveFloat = 1e-10  # relative eigen-residual the solver must reach
 
 
 class Spectrum(_Strict):
@@ -99,7 +99,8 @@ class Spectrum(_Strict):
     in log-frequency, held constant outside the table."""
 
     frequencies: list[PositiveFloat] = Field(min_length=1)
-    values: list[float] = Field(min_length=1)
+    values: list[float] = Field(min_length=1, json_schema_extra={"unit": "of what it scales (load: N, N m, Pa; "
+                                                                         "loss factor: -)"})
 
     @model_validator(mode="after")
     def _check(self):
@@ -126,7 +127,7 @@ class LoadSpec(_Strict):
     point: Optional[list[float]] = Field(None, min_length=3, max_length=3)
     direction: Optional[list[float]] = Field(None, min_length=3, max_length=3)
     radius: PositiveFloat = 0.005
-    amplitude: float = 1.0
+    amplitude: float = Field(1.0, json_schema_extra={"unit": "N, N m or Pa (by kind)"})
     spectrum: Optional[Spectrum] = None
 
     @model_validator(mode="after")
@@ -175,7 +176,7 @@ class ResponsePointSpec(_Strict):
     point: list[float] = Field(min_length=3, max_length=3)
     direction: Optional[list[float] | Literal["normal"]] = None
     surface: Optional[str] = None
-    tolerance: Optional[PositiveFloat] = None
+    tolerance: Optional[PositiveFloat] = Field(None, json_schema_extra={"unit": "m"})
 
     @model_validator(mode="after")
     def _check(self):

@@ -33,9 +33,9 @@ def scene_name_problem(name) -> str | None:
 
 
 class SceneInfo(_Strict):
-    name: str
-    kind: Literal["housing", "source", "runup"]
-    description: str = ""
+    name: str  # names the result folder (results/<name> unless --out is given) and the reports
+    kind: Literal["housing", "source", "runup"]  # which schema the rest of the file follows
+    description: str = ""  # one line, shown by `housingfe scenes`
 
     @field_validator("name")
     @classmethod
@@ -69,39 +69,78 @@ def resolve_scene_path(name_or_path: str) -> Path:
     raise InputError(f"{name_or_path}: no such scene (built-in: {', '.join(builtin_scenes())})")
 
 
+def load_toml_file(path: Path) -> dict:
+    """Parse a TOML file.  A UTF-8 byte-order mark (Windows editors write one) is skipped; a UTF-16/32 file is
+    named as such.  InputError "<path>: ..." on unreadable, non-UTF-8 or malformed text."""
+    try:
+        raw = Path(path).read_bytes()
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
+    for bom, encoding in ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
+                          (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16")):
+        if raw.startswith(bom):
+            raise InputError(f"{path}: starts with a {encoding} byte-order mark: a scene is UTF-8 text "
+                             "(save it as UTF-8)")
+    try:
+        text = raw.decode("utf-8-sig")   # utf-8-sig: a leading UTF-8 byte-order mark is dropped
+    except UnicodeDecodeError as exc:
+        raise InputError(f"{path}: not a UTF-8 text file (byte {exc.start}); a scene is TOML text") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{path}: malformed TOML: {exc}") from None
+
+
 def read_scene_dict(name_or_path: str) -> tuple[dict, Path]:
     """Parse a scene TOML into a dict; InputError naming the file on unreadable or malformed TOML."""
     path = resolve_scene_path(name_or_path)
-    try:
-        with open(path, "rb") as fh:
-            return tomllib.load(fh), path
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: malformed TOML: {exc}") from None
-    except UnicodeDecodeError as exc:
-        raise InputError(f"{path}: not a UTF-8 text file (byte {exc.start}); a scene is TOML text") from None
-    except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror}") from None
+    return load_toml_file(path), path
 
 
 def apply_overrides(data: dict, overrides: list[str], source: str = "--set") -> dict:
-    """Apply KEY=VALUE overrides (dotted keys, TOML values; bare words are strings)."""
+    """Apply KEY=VALUE overrides: dotted keys, TOML values (bare words are strings).  A number in the key picks an
+    entry of an array of tables, counted from 0, as in the error messages: `loads.0.amplitude=2` sets the
+    amplitude of the first [[loads]] entry.  A table that does not exist yet is created; an array entry is not."""
     for item in overrides:
         if "=" not in item:
             raise InputError(f"{source}: {item!r} is not KEY=VALUE")
         key, raw = item.split("=", 1)
+        key = key.strip()
         if not all(part.strip() for part in key.split(".")):
             raise InputError(f"{source}: {item!r}: empty key (give a dotted key such as mesh.size)")
+        if "[" in key:
+            raise InputError(f"{source}: {key}: write array entries with a dotted index from 0, e.g. "
+                             "loads.0.amplitude=2 for the first [[loads]] entry")
         try:
             value = tomllib.loads(f"v = {raw}")["v"]
         except tomllib.TOMLDecodeError:
             value = raw
         node = data
-        parts = key.strip().split(".")
-        for part in parts[:-1]:
-            node = node.setdefault(part, {})
+        parts = [part.strip() for part in key.split(".")]
+        for depth, part in enumerate(parts):
+            where = ".".join(parts[:depth])
+            last = depth == len(parts) - 1
+            if isinstance(node, list):
+                if not part.isdigit():
+                    raise InputError(f"{source}: {key}: {where} is an array: give an index from 0 "
+                                     f"({where}.0.…), not {part!r}")
+                if int(part) >= len(node):
+                    raise InputError(f"{source}: {key}: index {part} is out of range: {where} has "
+                                     f"{len(node)} entr{'y' if len(node) == 1 else 'ies'}"
+                                     + (f" (0 to {len(node) - 1})" if node else ""))
+                if last:
+                    node[int(part)] = value
+                else:
+                    node = node[int(part)]
+                continue
             if not isinstance(node, dict):
-                raise InputError(f"{source}: {key}: {part} is not a table")
-        node[parts[-1]] = value
+                raise InputError(f"{source}: {key}: {where} is not a table")
+            if last:
+                node[part] = value
+            else:
+                node = node.setdefault(part, {})
     return data
 
 
@@ -130,18 +169,24 @@ def _first_non_finite(data, key: str = ""):
     return None
 
 
-def _first_error(exc: ValidationError) -> str:
-    # a misspelt key also shows up as a missing one: name the unknown key, it is the cause
-    errors = sorted(exc.errors(), key=lambda e: e["type"] != "extra_forbidden")
-    err = errors[0]
+def _location(err) -> str:
     # pydantic puts the discriminator value of a union (geometry.<kind>.key) into the location: drop it
     loc_parts = list(err["loc"])
     if len(loc_parts) > 1 and loc_parts[0] == "geometry":
         del loc_parts[1]
-    loc = ".".join(str(p) for p in loc_parts)
+    return ".".join(str(p) for p in loc_parts)
+
+
+def _first_error(exc: ValidationError) -> str:
+    # a misspelt key also shows up as a missing one: name the unknown key, it is the cause
+    errors = sorted(exc.errors(), key=lambda e: e["type"] != "extra_forbidden")
+    err = errors[0]
+    loc = _location(err)
     msg = err["msg"]
     if err["type"] == "extra_forbidden":
         msg = "unknown key"
+    elif err["type"] == "missing":
+        msg = "missing"
     elif msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
         # our validators name the key first ("key: problem"): attach it to the location
@@ -149,5 +194,16 @@ def _first_error(exc: ValidationError) -> str:
             key, rest = msg.split(": ", 1)
             if key.replace("_", "").isalnum():
                 return f"{loc + '.' if loc else ''}{key}: {rest}"
-    extra = "" if len(exc.errors()) == 1 else f" (and {len(exc.errors()) - 1} more)"
+    # every other key at fault by name (a union reports one value several times: each key once)
+    missing, other = [], []
+    for e in errors[1:]:
+        where = _location(e)
+        if where != loc and where not in missing + other:
+            (missing if e["type"] == "missing" else other).append(where)
+    extra = []
+    if missing:
+        extra.append("also missing: " + ", ".join(missing))
+    if other:
+        extra.append("also wrong: " + ", ".join(other))
+    extra = f" ({'; '.join(extra)})" if extra else ""
     return f"{loc}: {msg}{extra}" if loc else f"{msg}{extra}"

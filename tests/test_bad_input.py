@@ -134,6 +134,9 @@ SCENE_CASES = [
     ("box-wrong-type", _set("geometry.length", "long"), ["geometry.length"]),
     ("box-negative", _set("geometry.wall_thickness", -0.008), ["geometry.wall_thickness"]),
     ("box-missing", _del("geometry.height"), ["geometry.height"]),
+    # issue 27: every missing key named, not "(and N more)"
+    ("box-missing-three", _all(_del("geometry.height"), _del("geometry.width"), _del("geometry.flange_width")),
+     ["geometry.height", "geometry.width", "geometry.flange_width", "missing"]),
     ("box-unknown", _set("geometry.depth", 0.1), ["geometry.depth", "unknown key"]),
     ("box-walls-too-thick", _set("geometry.wall_thickness", 0.2), ["geometry.wall_thickness"]),
     ("box-bolt-patch-off-flange", _set("geometry.bolt_patch_size", 0.1), ["geometry.bolt_patch_size"]),
@@ -352,7 +355,12 @@ SET_CASES = [
     ("set-wrong-type", "mesh.size=abc", ["mesh.size"]),
     ("set-empty-value", "analysis.modal.f_max=", ["analysis.modal.f_max"]),
     ("set-into-non-table", "scene.name.x=1", ["--set", "scene.name.x"]),
-    ("set-into-array", "loads.0.amplitude=2", ["--set", "loads.0.amplitude"]),
+    # issue 27: a dotted index from 0 reaches an entry of an array of tables; a bad one is named
+    ("set-array-index-out-of-range", "loads.1.amplitude=2", ["--set", "loads.1.amplitude", "out of range"]),
+    ("set-array-not-an-index", "loads.top.amplitude=2", ["--set", "loads.top.amplitude", "index"]),
+    ("set-array-brackets", "loads[0].amplitude=2", ["--set", "loads[0].amplitude", "loads.0.amplitude"]),
+    ("set-array-entry-bad-value", "loads.0.amplitude=loud", ["loads.0.amplitude"]),
+    ("set-array-entry-unknown-key", "loads.0.phase=1", ["loads.0.phase", "unknown key"]),
     ("set-out-of-range", "material.poisson_ratio=0.7", ["material.poisson_ratio"]),
     ("set-empty-key", "=5", ["--set"]),
 ]
@@ -404,6 +412,9 @@ def _file_cases(tmp_path: Path) -> dict:
     cases["symlink-loop"] = (loop, "loop.toml")
     cases["missing-file"] = (tmp_path / "missing.toml", "missing.toml")
     cases["unknown-scene-name"] = ("box-freee", "box-freee")
+    utf16 = tmp_path / "utf16.toml"
+    utf16.write_bytes(to_toml(BASE).encode("utf-16"))      # issue 27: a byte-order mark named as such
+    cases["utf16-with-bom"] = (utf16, "UTF-16 byte-order mark")
     top_array = tmp_path / "array.toml"
     top_array.write_text("scene = [1, 2]\n")
     cases["scene-not-a-table"] = (top_array, "scene")
@@ -412,7 +423,7 @@ def _file_cases(tmp_path: Path) -> dict:
 
 FILE_CASE_NAMES = ["empty-file", "comment-only-file", "binary-garbage", "not-utf8", "malformed-toml",
                    "duplicate-key", "directory-named-toml", "directory", "dangling-symlink", "symlink-loop",
-                   "missing-file", "unknown-scene-name", "scene-not-a-table"]
+                   "missing-file", "unknown-scene-name", "scene-not-a-table", "utf16-with-bom"]
 
 
 @pytest.mark.parametrize("command", ["run", "source"])
@@ -473,6 +484,13 @@ COMMAND_CASES = [
     ("bearing-unknown-option", ["bearing", "SKF 6312", "--load", "1e4", "0", "0", "0", "0", "--speed", "3"],
      ["--speed"]),
     ("bearing-nan-load", ["bearing", "SKF 6312", "--load", "nan", "0", "0", "0", "0"], ["load"]),
+    # issue 27: bearing geometry in millimetres (a 25 m ball) or in GPa is refused, naming the flag and the unit
+    ("bearing-ball-diameter-mm", ["bearing", "--balls", "9", "--ball-diameter", "25", "--pitch-diameter", "0.125",
+                                  "--load", "1e4", "0", "0", "0", "0"], ["--ball-diameter", "millimetres"]),
+    ("bearing-pitch-diameter-mm", ["bearing", "--balls", "9", "--ball-diameter", "0.025", "--pitch-diameter",
+                                   "125", "--load", "1e4", "0", "0", "0", "0"], ["--pitch-diameter", "millimetres"]),
+    ("bearing-modulus-gpa", ["bearing", "SKF 6312", "--youngs-modulus", "208", "--load", "1e4", "0", "0", "0", "0"],
+     ["--youngs-modulus", "GPa"]),
     ("bench-unknown", ["bench", "modall"], ["modall"]),
     ("bench-only-not-all", ["bench", "modal", "--only", "mpi"], ["--only"]),
     ("bench-notes-not-all", ["bench", "modal", "--notes"], ["--notes"]),

@@ -32,7 +32,7 @@ BAD_SCENES = {
                        "geometry.flange_thickness"),
     "poisson": (BOX.replace('name = "steel"', 'name = "steel"\npoisson_ratio = 0.5'), "material.poisson_ratio"),
     "f_max_zero": (BOX.replace("f_max = 4000.0", "f_max = 0.0"), "analysis.modal.f_max"),
-    "missing_key": (BOX.replace("height = 0.125", ""), "geometry.height: Field required"),
+    "missing_key": (BOX.replace("height = 0.125", ""), "geometry.height: missing"),
     "wrong_type": (BOX.replace("width = 0.225", 'width = "wide"'), "geometry.width"),
     "malformed": (BOX.replace("[mesh]", "[mesh"), "malformed TOML"),
     "unknown_material": (BOX.replace('name = "steel"', 'name = "unobtainium"'), "material.name"),

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -65,14 +64,9 @@ def register(subparsers) -> None:
 
 
 def _geometry_table_from_file(path: str) -> dict:
-    try:
-        data = tomllib.loads(Path(path).read_text())
-    except FileNotFoundError:
-        raise InputError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot read ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: not valid TOML ({exc})") from None
+    from housingfe.scenefile import load_toml_file
+
+    data = load_toml_file(Path(path))
     unknown = sorted(set(data) - {"bearing"})
     if unknown:
         raise InputError(f"{path}: {unknown[0]}: unknown key (the file holds one [bearing] table)")
@@ -90,6 +84,7 @@ def bearing_from_arguments(args: argparse.Namespace):
 
     flags = {key: getattr(args, flag[2:].replace("-", "_")) for flag, (key, *_) in _FLAGS.items()}
     flags = {k: v for k, v in flags.items() if v is not None}
+    flag_names = {key: flag for flag, (key, *_) in _FLAGS.items() if key in flags}   # errors name what was typed
     if args.designation is not None and args.geometry is not None:
         raise InputError("bearing: give a catalogue designation or --geometry, not both")
     if args.designation is not None:
@@ -106,18 +101,18 @@ def bearing_from_arguments(args: argparse.Namespace):
             table[key] = float(np.degrees(value)) if key == "contact_angle_deg" else value
         table.update(flags)
         where = f"bearing {base.designation} with overrides"
-        result = bearing_from_table(table, where)
+        result = bearing_from_table(table, where, flag_names)
         estimated = {k: v for k, v in base.estimated.items()
                      if not any(GEOMETRY_KEYS[f][0] == k for f in flags)}
         return dataclasses.replace(result, estimated=estimated)
     if args.geometry is not None:
         table = _geometry_table_from_file(args.geometry)
         table.update(flags)
-        return bearing_from_table(table, f"{args.geometry}: bearing")
+        return bearing_from_table(table, f"{args.geometry}: bearing", flag_names)
     if not flags:
         raise InputError("bearing: give a catalogue designation, --geometry FILE.toml or the internal geometry "
                          "(--balls, --ball-diameter, --pitch-diameter, ...)")
-    return bearing_from_table(flags, "bearing (command line)")
+    return bearing_from_table(flags, "bearing (command line)", flag_names)
 
 
 def _cmd_bearing(args: argparse.Namespace) -> int:

@@ -192,12 +192,14 @@ GEOMETRY_KEYS = {
 }
 
 
-def bearing_from_table(table: dict, where: str = "bearing") -> RollingBearing:
+def bearing_from_table(table: dict, where: str = "bearing", key_names: dict | None = None) -> RollingBearing:
     """RollingBearing from a table of internal geometry (the [bearing] table of `housingfe bearing --geometry`).
 
     Keys (SI, angle in degrees): see GEOMETRY_KEYS; elements, element_diameter and pitch_diameter are
     required.  Unknown keys, wrong types and non-physical values raise InputError("<where>: <key>: ...").
-    Defaults that stand in for unknown data are listed in the result's `estimated`."""
+    Defaults that stand in for unknown data are listed in the result's `estimated`.  Values far outside any real
+    bearing (a 25 m ball: millimetres given for metres) are refused, naming the key as `key_names` spells it
+    (e.g. the command-line flag) and the unit they look like."""
     if not isinstance(table, dict):
         raise InputError(f"{where}: need a table of bearing geometry")
     for key in table:
@@ -229,6 +231,7 @@ def bearing_from_table(table: dict, where: str = "bearing") -> RollingBearing:
             raise InputError(f"{where}: {key}: {value} m must be > 0")
         kwargs[name] = float(value) if isinstance(value, (int, float)) and key not in ("elements", "rows") \
             else value
+    _check_units(table, where, key_names or {})
     estimated = {}
     if kwargs["kind"] == "ball":
         for key, rule in (("conformity_inner", "0.52 (Harris typical)"), ("conformity_outer", "0.53 (Harris typical)")):
@@ -245,6 +248,37 @@ def bearing_from_table(table: dict, where: str = "bearing") -> RollingBearing:
     if z * dw >= math.pi * dpw:
         raise InputError(f"{where}: elements: {z} elements of {dw} m do not fit on the pitch circle ({dpw} m)")
     return bearing
+
+
+# Largest plausible values (SI) of the internal geometry: a value above is taken for a unit typo, not a bearing.
+# The largest rolling elements in catalogues are about 0.15 m (slewing rings, mill bearings), the largest
+# bearings about 5 m across; radial clearances are a fraction of a percent of the element diameter.
+_LENGTH_LIMITS_M = {"element_diameter": 0.3, "pitch_diameter": 5.0, "bore": 5.0, "outer_diameter": 6.0,
+                    "width": 1.0, "roller_length": 0.5}
+_YOUNGS_MODULUS_RANGE_PA = (50e9, 500e9)     # bearing steels ~208 GPa, silicon nitride ~310 GPa
+
+
+def _check_units(table: dict, where: str, key_names: dict) -> None:
+    """InputError naming the key when a value of `table` lies far outside any real rolling bearing and looks
+    like a value in another unit (mm for m, GPa or MPa for Pa)."""
+    for key, limit in _LENGTH_LIMITS_M.items():
+        value = table.get(key)
+        if value is not None and value > limit:
+            raise InputError(f"{where}: {key_names.get(key, key)}: {value:g} m is implausible for a rolling bearing "
+                             f"(at most {limit:g} m): it looks like millimetres ({value:g} mm = {value / 1e3:g} m); "
+                             "lengths are in m")
+    clearance, dw = table.get("radial_clearance"), table.get("element_diameter")
+    if clearance is not None and dw is not None and clearance > 0.1 * dw:
+        raise InputError(f"{where}: {key_names.get('radial_clearance', 'radial_clearance')}: {clearance:g} m is "
+                         f"{clearance / dw:.0%} of the element diameter ({dw:g} m): it looks like millimetres or "
+                         f"micrometres; lengths are in m (a clearance of 20 um is 2e-05)")
+    modulus = table.get("youngs_modulus")
+    low, high = _YOUNGS_MODULUS_RANGE_PA
+    if modulus is not None and not low <= modulus <= high:
+        unit = ": it looks like GPa" if modulus < 1e4 else ": it looks like MPa" if modulus < 1e7 else ""
+        raise InputError(f"{where}: {key_names.get('youngs_modulus', 'youngs_modulus')}: {modulus:g} Pa is outside "
+                         f"the range of bearing materials ({low:g} to {high:g} Pa){unit}; give Pa (208e9 for "
+                         "bearing steel)")
 
 
 # ----------------------------------------------------------------------------------------------- models

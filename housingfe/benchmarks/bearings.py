@@ -129,6 +129,7 @@ def main(out_dir: Path, quick: bool) -> None:
         write_csv(tmp / "bearings.csv", head_r, rolling)
         write_csv(tmp / "fluid_film.csv", head_f, fluid)
         _plot(tmp / "bearings.png", rolling, fluid)
+    print(f"results: {out_dir}/")
 
 
 if __name__ == "__main__":

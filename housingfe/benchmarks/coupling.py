@@ -164,6 +164,7 @@ def main(out_dir, quick: bool = False) -> None:
           f"extra_vs_same_nev_%: the same against the bare housing asked for {info['n_most']} eigenpairs "
           f"({info['bare_same_nev_s']:.3g} s CPU)")
     print(format_table(HEADER, rows))
+    print(f"results: {out_dir}/")
 
 
 def _plot(path: Path, rows, info) -> None:

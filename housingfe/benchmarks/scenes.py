@@ -73,7 +73,7 @@ def main(out_dir: Path, quick: bool = False) -> None:
             err_max, err_mean = frequency_error(s["frequencies_hz"], fine["frequencies_hz"], 0.9 * s["f_max_hz"])
             row += [err_max, err_mean, fine["dofs"], fine["wall_time_s"]]
         rows.append(row)
-        print(format_table(HEADER, [row], "{:.3g}").splitlines()[-1], flush=True)
+        print(format_table(HEADER, [row], "{:.3g}", width=None).splitlines()[-1], flush=True)
     with atomic_output_dir(out_dir) as tmp:
         write_csv(tmp / "bench-scenes.csv", HEADER, rows)
         (tmp / "bench-scenes.txt").write_text(format_table(HEADER, rows, "{:.3g}") + "\n")

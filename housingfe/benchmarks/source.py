@@ -149,6 +149,7 @@ def main(out_dir: Path, quick: bool) -> None:
         fig.tight_layout()
         fig.savefig(tmp / "bench_source.png", dpi=120)
         plt.close(fig)
+    print(f"results: {out_dir}/")
 
 
 if __name__ == "__main__":

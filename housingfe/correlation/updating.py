@@ -633,6 +633,7 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
             write_csv(out / "targets.csv", ["when"] + header,
                       [("before", *r) for r in summary["before"]] + [("after", *r) for r in summary["after"]])
             _convergence_png(fits, out / "convergence.png")
+    echo(f"results: {out_dir}/")
     return summary
 
 

@@ -79,14 +79,17 @@ class BearingSpec(_Strict):
     bore: str | None = None
     axis: Vector3 = (0.0, 0.0, 1.0)
     designation: str | None = None
-    load: tuple[float, float, float, float, float] | None = None
+    load: tuple[float, float, float, float, float] | None = Field(None, json_schema_extra={"unit": "N, N, N, N m, N m"})
     model: str | None = None     # a name in housingfe.bearings.rolling.BEARING_MODELS (checked below)
     # tilt (rad) held by the shaft instead of zero moments (a shaft on two bearings sets the tilt; see
     # housingfe.verification.bearing_rows)
-    fixed_tilt: tuple[float, float] | None = None
-    stiffness: tuple[float, float, float, float, float, float] | None = None
-    stiffness_matrix: Matrix6 | None = Field(None, min_length=6, max_length=6)
-    damping_matrix: Matrix6 | None = Field(None, min_length=6, max_length=6)
+    fixed_tilt: tuple[float, float] | None = Field(None, json_schema_extra={"unit": "rad"})
+    stiffness: tuple[float, float, float, float, float, float] | None = Field(
+        None, json_schema_extra={"unit": "N/m (x, y, z), N m/rad (rotations)"})
+    stiffness_matrix: Matrix6 | None = Field(None, min_length=6, max_length=6,
+                                             json_schema_extra={"unit": "N/m, N/rad, N m/rad"})
+    damping_matrix: Matrix6 | None = Field(None, min_length=6, max_length=6,
+                                           json_schema_extra={"unit": "N s/m, N m s/rad"})
 
     @model_validator(mode="after")
     def _one(self):
@@ -127,10 +130,10 @@ class GearMeshSpec(_Strict):
 
     a: str
     b: str
-    stiffness: PositiveFloat
+    stiffness: PositiveFloat = Field(json_schema_extra={"unit": "N/m"})
     point: Vector3
     direction: Vector3
-    damping: float = Field(0.0, ge=0.0)
+    damping: float = Field(0.0, ge=0.0, json_schema_extra={"unit": "N s/m"})
 
 
 class TieRodSpec(_Strict):
@@ -141,8 +144,8 @@ class TieRodSpec(_Strict):
     a: str
     b: str
     diameter: PositiveFloat
-    rigid_end_a: float = Field(0.0, ge=0.0)
-    rigid_end_b: float = Field(0.0, ge=0.0)
+    rigid_end_a: float = Field(0.0, ge=0.0, json_schema_extra={"unit": "m"})
+    rigid_end_b: float = Field(0.0, ge=0.0, json_schema_extra={"unit": "m"})
 
 
 class CouplingSpec(_Strict):

@@ -26,13 +26,13 @@ class BoxGeometry(_Strict):
     """The open welded box of Sec. 4.2 (lengths in m; H from the flange underside to the top)."""
 
     kind: Literal["box"]
-    length: PositiveFloat
-    width: PositiveFloat
-    height: PositiveFloat
-    wall_thickness: PositiveFloat
-    flange_thickness: PositiveFloat
-    flange_width: PositiveFloat
-    bolt_patch_size: PositiveFloat = 0.024
+    length: PositiveFloat           # outer length along x, walls included (flange not)
+    width: PositiveFloat            # outer width along y, walls included (flange not)
+    height: PositiveFloat           # along z, from the flange underside to the top of the top plate
+    wall_thickness: PositiveFloat   # the five plates (top, front, back, left, right)
+    flange_thickness: PositiveFloat  # the foot flange around the open bottom
+    flange_width: PositiveFloat     # how far the flange stands out beyond the outer wall faces
+    bolt_patch_size: PositiveFloat = 0.024  # side of the square bolt_1..bolt_8 patches on the flange underside
 
     @model_validator(mode="after")
     def _consistent(self):

@@ -18,10 +18,10 @@ EdgeCondition = Literal["free", "clamped", "simply_supported"]
 
 
 class PlateEdges(_Strict):
-    x0: EdgeCondition = "free"
-    x1: EdgeCondition = "free"
-    y0: EdgeCondition = "free"
-    y1: EdgeCondition = "free"
+    x0: EdgeCondition = "free"  # the edge face x = 0 (surface edge_x0)
+    x1: EdgeCondition = "free"  # the edge face x = a (surface edge_x1)
+    y0: EdgeCondition = "free"  # the edge face y = 0 (surface edge_y0)
+    y1: EdgeCondition = "free"  # the edge face y = b (surface edge_y1)
 
 
 class PlateGeometry(_Strict):
@@ -29,9 +29,9 @@ class PlateGeometry(_Strict):
     displacement on the edge face."""
 
     kind: Literal["plate"]
-    a: PositiveFloat
-    b: PositiveFloat
-    h: PositiveFloat
+    a: PositiveFloat  # length along x
+    b: PositiveFloat  # width along y
+    h: PositiveFloat  # thickness along z
     edges: PlateEdges = PlateEdges()
 
     @model_validator(mode="after")

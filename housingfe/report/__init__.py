@@ -338,7 +338,7 @@ def write_harmonic_outputs(folder: Path, model, forced, comm, *, scene_name: str
     if pictures:
         plot_transfer_functions(folder / "tf_bands.png", forced, rows, solvers)
     if forced.sound_power:
-        write_sound_power(folder, forced, pictures)
+        write_sound_power(folder, forced, pictures, scene_name)
 
 
 def tf_omega_rows(forced) -> list:
@@ -470,8 +470,10 @@ def sound_power_rows(forced) -> list:
     return rows
 
 
-def write_sound_power(folder: Path, forced, pictures: bool) -> None:
-    """sound_power.csv and, with pictures, sound_power.png (L_sigma over frequency and L_W per band)."""
+def write_sound_power(folder: Path, forced, pictures: bool, scene_name: str = "") -> None:
+    """sound_power.csv and, with pictures, sound_power.png: the radiation index L_sigma = 10 lg sigma (dB) per
+    line and L_W (dB re 1 pW) per 1/3-octave band of each load case, for the load's amplitude and spectrum as the
+    scene gives them, titled with the scene, the radiation model and the radiating area."""
     rows = sound_power_rows(forced)
     if forced.sound_power[0].foller is not None:
         write_json(folder / "foller.json", forced.sound_power[0].foller)
@@ -484,21 +486,34 @@ def write_sound_power(folder: Path, forced, pictures: bool) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4))
+    units = {"force": "N", "moment": "N m", "pressure": "Pa"}
+    kinds = {lc.name: lc.kind for lc in forced.loads}
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(12, 4.6))
     for sp in forced.sound_power:
+        unit = units.get(kinds.get(sp.load_case), "")
         a1.semilogx(sp.spectrum.frequencies_hz, sp.radiation_index_db, lw=0.8, label=f"{sp.load_case} ({sp.model})")
         a2.plot(np.arange(len(sp.spectrum.bands.nominal)), sp.spectrum.band_L_W_db, "o-", ms=3,
-                label=f"{sp.load_case}: total {sp.spectrum.total_L_W_db:.1f} dB, {sp.spectrum.total_L_WA_db:.1f} dB(A)")
+                label=f"{sp.load_case} ({kinds.get(sp.load_case, 'load')}{', ' + unit if unit else ''} rms): total "
+                      f"{sp.spectrum.total_L_W_db:.1f} dB, {sp.spectrum.total_L_WA_db:.1f} dB(A)")
     nominal = forced.sound_power[0].spectrum.bands.nominal
     a2.set_xticks(np.arange(len(nominal)), [f"{v:g}" for v in nominal], rotation=90, fontsize=7)
+    a1.set_title("radiation index per line", fontsize=9)
     a1.set_xlabel("frequency (Hz)")
-    a1.set_ylabel("radiation index L_sigma (dB)")
+    a1.set_ylabel("L_sigma = 10 lg sigma (dB)")
     a1.grid(alpha=0.3, which="both")
     a1.legend(fontsize=7)
-    a2.set_xlabel("1/3-octave band (Hz)")
-    a2.set_ylabel("L_W (dB re 1 pW, per unit load)")
+    a2.set_title("sound power per 1/3-octave band, for the scene's load amplitude and spectrum", fontsize=9)
+    a2.set_xlabel("1/3-octave band centre frequency (Hz)")
+    a2.set_ylabel("L_W (dB re 1 pW)")
     a2.grid(alpha=0.3)
     a2.legend(fontsize=7)
+    models = sorted({sp.model for sp in forced.sound_power})
+    fig.suptitle(f"{scene_name + ': ' if scene_name else ''}sound power L_W = L_v + 10 lg(S/S0) + L_sigma, "
+                 f"radiation model {', '.join(models)}, radiating surface S = {forced.observer.area:.3g} m^2",
+                 fontsize=10)
     fig.tight_layout()
-    fig.savefig(folder / "sound_power.png", dpi=110)
+    # the labels also as PNG text, for readers (and tests) that cannot see the picture
+    fig.savefig(folder / "sound_power.png", dpi=110, metadata={
+        "Title": fig._suptitle.get_text(),
+        "Description": " | ".join(f"{ax.get_title()}: x {ax.get_xlabel()}, y {ax.get_ylabel()}" for ax in (a1, a2))})
     plt.close(fig)

@@ -94,10 +94,10 @@ class InteriorTable(_Strict):
 
 
 class BearingsTable(_Strict):
-    pinion: tuple[PositiveFloat, PositiveFloat, PositiveFloat, PositiveFloat, PositiveFloat] = \
-        dyn.APPENDIX_C_BEARINGS["pinion"]
-    wheel: tuple[PositiveFloat, PositiveFloat, PositiveFloat, PositiveFloat, PositiveFloat] = \
-        dyn.APPENDIX_C_BEARINGS["wheel"]
+    pinion: tuple[PositiveFloat, PositiveFloat, PositiveFloat, PositiveFloat, PositiveFloat] = Field(
+        dyn.APPENDIX_C_BEARINGS["pinion"], json_schema_extra={"unit": "N/m (3), N m/rad (2)"})
+    wheel: tuple[PositiveFloat, PositiveFloat, PositiveFloat, PositiveFloat, PositiveFloat] = Field(
+        dyn.APPENDIX_C_BEARINGS["wheel"], json_schema_extra={"unit": "N/m (3), N m/rad (2)"})
 
 
 class SourceTable(_Strict):

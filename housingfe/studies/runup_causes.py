@@ -142,6 +142,7 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
             (tmp / "causes.md").write_text(text)
     if comm.rank == 0:
         print(text)
+        print(f"results: {out}/")
     return out
 
 

@@ -121,7 +121,8 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
         rows += provider_rows(failures)
     write_outputs(rows, Path(out_dir), json_path)
     print(format_rows(rows))
-    print(f"{len(rows)} rows in {time.perf_counter() - t0:.0f} s; written to {out_dir}/validate.csv, validate.md"
+    print(f"{len(rows)} rows in {time.perf_counter() - t0:.0f} s; written to {out_dir}/validate.csv, validate.md "
+          "(sources and notes whole)"
           + (f" and {json_path}" if json_path else ""))
     if failures:
         raise SolverError(f"validate: {len(failures)} computation(s) failed, their rows are missing: "
@@ -472,11 +473,22 @@ def _cells(r: dict) -> list[str]:
             r.get("note", "")]
 
 
-def format_rows(rows: list[dict]) -> str:
-    """A plain-text table of the rows."""
+def format_rows(rows: list[dict], width: int = 120) -> str:
+    """A plain-text table of the rows for a terminal, at most `width` characters wide: the numbers whole, the
+    source and note shortened with "…" where they would not fit (validate.md and validate.csv hold them whole)."""
     from housingfe.outputs import format_table
 
-    return format_table(COLUMNS, [_cells(r) for r in rows])
+    cells = [_cells(r) for r in rows]
+    numbers = [c[:6] for c in cells]
+    fixed = [max([len(COLUMNS[i])] + [len(c[i]) for c in numbers]) for i in range(6)]
+    room = width - sum(fixed) - 2 * 6    # what is left for "source  note" (two column gaps)
+    source_w = max(len("source"), min(max((len(c[6]) for c in cells), default=0), room // 3))
+    note_w = max(len("note"), room - source_w - 2)
+
+    def cut(text: str, n: int) -> str:
+        return text if len(text) <= n else text[:n - 1] + "…"
+
+    return format_table(COLUMNS, [c[:6] + [cut(c[6], source_w), cut(c[7], note_w)] for c in cells], width=width)
 
 
 def write_outputs(rows: list[dict], out_dir: Path, json_path) -> None:

@@ -104,7 +104,7 @@ def test_bad_geometry_exit_2_one_line(capsys, tmp_path):
     toml.write_text("[bearing]\nelements = 12\nelement_diameter = 0.025\npitch_diameter = 0.125\nballs = 3\n")
     _one_line_exit_2(capsys, ["bearing", "--geometry", str(toml), *load], "balls: unknown key")
     toml.write_text("[bearing\n")
-    _one_line_exit_2(capsys, ["bearing", "--geometry", str(toml), *load], "not valid TOML")
+    _one_line_exit_2(capsys, ["bearing", "--geometry", str(toml), *load], "malformed TOML")
     _one_line_exit_2(capsys, ["bearing", "--geometry", str(tmp_path / "none.toml"), *load], "no such file")
     _one_line_exit_2(capsys, ["bearing", "6312", "--geometry", str(toml), *load], "not both")
     # an angular contact bearing loaded axially the wrong way cannot carry it
