@@ -113,9 +113,9 @@ def evaluate(scene, results: dict, gm) -> tuple[list[dict], list[dict]]:
                              "distance to measured windows (rpm): " + " ".join("-" if d is None else f"{d:g}"
                                                                                for d in match)))
         slope = speed_law_slope(s, lwa)
-        if np.isfinite(slope) and res.routes[route].excitation_db is not None:
-            rows.append(speed_law_row(decompose(res, route, rad, top, "total"),
-                                      decompose(res, route, rad, top, "tooth_band")))
+        total = decompose(res, route, rad, top, "total") if res.routes[route].excitation_db is not None else None
+        if np.isfinite(slope) and total is not None and total.made_by:
+            rows.append(speed_law_row(total, decompose(res, route, rad, top, "tooth_band")))
         elif np.isfinite(slope):
             rows.append(_row("speed_law", f"{route}: L_WA slope dB(A) per doubling of speed, 250-1500 rpm",
                              round(slope, 2), 6.0, None, "within 2 dB of 6", abs(slope - 6.0) <= 2.0,

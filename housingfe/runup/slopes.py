@@ -144,11 +144,14 @@ class SlopeDecomposition:
     def sentence(self) -> str:
         """One line: L_WA's slope, the terms that add up to it, and the term that makes it."""
         s = self.slopes
+        where = f"{self.route} ({self.radiation}, {self.torque_nm:g} N m, {self.basis.replace('_', ' ')})"
+        if not (np.isfinite(s["L_WA"]) and self.made_by):
+            lo, hi = SPEED_LAW_RANGE_RPM
+            return f"{where}: no speed law (fewer than three speeds or less than a doubling of speed in {lo:g}-{hi:g} rpm)"
         terms = " + ".join(f"{t} {s[t]:+.2f}" for t in TERMS if t != "L_S")
         held = (f", held back by {self.held_back_by} ({s[self.held_back_by]:+.2f})" if self.held_back_by
                 else ", no term falls with speed")
-        return (f"{self.route} ({self.radiation}, {self.torque_nm:g} N m, {self.basis.replace('_', ' ')}): L_WA "
-                f"{s['L_WA']:+.2f} dB(A)/doubling = {terms} (residual {self.sum_residual_db:.1e}); made by "
+        return (f"{where}: L_WA {s['L_WA']:+.2f} dB(A)/doubling = {terms} (residual {self.sum_residual_db:.1e}); made by "
                 f"{self.made_by} ({s[self.made_by]:+.2f}){held}")
 
     def to_json(self) -> dict:
@@ -236,6 +239,8 @@ def plot(path, decompositions) -> None:
     import matplotlib.pyplot as plt
 
     curves = [d for d in decompositions if d.radiation == decompositions[0].radiation]
+    if not any(np.isfinite(d.slopes["L_WA"]) for d in curves):
+        return                                  # no speed law to draw (less than a doubling of speed)
     keys = sorted({(d.route, d.torque_nm) for d in curves})
     fig, axes = plt.subplots(len(keys), 3, figsize=(15, 3.8 * len(keys)), squeeze=False)
     names = (*(t for t in TERMS if t != "L_S"), "L_W", "L_WA")
@@ -246,6 +251,8 @@ def plot(path, decompositions) -> None:
             ax = axes[row, col]
             s = d.speeds_rpm
             sel = (s >= SPEED_LAW_RANGE_RPM[0]) & (s <= SPEED_LAW_RANGE_RPM[1])
+            if not np.any(sel):
+                continue
             for j, t in enumerate(names):
                 v = d.levels[t][sel]
                 ax.plot(s[sel], v - v[0], "-" if t in TERMS else "--", color=f"C{j}",

@@ -148,3 +148,21 @@ def test_cli_writes_the_slope_terms(tmp_path):
         law = [r for r in csv.DictReader(fh) if r["check"] == "speed_law"]
     assert len(law) == 2 and all("made by" in r["note"] for r in law)
     assert "made by" in proc.stdout
+
+
+def test_less_than_a_doubling_of_speed_reports_no_law(tmp_path):
+    # a run-up of 1000-1500 rpm (as the MPI test's): no slope to fit, and every output says so instead of failing
+    from housingfe.runup.slopes import plot, slope_rows, table
+
+    point = np.repeat(np.arange(3), 2)
+    speeds = np.array([1000.0, 1250.0, 1500.0])
+    harm = np.tile([1, 2], 3)
+    freq = 0.4 * speeds[point] * harm
+    lev = term_levels(point, 3, harm, freq, np.full(6, 100.0), np.full(6, 90.0), np.zeros(6), -1.2, "total")
+    d = SlopeDecomposition("r", "erp", 2000.0, "total", "exc", "T", speeds, lev)
+    assert math.isnan(d.slopes["L_WA"]) and d.made_by == "" and d.held_back_by == ""
+    assert "no speed law" in d.sentence()
+    assert "r" in table([d]) and len(slope_rows([d])) == 9
+    assert d.to_json()["slopes_dB_per_doubling"]["L_WA"] is None
+    plot(tmp_path / "p.png", [d])               # nothing to draw: no file, no error
+    assert not (tmp_path / "p.png").exists()
