@@ -214,7 +214,9 @@ def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float) -> tuple[Li
 class RouteResult:
     """One route on every line: L_v (dB re 5e-8 m/s) per line, the response (LoadResponse, for the numerical
     radiator), the Ritz coordinates (vectors, lines), L_omega of the wheel on the coupled model per line (dB re
-    5e-8 rad/s), TF_omega per line (dB) where the route has it."""
+    5e-8 rad/s), TF_omega per line (dB) where the route has it; the route's excitation level per line (dB) and
+    what it and the transfer L_v - excitation are (names with units; housingfe.runup.slopes splits the speed law
+    into these terms)."""
 
     name: str
     L_v: np.ndarray
@@ -222,6 +224,9 @@ class RouteResult:
     coefficients: np.ndarray
     L_omega_coupled: np.ndarray
     tf_omega: np.ndarray | None = None
+    excitation_db: np.ndarray | None = None
+    excitation_name: str = ""
+    transfer_name: str = ""
 
 
 def _wheel_omega_level(model: GearboxModel, response, frequency) -> np.ndarray:
@@ -238,7 +243,8 @@ def tf_omega_route(model: GearboxModel, lines: Lines) -> RouteResult:
     resp = model.reduction.response_of(f, c)
     tf = resp.velocity_level_db - _wheel_omega_level(model, resp, f)
     # the wheel's L_omega on this route is the source's (the route's input): no coupled value of its own
-    return RouteResult("tf_omega", lines.L_omega + tf, resp, c, np.full(len(f), np.nan), tf)
+    return RouteResult("tf_omega", lines.L_omega + tf, resp, c, np.full(len(f), np.nan), tf, lines.L_omega,
+                       "L_omega of the source (dB re 5e-8 rad/s)", "TF_omega = L_v - L_omega (dB)")
 
 
 @register_route("mesh_force")
@@ -247,7 +253,10 @@ def mesh_force_route(model: GearboxModel, lines: Lines) -> RouteResult:
     f = lines.frequency
     c = model.reduction.coefficients(f, {"mesh": lines.mesh_excitation})
     resp = model.reduction.response_of(f, c)
-    return RouteResult("mesh_force", resp.velocity_level_db, resp, c, _wheel_omega_level(model, resp, f))
+    L_F = levels.level(np.abs(lines.mesh_excitation) ** 2, levels.F0)
+    return RouteResult("mesh_force", resp.velocity_level_db, resp, c, _wheel_omega_level(model, resp, f),
+                       excitation_db=L_F, excitation_name="L_F, mesh excitation F_n - k_m d_n (dB re 1 N)",
+                       transfer_name="L_v - L_F (dB re 5e-8 m/s per N)")
 
 
 # ------------------------------------------------------------------------------------------------ run-up

@@ -1,6 +1,8 @@
 """Run-up outputs: runup.csv (totals per speed, torque, route, radiation), runup_harmonics.csv (per tooth harmonic),
 spectra_<rpm>.csv / .png (like Figs. 5.2/5.5/5.8/5.9), runup.png (like Figs. 5.4/5.7/5.10 with the measured points),
-checks.csv and runup.json (timings, provenance, the modal basis used, checks, modal contributions per peak)."""
+slope_terms.csv / .png (the speed law split into the chain's terms, housingfe.runup.slopes), checks.csv,
+summary.txt (the console summary) and runup.json (timings, provenance, the modal basis used, checks, modal
+contributions per peak, the slope decomposition)."""
 from __future__ import annotations
 
 import platform
@@ -10,6 +12,7 @@ import numpy as np
 
 from housingfe import outputs
 from housingfe.data import thesis
+from housingfe.runup import slopes as slope_terms
 
 TOTAL_COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "tooth_frequency_hz", "L_omega_dB",
                  "L_omega_coupled_dB", "Lv_tooth_dB", "Lv_dB", "Lw_dB", "LwA_dB", "harmonics")
@@ -24,8 +27,10 @@ def _fmt(v):
     return "" if v is None else v
 
 
-def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict) -> None:
-    """Every output file of a run-up into `folder` (rank 0)."""
+def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict,
+          decompositions: list = ()) -> None:
+    """Every output file of a run-up into `folder` (rank 0); decompositions: housingfe.runup.slopes
+    SlopeDecomposition of every curve."""
     totals = [r for _, res in results.values() for r in res.totals]
     outputs.write_csv(folder / "runup.csv", TOTAL_COLUMNS, ([_fmt(r[k]) for k in TOTAL_COLUMNS] for r in totals))
     harm = [r for _, res in results.values() for r in res.harmonic_rows()]
@@ -39,6 +44,12 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
                               ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for r in rows))
             spectrum_plot(folder / f"spectra_{speed:g}rpm.png", rows, speed, scene.radiation.models[0])
     runup_plot(folder / "runup.png", scene, totals)
+    if decompositions:
+        outputs.write_csv(folder / "slope_terms.csv", slope_terms.SLOPE_COLUMNS,
+                          ([_fmt(r[k]) for k in slope_terms.SLOPE_COLUMNS]
+                           for r in slope_terms.slope_rows(decompositions)))
+        slope_terms.plot(folder / "slope_terms.png", decompositions)
+    (folder / "summary.txt").write_text(summary_text(scene, results, gm, check_rows, timings, decompositions) + "\n")
     import dolfinx
 
     outputs.write_json(folder / "runup.json", {
@@ -48,6 +59,7 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "modal_basis": gm.summary(),
         "ritz_reanalysis": {f"{t:g}": m.reduction.frequencies_hz[:12].tolist() for t, (m, _) in results.items()},
         "checks": check_rows, "peak_contributions": contributions,
+        "slope_terms": [d.to_json() for d in decompositions],
         "area_level_dB": next(iter(results.values()))[1].area_level_db,
         "provenance": {"python": platform.python_version(), "dolfinx": dolfinx.__version__,
                        "machine": platform.machine(), "mpi_ranks": gm.structure.V.mesh.comm.size},
@@ -137,8 +149,9 @@ def runup_plot(path: Path, scene, totals: list) -> None:
     plt.close(fig)
 
 
-def summary_text(scene, results: dict, gm, check_rows: list, timings: dict) -> str:
-    """The console summary: the model, the run-up maxima per route, the checks, the time split."""
+def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, decompositions: list = ()) -> str:
+    """The console summary: the model, the run-up maxima per route, the checks, which term makes the speed law
+    (one line per curve, and the table of slopes), the time split."""
     b = gm.basis
     lines = [f"{scene.scene.name}: coupled gearbox {gm.structure.dofs} DOFs, {len(b.eigenvalues)} modes to "
              f"{b.f_max:.0f} Hz ({b.rigid_count} zero), {len(gm.reduction.vectors)} Ritz vectors; radiating area "
@@ -154,6 +167,10 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict) -> s
     for r in check_rows:
         lines.append(f"  {r['quantity']}: {r['ours']} | {_fmt(r['measured'])} | {_fmt(r['thesis_calculated'])} | "
                      f"{r['passed'] or '-'}")
+    if decompositions:
+        lines.append("speed law (slope_terms.csv):")
+        lines += [f"  {d.sentence()}" for d in decompositions]
+        lines.append(slope_terms.table(decompositions))
     split = ", ".join(f"{k[:-2]} {v:.1f}" for k, v in timings.items() if k.endswith("_s") and v >= 0.05)
     lines.append(f"time (s): {split}")
     return "\n".join(lines)

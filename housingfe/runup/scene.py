@@ -182,7 +182,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     from mpi4py import MPI
 
     from housingfe import outputs
-    from housingfe.runup import checks, report
+    from housingfe.runup import checks, report, slopes
     from housingfe.runup.chain import build_gearbox_model, runup, source_lines, with_drivetrain
     from housingfe.scene import load_housing_scene
 
@@ -221,12 +221,13 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
             timings[k] = timings.get(k, 0.0) + v
         results[torque] = (m, res)
     check_rows, contributions = checks.evaluate(scene, results, gm)
+    decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
-            report.write(tmp, scene, results, gm, check_rows, contributions, timings)
+            report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions)
     if comm.rank == 0:
-        print(report.summary_text(scene, results, gm, check_rows, timings))
+        print(report.summary_text(scene, results, gm, check_rows, timings, decompositions))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
 

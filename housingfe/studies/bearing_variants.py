@@ -38,8 +38,10 @@ POSITIONS = ("pinion_front", "pinion_back", "wheel_front", "wheel_back")
 # the thesis' FEM stand-in for self-aligning bearings (Sec. 5.8): the ball bearing matrices with their moment
 # rows and columns zeroed ("the stiffness matrix of the ball bearings was used with zero moment stiffness")
 THESIS_SELF_ALIGNING = "ball_zero_moment"
-# a diagnostic: the ball matrices with the moment stiffness of the thesis' own interior model (Appendix C:
-# 3.4-5.2e6 N m/rad, some 25x what Lim's theory gives for these bearings here)
+# a sensitivity of the moment terms: the ball matrices with Appendix C's rotational values (3.4-5.2e6 N m/rad) on
+# every bearing.  They are NOT one bearing's moment stiffness: Appendix C's theta values are the lumped shaft's
+# tilt on its two bearings, k_theta = k_r L^2 / 4 with one span L = 0.16-0.17 m for all four
+# (tests/studies/test_appendix_c_tilt.py); a bearing's own (Lim, Sec. 4.6: 1.7-2.5e5) is 15-30x smaller
 APPENDIX_C_MOMENTS = "ball_appendix_c_moments"
 
 

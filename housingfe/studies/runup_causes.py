@@ -10,8 +10,10 @@ basis):
 * modes: the basis truncated at f_max (the thesis' 4 kHz, no modes above, no static correction) and at 2 kHz,
   against ours (modes to 1.5 f_max plus static residual vectors);
 * lines: the tooth frequency alone (what the thesis' tooth-band figures show) against every harmonic to f_max;
-* bearings: the bearings' moment stiffness removed (self-aligning bearings, a Rayleigh-Ritz re-analysis) — how
-  the shafts meet the housing;
+* bearings (how the shafts meet the housing, Rayleigh-Ritz re-analyses): the ball bearings' moment stiffness
+  removed (their moment rows and columns zeroed, the thesis' FE stand-in for self-aligning bearings, Sec. 5.8),
+  and the self-aligning configuration itself (spherical roller model: zero moment stiffness and about five times
+  the ball bearings' radial stiffness; benchmarks/experiments/bearing_ranking/ separates the two);
 * radiation: Föller's sigma against sigma = 1 (from the scene's radiators);
 * modes per 1/3-octave band of the tooth frequencies (125-630 Hz) in the coupled model.
 
@@ -38,6 +40,23 @@ def _truncated(basis, f_max: float):
     keep = int(np.sum(basis.frequencies_hz < f_max))
     return dataclasses.replace(basis, eigenvalues=basis.eigenvalues[:keep], vectors=basis.vectors[:keep],
                                residuals=basis.residuals[:keep], f_max=f_max, expected_count=keep)
+
+
+def without_moment_stiffness(drivetrain):
+    """The drivetrain with every FE bearing's 6x6 K (its own, at the statics loads) with the tilt rows and columns
+    (theta_x, theta_y) zeroed: what the thesis' FE used for self-aligning bearings (Sec. 5.8)."""
+    spec = drivetrain.to_coupling_spec()
+    matrices = {b.name: b.matrices() for b in spec.bearings}
+    seats = []
+    for seat in drivetrain.bearings:
+        K, C = matrices[seat.name]
+        K = np.array(K, float)
+        K[3:5, :] = 0.0
+        K[:, 3:5] = 0.0
+        seats.append(dataclasses.replace(
+            seat, designation=None, model=None, stiffness=None, stiffness_matrix=tuple(map(tuple, K)),
+            damping_matrix=None if C is None else tuple(map(tuple, np.asarray(C, float)))))
+    return dataclasses.replace(drivetrain, bearings=tuple(seats), bearing_configuration=None)
 
 
 def _rows(variant: str, res, torque: float, reference: dict | None) -> list[dict]:
@@ -123,9 +142,11 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
                       torque, ref)
     rows += _rows("tooth frequency line only (harmonic 1)", _tooth_only(base), torque, ref)
     if scene.drivetrain.bearings == "ball":
+        rows += _rows("ball bearings without moment stiffness (moment rows and columns zeroed, re-analysed)",
+                      run(with_drivetrain(gm, without_moment_stiffness(dt))), torque, ref)
         other = dataclasses.replace(dt, bearing_configuration="self_aligning")
-        rows += _rows("bearings without moment stiffness (self-aligning, re-analysed)", run(with_drivetrain(gm, other)),
-                      torque, ref)
+        rows += _rows("self-aligning bearings (spherical roller model: no moment stiffness AND ~5x the radial "
+                      "stiffness, re-analysed)", run(with_drivetrain(gm, other)), torque, ref)
     n = gm.basis.rigid_count
     freqs = gm.basis.frequencies_hz[n:]
     bands = third_octave_bands(125.0, 630.0)

@@ -17,16 +17,11 @@ import numpy as np
 import pytest
 
 from housingfe.drivetrain.description import test_gearbox, with_torque
-from housingfe.radiation.radiators import RADIATORS
 from housingfe.response.harmonic import Load, harmonic_response, loss_factor
 from housingfe.response.reduced import RitzReduction
 from housingfe.runup.chain import build_gearbox_model, runup, source_lines, unit_loads, with_drivetrain
-from housingfe.runup.scene import housing_model_for
-from housingfe.scene import load_housing_scene
+from tests.runup.conftest import F_LINES, SPEEDS
 from tests.test_cli import housingfe
-
-F_LINES = 1500.0
-SPEEDS = [500.0, 1000.0, 1100.0]
 
 
 def test_mesh_excitation_reproduces_the_lumped_response():
@@ -43,17 +38,6 @@ def test_mesh_excitation_reproduces_the_lumped_response():
         q = np.linalg.solve(Z, -m.h * F_exc[n - 1])
         np.testing.assert_allclose(q, 2 * exc.state.Q[H + n], rtol=1e-9, atol=1e-9 * np.abs(q).max())
         assert m.h @ q == pytest.approx(exc.transmission_error[n - 1], rel=1e-9)
-
-
-@pytest.fixture(scope="module")
-def coarse(comm):
-    hs, _ = load_housing_scene("test-gearbox", ["mesh.size=0.06"])
-    hm = housing_model_for(hs, F_LINES, comm)
-    dt = test_gearbox("A")
-    gm = build_gearbox_model(hm, dt, F_LINES, radiators={"erp": RADIATORS["erp"]()})
-    src = dt.source_model()
-    lines, _ = source_lines(src, SPEEDS, [2000.0], F_LINES)
-    return gm, src, lines, runup(gm, None, SPEEDS, [2000.0], lines=lines)
 
 
 @pytest.mark.slow

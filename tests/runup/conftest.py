@@ -1,0 +1,23 @@
+"""The coarse coupled test gearbox run-up shared by the run-up tests (built once per session)."""
+import pytest
+
+F_LINES = 1500.0
+SPEEDS = [500.0, 1000.0, 1100.0]
+
+
+@pytest.fixture(scope="session")
+def coarse(comm):
+    """(GearboxModel, source, lines, RunupResult): test gearbox on a 60 mm mesh, set A, 2000 N m, lines to 1.5 kHz."""
+    from housingfe.drivetrain.description import test_gearbox
+    from housingfe.radiation.radiators import RADIATORS
+    from housingfe.runup.chain import build_gearbox_model, runup, source_lines
+    from housingfe.runup.scene import housing_model_for
+    from housingfe.scene import load_housing_scene
+
+    hs, _ = load_housing_scene("test-gearbox", ["mesh.size=0.06"])
+    hm = housing_model_for(hs, F_LINES, comm)
+    dt = test_gearbox("A")
+    gm = build_gearbox_model(hm, dt, F_LINES, radiators={"erp": RADIATORS["erp"]()})
+    src = dt.source_model()
+    lines, _ = source_lines(src, SPEEDS, [2000.0], F_LINES)
+    return gm, src, lines, runup(gm, None, SPEEDS, [2000.0], lines=lines)
