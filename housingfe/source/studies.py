@@ -5,7 +5,10 @@
       beta = asin(pi/18) = 10.05 deg, which makes the seven widths give eps_beta = 0.5, 0.75, ..., 2.0
       (the quarter steps of B/d1 = 0.5 ... 1.5 of the text).  Spur reference (beta = 0) at B = 40.5 mm.
   correction study (Fig. 2.18, Sec. 5.7): L_omega in the tooth band of the built-in gear sets over torque
-      at 1500 rpm and averaged (energy) over 800-1500 rpm, differences relative to set A.
+      at 1500 rpm and averaged (energy) over 800-1500 rpm, differences relative to set A (the thesis' own
+      calculation, so with its two-dimensional engagement shock, engagement = "thesis-2d").
+  excitation spectrum (issue 28): the quasi-static engagement shock F_e and excitation k_m (d - mean d) per
+      tooth harmonic of the built-in gear sets, both engagement models (`housingfe source-spectrum`).
 
 Run: `python -m housingfe.source.studies [out_dir]` (default results/source-studies); writes CSV + PNG.
 """
@@ -14,6 +17,8 @@ from __future__ import annotations
 import math
 import sys
 from pathlib import Path
+
+import numpy as np
 
 from housingfe.outputs import format_table, write_csv
 from housingfe.source.gears import GearPair
@@ -77,7 +82,7 @@ def main(out_dir: Path) -> None:
     fig.savefig(out_dir / "overlap_study.png", dpi=120)
     plt.close(fig)
 
-    study = correction_study()
+    study = correction_study(engagement="thesis-2d")
     ref = study["gearset-A"]
     rows = []
     fig, ax = plt.subplots(figsize=(7, 4.5))
@@ -96,6 +101,119 @@ def main(out_dir: Path) -> None:
     fig.tight_layout()
     fig.savefig(out_dir / "corrections.png", dpi=120)
     plt.close(fig)
+
+
+# ------------------------------------------------------------------------------------------------ spectrum
+SPECTRUM_SCENES = ("gearset-A", "gearset-B", "gearset-C", "gearset-D", "gearset-uncorrected", "gearset-double-helical")
+ENGAGEMENT_LABELS = {"thesis-2d": "thesis 2-D (Eq. 2.62)", "face-width": "face width (default)"}
+FLAT_OCTAVE_DB = 3.0       # an octave of harmonics whose envelope falls by less than half of 1/n's 6 dB is "flat"
+
+
+def excitation_spectrum(scenes=SPECTRUM_SCENES, harmonics: int = 15, torque_nm: float | None = None) -> list[dict]:
+    """Quasi-static excitation per tooth harmonic n = 1..harmonics of every scene (built-in roosmalen source scene
+    or TOML path) at its torque_Nm (or `torque_nm`, pinion, N m), for both engagement models.
+
+    Per row: scene, engagement, n, overlap_ratio, shock_N (one-sided amplitude of the engagement shock F_e, N)
+    and excitation_N: one-sided amplitude of k_m (d - mean d) with d = (F - F_e) / S(t) the quasi-static mesh
+    compression (what mesh stiffness variation and shock together impose on a structure that holds the mean
+    stiffness k_m: the load of the run-up's mesh_force route at low speed), N."""
+    from housingfe.source import dynamics as dyn
+    from housingfe.source import roosmalen as rs
+    from housingfe.source.cli import load_scene
+
+    rows = []
+    for name in scenes:
+        scene, path = load_scene(name)
+        table = rs.parse(scene, str(path))
+        pair, corr, _, interior, model = rs.build(table, str(path))
+        torque = torque_nm or table.torque_Nm
+        label = scene.get("scene", {}).get("name", str(name))
+        op = rs.OperatingPoint(pair, corr, interior, model, torque, table.stiffness_positions, engagement="face-width")
+        shocks = {"thesis-2d": dyn.engagement_force(pair, corr, op.S, op.normal_force), "face-width": op.shock}
+        for engagement, shock in shocks.items():
+            d = (op.normal_force - shock) / op.S
+            excitation = op.curve.mean * (d - d.mean())
+            amp_f = 2 * np.abs(np.fft.rfft(shock)[1:harmonics + 1]) / shock.size
+            amp_x = 2 * np.abs(np.fft.rfft(excitation)[1:harmonics + 1]) / excitation.size
+            for n in range(1, harmonics + 1):
+                rows.append({"scene": label, "engagement": engagement, "n": n, "torque_Nm": torque,
+                             "overlap_ratio": pair.overlap_ratio, "shock_N": float(amp_f[n - 1]),
+                             "excitation_N": float(amp_x[n - 1])})
+    return rows
+
+
+def envelope_decay(amplitudes) -> dict:
+    """Does a harmonic spectrum a_1..a_N decay at least as 1/n with no flat range?  The upper envelope
+    E(n) = max_{m >= n} a_m; "at least as 1/n": n E(n) <= a_1 for every n (max_n_envelope_ratio = max n E(n) / a_1
+    <= 1); "no flat range": every octave n -> 2n (2n <= N) lowers the envelope by at least FLAT_OCTAVE_DB
+    (min_octave_drop_dB; 1/n gives 6.0 dB).  Returns those two numbers, the octave where the drop is smallest
+    and passed (both hold)."""
+    a = np.asarray(amplitudes, dtype=float)
+    N = a.size
+    env = np.maximum.accumulate(a[::-1])[::-1]
+    n = np.arange(1, N + 1)
+    ratio = float(np.max(n * env) / a[0]) if a[0] > 0 else math.inf
+    drops = [(20 * math.log10(env[k - 1] / env[2 * k - 1]) if env[2 * k - 1] > 0 else math.inf, k)
+             for k in range(1, N // 2 + 1)]
+    worst, at = min(drops)
+    return {"max_n_envelope_ratio": ratio, "min_octave_drop_dB": float(worst), "worst_octave": (at, 2 * at),
+            "passed": bool(ratio <= 1.0 + 1e-9 and worst >= FLAT_OCTAVE_DB)}
+
+
+def write_excitation_spectrum(rows: list[dict], out_dir: Path) -> dict:
+    """excitation_spectrum.csv (all rows), excitation_spectrum.md (shock per harmonic, both models, every set,
+    and the envelope check), excitation_spectrum.png; returns {(scene, engagement): envelope_decay(shock)}."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    keys = ["scene", "engagement", "n", "torque_Nm", "overlap_ratio", "shock_N", "excitation_N"]
+    write_csv(out_dir / "excitation_spectrum.csv", keys, [[r[k] for k in keys] for r in rows])
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    models = list(ENGAGEMENT_LABELS)
+    series = {(s, m): [r for r in rows if r["scene"] == s and r["engagement"] == m] for s in scenes for m in models}
+    checks = {k: envelope_decay([r["shock_N"] for r in v]) for k, v in series.items()}
+    harmonics = [r["n"] for r in series[(scenes[0], models[0])]]
+    short = {"thesis-2d": "2-D", "face-width": "fw"}
+    head = ["n"] + [f"{s.removeprefix('gearset-')} {short[m]}" for s in scenes for m in models]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for i, n in enumerate(harmonics):
+        lines.append("| " + " | ".join([str(n)] + [f"{series[(s, m)][i]['shock_N']:.0f}" for s in scenes
+                                                    for m in models]) + " |")
+    lines.append("| eps_beta | " + " | ".join(f"{series[(s, m)][0]['overlap_ratio']:.3f}" for s in scenes
+                                              for m in models) + " |")
+    lines.append("| smallest octave drop, dB | " + " | ".join(f"{checks[(s, m)]['min_octave_drop_dB']:.1f}"
+                                                              for s in scenes for m in models) + " |")
+    lines.append("| max n E(n) / F_1 | " + " | ".join(f"{checks[(s, m)]['max_n_envelope_ratio']:.2f}"
+                                                      for s in scenes for m in models) + " |")
+    lines.append("| envelope check | " + " | ".join("pass" if checks[(s, m)]["passed"] else "FAIL"
+                                                    for s in scenes for m in models) + " |")
+    (out_dir / "excitation_spectrum.md").write_text(
+        "Engagement shock F_e, one-sided amplitude per tooth harmonic n [N] (2-D: thesis Eq. 2.62; fw: face "
+        "width)\n\n" + "\n".join(lines) + "\n")
+    cols = min(3, len(scenes))
+    rows_fig = math.ceil(len(scenes) / cols)
+    fig, axes = plt.subplots(rows_fig, cols, figsize=(4.2 * cols, 3.4 * rows_fig), squeeze=False, sharey=True)
+    for ax, s in zip(axes.flat, scenes):
+        for m, style in zip(models, ("s-", "o-")):
+            ax.semilogy(harmonics, [max(r["shock_N"], 1e-3) for r in series[(s, m)]], style, ms=3,
+                        label=ENGAGEMENT_LABELS[m])
+        f1 = series[(s, "thesis-2d")][0]["shock_N"]
+        ax.semilogy(harmonics, [f1 / n for n in harmonics], "k:", lw=0.8, label="1/n from the 2-D n = 1")
+        ax.set_title(f"{s} (eps_beta = {series[(s, models[0])][0]['overlap_ratio']:.2f})", fontsize=9)
+        ax.set_xlabel("tooth harmonic n")
+        ax.grid(True, which="both", lw=0.3)
+    for ax in axes.flat[len(scenes):]:
+        ax.set_visible(False)
+    axes[0, 0].set_ylabel("F_e amplitude [N]")
+    axes[0, 0].legend(fontsize=7)
+    fig.suptitle(f"quasi-static engagement shock per tooth harmonic, {rows[0]['torque_Nm']:g} N m", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(out_dir / "excitation_spectrum.png", dpi=120)
+    plt.close(fig)
+    return checks
 
 
 if __name__ == "__main__":
