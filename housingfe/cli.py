@@ -18,6 +18,7 @@ _EXTENSIONS = (
     "housingfe.correlation.cli",
     "housingfe.radiation",
     "housingfe.source.cli",
+    "housingfe.source.studies",
     "housingfe.studies.bearing_variants",
     "housingfe.studies.runup_causes",
 )

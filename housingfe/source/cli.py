@@ -67,37 +67,9 @@ def _cmd_source(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_spectrum(args: argparse.Namespace) -> int:
-    from housingfe.outputs import atomic_output_dir
-    from housingfe.source.studies import SPECTRUM_SCENES, excitation_spectrum, write_excitation_spectrum
-
-    scenes = args.scenes or list(SPECTRUM_SCENES)
-    if args.harmonics < 2:
-        raise InputError(f"source-spectrum: --harmonics: {args.harmonics} must be >= 2")
-    for name in scenes:                      # bad names stop here, before any computation or folder
-        scene, path = load_scene(name)
-        if scene["source"]["model"] != "roosmalen":
-            raise InputError(f"{path}: source.model: source-spectrum needs 'roosmalen', not {scene['source']['model']!r}")
-    rows = excitation_spectrum(scenes, harmonics=args.harmonics, torque_nm=args.torque)
-    out_dir = Path(args.out)
-    with atomic_output_dir(out_dir) as tmp:
-        write_excitation_spectrum(rows, tmp)
-    print((out_dir / "excitation_spectrum.md").read_text())
-    print(f"results in {out_dir}")
-    return 0
-
-
 def register_cli(subparsers) -> None:
-    """Add `housingfe source <scene> [--out DIR]` and `housingfe source-spectrum [SCENE ...]`."""
+    """Add `housingfe source <scene> [--out DIR]`."""
     p = subparsers.add_parser("source", help="gear excitation source: stiffness, L_omega, bearing spectra")
     p.add_argument("scene", help="built-in source scene (e.g. gearset-A) or path to a TOML file")
     p.add_argument("--out", default=None, help="result folder (default results/<scene name>)")
     p.set_defaults(func=_cmd_source)
-    p = subparsers.add_parser("source-spectrum", help="quasi-static engagement shock per tooth harmonic, both "
-                              "engagement models (thesis-2d, face-width), table + plot")
-    p.add_argument("scenes", nargs="*", help="roosmalen source scenes (default: gear sets A-D, uncorrected, "
-                   "double helical)")
-    p.add_argument("--harmonics", type=int, default=15, help="tooth harmonics n = 1..N (default 15)")
-    p.add_argument("--torque", type=float, default=None, help="pinion torque, N m (default: each scene's)")
-    p.add_argument("--out", default="results/source-spectrum", help="result folder")
-    p.set_defaults(func=_cmd_spectrum)

@@ -64,6 +64,7 @@ def test_source_spectrum_command_writes_table_and_plot(tmp_path):
     (["no-such-gearset"], "no-such-gearset"),
     (["box-free"], "scene.kind"),
     (["gearset-A", "--harmonics", "1"], "--harmonics"),
+    (["gearset-A", "--torque", "-5"], "--torque"),
 ])
 def test_source_spectrum_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
     out = tmp_path / "spec"
