@@ -161,9 +161,29 @@ def envelope_decay(amplitudes) -> dict:
             "passed": bool(ratio <= 1.0 + 1e-9 and worst >= FLAT_OCTAVE_DB)}
 
 
+def _markdown_table(series: dict, scenes: list, models: list, key: str) -> tuple[str, dict]:
+    """One Markdown table of `key` per harmonic (rows) for every scene and model (columns), with eps_beta and the
+    envelope check (`envelope_decay`) below; returns (text, {(scene, model): check})."""
+    checks = {k: envelope_decay([r[key] for r in v]) for k, v in series.items()}
+    harmonics = [r["n"] for r in series[(scenes[0], models[0])]]
+    short = {"thesis-2d": "2-D", "face-width": "fw"}
+    cols = [(s, m) for s in scenes for m in models]
+    head = ["n"] + [f"{s.removeprefix('gearset-')} {short[m]}" for s, m in cols]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for i, n in enumerate(harmonics):
+        lines.append("| " + " | ".join([str(n)] + [f"{series[c][i][key]:.0f}" for c in cols]) + " |")
+    lines.append("| eps_beta | " + " | ".join(f"{series[c][0]['overlap_ratio']:.3f}" for c in cols) + " |")
+    lines.append("| smallest octave drop, dB | " + " | ".join(f"{checks[c]['min_octave_drop_dB']:.1f}" for c in cols)
+                 + " |")
+    lines.append("| max n E(n) / a_1 | " + " | ".join(f"{checks[c]['max_n_envelope_ratio']:.2f}" for c in cols) + " |")
+    lines.append("| envelope check | " + " | ".join("pass" if checks[c]["passed"] else "FAIL" for c in cols) + " |")
+    return "\n".join(lines), checks
+
+
 def write_excitation_spectrum(rows: list[dict], out_dir: Path) -> dict:
-    """excitation_spectrum.csv (all rows), excitation_spectrum.md (shock per harmonic, both models, every set,
-    and the envelope check), excitation_spectrum.png; returns {(scene, engagement): envelope_decay(shock)}."""
+    """excitation_spectrum.csv (all rows), excitation_spectrum.md (the shock F_e and the quasi-static excitation
+    per harmonic, both models, every set, with the envelope check), excitation_spectrum.png; returns
+    {(scene, engagement): envelope_decay(excitation)} (the validate check)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -175,32 +195,24 @@ def write_excitation_spectrum(rows: list[dict], out_dir: Path) -> dict:
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     models = list(ENGAGEMENT_LABELS)
     series = {(s, m): [r for r in rows if r["scene"] == s and r["engagement"] == m] for s in scenes for m in models}
-    checks = {k: envelope_decay([r["shock_N"] for r in v]) for k, v in series.items()}
-    harmonics = [r["n"] for r in series[(scenes[0], models[0])]]
-    short = {"thesis-2d": "2-D", "face-width": "fw"}
-    head = ["n"] + [f"{s.removeprefix('gearset-')} {short[m]}" for s in scenes for m in models]
-    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for i, n in enumerate(harmonics):
-        lines.append("| " + " | ".join([str(n)] + [f"{series[(s, m)][i]['shock_N']:.0f}" for s in scenes
-                                                    for m in models]) + " |")
-    lines.append("| eps_beta | " + " | ".join(f"{series[(s, m)][0]['overlap_ratio']:.3f}" for s in scenes
-                                              for m in models) + " |")
-    lines.append("| smallest octave drop, dB | " + " | ".join(f"{checks[(s, m)]['min_octave_drop_dB']:.1f}"
-                                                              for s in scenes for m in models) + " |")
-    lines.append("| max n E(n) / F_1 | " + " | ".join(f"{checks[(s, m)]['max_n_envelope_ratio']:.2f}"
-                                                      for s in scenes for m in models) + " |")
-    lines.append("| envelope check | " + " | ".join("pass" if checks[(s, m)]["passed"] else "FAIL"
-                                                    for s in scenes for m in models) + " |")
+    shock_md, _ = _markdown_table(series, scenes, models, "shock_N")
+    excitation_md, checks = _markdown_table(series, scenes, models, "excitation_N")
+    torque = rows[0]["torque_Nm"]
     (out_dir / "excitation_spectrum.md").write_text(
-        "Engagement shock F_e, one-sided amplitude per tooth harmonic n [N] (2-D: thesis Eq. 2.62; fw: face "
-        "width)\n\n" + "\n".join(lines) + "\n")
+        f"Engagement shock F_e, one-sided amplitude per tooth harmonic n [N], {torque:g} N m (2-D: thesis Eq. 2.62, "
+        "engagement = \"thesis-2d\"; fw: per face-width slice, engagement = \"face-width\")\n\n" + shock_md
+        + "\n\nQuasi-static excitation k_m (d - mean d), d = (F - F_e) / S(t), one-sided amplitude per tooth harmonic "
+        "n [N] (the check of issue 28 is on this one)\n\n" + excitation_md + "\n")
+    harmonics = [r["n"] for r in series[(scenes[0], models[0])]]
     cols = min(3, len(scenes))
     rows_fig = math.ceil(len(scenes) / cols)
     fig, axes = plt.subplots(rows_fig, cols, figsize=(4.2 * cols, 3.4 * rows_fig), squeeze=False, sharey=True)
     for ax, s in zip(axes.flat, scenes):
-        for m, style in zip(models, ("s-", "o-")):
-            ax.semilogy(harmonics, [max(r["shock_N"], 1e-3) for r in series[(s, m)]], style, ms=3,
-                        label=ENGAGEMENT_LABELS[m])
+        for m, colour, marker in zip(models, ("C0", "C1"), ("s", "o")):
+            ax.semilogy(harmonics, [max(r["shock_N"], 1e-3) for r in series[(s, m)]], "-", color=colour,
+                        marker=marker, ms=3, label=f"F_e, {ENGAGEMENT_LABELS[m]}")
+            ax.semilogy(harmonics, [max(r["excitation_N"], 1e-3) for r in series[(s, m)]], "--", color=colour,
+                        lw=0.9, label=f"k_m (d - mean d), {m}")
         f1 = series[(s, "thesis-2d")][0]["shock_N"]
         ax.semilogy(harmonics, [f1 / n for n in harmonics], "k:", lw=0.8, label="1/n from the 2-D n = 1")
         ax.set_title(f"{s} (eps_beta = {series[(s, models[0])][0]['overlap_ratio']:.2f})", fontsize=9)
@@ -208,9 +220,9 @@ def write_excitation_spectrum(rows: list[dict], out_dir: Path) -> dict:
         ax.grid(True, which="both", lw=0.3)
     for ax in axes.flat[len(scenes):]:
         ax.set_visible(False)
-    axes[0, 0].set_ylabel("F_e amplitude [N]")
-    axes[0, 0].legend(fontsize=7)
-    fig.suptitle(f"quasi-static engagement shock per tooth harmonic, {rows[0]['torque_Nm']:g} N m", fontsize=10)
+    axes[0, 0].set_ylabel("amplitude [N]")
+    axes[0, 0].legend(fontsize=6)
+    fig.suptitle(f"quasi-static engagement shock F_e and excitation per tooth harmonic, {torque:g} N m", fontsize=10)
     fig.tight_layout()
     fig.savefig(out_dir / "excitation_spectrum.png", dpi=120)
     plt.close(fig)
