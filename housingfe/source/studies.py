@@ -175,7 +175,7 @@ def _markdown_table(series: dict, scenes: list, models: list, key: str) -> tuple
     lines.append("| eps_beta | " + " | ".join(f"{series[c][0]['overlap_ratio']:.3f}" for c in cols) + " |")
     lines.append("| smallest octave drop, dB | " + " | ".join(f"{checks[c]['min_octave_drop_dB']:.1f}" for c in cols)
                  + " |")
-    lines.append("| max n E(n) / a_1 | " + " | ".join(f"{checks[c]['max_n_envelope_ratio']:.2f}" for c in cols) + " |")
+    lines.append("| max n E(n) / a_1 | " + " | ".join(f"{checks[c]['max_n_envelope_ratio']:.3f}" for c in cols) + " |")
     lines.append("| envelope check | " + " | ".join("pass" if checks[c]["passed"] else "FAIL" for c in cols) + " |")
     return "\n".join(lines), checks
 
