@@ -19,6 +19,7 @@ _EXTENSIONS = (
     "housingfe.radiation",
     "housingfe.reference",
     "housingfe.source.cli",
+    "housingfe.source.studies",
     "housingfe.studies.bearing_variants",
     "housingfe.studies.runup_causes",
 )

@@ -77,7 +77,7 @@ def end_to_end(scene, housing_scene, drivetrain, torque, comm) -> dict:
     gm = build_gearbox_model(housing_model, drivetrain, spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
     t0 = time.perf_counter()
-    source = drivetrain.source_model(harmonics=spec.harmonics)
+    source = drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement)
     lines, _ = source_lines(source, spec.speeds, [torque], spec.f_max_hz)
     source_s = time.perf_counter() - t0
     result = runup(gm, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
@@ -301,7 +301,7 @@ def main(out_dir: Path, quick: bool) -> None:
     spec_b = scene.drivetrain.model_copy(update={"gear_set": "B"})
     dt_b = drivetrain_of(spec_b, torque)
     t0 = time.perf_counter()
-    source_b = dt_b.source_model(harmonics=spec.harmonics)
+    source_b = dt_b.source_model(harmonics=spec.harmonics, engagement=spec.engagement)
     source_b_s = time.perf_counter() - t0
     reuses.append(reuse(gm, scene, "gear set B", dt_b, source_b, torque))
     reuses[-1]["source_s"] += source_b_s

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Optional
+from typing import Literal, Optional
 
 import numpy as np
 from pydantic import Field, PositiveFloat, PositiveInt, field_validator, model_validator
@@ -21,6 +21,7 @@ from pydantic import Field, PositiveFloat, PositiveInt, field_validator, model_v
 from housingfe.errors import InputError
 from housingfe.scene import RadiationPlate
 from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table, read_scene_dict
+from housingfe.source.dynamics import DEFAULT_ENGAGEMENT
 from housingfe.source.operating import SPEED_RANGE_RPM
 
 
@@ -77,7 +78,7 @@ class RunupSpec(_Strict):
     """Speeds (pinion, rev/min) from speed_min to speed_max in speed_step; torques (pinion, N m); the harmonics of
     the tooth frequency up to f_max_hz; a modal basis to basis_factor x f_max_hz; routes of
     housingfe.runup.chain.ROUTES; modal damping ratio (Sec. 5.4: 0.04); harmonics of the source's harmonic balance;
-    spectra at spectrum_speeds_rpm; the observed (radiating) surface."""
+    spectra at spectrum_speeds_rpm; the observed (radiating) surface; the source's engagement shock model."""
 
     speed_min_rpm: PositiveFloat = 50.0
     speed_max_rpm: PositiveFloat = 1500.0
@@ -90,6 +91,9 @@ class RunupSpec(_Strict):
     harmonics: PositiveInt = 30
     spectrum_speeds_rpm: list[PositiveFloat] = [500.0, 1000.0, 1500.0]
     surface: str = "outer"
+    # the source's engagement shock (housingfe.source.dynamics.ENGAGEMENT_MODELS): "face-width" distributes
+    # Eq. 2.62 over the face-width slices; "thesis-2d" is the thesis' two-dimensional shock (the replica)
+    engagement: Literal["face-width", "thesis-2d"] = DEFAULT_ENGAGEMENT
 
     @field_validator("routes")
     @classmethod
@@ -208,7 +212,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
     timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
-    source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics)
+    source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement)
     results = {}
     for torque in spec.torques_nm:
         t1 = time.perf_counter()

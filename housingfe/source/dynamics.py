@@ -31,7 +31,12 @@ import scipy.linalg as sla
 from housingfe.errors import InputError, SolverError
 from housingfe.levels import OMEGA0, band_sum, level, third_octave_bands
 from housingfe.source.gears import GearPair
-from housingfe.source.stiffness import Corrections
+from housingfe.source.stiffness import Corrections, flank_gaps
+
+# the engagement shock models (`engagement` of source and run-up scenes): the thesis' two-dimensional Eq. 2.62, and
+# the same shock per face-width slice of the contact lines (a helical tooth enters and leaves gradually)
+ENGAGEMENT_MODELS = ("face-width", "thesis-2d")
+DEFAULT_ENGAGEMENT = "face-width"
 
 N_DOF = 14       # after eliminating the prescribed far-end angle (DOF 15 of the thesis)
 WHEEL_THETA_Z = 11
@@ -212,7 +217,7 @@ def preload_force(mats: Matrices, torque: float) -> np.ndarray:
 
 # ------------------------------------------------------------------------------------ excitation
 def engagement_force(pair: GearPair, corrections: Corrections, stiffness: np.ndarray, normal_force: float,
-                     n_samples: int | None = None) -> np.ndarray:
+                     n_samples: int | None = None, contact_ratio: float | None = None) -> np.ndarray:
     """Engagement/disengagement shock force F_e [N] over one mesh period (eq. 2.62, Fig. 2.14/2.16),
     sampled at the positions of `stiffness` (S(t) [N/m], one period, uniformly spaced).
 
@@ -220,14 +225,16 @@ def engagement_force(pair: GearPair, corrections: Corrections, stiffness: np.nda
     length eps_tot * p; every pair in contact is asked for the deflection delta_i = max(delta - e(s_i), 0)
     with delta = F / S(t) and e the tip relief of the wheel (at the start, length l_2) and the pinion (at
     the end, length l_1); F_e = S(t) (sum_i delta_i - mean) / eps_tot.  For the 3-D correction D the
-    relief ramps are those of Fig. F.1's profile direction (amount, length)."""
+    relief ramps are those of Fig. F.1's profile direction (amount, length).  contact_ratio: eps_tot by default
+    (the thesis treats a helical pair as a spur pair with the total contact ratio); eps_alpha gives the shock
+    of the transverse section."""
     S = np.asarray(stiffness, dtype=float)
     n = S.size if n_samples is None else n_samples
     t = np.arange(n) / n
     if n != S.size:
         S = np.interp(t, np.arange(S.size) / S.size, S, period=1.0)
     pitch = pair.transverse_base_pitch
-    eps = pair.total_contact_ratio
+    eps = pair.total_contact_ratio if contact_ratio is None else contact_ratio
     length = eps * pitch
     delta = normal_force / S
     total = np.zeros(n)
@@ -243,6 +250,79 @@ def engagement_force(pair: GearPair, corrections: Corrections, stiffness: np.nda
             e += ca1 * np.clip((s - (length - l1)) / l1, 0, 1)
         total += np.where(inside, np.maximum(delta - e, 0.0), 0.0)
     return S * (total - total.mean()) / eps
+
+
+def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffness: np.ndarray,
+                                normal_force: float, load_share: np.ndarray | None = None,
+                                n_slices: int = 256, n_samples: int | None = None,
+                                origin: float = 0.0) -> np.ndarray:
+    """Engagement/disengagement shock force F_e [N] over one mesh period, distributed over the face width:
+    Eq. 2.62 applied per face-width slice of the contact lines, sampled like `engagement_force`.
+
+    Every helix is cut into `n_slices` slices of width b / n_slices at offsets o_j from its leading face; slice j
+    of tooth pair k sits at the roll position s = origin + (t + k) p_bt + o_j tan(beta_b) [m from T1] (origin = 0:
+    the convention of MeshModel.contact_points, so F_e is in phase with the stiffness curve; origin = A puts
+    pair 0's leading face at the start of contact at t = 0, as `engagement_force` does) and is in contact for
+    A <= s < E.  Its required deflection is max(delta - e, 0), delta = F / S(t), e the gap of the corrections at
+    (s, w) (`flank_gaps`: tip reliefs, the 3-D triangular correction, width relief).  The slices are springs of
+    stiffness S(t) phi_j / (eps_alpha n_slices n_helices), phi_j = `load_share` (helices, m) resampled to the
+    slices (how the mesh stiffness is distributed across the face, mean 1; None: uniform):
+    F_e = S(t) (D(t) - mean D), D = sum over slices in contact of phi_j max(delta - e, 0) / (eps_alpha n_slices
+    n_helices).  A slice's share of the load is thus its stiffness times its deflection compatibility, and a
+    helical tooth enters over eps_beta mesh periods instead of at once.
+
+    Limits (tests/source/test_dynamics.py): spur gears (eps_beta = 0) with origin = A give exactly
+    `engagement_force`; for a uniform load and constant S the harmonics are those of the transverse-section
+    shock (Eq. 2.62 with eps_alpha) times the slices' array factor, |sinc(n eps_beta)| for many slices."""
+    S = np.asarray(stiffness, dtype=float)
+    n = S.size if n_samples is None else n_samples
+    t = np.arange(n) / n
+    if n != S.size:
+        S = np.interp(t, np.arange(S.size) / S.size, S, period=1.0)
+    if n_slices < 1:
+        raise InputError(f"dynamics: n_slices: need at least 1 slice, got {n_slices}")
+    p = pair.transverse_base_pitch
+    A, E_ = pair.path_of_contact
+    b = pair.contact_width
+    tb = math.tan(pair.base_helix_angle)
+    helices = 2 if pair.kind == "double_helical" else 1
+    offset = (np.arange(n_slices) + 0.5) / n_slices * b
+    if load_share is None:
+        share = np.ones((helices, n_slices))
+    else:
+        ls = np.atleast_2d(np.asarray(load_share, dtype=float))
+        if ls.shape[0] != helices or not np.all(np.isfinite(ls)) or ls.min() < 0:
+            raise InputError(f"dynamics: load_share: need ({helices}, m) finite values >= 0, got shape {ls.shape}")
+        centres = (np.arange(ls.shape[1]) + 0.5) / ls.shape[1] * b
+        share = np.array([np.interp(np.where(hx == 0, offset, b - offset), centres, ls[hx]) for hx in range(helices)])
+        share /= share.mean()
+    delta = (normal_force / S)[:, None]
+    k_lo = math.floor((A - origin - b * tb) / p) - 1
+    k_hi = math.ceil((E_ - origin) / p) + 1
+    total = np.zeros(n)
+    for hx in range(helices):
+        w_local = offset if hx == 0 else b - offset           # helix 1 has the opposite hand
+        w = w_local + hx * (b + pair.helix_gap)
+        for k in range(k_lo, k_hi + 1):
+            s = origin + (t[:, None] + k) * p + offset[None, :] * tb
+            inside = (s >= A) & (s < E_)
+            if not inside.any():
+                continue
+            e = flank_gaps(pair, corrections, s, w_local[None, :], w[None, :], hx)
+            total += (np.where(inside, np.maximum(delta - e, 0.0), 0.0) * share[hx][None, :]).sum(axis=1)
+    total /= pair.transverse_contact_ratio * n_slices * helices
+    return S * (total - total.mean())
+
+
+def engagement_shock(model: str, pair: GearPair, corrections: Corrections, stiffness: np.ndarray,
+                     normal_force: float, load_share: np.ndarray | None = None) -> np.ndarray:
+    """F_e [N] of the engagement model `model` (ENGAGEMENT_MODELS): "thesis-2d" = `engagement_force` (Eq. 2.62,
+    the replica of the thesis), "face-width" = `engagement_force_face_width` with the given load share."""
+    if model == "thesis-2d":
+        return engagement_force(pair, corrections, stiffness, normal_force)
+    if model == "face-width":
+        return engagement_force_face_width(pair, corrections, stiffness, normal_force, load_share=load_share)
+    raise InputError(f"engagement: {model!r} is not one of {', '.join(ENGAGEMENT_MODELS)}")
 
 
 # ------------------------------------------------------------------------------------ harmonic balance

@@ -79,7 +79,7 @@ class SourceModel:
     def __init__(self, pair: GearPair, corrections: Corrections, interior: dyn.LumpedInterior,
                  geometry: dyn.ShaftGeometry, *, mesh_model: MeshModel | None = None, n_slices: int = 24,
                  torque_configuration: int = 2, stiffness_positions: int = 32, harmonics: int = 30,
-                 speed_range_rpm: tuple[float, float] = SPEED_RANGE_RPM):
+                 speed_range_rpm: tuple[float, float] = SPEED_RANGE_RPM, engagement: str = dyn.DEFAULT_ENGAGEMENT):
         self.pair, self.corrections, self.interior, self.geometry = pair, corrections, interior, geometry
         self.mesh_model = mesh_model or MeshModel(
             pair, shafts=(ShaftBending(*geometry.pinion_spans, geometry.pinion_shaft_diameter),
@@ -88,6 +88,9 @@ class SourceModel:
         self.stiffness_positions = int(stiffness_positions)
         self.harmonics = int(harmonics)
         self.speed_range_rpm = (float(speed_range_rpm[0]), float(speed_range_rpm[1]))
+        if engagement not in dyn.ENGAGEMENT_MODELS:
+            raise InputError(f"engagement: {engagement!r} is not one of {', '.join(dyn.ENGAGEMENT_MODELS)}")
+        self.engagement = engagement
         self._points: dict[float, object] = {}
 
     @classmethod
@@ -101,7 +104,8 @@ class SourceModel:
         table = roosmalen.parse(data, str(path))
         pair, corr, geometry, interior, model = roosmalen.build(table, str(path))
         return cls(pair, corr, interior, geometry, mesh_model=model, stiffness_positions=table.stiffness_positions,
-                   harmonics=table.harmonics, speed_range_rpm=(table.speed_min_rpm, table.speed_max_rpm))
+                   harmonics=table.harmonics, speed_range_rpm=(table.speed_min_rpm, table.speed_max_rpm),
+                   engagement=table.engagement)
 
     def _point(self, torque: float):
         """Stiffness curve, matrices, shock and preload at a torque (cached: they do not depend on speed)."""
@@ -109,7 +113,7 @@ class SourceModel:
 
         if torque not in self._points:
             self._points[torque] = OperatingPoint(self.pair, self.corrections, self.interior, self.mesh_model,
-                                                  torque, self.stiffness_positions)
+                                                  torque, self.stiffness_positions, engagement=self.engagement)
         return self._points[torque]
 
     def operating_point(self, speed_rpm: float, torque_nm: float) -> Excitation:

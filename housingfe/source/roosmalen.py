@@ -5,7 +5,8 @@ Scene layout (all tables forbid unknown keys; lengths in mm and angles in degree
 so, as in Appendix F):
 
     [source]              model, torque_Nm, speed_min_rpm, speed_max_rpm, speed_steps, spectrum_speeds_rpm,
-                          torque_run_Nm, harmonics, stiffness_positions, slices, torque_configuration
+                          torque_run_Nm, harmonics, stiffness_positions, slices, torque_configuration,
+                          engagement ("face-width" default | "thesis-2d": the thesis' Eq. 2.62 replica)
     [source.gears]        Appendix F data (module_mm, teeth, ..., power_kW, max_speed_rpm)
     [source.corrections]  pinion_um, pinion_mm, wheel_um, wheel_mm, ... (Appendix F, as measured)
     [source.shafts]       bearing spans, shaft diameters, torsion shafts 1-4, coupling inertias
@@ -29,6 +30,7 @@ from housingfe.source.stiffness import (
     Corrections,
     MeshModel,
     ShaftBending,
+    face_load_share,
     iso6336_stiffness,
     normal_force_from_torque,
     stiffness_curve,
@@ -113,6 +115,7 @@ class SourceTable(_Strict):
     stiffness_positions: int = Field(32, ge=4, le=512)
     slices: int = Field(16, ge=2, le=200)
     torque_configuration: Literal[1, 2] = 2
+    engagement: Literal["face-width", "thesis-2d"] = dyn.DEFAULT_ENGAGEMENT
     measured_L_omega_dB: Optional[dict[str, float]] = None
     gears: GearsTable
     corrections: CorrectionsTable = CorrectionsTable()
@@ -151,15 +154,21 @@ def build(table: SourceTable, scene_path: str = "scene"):
 
 
 class OperatingPoint:
-    """Stiffness curve, matrices, shock force and preload for one pinion torque [N m]."""
+    """Stiffness curve, matrices, shock force and preload for one pinion torque [N m].  engagement: the shock
+    model (housingfe.source.dynamics.ENGAGEMENT_MODELS): "face-width" (default) distributes Eq. 2.62 over the
+    face-width slices with the load share of `face_load_share`, "thesis-2d" is the thesis' Eq. 2.62."""
 
-    def __init__(self, pair, corr, interior, model, torque: float, n_positions: int, n_samples: int = 256):
+    def __init__(self, pair, corr, interior, model, torque: float, n_positions: int, n_samples: int = 256,
+                 engagement: str = dyn.DEFAULT_ENGAGEMENT):
         self.torque = torque
+        self.engagement = engagement
         self.normal_force = normal_force_from_torque(pair, torque)
         self.curve = stiffness_curve(model, self.normal_force, n_positions)
         t = np.arange(n_samples) / n_samples
         self.S = np.interp(t, self.curve.position, self.curve.stiffness, period=1.0)
-        self.shock = dyn.engagement_force(pair, corr, self.S, self.normal_force)
+        self.load_share = (face_load_share(model, self.normal_force, n_positions=n_positions)
+                           if engagement == "face-width" else None)
+        self.shock = dyn.engagement_shock(engagement, pair, corr, self.S, self.normal_force, self.load_share)
         self.mats = dyn.assemble(pair, interior, self.curve.mean)
         self.f0 = dyn.preload_force(self.mats, torque)
 
@@ -208,7 +217,8 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     plt.close(fig)
 
     # ---- stiffness at the scene torque
-    op = OperatingPoint(pair, corr, interior, model, table.torque_Nm, table.stiffness_positions)
+    op = OperatingPoint(pair, corr, interior, model, table.torque_Nm, table.stiffness_positions,
+                        engagement=table.engagement)
     c = op.curve
     iso = iso6336_stiffness(pair)
     write_csv(out_dir / "stiffness.csv", ["position_fraction_of_pitch", "mesh_stiffness_N_per_m",
@@ -283,7 +293,8 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     # ---- torque run at one speed
     torque_rows = []
     for T in table.torque_run_Nm:
-        opT = op if T == table.torque_Nm else OperatingPoint(pair, corr, interior, model, T, table.stiffness_positions)
+        opT = op if T == table.torque_Nm else OperatingPoint(pair, corr, interior, model, T, table.stiffness_positions,
+                                                             engagement=table.engagement)
         st = opT.steady_state(pair, table.torque_run_speed_rpm, H)
         torque_rows.append([table.torque_run_speed_rpm, T, pair.tooth_frequency(table.torque_run_speed_rpm),
                             dyn.tooth_band_level(st), opT.curve.mean, opT.curve.deflection.mean() * 1e6])
@@ -351,10 +362,10 @@ def correction_study(scenes: tuple[str, ...] = ("gearset-uncorrected", "gearset-
                                                 "gearset-D"),
                      torques: tuple[float, ...] = (400.0, 800.0, 1200.0, 1600.0, 2000.0),
                      speeds_rpm: tuple[float, ...] = tuple(np.linspace(800.0, 1500.0, 15)),
-                     harmonics: int = 20) -> dict:
+                     harmonics: int = 20, engagement: str | None = None) -> dict:
     """L_omega in the tooth band for the built-in gear sets over torque (at 1500 rpm, as Fig. 2.18) and
-    the mean over `speeds_rpm` at each torque.  Returns {scene: {"torque": [...], "L_1500": [...],
-    "L_mean": [...]}} in dB."""
+    the mean over `speeds_rpm` at each torque; engagement: the shock model (None: each scene's own).
+    Returns {scene: {"torque": [...], "L_1500": [...], "L_mean": [...]}} in dB."""
     from housingfe.source.cli import load_scene
 
     out = {}
@@ -364,7 +375,8 @@ def correction_study(scenes: tuple[str, ...] = ("gearset-uncorrected", "gearset-
         pair, corr, _, interior, model = build(table, str(path))
         rows = {"torque": list(torques), "L_1500": [], "L_mean": []}
         for T in torques:
-            op = OperatingPoint(pair, corr, interior, model, T, table.stiffness_positions)
+            op = OperatingPoint(pair, corr, interior, model, T, table.stiffness_positions,
+                                engagement=engagement or table.engagement)
             rows["L_1500"].append(dyn.tooth_band_level(op.steady_state(pair, 1500.0, harmonics)))
             levels = [dyn.tooth_band_level(op.steady_state(pair, float(s), harmonics)) for s in speeds_rpm]
             # energy mean over the speeds (a level average would weight dips too much)

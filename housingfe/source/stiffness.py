@@ -250,6 +250,35 @@ def beam_influence(z: np.ndarray, shaft: ShaftBending, gear_diameter: float, fac
     return (m * w) @ m.T
 
 
+# ----------------------------------------------------------------------------- flank gaps
+def flank_gaps(pair: GearPair, corrections: Corrections, s, w_local, w, helix) -> np.ndarray:
+    """Initial gap [m] along the flank normal that the corrections open at contact points: roll position s [m]
+    along the transverse line of action from T1, axial position w_local [m] within its helix and w [m] over
+    the gear, helix index (0/1; helix 1 of a double helical gear has the opposite hand).  Arrays broadcast.
+    Tip reliefs ramp linearly from the tip (pinion: from E, wheel: from A) over their length along the line of
+    action; the 3-D triangular correction D also runs out over triangle_width from its corner Q; the pinion's
+    width relief ramps from the face w = 0."""
+    c = corrections
+    A, E_ = pair.path_of_contact
+    s, w_local, w, helix = np.broadcast_arrays(*(np.asarray(x, dtype=float) for x in (s, w_local, w, helix)))
+    b = pair.contact_width
+    # the corner Q where a helix' contact starts/ends depends on the helix hand
+    w_from_pinion_corner = np.where(helix == 0, w_local, b - w_local)
+    gap = np.zeros(s.shape)
+    for g, dist in ((0, E_ - s), (1, s - A)):
+        amt, length = c.tip_relief[g], c.tip_relief_length[g]
+        if amt <= 0:
+            continue
+        if c.triangular:
+            wq = w_from_pinion_corner if g == 0 else b - w_from_pinion_corner
+            gap += amt * np.maximum(0.0, 1 - dist / length - wq / c.triangle_width[g])
+        else:
+            gap += amt * np.maximum(0.0, 1 - dist / length)
+    if c.width_relief > 0:
+        gap += c.width_relief * np.maximum(0.0, 1 - w / c.width_relief_length)
+    return gap
+
+
 # ----------------------------------------------------------------------------- mesh model
 @dataclass
 class MeshModel:
@@ -333,25 +362,7 @@ class MeshModel:
 
     def gaps(self, pts: dict[str, np.ndarray]) -> np.ndarray:
         """Initial gap [m] along the normal at each contact point from the flank corrections."""
-        p, c = self.pair, self.corrections
-        A, E_ = p.path_of_contact
-        s, w, hx = pts["s"], pts["w_local"], pts["helix"]
-        b = p.contact_width
-        # the corner Q where a helix' contact starts/ends depends on the helix hand
-        w_from_pinion_corner = np.where(hx == 0, w, b - w)
-        gap = np.zeros_like(s)
-        for g, dist in ((0, E_ - s), (1, s - A)):
-            amt, length = c.tip_relief[g], c.tip_relief_length[g]
-            if amt <= 0:
-                continue
-            if c.triangular:
-                wq = w_from_pinion_corner if g == 0 else b - w_from_pinion_corner
-                gap += amt * np.maximum(0.0, 1 - dist / length - wq / c.triangle_width[g])
-            else:
-                gap += amt * np.maximum(0.0, 1 - dist / length)
-        if c.width_relief > 0:
-            gap += c.width_relief * np.maximum(0.0, 1 - pts["w"] / c.width_relief_length)
-        return gap
+        return flank_gaps(self.pair, self.corrections, pts["s"], pts["w_local"], pts["w"], pts["helix"])
 
     def body_compliance(self, w: np.ndarray) -> np.ndarray:
         """Compliance [m/N] between axial positions w through shaft bending and wheel-body torsion of
@@ -497,6 +508,43 @@ def stiffness_curve(model: MeshModel, total_force: float, n_positions: int = 32)
     k = np.array([o["stiffness"] for o in out])
     return StiffnessCurve(position=pos, stiffness=k, per_width=k / model.pair.total_contact_width,
                           deflection=np.array([o["delta"] for o in out]), total_force=total_force)
+
+
+def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = None,
+                    n_positions: int = 8) -> np.ndarray:
+    """Relative mesh stiffness per unit face width over the face, (helices, n_bins), mean 1 [-]: bin j of helix
+    hx covers w_local in [j, j + 1) * b / n_bins.
+
+    A contact point's share of the load is its stiffness times its deflection compatibility (Sec. 2.3); on the
+    UNCORRECTED flanks every point has the same approach delta, so its stiffness is F_i / delta.  Summed per
+    bin of the face width and averaged over `n_positions` mesh positions of one base pitch at `total_force`
+    [N], this is how the mesh stiffness is distributed across the face: shaft bending, wheel-body torsion and
+    the plate coupling of the teeth make it non-uniform (the profile direction averages out over the pitch)."""
+    if not total_force > 0:
+        raise InputError(f"stiffness: total force must be > 0 N, got {total_force}")
+    bare = MeshModel(model.pair, shafts=model.shafts, corrections=Corrections(), n_slices=model.n_slices,
+                     torque_configuration=model.torque_configuration,
+                     include_plate_coupling=model.include_plate_coupling)
+    n_bins = n_bins or model.n_slices
+    b = model.pair.contact_width
+    acc = np.zeros((bare.helices, n_bins))
+    count = np.zeros((bare.helices, n_bins))
+    pbt = model.pair.transverse_base_pitch
+    centres = (np.arange(n_bins) + 0.5) / n_bins * b
+    for x in np.arange(n_positions) / n_positions:
+        pts, F, delta = bare.load_distribution(x * pbt, total_force)
+        density = F / (delta * pts["width"])            # stiffness per unit face width [N/m^2]
+        for key in set(zip(pts["pair"].tolist(), pts["helix"].tolist())):     # one contact line at a time
+            idx = np.flatnonzero((pts["pair"] == key[0]) & (pts["helix"] == key[1]))
+            idx = idx[np.argsort(pts["w_local"][idx])]
+            w, half = pts["w_local"][idx], 0.5 * pts["width"][idx]
+            covered = (centres >= w[0] - half[0]) & (centres <= w[-1] + half[-1])
+            acc[key[1]] += np.where(covered, np.interp(centres, w, density[idx]), 0.0)
+            count[key[1]] += covered
+    # per contact line covering a bin, not per position: with a few positions the number of lines over a bin
+    # jumps between floor and ceil of eps_alpha * n_positions, which is sampling, not stiffness
+    share = acc / np.maximum(count, 1)
+    return share / share.mean()
 
 
 def normal_force_from_torque(pair: GearPair, pinion_torque: float) -> float:

@@ -115,7 +115,7 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
     gm = build_gearbox_model(model, dt, spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators_of(scene.radiation, model),
                              surface=spec.surface)
-    lines, _ = source_lines(dt.source_model(harmonics=spec.harmonics), spec.speeds, [torque], spec.f_max_hz)
+    lines, _ = source_lines(dt.source_model(harmonics=spec.harmonics, engagement=spec.engagement), spec.speeds, [torque], spec.f_max_hz)
 
     def run(m):
         return runup(m, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)

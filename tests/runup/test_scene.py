@@ -28,6 +28,7 @@ def test_builtin_scenes_validate(name):
     ('radiation.models=["erp","sonar"]', "radiation.models"),
     ("runup.torques_nm=[-5.0]", "runup.torques_nm"),
     ("runup.colour=1", "runup.colour"),
+    ('runup.engagement="3-d"', "runup.engagement"),
 ])
 def test_bad_values_name_the_key(override, key):
     with pytest.raises(InputError) as err:

@@ -78,3 +78,17 @@ def test_builtin_gearsets_are_valid_source_scenes():
         which = "double_helical" if "double" in name else "single_helical"
         assert pair.kind == which
         assert pair.transverse_contact_ratio == pytest.approx(REF["gears"][which]["transverse_contact_ratio"], abs=5e-4)
+
+
+def test_engagement_key_selects_the_shock_model(tmp_path):
+    """source.engagement: "face-width" (default) or "thesis-2d"; anything else is named as the bad key."""
+    from housingfe.scenefile import read_scene_dict
+    from housingfe.source import roosmalen
+
+    data, path = read_scene_dict(str(_small_scene(tmp_path)))
+    assert roosmalen.parse(data, str(path)).engagement == "face-width"
+    data["source"]["engagement"] = "thesis-2d"
+    assert roosmalen.parse(data, str(path)).engagement == "thesis-2d"
+    data["source"]["engagement"] = "3-d"
+    with pytest.raises(housingfe.errors.InputError, match="source.engagement"):
+        roosmalen.parse(data, str(path))

@@ -181,3 +181,66 @@ def test_static_tilt_moment_is_axial_force_times_pitch_radius():
     assert interior.pinion_bearings[4] * q[4] == pytest.approx(-fn * sb * rw1, rel=1e-9)
     assert interior.wheel_bearings[4] * q[10] == pytest.approx(-fn * sb * rw2, rel=1e-9)
     assert interior.pinion_bearings[2] * q[2] == pytest.approx(fn * sb, rel=1e-9)    # axial force on the pinion
+
+
+# ------------------------------------------------------------------ engagement over the face width
+def _spur_pair():
+    """The test gears' data with a zero helix angle (a spur pair, eps_beta = 0)."""
+    table = dict(REF["single_helical"], helix_angle_deg=0.0, kind="spur")
+    return GearPair.from_table({k: v for k, v in table.items() if k in (
+        "module_mm", "teeth", "pressure_angle_deg", "helix_angle_deg", "addendum_modification", "face_width_mm",
+        "centre_distance_mm", "addendum_coefficient", "dedendum_coefficient", "rack_tip_radius_factor", "kind")})
+
+
+SET_A = Corrections.from_table(REF["profile_corrections"]["A"])
+
+
+@pytest.mark.parametrize("corrections", [Corrections(), SET_A])
+def test_face_width_shock_of_a_spur_pair_is_the_thesis_shock(corrections):
+    """eps_beta = 0: every slice of a contact line enters and leaves at once, so the face-width shock is Eq. 2.62
+    sample by sample (time-varying S, any load share across the face: a spur line's slices sum to one pair)."""
+    spur = _spur_pair()
+    assert spur.overlap_ratio == 0.0
+    S = _stiffness_wave(n=256, rel_amp=0.2)
+    force = 40e3
+    ref = dyn.engagement_force(spur, corrections, S, force)
+    A = spur.path_of_contact[0]
+    share = np.linspace(0.7, 1.3, 24)[None, :]           # a skewed load across the face changes nothing
+    for load_share in (None, share):
+        ours = dyn.engagement_force_face_width(spur, corrections, S, force, load_share=load_share, n_slices=16,
+                                               origin=A)
+        np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-9 * np.ptp(ref))
+
+
+@pytest.mark.parametrize("face_mm", [25.0, 66.0])
+def test_uniform_face_width_shock_is_the_transverse_shock_times_sinc(face_mm):
+    """Uniform load along the line and constant S: slice j is the transverse-section shock (Eq. 2.62 with
+    eps_alpha) delayed by o_j tan(beta_b) / p_bt, so harmonic n is multiplied by the slices' array factor
+    sin(pi n eps_beta) / (J sin(pi n eps_beta / J)) -> sinc(n eps_beta) for many slices (notes §5.2)."""
+    from dataclasses import replace
+
+    pair = replace(PAIR, face_width=(face_mm * 1e-3, face_mm * 1e-3))
+    eps_b = pair.overlap_ratio
+    S = np.full(2048, K_MEAN)
+    force = 40e3
+    A = pair.path_of_contact[0]
+    transverse = dyn.engagement_force(pair, SET_A, S, force, contact_ratio=pair.transverse_contact_ratio)
+    sliced = dyn.engagement_force_face_width(pair, SET_A, S, force, n_slices=600, origin=A)
+    n = np.arange(1, 16)
+    amp = lambda x: 2 * np.abs(np.fft.rfft(x)[1:16]) / x.size     # noqa: E731
+    expected = amp(transverse) * np.abs(np.sinc(n * eps_b))
+    np.testing.assert_allclose(amp(sliced), expected, rtol=0, atol=2e-3 * amp(transverse)[0])
+    # the tolerance is far below the reduction the slices make (the test can tell sinc from no smoothing)
+    assert np.max(amp(transverse) - expected) > 50 * 2e-3 * amp(transverse)[0]
+
+
+def test_face_width_is_the_default_engagement_and_thesis_2d_the_replica():
+    force = 40e3
+    S = np.full(256, K_MEAN)
+    assert dyn.DEFAULT_ENGAGEMENT == "face-width"
+    np.testing.assert_array_equal(dyn.engagement_shock("thesis-2d", PAIR, SET_A, S, force),
+                                  dyn.engagement_force(PAIR, SET_A, S, force))
+    np.testing.assert_array_equal(dyn.engagement_shock("face-width", PAIR, SET_A, S, force),
+                                  dyn.engagement_force_face_width(PAIR, SET_A, S, force))
+    with pytest.raises(housingfe.errors.InputError, match="engagement"):
+        dyn.engagement_shock("3d", PAIR, SET_A, S, force)

@@ -207,3 +207,21 @@ def test_double_helical_helices_share_the_load_equally_without_body_coupling():
     # opposite hand: the same point of the path of contact sits at mirrored face positions
     b = pair.contact_width
     assert np.allclose([k[2] for k in key0], [b - k[2] for k in key1], atol=1e-12)
+
+
+def test_face_load_share_follows_where_the_torques_enter():
+    """Sec. 2.3, Fig. 2.7: wheel-body torsion loads the face where the torques enter.  With both torques entering at
+    w = 0 (configuration 1) the mesh stiffness per unit width is highest there and falls towards the far face (the
+    last bin may rise a little again: the plate's free edge); with the wheel torque leaving at the far face
+    (configuration 2) the two twists partly compensate and the face is more even."""
+    from housingfe.source.stiffness import face_load_share
+
+    pair = GearPair.from_table(REF["single_helical"])
+    force = normal_force_from_torque(pair, 2000.0)
+    share = {c: face_load_share(MeshModel(pair, shafts=SHAFTS, n_slices=8, torque_configuration=c), force,
+                                n_bins=8, n_positions=8)[0] for c in (1, 2)}
+    for c, phi in share.items():
+        assert phi.shape == (8,) and phi.mean() == pytest.approx(1.0, rel=1e-12)
+    for phi in share.values():
+        assert np.argmax(phi) == 0 and phi[:4].mean() > 1.02 > 0.98 > phi[4:].mean()
+    assert share[2][0] / share[2][-1] < share[1][0] / share[1][-1]
