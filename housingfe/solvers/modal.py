@@ -26,11 +26,24 @@ from housingfe.errors import SolverError
 from housingfe.solvers import mumps
 
 # Rigid-body (mechanism) modes are classified against the scale of the matrices, not against f_max: the
-# computed zero eigenvalues are round-off, |lambda| ~ 1e-17..1e-16 of lambda_scale = max_i K_ii / M_ii (an
-# estimate of the highest eigenvalue of the mesh), on the plate, box and coupled models measured, whatever
-# f_max; the lowest elastic mode of NAFEMS FV12 (a 10 m x 50 mm plate, the most slender scene) is at 4.4e-10
-# of it.  Below 1e-13 lambda_scale an eigenvalue is zero to double precision.
-RIGID_EIGENVALUE_RATIO = 1e-13
+# computed zero eigenvalues are round-off, |lambda| ~ 1e-18..1e-16 of lambda_scale = max_i K_ii / M_ii (an
+# estimate of the highest eigenvalue of the mesh), on the plate, box, cube and coupled models measured, whatever
+# f_max, units or size.  The lowest elastic eigenvalue falls with the walls' slenderness, about as (t/L)^4: a
+# free plate of t/L = 1/1000 has it at 2e-13..1e-12 of lambda_scale (Q3..S2R, one layer), one of t/L = 1/2000 at
+# 8e-14 (bench stability), so the line between zero and elastic sits at 1e-15 (it was 1e-13, which counted that
+# plate's first elastic mode as a rigid one).
+RIGID_EIGENVALUE_RATIO = 1e-15
+# A null-space candidate (a free structure's exact rigid motions, null_space_basis) is accepted when
+# ||K r|| <= NULL_VECTOR_RATIO lambda_scale ||M r||: the box's are at ~1e-17.
+NULL_VECTOR_RATIO = 1e-13
+# The inertia count and the eigensolve both work on K - sigma M in double precision.  When (2 pi f_max)^2 lies below
+# PRECISION_FLOOR of lambda_scale the eigenvalues of interest are round-off against the mesh's highest one (free
+# plates, one element layer, elements 625 thicknesses wide, t/L = 1/10 000: sigma_max at 2.5e-15..4.4e-15 of it,
+# the LDL^T counted 0 of 16 eigenvalues) and solve_modes refuses.  Above the floor the count can still fail on the
+# stiffest element families (S2R at t/L = 1/3333, 3.5e-13: 0 of 16), which a free structure exposes: its known
+# rigid motions must all be counted (solve_modes checks it).  A cantilever's static-range FRF asks for f_max at
+# 1.5e-13 (no mode below it) and gets its exact count of 0; Q2 at t/L = 1/5000 (4e-14) counts and solves right.
+PRECISION_FLOOR = 1e-14
 # Kept for small dense models that have no matrix scale at hand (housingfe.drivetrain.interior): a frequency ratio.
 RIGID_FREQUENCY_RATIO = 1e-4
 # From this many DOFs on, method="auto" uses the block Krylov–Schur (housingfe.solvers.block_eigen): below,
@@ -202,7 +215,14 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     if method not in EIGENSOLVERS and method != "auto":
         raise ValueError(f"unknown eigensolver {method!r}: choose from auto, {', '.join(EIGENSOLVERS)}")
     sigma_max = (2 * math.pi * f_max) ** 2
+    scale = eigenvalue_scale(K, M)
+    if sigma_max < PRECISION_FLOOR * scale:
+        raise SolverError(f"f_max = {f_max:g} Hz is at {sigma_max / scale:.1e} of the model's highest eigenvalue: "
+                          "below what double precision resolves (the inertia count and the zero-mode test become "
+                          "round-off); walls far thinner than the elements are wide cause this: use elements "
+                          "closer to the wall thickness in size, or a higher f_max")
     chosen = method if method != "auto" else ("block" if K.getSize()[0] >= BLOCK_MIN_DOFS else "slepc")
+    first_choice = chosen
     t0 = time.perf_counter()
     # one pattern comparison for every K - s M below (each one copied the CSR arrays on 2 ranks: 0.2-1.4 s
     # at 309 k DOFs)
@@ -213,8 +233,15 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
     # at the shift 5.0-5.3 s instead of 7.4-8.1 s); a count alone discards its factors as it goes
     reuse_analysis = chosen == "block"
     factor = mumps.ldlt(A, backend, count_only=not reuse_analysis)
+    null = null_space_basis(K, M, null_space) if null_space else None
     try:
         expected = _count_below(factor, A)
+        if null is not None and expected < null.shape[1]:
+            # the known zero eigenvalues all lie below sigma_max > 0: a count below their number is round-off
+            raise SolverError(f"the inertia count at f_max = {f_max:g} Hz found {expected} eigenvalues below it, fewer "
+                              f"than the {null.shape[1]} rigid-body modes the model has: K - sigma M is beyond what "
+                              "double precision resolves (walls far thinner than the elements are wide): use "
+                              "elements closer to the wall thickness in size, or a higher f_max")
     except BaseException:
         factor.destroy()
         A.destroy()
@@ -240,7 +267,6 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
                 shift, phases["factor_s"] = sigma_max, 0.0
             else:
                 factor, A = _factorise_at(K, M, shift, factor, A, structure, backend, phases)
-            null = null_space_basis(K, M, null_space) if null_space else None
             known = [] if null is None else _zero_pairs(M, null, requested)
             phases["deflated"] = len(known)
             pairs = known + (_block_krylov_schur(factor, M, shift, requested - len(known), tol, sigma_max, phases,
@@ -265,6 +291,12 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
         # gearbox: 62 of 63): ask again for a few more; the extras above f_max are dropped
         pairs = _krylov_schur(K, M, shift, requested + max(2, requested // 20), ncv, tol, purify, sigma_max,
                               keep=requested, structure=structure)
+    if nev is None and len(pairs) < requested and method == "auto" and first_choice == "slepc":
+        # a single-vector Krylov method finds the members of a multiplet one after another and can miss one even
+        # with more vectors asked for (free cube, 1 029 DOFs: a triple eigenvalue at 0.99 f_max, 57 of 58 after the
+        # retry); a block of vectors spans a multiplet at once (58 of 58): the block method decides
+        return solve_modes(K, M, f_max, tol=tol, require_complete=require_complete, method="block",
+                           keep_solver=keep_solver, backend=backend, null_space=null_space)
     t_solve = time.perf_counter() - t0
     values = np.array([p[0] for p in pairs])
     vectors = [p[1] for p in pairs]
@@ -274,7 +306,7 @@ def solve_modes(K: PETSc.Mat, M: PETSc.Mat, f_max: float, *, nev: int | None = N
                                                  rayleigh=chosen == "block" and one_factor)
     result = ModalResult(values, vectors, expected, residuals, f_max,
                          {"inertia_s": t_inertia, "eigensolve_s": t_solve,
-                          **{f"eigensolve_{k}": v for k, v in phases.items()}}, eigenvalue_scale(K, M),
+                          **{f"eigensolve_{k}": v for k, v in phases.items()}}, scale,
                          eigensolver=chosen, shifted_solver=kept[0] if kept else None)
     if require_complete and not result.complete:
         result.release_solver()
@@ -312,8 +344,8 @@ def _destroy(factor, A: PETSc.Mat) -> None:
 
 def null_space_basis(K: PETSc.Mat, M: PETSc.Mat, vectors: list) -> np.ndarray | None:
     """The vectors (PETSc Vecs in K's layout) as an M-orthonormal basis (local rows x r), or None when one of
-    them is not null to round-off: ||K r|| > RIGID_EIGENVALUE_RATIO eigenvalue_scale ||M r|| (the test that
-    classifies a computed eigenvalue as zero; the box's rigid motions: ~1e-17) or they are linearly dependent."""
+    them is not null to round-off: ||K r|| > NULL_VECTOR_RATIO eigenvalue_scale ||M r|| (the box's rigid motions:
+    ~1e-17) or they are linearly dependent."""
     X = _dense_columns(K, vectors)
     KX, MX = K.matMult(X), M.matMult(X)
     x, kx, mx = X.getDenseArray().copy(), KX.getDenseArray(), MX.getDenseArray()
@@ -322,7 +354,7 @@ def null_space_basis(K: PETSc.Mat, M: PETSc.Mat, vectors: list) -> np.ndarray | 
     gram = comm.allreduce(x.T @ mx)
     for A in (X, KX, MX):
         A.destroy()
-    if np.any(np.sqrt(norms[0]) > RIGID_EIGENVALUE_RATIO * eigenvalue_scale(K, M) * np.sqrt(norms[1])):
+    if np.any(np.sqrt(norms[0]) > NULL_VECTOR_RATIO * eigenvalue_scale(K, M) * np.sqrt(norms[1])):
         return None
     try:
         L = np.linalg.cholesky((gram + gram.T) / 2)
