@@ -93,6 +93,8 @@ def _run(scene, out: Path, comm, t_start: float) -> Path:
             print(report.modal_summary_text(summary))
         if forced is not None:
             print(report.harmonic_summary_text(forced))
+            if modes is None and model.resolution is not None:
+                print("\n".join(report.resolution_lines(model.resolution.as_dict())))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
 
@@ -156,7 +158,11 @@ def modal_summary(model, result, checks: dict, wall_time_s: float) -> dict:
         "centre_of_gravity_from_rigid_modes_m": checks.get("centre_of_gravity_m"),
         "dofs": model.dofs,
         "f_max_hz": result.f_max,
+        # complete = every eigenvalue of the discrete model below f_max was found (inertia count): how close the
+        # discrete model's eigenvalues are to the housing's is the resolution's estimate
         "complete": result.complete,
+        "complete_means": "all eigenvalues of the discrete FE model below f_max were found (inertia count); its "
+                          "discretisation error is estimated under resolution",
         "eigenvalues_below_f_max_by_inertia": result.expected_count,
         "residuals": result.residuals[n_rigid:],
         "rigid_body_residuals": result.residuals[:n_rigid],
@@ -167,6 +173,7 @@ def modal_summary(model, result, checks: dict, wall_time_s: float) -> dict:
         "mpi_ranks": model.V.mesh.comm.size,
         "timings_s": {**model.timings, **result.timings},
         "wall_time_s": wall_time_s,
+        "resolution": model.resolution.as_dict() if model.resolution is not None else None,
     }
     summary["published"] = published.modal_comparison(scene, summary)
     return summary

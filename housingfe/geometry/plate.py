@@ -45,6 +45,11 @@ class PlateGeometry(_Strict):
     def min_thickness(self) -> float:
         return self.h
 
+    @property
+    def wall_thicknesses(self) -> dict[str, float]:
+        """The plates whose bending waves the mesh must resolve: name -> thickness (m)."""
+        return {"plate": self.h}
+
 
 def plate_model(a: float, b: float, h: float) -> BlockModel:
     """Block model of a plate (lengths in m)."""
