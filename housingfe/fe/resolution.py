@@ -190,8 +190,8 @@ class Resolution:
 
 
 def percent(err: float) -> str:
-    """An error as a short percentage: ~3.1 %, ~0.42 %, ~140 %."""
-    return f"~{err:.0%}" if err >= 1.0 else f"~{err * 100:.2g} %"
+    """An error as a short percentage: ~3.1 %, ~0.42 %, ~50 %, > 100 %."""
+    return "> 100 %" if err > 1.0 else f"~{err * 100:.2g} %"
 
 
 def error_at(family: str, x: float) -> tuple[float | None, float | None]:
@@ -254,8 +254,10 @@ def check_resolution(geometry, mesh, size: float, f_max: float, material) -> Res
         raise InputError(
             f"{key}: {largest * 1e3:.3g} mm elements are far too coarse for f_max = {f_max:g} Hz: "
             f"{w['elements_per_wavelength']:.2g} {res.family} elements per bending wavelength of the {w['name']} "
-            f"({w['thickness_m'] * 1e3:.3g} mm thick, lambda_b = {w['bending_wavelength_m'] * 1e3:.3g} mm){err}; "
-            f"use mesh.size <= {good * 1e3:.3g} mm for ~{WARN_ERROR:.0%}, a lower f_max, or set "
+            f"({w['thickness_m'] * 1e3:.3g} mm thick, lambda_b = {w['bending_wavelength_m'] * 1e3:.3g} mm){err}"
+            + (f" (at {f_max:g} Hz no thin plate: the wavelength is under {THIN_WALL_WAVELENGTHS:g} thicknesses)"
+               if w["bending_wavelength_m"] < THIN_WALL_WAVELENGTHS * w["thickness_m"] else "")
+            + f"; use mesh.size <= {good * 1e3:.3g} mm for ~{WARN_ERROR:.0%}, a lower f_max, or set "
             f"mesh.allow_coarse = true to run anyway")
     return res
 

@@ -45,7 +45,8 @@ def modal_summary_text(summary: dict) -> str:
         lines.append("compared with published values:")
         lines.append(format_table(
             ["quantity", "ours", "published", "unit", "source"],
-            [[r["quantity"], r["ours"], r["published"], r["unit"], r["source"]] for r in summary["published"]]))
+            [[r["quantity"], "-" if r["ours"] is None else r["ours"], r["published"], r["unit"], r["source"]]
+             for r in summary["published"]]))
     return "\n".join(lines)
 
 
@@ -53,13 +54,14 @@ def _error_clause(resolution: dict) -> str:
     err, bound = resolution["estimated_error_near_f_max"], resolution["error_bound_near_f_max"]
     if err is None:
         return f"discretisation error not estimated ({resolution['element_family']} elements are not calibrated)"
-    typical = "< 1 %" if resolution["below_calibration"] else _percent(err)
+    # finer than every calibration point with >= 1 % error: the bound (or 1 %) is all the data say
+    typical = f"< {_percent(min(bound, 0.01))}" if resolution["below_calibration"] else _percent(err)
     return (f"estimated discretisation error near f_max {typical} (bound {_percent(bound)}"
             + (", extrapolated" if resolution["extrapolated"] else "") + ")")
 
 
 def _percent(err: float) -> str:
-    return f"~{err:.0%}" if err >= 1.0 else f"~{err * 100:.2g} %"
+    return "> 100 %" if err > 1.0 else f"~{err * 100:.2g} %"
 
 
 def resolution_text(resolution: dict) -> str:
