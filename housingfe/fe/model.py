@@ -10,7 +10,7 @@ import time
 from dataclasses import dataclass, field
 
 from housingfe.errors import InputError
-from housingfe.fe.resolution import assess, check_resolution, largest_cell_edge
+from housingfe.fe.resolution import assess, check_resolution, wall_element_sizes
 from housingfe.geometry import HousingMesh, build_mesh
 from housingfe.geometry.mesh import bending_wavelength
 from housingfe.materials import Material
@@ -143,8 +143,8 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
     K, M = elasticity.assemble_stiffness_mass(V, materials, bcs, foundation_forms(supports, housing, V), reduced)
     timings = {"mesh_s": housing.mesh_time_s, "assembly_s": time.perf_counter() - t0}
     free = not bcs and not any(s.kind == "elastic" for s in supports)
-    resolution = assess(geometry, mesh, largest_cell_edge(housing.mesh), f_max, material,
-                        "longest cell edge of the mesh")
+    resolution = assess(geometry, mesh, wall_element_sizes(geometry, housing), f_max, material,
+                        "longest cell edge in each wall")
     return HousingModel(housing, material, V, bcs, K, M, 6 if free else 0, timings, materials,
                         element_degree=mesh.degree, reduced_integration=reduced, resolution=resolution)
 

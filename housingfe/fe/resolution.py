@@ -121,15 +121,15 @@ def graded_largest_element(size: float, grading: float) -> float:
 
 @dataclass
 class Resolution:
-    """The resolution of a mesh at f_max (Hz).  walls: one dict per wall (name, thickness_m, bending_wavelength_m,
-    x = h / bending wavelength, elements_per_wavelength, nodes_per_wavelength, estimated_error, error_bound);
+    """The resolution of a mesh at f_max (Hz).  walls: one dict per wall (name, thickness_m, element_size_m = h,
+    bending_wavelength_m, x = h / bending wavelength, elements_per_wavelength, nodes_per_wavelength, estimated_error, error_bound);
     estimated_error / error_bound: those of the worst wall (relative frequency error of a mode near f_max, typical
     and the calibration's upper bound; None for an uncalibrated family); status: "ok", "coarse" (warned) or
     "far too coarse" (refused before meshing unless mesh.allow_coarse)."""
 
     family: str
     f_max_hz: float
-    element_size_m: float
+    element_size_m: float           # that of the worst wall
     element_size_measure: str
     walls: list[dict]
     status: str
@@ -203,19 +203,20 @@ def error_at(family: str, x: float) -> tuple[float | None, float | None]:
     return ct * x**q, e0 + cb * x**q
 
 
-def assess(geometry, mesh, element_size: float, f_max: float, material, measure: str) -> Resolution:
-    """The resolution of a mesh of `element_size` (m, the longest cell edge; `measure` says where it comes from)
-    at f_max (Hz) on every wall of a geometry spec (its wall_thicknesses, else its min_thickness), for the
+def assess(geometry, mesh, element_size, f_max: float, material, measure: str) -> Resolution:
+    """The resolution of a mesh of `element_size` (m, the longest cell edge; or a dict wall name -> that of each
+    wall, see wall_element_sizes; `measure` says where it comes from) at f_max (Hz) on every wall of a geometry spec (its wall_thicknesses, else its min_thickness), for the
     housing's material (SI) and a scene's mesh spec (element, degree, family, integration)."""
     family = element_family(mesh)
     p = nodes_per_element_edge(mesh)
     thicknesses = getattr(geometry, "wall_thicknesses", None) or {"thinnest wall": geometry.min_thickness}
     walls = []
     for name, t in thicknesses.items():
+        h = element_size[name] if isinstance(element_size, dict) else element_size
         lam = bending_wavelength(f_max, t, material.youngs_modulus, material.poisson_ratio, material.density)
-        typical, bound = error_at(family, element_size / lam)
-        walls.append({"name": name, "thickness_m": t, "bending_wavelength_m": lam, "x": element_size / lam,
-                      "elements_per_wavelength": lam / element_size, "nodes_per_wavelength": p * lam / element_size,
+        typical, bound = error_at(family, h / lam)
+        walls.append({"name": name, "thickness_m": t, "element_size_m": h, "bending_wavelength_m": lam,
+                      "x": h / lam, "elements_per_wavelength": lam / h, "nodes_per_wavelength": p * lam / h,
                       "estimated_error": typical, "error_bound": bound})
     worst = min(walls, key=lambda w: w["nodes_per_wavelength"])
     err = worst["estimated_error"]
@@ -229,13 +230,13 @@ def assess(geometry, mesh, element_size: float, f_max: float, material, measure:
             f"mesh too coarse for f_max = {f_max:g} Hz: {worst['elements_per_wavelength']:.2g} {family} elements per "
             f"bending wavelength of the {worst['name']} ({worst['thickness_m'] * 1e3:.3g} mm)"
             + (f", estimated error of the modes near f_max {percent(err)}" if err is not None else "")
-            + (" (far too coarse)" if far else f" (warned above {WARN_ERROR:.0%})"))
+            + (" (far too coarse)" if far else f" (warned above {WARN_ERROR * 100:g} %)"))
     thick = [w["name"] for w in walls if w["bending_wavelength_m"] < THIN_WALL_WAVELENGTHS * w["thickness_m"]]
     if thick:
         warnings.append(f"at {f_max:g} Hz the {', '.join(thick)} are no thin plates (bending wavelength < "
                         f"{THIN_WALL_WAVELENGTHS:g} thicknesses): the wave picture, and this estimate, do not hold")
     status = "far too coarse" if far else "coarse" if coarse else "ok"
-    return Resolution(family, f_max, element_size, measure, walls, status, warnings)
+    return Resolution(family, f_max, worst["element_size_m"], measure, walls, status, warnings)
 
 
 def check_resolution(geometry, mesh, size: float, f_max: float, material) -> Resolution:
@@ -257,7 +258,7 @@ def check_resolution(geometry, mesh, size: float, f_max: float, material) -> Res
             f"({w['thickness_m'] * 1e3:.3g} mm thick, lambda_b = {w['bending_wavelength_m'] * 1e3:.3g} mm){err}"
             + (f" (at {f_max:g} Hz no thin plate: the wavelength is under {THIN_WALL_WAVELENGTHS:g} thicknesses)"
                if w["bending_wavelength_m"] < THIN_WALL_WAVELENGTHS * w["thickness_m"] else "")
-            + f"; use mesh.size <= {good * 1e3:.3g} mm for ~{WARN_ERROR:.0%}, a lower f_max, or set "
+            + f"; use mesh.size <= {good * 1e3:.3g} mm for ~{WARN_ERROR * 100:g} %, a lower f_max, or set "
             f"mesh.allow_coarse = true to run anyway")
     return res
 
@@ -271,18 +272,56 @@ def suggested_size(family: str, wavelength: float, degree: int) -> float:
     return wavelength * degree / 4.0
 
 
-def largest_cell_edge(mesh) -> float:
-    """The longest cell edge (m) of a dolfinx mesh, over all ranks: the element size that limits how well the
-    mesh resolves a bending wave (vertices only: the straight edges of the affine cells of housingfe's meshes)."""
+def cell_longest_edges(mesh):
+    """The longest edge (m) of every local cell of a dolfinx tetrahedral or hexahedral mesh (from its vertices:
+    housingfe's meshes have affine cells)."""
+    import itertools
+
     import numpy as np
     from dolfinx import cpp
+
+    tdim = mesh.topology.dim
+    n_local = mesh.topology.index_map(tdim).size_local
+    if n_local == 0:
+        return np.zeros(0)
+    nodes = cpp.mesh.entities_to_geometry(getattr(mesh, "_mesh", mesh), tdim, np.arange(n_local, dtype=np.int32),
+                                          False)
+    x = mesh.geometry.x
+    if nodes.shape[1] in (4, 10):          # tetrahedron: every vertex pair is an edge
+        pairs = list(itertools.combinations(range(4), 2))
+    else:                                  # hexahedron, vertices in lexicographic order: edges differ in one bit
+        pairs = [(a, b) for a, b in itertools.combinations(range(8), 2) if bin(a ^ b).count("1") == 1]
+    return np.max([np.linalg.norm(x[nodes[:, a]] - x[nodes[:, b]], axis=1) for a, b in pairs], axis=0)
+
+
+def largest_cell_edge(mesh, cells=None) -> float:
+    """The longest cell edge (m) of a dolfinx mesh (of the given local cells only), over all ranks: the element
+    size that limits how well the mesh resolves a bending wave; 0 where there are no such cells."""
     from mpi4py import MPI
 
-    mesh.topology.create_entities(1)
-    n_local = mesh.topology.index_map(1).size_local
-    edges = np.arange(n_local, dtype=np.int32)
-    ends = cpp.mesh.entities_to_geometry(getattr(mesh, "_mesh", mesh), 1, edges, False) if n_local \
-        else np.zeros((0, 2), np.int32)
-    x = mesh.geometry.x
-    lengths = np.linalg.norm(x[ends[:, 0]] - x[ends[:, 1]], axis=1) if n_local else np.zeros(0)
+    lengths = cell_longest_edges(mesh)
+    if cells is not None:
+        lengths = lengths[cells[cells < len(lengths)]]
     return mesh.comm.allreduce(float(lengths.max(initial=0.0)), op=MPI.MAX)
+
+
+def wall_element_sizes(geometry, housing) -> dict[str, float]:
+    """The longest cell edge (m) in each wall of wall_thicknesses (its cells: the cell groups that
+    geometry.wall_cell_groups names by prefix); a wall without cells of its own gets the mesh's longest edge."""
+    import numpy as np
+    from mpi4py import MPI
+
+    mesh = housing.mesh
+    lengths = cell_longest_edges(mesh)
+    overall = mesh.comm.allreduce(float(lengths.max(initial=0.0)), op=MPI.MAX)
+    prefixes = getattr(geometry, "wall_cell_groups", {})
+    sizes = {}
+    for wall in getattr(geometry, "wall_thicknesses", None) or {"thinnest wall": geometry.min_thickness}:
+        tags = [tag for name, tag in housing.cell_groups.items()
+                if any(name.startswith(p) for p in prefixes.get(wall, ()))]
+        cells = np.unique(np.concatenate([housing.cell_tags.find(t) for t in tags])) if tags else np.zeros(0, int)
+        cells = cells[cells < len(lengths)]
+        local = float(lengths[cells].max(initial=0.0))
+        size = mesh.comm.allreduce(local, op=MPI.MAX)
+        sizes[wall] = size if size > 0 else overall
+    return sizes

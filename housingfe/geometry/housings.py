@@ -216,6 +216,14 @@ class GearboxGeometry(_Strict):
             walls[f"rib {rib.name}"] = min(hi - lo for lo, hi in (rib.x, rib.y, rib.z))
         return walls
 
+    @property
+    def wall_cell_groups(self) -> dict[str, tuple[str, ...]]:
+        """The cell groups (name prefixes) of each entry of wall_thicknesses."""
+        groups = {"walls": ("top", "front", "back", "side"), "bearing plates": ("bearing_plate",), "rim": ("rim",),
+                  "feet": ("foot",), "covers": ("cover_",)}
+        groups.update({f"rib {rib.name}": (f"rib_{rib.name}",) for rib in self.ribs})
+        return {name: groups[name] for name in self.wall_thicknesses}
+
 # --------------------------------------------------------------------------------------------- box halves
 
 

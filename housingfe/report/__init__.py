@@ -73,7 +73,7 @@ def resolution_text(resolution: dict) -> str:
             f"{w['elements_per_wavelength']:.3g} {resolution['element_family']} elements "
             f"({w['nodes_per_wavelength']:.3g} node spacings) per bending wavelength of the {w['name']} "
             f"({w['thickness_m'] * 1e3:.3g} mm thick, lambda_b {w['bending_wavelength_m'] * 1e3:.3g} mm, longest "
-            f"element edge {resolution['element_size_m'] * 1e3:.3g} mm)"
+            f"element edge there {w.get('element_size_m', resolution['element_size_m']) * 1e3:.3g} mm)"
             + (f"; other walls: {', '.join(others)} elements per wavelength" if others else "")
             + f"; {_error_clause(resolution)}")
 
