@@ -233,7 +233,7 @@ def assess(geometry, mesh, element_size, f_max: float, material, measure: str) -
             + (" (far too coarse)" if far else f" (warned above {WARN_ERROR * 100:g} %)"))
     thick = [w["name"] for w in walls if w["bending_wavelength_m"] < THIN_WALL_WAVELENGTHS * w["thickness_m"]]
     if thick:
-        warnings.append(f"at {f_max:g} Hz the {', '.join(thick)} are no thin plates (bending wavelength < "
+        warnings.append(f"no thin plate at {f_max:g} Hz: {', '.join(thick)} (bending wavelength < "
                         f"{THIN_WALL_WAVELENGTHS:g} thicknesses): the wave picture, and this estimate, do not hold")
     status = "far too coarse" if far else "coarse" if coarse else "ok"
     return Resolution(family, f_max, worst["element_size_m"], measure, walls, status, warnings)

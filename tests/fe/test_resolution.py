@@ -114,6 +114,21 @@ def test_megahertz_plate_is_refused(tmp_path):
     assert not out.exists()
 
 
+def test_megahertz_plate_run_anyway_says_its_modes_are_the_mesh_s(tmp_path):
+    """Run anyway, the 1 MHz plate's ~900 modes on ~1000 DOFs are "complete" only for the discrete model: the
+    summary says so and warns that f_max is in the top of the discrete spectrum and that the wall is no thin
+    plate at that frequency."""
+    out = tmp_path / "out"
+    proc = housingfe("run", "nafems-fv12", *MEGAHERTZ_PLATE, "--set", "mesh.allow_coarse=true", "--out", str(out),
+                     cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    summary = (out / "summary.txt").read_text()
+    assert "complete (of the discrete model): True" in summary and "error near f_max > 100 %" in summary
+    warnings = strict_json(out / "modes.json")["resolution"]["warnings"]
+    assert any("top of the discrete spectrum" in w for w in warnings)
+    assert any("no thin plate" in w for w in warnings)
+
+
 def test_allow_coarse_runs_and_warns_in_summary_and_json(tmp_path):
     """With mesh.allow_coarse the coarse run goes ahead, and both summary.txt and modes.json say how coarse it
     is: the estimated error stands next to "complete"."""
