@@ -11,6 +11,7 @@ import fcntl
 import glob
 import hashlib
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -334,14 +335,28 @@ def atomic_output_dir(out_dir: str | os.PathLike, comm=None) -> Iterator[Path]:
         release_output(out)
 
 
-def write_json(path: Path, data) -> None:
-    """Write `data` as indented JSON (numpy scalars and arrays converted)."""
-    def default(o):
-        if hasattr(o, "tolist"):
-            return o.tolist()
-        raise TypeError(f"not JSON serialisable: {type(o)}")
+def json_safe(data):
+    """`data` with numpy scalars and arrays as Python lists and numbers, tuples as lists, and every NaN or
+    infinity as None: strict JSON (RFC 8259 has no NaN; Python's json would write a bare `NaN`)."""
+    if isinstance(data, dict):
+        return {k: json_safe(v) for k, v in data.items()}
+    if isinstance(data, (list, tuple)):
+        return [json_safe(v) for v in data]
+    if hasattr(data, "tolist") and not isinstance(data, (str, bytes)):
+        return json_safe(data.tolist())
+    if isinstance(data, float) and not math.isfinite(data):
+        return None
+    return data
 
-    path.write_text(json.dumps(data, indent=2, default=default) + "\n")
+
+def dumps_json(data, **kwargs) -> str:
+    """json.dumps of json_safe(data), refusing anything that still is not strict JSON (allow_nan=False)."""
+    return json.dumps(json_safe(data), allow_nan=False, **kwargs)
+
+
+def write_json(path: Path, data) -> None:
+    """Write `data` as indented strict JSON (numpy scalars and arrays converted, NaN and infinities as null)."""
+    path.write_text(dumps_json(data, indent=2) + "\n")
 
 
 def write_csv(path: Path, header: Sequence[str], rows: Iterable[Sequence]) -> None:

@@ -70,6 +70,9 @@ class MeshSpec(_Strict):
     # converge at O(h) only (box, Q3: rates 0.7-1.4 per mode); < 1 puts the elements there.
     grading: float = Field(default=1.0, gt=0.0, le=1.0)
     allow_large: bool = False   # run even when the estimated memory exceeds what the machine has available
+    # run even when the mesh is far too coarse for f_max (housingfe.fe.resolution: the estimated error of the modes
+    # near f_max above REFUSE_ERROR); the run then reports the estimate and warns
+    allow_coarse: bool = False
     # "serendipity" (hex, degree 2: the 20-node brick) with integration "reduced" (2x2x2 Gauss points in the
     # stiffness, the mass fully integrated) is CalculiX's / Abaqus' C3D20R: softer in bending than Q2/Q3 at
     # the same DOFs; with 3 layers through the walls it reaches 0.86 % on the free box at 40 k DOFs (bench

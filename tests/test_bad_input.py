@@ -348,6 +348,31 @@ def test_five_metre_flange_is_stopped_before_meshing(tmp_path, capsys, monkeypat
     _expect_one_line_error(code, err, ["geometry.flange_width"], tmp_path, out)
 
 
+# issue 27: a mesh far too coarse for f_max (about one element per bending wavelength of the walls, or a plate
+# asked for everything below 1 MHz) stops before gmsh, naming the size key (housingfe.fe.resolution)
+COARSE_CASES = [
+    ("coarse-6mm-walls-2kHz", _all(_set("geometry.wall_thickness", 0.006), _set("mesh.size", 0.15),
+                                   _set("mesh.degree", 2), _set("analysis.modal.f_max", 2000.0)),
+     ["mesh.size", "mesh.allow_coarse"]),
+    ("plate-1MHz", _all(_set("geometry", {"kind": "plate", "a": 0.3, "b": 0.2, "h": 0.005}), _set("supports", []),
+                        _set("mesh.size", 0.05), _set("analysis.modal.f_max", 1e6), _del("analysis.harmonic"),
+                        _del("loads"), _del("radiation")), ["mesh.size", "far too coarse"]),
+]
+
+
+@pytest.mark.parametrize("change, needles", [c[1:] for c in COARSE_CASES], ids=[c[0] for c in COARSE_CASES])
+def test_mesh_far_too_coarse_for_f_max_is_stopped_before_meshing(change, needles, tmp_path, capsys, monkeypatch):
+    import housingfe.fe.model
+
+    def no_meshing(*args, **kwargs):
+        raise AssertionError("a mesh far too coarse for f_max reached the mesher")
+
+    monkeypatch.setattr(housingfe.fe.model, "build_mesh", no_meshing)
+    path, out = _scene_case(change, tmp_path)
+    code, err = _run_cli(["run", str(path), "--out", str(out)], capsys)
+    _expect_one_line_error(code, err, needles, tmp_path, out)
+
+
 # ---------------------------------------------------------------- --set
 SET_CASES = [
     ("set-no-equals", "mesh.size", ["--set", "mesh.size"]),
@@ -582,7 +607,7 @@ def test_console_script_end_to_end(args, tmp_path):
     assert not (tmp_path / "results").exists()
 
 
-CORPUS_SIZE = (len(SCENE_CASES) + len(MESH_CASES) + 1 + len(SET_CASES) + 2 * len(FILE_CASE_NAMES) + 1
+CORPUS_SIZE = (len(SCENE_CASES) + len(MESH_CASES) + 1 + len(COARSE_CASES) + len(SET_CASES) + 2 * len(FILE_CASE_NAMES) + 1
                + len(SOURCE_CASES) + len(COMMAND_CASES) + 5)
 
 

@@ -7,12 +7,12 @@ with the keys of `rolling.GEOMETRY_KEYS`) or command-line flags (`--balls Z --ba
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 import numpy as np
 
 from housingfe.errors import InputError
+from housingfe.outputs import dumps_json
 
 # flag -> (TOML key of rolling.GEOMETRY_KEYS, type, metavar, help)
 _FLAGS = {
@@ -131,7 +131,7 @@ def _cmd_bearing(args: argparse.Namespace) -> int:
     if args.json:
         data = result.as_dict()
         data["estimated"] = geometry.estimated
-        print(json.dumps(data, indent=2))
+        print(dumps_json(data, indent=2))
         return 0
     print(format_result(result, geometry.estimated))
     return 0

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.benchmarks._launch import mpi_environment, mpi_launcher
-from housingfe.outputs import atomic_output_dir, format_table, write_csv
+from housingfe.outputs import atomic_output_dir, dumps_json, format_table, write_csv
 
 SCENE = "box-free-frf"
 MESH = ["mesh.degree=3", "mesh.grading=0.25", "output.pictures=false"]
@@ -114,7 +114,7 @@ def main(out_dir: Path, quick: bool = False) -> None:
     with atomic_output_dir(out_dir) as tmp:
         write_csv(tmp / "mpi_bench.csv", header, rows)
         (tmp / "mpi_bench.txt").write_text(table + "\n" + note + "\n")
-        (tmp / "timings.json").write_text(json.dumps({str(k): [r["timings"] for r in v] for k, v in runs.items()},
+        (tmp / "timings.json").write_text(dumps_json({str(k): [r["timings"] for r in v] for k, v in runs.items()},
                                                      indent=1))
         _plot(tmp / "mpi_bench.png", rows)
     print(table)

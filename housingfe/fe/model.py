@@ -10,6 +10,7 @@ import time
 from dataclasses import dataclass, field
 
 from housingfe.errors import InputError
+from housingfe.fe.resolution import assess, check_resolution, wall_element_sizes
 from housingfe.geometry import HousingMesh, build_mesh
 from housingfe.geometry.mesh import bending_wavelength
 from housingfe.materials import Material
@@ -44,6 +45,7 @@ class HousingModel:
     scene: object = None
     element_degree: int = 2
     reduced_integration: bool = False
+    resolution: object = None   # housingfe.fe.resolution.Resolution of the mesh at f_max (measured on the mesh)
 
     # ----------------------------------------------------------------------- the Structure protocol
     C = None               # no viscous damping matrix on the bare housing
@@ -117,13 +119,16 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
 
     geometry: a geometry spec (housingfe.geometry.specs); material: the housing's Material (SI); mesh: a
     housingfe.scene.MeshSpec (element, degree, size or elements_per_wavelength, layers, allow_large); f_max: the
-    highest frequency of interest (Hz), which sets the element size when mesh.size is not given; regions: cell
+    highest frequency of interest (Hz), which sets the element size when mesh.size is not given and against which
+    the mesh's resolution is checked (housingfe.fe.resolution: InputError before meshing when far too coarse,
+    unless mesh.allow_coarse; the measured resolution is model.resolution); regions: cell
     group name -> Material (or a material spec with .resolve()) overriding `material` there; supports: support
     specs (kind fixed | normal | elastic, surface, stiffnesses in N/m^3)."""
     from housingfe.solvers import elasticity
 
     regions = dict(regions or {})
     size = element_size(mesh, geometry, f_max, material)
+    check_resolution(geometry, mesh, size, f_max, material)
     check_model_size(geometry, mesh, size, comm)
     housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm, grading=mesh.grading,
                          layer_size=mesh.layer_size)
@@ -138,8 +143,10 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
     K, M = elasticity.assemble_stiffness_mass(V, materials, bcs, foundation_forms(supports, housing, V), reduced)
     timings = {"mesh_s": housing.mesh_time_s, "assembly_s": time.perf_counter() - t0}
     free = not bcs and not any(s.kind == "elastic" for s in supports)
+    resolution = assess(geometry, mesh, wall_element_sizes(geometry, housing), f_max, material,
+                        "longest cell edge in each wall")
     return HousingModel(housing, material, V, bcs, K, M, 6 if free else 0, timings, materials,
-                        element_degree=mesh.degree, reduced_integration=reduced)
+                        element_degree=mesh.degree, reduced_integration=reduced, resolution=resolution)
 
 
 def available_memory_bytes() -> tuple[int, int]:

@@ -56,6 +56,16 @@ class BoxGeometry(_Strict):
     def min_thickness(self) -> float:
         return min(self.wall_thickness, self.flange_thickness)
 
+    @property
+    def wall_thicknesses(self) -> dict[str, float]:
+        """The plates whose bending waves the mesh must resolve: name -> thickness (m)."""
+        return {"walls": self.wall_thickness, "flange": self.flange_thickness}
+
+    @property
+    def wall_cell_groups(self) -> dict[str, tuple[str, ...]]:
+        """The cell groups (name prefixes) of each entry of wall_thicknesses."""
+        return {"walls": ("top", "left", "right", "front", "back"), "flange": ("flange",)}
+
 
 def box_model(length: float, width: float, height: float, wall_thickness: float,
               flange_thickness: float, flange_width: float, bolt_patch_size: float = 0.024) -> BlockModel:

@@ -201,6 +201,29 @@ class GearboxGeometry(_Strict):
     def min_thickness(self) -> float:
         return self.wall_thickness
 
+    @property
+    def wall_thicknesses(self) -> dict[str, float]:
+        """The plates whose bending waves the mesh must resolve: name -> thickness (m); the rim counts as a plate
+        of its smaller cross-section dimension, a rib as one of its thinnest extent."""
+        walls = {"walls": self.wall_thickness, "bearing plates": self.bearing_plate.thickness}
+        if self.rim is not None:
+            walls["rim"] = min(self.rim.width, self.rim.height)
+        if self.feet is not None:
+            walls["feet"] = self.feet.thickness
+        if self.covers is not None:
+            walls["covers"] = self.covers.thickness
+        for rib in self.ribs:
+            walls[f"rib {rib.name}"] = min(hi - lo for lo, hi in (rib.x, rib.y, rib.z))
+        return walls
+
+    @property
+    def wall_cell_groups(self) -> dict[str, tuple[str, ...]]:
+        """The cell groups (name prefixes) of each entry of wall_thicknesses."""
+        groups = {"walls": ("top", "front", "back", "side"), "bearing plates": ("bearing_plate",), "rim": ("rim",),
+                  "feet": ("foot",), "covers": ("cover_",)}
+        groups.update({f"rib {rib.name}": (f"rib_{rib.name}",) for rib in self.ribs})
+        return {name: groups[name] for name in self.wall_thicknesses}
+
 # --------------------------------------------------------------------------------------------- box halves
 
 

@@ -45,6 +45,16 @@ class PlateGeometry(_Strict):
     def min_thickness(self) -> float:
         return self.h
 
+    @property
+    def wall_thicknesses(self) -> dict[str, float]:
+        """The plates whose bending waves the mesh must resolve: name -> thickness (m)."""
+        return {"plate": self.h}
+
+    @property
+    def wall_cell_groups(self) -> dict[str, tuple[str, ...]]:
+        """The cell groups (name prefixes) of each entry of wall_thicknesses."""
+        return {"plate": ("plate",)}
+
 
 def plate_model(a: float, b: float, h: float) -> BlockModel:
     """Block model of a plate (lengths in m)."""

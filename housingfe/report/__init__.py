@@ -11,18 +11,21 @@ from housingfe.outputs import format_table, write_csv, write_json
 def modal_summary_text(summary: dict) -> str:
     """The human-readable summary of a modal run (summary.txt and the terminal)."""
     f = summary["frequencies_hz"]
+    resolution = summary.get("resolution")
     lines = [
         f"scene {summary['scene']}: {summary['description']}",
         f"{summary['dofs']} DOFs ({summary['element']}, element size {summary['element_size_m'] * 1e3:.1f} mm, "
         f"{summary['mpi_ranks']} MPI rank(s)), wall time {summary['wall_time_s']:.1f} s",
         f"{len(f)} elastic modes below {summary['f_max_hz']:g} Hz; "
-        f"complete: {summary['complete']} (inertia count {summary['eigenvalues_below_f_max_by_inertia']} "
-        f"incl. {len(summary['rigid_body_frequencies_hz'])} rigid-body modes)",
+        f"complete (of the discrete model): {summary['complete']} (inertia count "
+        f"{summary['eigenvalues_below_f_max_by_inertia']} incl. {len(summary['rigid_body_frequencies_hz'])} "
+        f"rigid-body modes)" + (f"; {_error_clause(resolution)}" if resolution else ""),
         f"max relative residual {max(summary['residuals'], default=0.0):.1e}",
         f"mass {summary['mass_kg']:.3f} kg (geometry)"
         + (f", {summary['mass_from_rigid_modes_kg']:.3f} kg (rigid-body modes)"
            if summary["mass_from_rigid_modes_kg"] is not None else ""),
     ]
+    lines += resolution_lines(resolution)
     if len(f):
         lines.append("elastic eigenfrequencies (Hz):")
         for i in range(0, len(f), 8):
@@ -42,8 +45,44 @@ def modal_summary_text(summary: dict) -> str:
         lines.append("compared with published values:")
         lines.append(format_table(
             ["quantity", "ours", "published", "unit", "source"],
-            [[r["quantity"], r["ours"], r["published"], r["unit"], r["source"]] for r in summary["published"]]))
+            [[r["quantity"], "-" if r["ours"] is None else r["ours"], r["published"], r["unit"], r["source"]]
+             for r in summary["published"]]))
     return "\n".join(lines)
+
+
+def _error_clause(resolution: dict) -> str:
+    err, bound = resolution["estimated_error_near_f_max"], resolution["error_bound_near_f_max"]
+    if err is None:
+        return f"discretisation error not estimated ({resolution['element_family']} elements are not calibrated)"
+    # finer than every calibration point with >= 1 % error: the bound (or 1 %) is all the data say
+    typical = f"< {_percent(min(bound, 0.01))}" if resolution["below_calibration"] else _percent(err)
+    return (f"estimated discretisation error near f_max {typical} (bound {_percent(bound)}"
+            + (", extrapolated" if resolution["extrapolated"] else "") + ")")
+
+
+def _percent(err: float) -> str:
+    return "> 100 %" if err > 1.0 else f"~{err * 100:.2g} %"
+
+
+def resolution_text(resolution: dict) -> str:
+    """One line: elements and node spacings per bending wavelength of the worst wall at f_max, the other walls'
+    elements per wavelength, and the estimated error of the modes near f_max (housingfe.fe.resolution)."""
+    w = next(w for w in resolution["walls"] if w["name"] == resolution["worst_wall"])
+    others = [f"{x['name']} {x['elements_per_wavelength']:.3g}" for x in resolution["walls"] if x is not w]
+    return (f"resolution at {resolution['f_max_hz']:g} Hz ({resolution['status']}): "
+            f"{w['elements_per_wavelength']:.3g} {resolution['element_family']} elements "
+            f"({w['nodes_per_wavelength']:.3g} node spacings) per bending wavelength of the {w['name']} "
+            f"({w['thickness_m'] * 1e3:.3g} mm thick, lambda_b {w['bending_wavelength_m'] * 1e3:.3g} mm, longest "
+            f"element edge there {w.get('element_size_m', resolution['element_size_m']) * 1e3:.3g} mm)"
+            + (f"; other walls: {', '.join(others)} elements per wavelength" if others else "")
+            + f"; {_error_clause(resolution)}")
+
+
+def resolution_lines(resolution: dict | None) -> list[str]:
+    """The resolution line and its warnings (empty without a resolution)."""
+    if not resolution:
+        return []
+    return [resolution_text(resolution)] + [f"WARNING: {w}" for w in resolution["warnings"]]
 
 
 def write_modal_outputs(folder: Path, model, result, summary: dict, comm, output) -> None:
@@ -312,8 +351,10 @@ def write_harmonic_outputs(folder: Path, model, forced, comm, *, scene_name: str
                 h = ri.receptance[j, k]
                 rec.append([lj.name, ri.name, f, h.real, h.imag, abs(h)])
     write_csv(folder / "receptance.csv", ["response_at", "load_case", "frequency_hz", "real", "imag", "abs"], rec)
+    resolution = model.resolution.as_dict() if getattr(model, "resolution", None) is not None else None
     write_json(folder / "harmonic.json", {
         "scene": scene_name, "solvers": solvers, "timings_s": forced.timings, **forced.facts,
+        "resolution": resolution,
         "band_comparison_vs_direct": band_comparison(forced),
         "sample_points": {N: {"points_m": s.points, "weights_m2": s.weights}
                           for N, s in forced.observer.samples.items()},
@@ -329,7 +370,8 @@ def write_harmonic_outputs(folder: Path, model, forced, comm, *, scene_name: str
             "frequencies_hz": sorted({d.frequency for d in forced.deflection_shapes}),
             "fields": "displacement_re, displacement_im (m, rms phasor for the load's amplitude, e^{i omega t}), "
                       "displacement_abs (m, |u|); time = frequency (Hz)"}})
-    (folder / "summary_forced.txt").write_text(harmonic_summary_text(forced) + "\n")
+    (folder / "summary_forced.txt").write_text(harmonic_summary_text(forced) + "\n"
+                                               + "".join(line + "\n" for line in resolution_lines(resolution)))
     if forced.angular_velocity_node:
         write_csv(folder / "tf_omega.csv", ["load_case", "solver", "frequency_hz", "L_omega_dB", "TF_omega_dB"],
                   tf_omega_rows(forced))

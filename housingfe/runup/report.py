@@ -12,6 +12,7 @@ import numpy as np
 
 from housingfe import outputs
 from housingfe.data import thesis
+from housingfe.report import resolution_lines
 from housingfe.runup import slopes as slope_terms
 
 TOTAL_COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "tooth_frequency_hz", "L_omega_dB",
@@ -57,6 +58,7 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "scene_settings": scene.model_dump(mode="json"),
         "timings_s": timings,
         "modal_basis": gm.summary(),
+        "housing_resolution": _resolution(gm),
         "ritz_reanalysis": {f"{t:g}": m.reduction.frequencies_hz[:12].tolist() for t, (m, _) in results.items()},
         "checks": check_rows, "peak_contributions": contributions,
         "slope_terms": [d.to_json() for d in decompositions],
@@ -149,6 +151,12 @@ def runup_plot(path: Path, scene, totals: list) -> None:
     plt.close(fig)
 
 
+def _resolution(gm) -> dict | None:
+    """The housing mesh's resolution of the highest line (housingfe.fe.resolution), None if not known."""
+    res = getattr(getattr(gm, "housing_model", None), "resolution", None)
+    return res.as_dict() if res is not None else None
+
+
 def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, decompositions: list = ()) -> str:
     """The console summary: the model, the run-up maxima per route, the checks, which term makes the speed law
     (one line per curve, and the table of slopes), the time split."""
@@ -156,6 +164,7 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
     lines = [f"{scene.scene.name}: coupled gearbox {gm.structure.dofs} DOFs, {len(b.eigenvalues)} modes to "
              f"{b.f_max:.0f} Hz ({b.rigid_count} zero), {len(gm.reduction.vectors)} Ritz vectors; radiating area "
              f"{gm.area:.3f} m2"]
+    lines += resolution_lines(_resolution(gm))
     for torque, (_, res) in results.items():
         for route in res.routes:
             for rad in res.radiators:

@@ -50,16 +50,19 @@ def modal_comparison(scene, summary: dict) -> list[dict]:
     rows = []
     if ref.frequencies_hz:
         for i, f_ref in enumerate(ref.frequencies_hz):
-            ours = float(freqs[i]) if i < len(freqs) else float("nan")
-            rows.append(row(name, f"elastic mode {i + 1}", ours, f_ref, "Hz", ref.source))
+            # a published mode above this run's f_max has no counterpart here: no number (null in JSON)
+            ours = float(freqs[i]) if i < len(freqs) else None
+            rows.append(row(name, f"elastic mode {i + 1}", ours, f_ref, "Hz", ref.source,
+                            "" if ours is not None else _above_f_max(len(freqs), summary["f_max_hz"])))
     if ref.section:
         data = thesis()[ref.section]
         src = thesis_source(ref.section)
         if "mass_kg" in data:
             rows.append(row(name, "mass", summary["mass_kg"], data["mass_kg"], "kg", src))
         if "fem_first_elastic_Hz" in data:
-            rows.append(row(name, "first elastic mode (thesis FEM)", float(freqs[0]),
-                            data["fem_first_elastic_Hz"], "Hz", src))
+            rows.append(row(name, "first elastic mode (thesis FEM)", float(freqs[0]) if len(freqs) else None,
+                            data["fem_first_elastic_Hz"], "Hz", src,
+                            "" if len(freqs) else _above_f_max(0, summary["f_max_hz"])))
         for key, value in data.items():
             if key.startswith("fem_modes_below_"):
                 f_lim = float(key.removeprefix("fem_modes_below_").removesuffix("Hz"))
@@ -72,6 +75,10 @@ def modal_comparison(scene, summary: dict) -> list[dict]:
                     rows.append(row(name, f"elastic modes below {f_lim:g} Hz (thesis EMA found)",
                                     int(np.sum(freqs < f_lim)), value, "-", src))
     return rows
+
+
+def _above_f_max(found: int, f_max: float) -> str:
+    return f"not computed: {found} elastic mode(s) below this run's f_max = {f_max:g} Hz"
 
 
 def interior_comparison(scene, interior: dict) -> list[dict]:

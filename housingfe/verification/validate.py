@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.errors import InputError, SolverError
-from housingfe.outputs import atomic_output_dir, reserve_output
+from housingfe.outputs import atomic_output_dir, dumps_json, reserve_output
 from housingfe.scene import load_housing_scene
 from housingfe.scenefile import builtin_scenes
 from housingfe.verification.published import THESIS, row, thesis, thesis_source
@@ -156,6 +156,7 @@ from pathlib import Path
 job = json.loads(sys.argv[1])
 logging.disable(logging.INFO)
 from housingfe.errors import InputError, SolverError
+from housingfe.outputs import dumps_json
 try:
     if job["kind"] == "run":
         from housingfe.run import run_scene
@@ -510,7 +511,7 @@ def write_outputs(rows: list[dict], out_dir: Path, json_path) -> None:
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
         keys = ("scene", "quantity", "ours", "published", "unit", "source", "note")
         with open(json_path, "w") as fh:
-            json.dump([{k: _jsonable(r.get(k, "")) for k in keys} for r in rows], fh, indent=1)
+            fh.write(dumps_json([{k: _jsonable(r.get(k, "")) for k in keys} for r in rows], indent=1))
 
 
 def _csv(v):
