@@ -106,6 +106,8 @@ def element_size(mesh, geometry, f_max: float, material: Material) -> float:
     (Hz) divided by mesh.elements_per_wavelength.  mesh: a housingfe.scene.MeshSpec; geometry: a geometry spec."""
     if mesh.size is not None:
         return mesh.size
+    if geometry.min_thickness is None:      # an imported mesh brings its own elements
+        return 0.0
     wavelength = bending_wavelength(f_max, geometry.min_thickness,
                                     material.youngs_modulus, material.poisson_ratio, material.density)
     return wavelength / mesh.elements_per_wavelength
