@@ -225,6 +225,23 @@ def read_mesh_file(path, units: str, key: str = "geometry") -> MeshFile:
             out.cell_sets[name] = np.unique(np.concatenate(vol))
         if surf:
             out.surface_sets[name] = surf
+    # gmsh physical groups by name (the msh 2.2 reader leaves them in field_data and cell_data)
+    if "gmsh:physical" in raw.cell_data:
+        for name, (tag, dim) in ((n, tuple(int(t) for t in v[:2])) for n, v in raw.field_data.items()):
+            vol, surf = [], set()
+            for i, block in enumerate(raw.cells):
+                hit = np.flatnonzero(np.asarray(raw.cell_data["gmsh:physical"][i]) == tag)
+                if not len(hit):
+                    continue
+                if dim == 3 and i in offsets:
+                    vol.append(offsets[i] + hit)
+                elif dim == 2 and block.type in SURFACE_CELLS:
+                    nodes = renumber[block.data[hit, :SURFACE_CELLS[block.type]]]
+                    surf |= {tuple(sorted(f)) for f in nodes.tolist() if min(f) >= 0}
+            if vol:
+                out.cell_sets.setdefault(name, np.unique(np.concatenate(vol)))
+            if surf:
+                out.surface_sets.setdefault(name, surf)
     # Nastran property ids and gmsh physical volumes without names
     for data_key, prefix in (("nastran:ref", "PID"), ("gmsh:physical", "physical_")):
         if data_key in raw.cell_data:
@@ -314,14 +331,14 @@ def _read_on_root(geometry, comm, key: str):
 
 
 def build_imported_mesh(geometry: MeshGeometry, comm, key: str = "geometry"):
-    """The distributed HousingMesh of a mesh-file geometry (collective).  Cell tags: the volume cell sets;
+    """The fields of the distributed HousingMesh of a mesh-file geometry (collective; housingfe.geometry.mesh
+    .build_mesh makes the HousingMesh and adds the element quality).  Cell tags: the volume cell sets;
     facet tags: "outer" and the named bores and surfaces (tag values = distinct combinations of groups)."""
     import ufl
     from dolfinx import fem
     from dolfinx.mesh import create_mesh, exterior_facet_indices, meshtags
     from mpi4py import MPI
 
-    from housingfe.geometry.mesh import HousingMesh, element_quality
 
     t0 = time.perf_counter()
     mf, groups = _read_on_root(geometry, comm, key)
@@ -378,12 +395,10 @@ def build_imported_mesh(geometry: MeshGeometry, comm, key: str = "geometry"):
         raise InputError(f"{geometry.file}: {key}.file: the mesh has no volume")
     centroid = np.array([comm.allreduce(fem.assemble_scalar(fem.form(xs[i] * ufl.dx(domain=mesh))), op=MPI.SUM)
                          for i in range(3)]) / volume
-    quality = element_quality(mesh)
-    quality.update(mesher=f"imported {source} from {Path(geometry.file).name}", notes=notes)
-    return HousingMesh(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=cell_groups,
-                       facet_groups=facet_groups, volume=volume, centroid=centroid, element_size=size,
-                       element="tet" if cell_type == "tetrahedron" else "hex", mesh_time_s=time.perf_counter() - t0,
-                       quality=quality)
+    return dict(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=cell_groups,
+                facet_groups=facet_groups, volume=volume, centroid=centroid, element_size=size,
+                element="tet" if cell_type == "tetrahedron" else "hex", mesh_time_s=time.perf_counter() - t0,
+                quality={"mesher": f"imported {source} from {Path(geometry.file).name}", "notes": notes})
 
 
 def estimate_imported_dofs(geometry: MeshGeometry, degree: int) -> int:
@@ -465,10 +480,12 @@ def write_mesh_file(housing, path, units: str = "m", order: int | None = None, n
         else:
             point_sets[name] = np.unique(corners)
     del tags, f2v
-    out = meshio.Mesh(x / UNIT_SCALE[units], blocks, point_sets=point_sets, cell_sets=cell_sets)
-    if path.suffix.lower() == ".msh":
+    out = meshio.Mesh(x / UNIT_SCALE[units], blocks, point_sets=point_sets)
+    if path.suffix.lower() == ".msh":     # physical groups: the volume (1), then one per named surface
         out.cell_data["gmsh:physical"] = [np.full(len(b[1]), i + 1) for i, b in enumerate(blocks)]
         out.cell_data["gmsh:geometrical"] = [np.full(len(b[1]), i + 1) for i, b in enumerate(blocks)]
+        out.field_data = {"housing": np.array([1, 3])}
+        out.field_data.update({name: np.array([i + 2, 2]) for i, name in enumerate(cell_sets)})
         meshio.write(str(path), out, file_format="gmsh22", binary=False)
     elif path.suffix.lower() in (".bdf", ".nas"):
         _write_nastran(path, out.points, meshio_type, cells_vtk)

@@ -96,7 +96,9 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
     """
     imported = own_mesh_kind(geometry)
     if imported is not None:        # a mesh file: element, size and layers are the file's
-        return imported.mesh(geometry, comm)
+        fields = imported.mesh(geometry, comm)
+        quality = {**element_quality(fields["mesh"]), **fields.pop("quality")}
+        return HousingMesh(**fields, quality=quality)
     import gmsh
     from dolfinx.io import gmshio
 

@@ -29,7 +29,7 @@ class GeometryKind:
     """A registered geometry kind: its scene spec class and its builder (spec -> BlockModel).
 
     Kinds that bring their own mesh (an imported mesh file) have no block model: `mesh(spec, comm)` returns the
-    distributed housingfe.geometry.mesh.HousingMesh and `estimate_dofs(spec, degree)` its displacement DOFs."""
+    fields of the distributed housingfe.geometry.mesh.HousingMesh (a dict; build_mesh adds the quality) and `estimate_dofs(spec, degree)` its displacement DOFs."""
 
     spec: type
     build: Callable | None
@@ -44,7 +44,7 @@ def register_geometry(spec: type, build: Callable | None, *, mesh: Callable | No
                       estimate_dofs: Callable | None = None) -> type:
     """Register a geometry kind: `spec` is a pydantic model with `kind: Literal["<name>"]`, `build(spec)` returns
     its housingfe.geometry.blocks.BlockModel; a kind with its own mesh gives build=None, `mesh(spec, comm)` ->
-    HousingMesh and `estimate_dofs(spec, degree)` -> DOFs instead.  Returns spec."""
+    the HousingMesh fields (dict) and `estimate_dofs(spec, degree)` -> DOFs instead.  Returns spec."""
     (name,) = typing.get_args(spec.model_fields["kind"].annotation)
     if name in GEOMETRY_KINDS:
         raise ValueError(f"geometry kind {name!r} is registered twice")
