@@ -19,6 +19,7 @@ _EXTENSIONS = (
     "housingfe.radiation",
     "housingfe.source.cli",
     "housingfe.studies.bearing_variants",
+    "housingfe.studies.reduce",
     "housingfe.studies.runup_causes",
 )
 
