@@ -168,6 +168,11 @@ def check_model_size(geometry, mesh, size: float, comm) -> dict:
     need = MEMORY_BASE_BYTES * comm.size + MEMORY_PER_DOF_BYTES * dofs
     available, total = comm.bcast(available_memory_bytes() if comm.rank == 0 else None, root=0)
     estimate = {"dofs": dofs, "memory_bytes": need, "available_bytes": available, "total_bytes": total}
+    if available and need > available and not mesh.allow_large and geometry.min_thickness is None:
+        raise InputError(f"{geometry.file}: mesh.degree: model too large: ~{dofs:,} DOFs at degree {mesh.degree} "
+                         f"need ~{need / 1e9:.1f} GB, this machine has {available / 1e9:.1f} GB available "
+                         f"(MemAvailable, {total / 1e9:.1f} GB total); use a coarser mesh file or a lower "
+                         f"mesh.degree, or set mesh.allow_large = true to run anyway")
     if available and need > available and not mesh.allow_large:
         size_key = "mesh.size" if mesh.size is not None else "mesh.elements_per_wavelength"
         lengths = {k: v for k, v in geometry.model_dump().items()

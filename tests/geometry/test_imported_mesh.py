@@ -189,6 +189,28 @@ def test_bad_mesh_files(tmp_path, capsys, comm):
          'set geometry.units = "mm"')
 
 
+def test_memory_guard_names_the_mesh_file(tmp_path, comm, monkeypatch):
+    """The model-size guard counts the DOFs from the file's vertices, edges, faces and cells (the box: 10 557 at
+    Q2 from the linear and the quadratic file, 44 256 at Q3) and stops before building anything when that needs
+    more memory than the machine has."""
+    from housingfe.fe import model as model_module
+    from housingfe.geometry.mesh import estimate_dofs
+
+    model = build_model_from_scene(builtin("hex", 0.06), comm)
+    write_mesh_file(model.housing, tmp_path / "box.inp", units="mm", order=2)
+    write_mesh_file(model.housing, tmp_path / "box8.inp", units="mm")
+    scene = load_housing_scene(str(mesh_scene(tmp_path, "box.inp")))[0]
+    linear = load_housing_scene(str(mesh_scene(tmp_path, "box8.inp")))[0]
+    assert estimate_dofs(scene.geometry, "hex", 2, 0.0, 1) == estimate_dofs(linear.geometry, "hex", 2, 0.0, 1) \
+        == model.dofs
+    q3 = build_model_from_scene(builtin("hex", 0.06, "mesh.degree=3"), comm)
+    assert estimate_dofs(linear.geometry, "hex", 3, 0.0, 1) == q3.dofs
+    monkeypatch.setattr(model_module, "available_memory_bytes", lambda: (int(0.2e9), int(1e9)))
+    with pytest.raises(InputError, match=r"box.inp: mesh.degree: model too large: ~10,557 DOFs at degree 2 "
+                                         r".*set mesh.allow_large = true"):
+        build_model_from_scene(scene, comm)
+
+
 if __name__ == "__main__":       # mpirun -n 2 python -m tests.geometry.test_imported_mesh SCENE: the 2-rank half
     from mpi4py import MPI
 
