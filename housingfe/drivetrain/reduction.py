@@ -127,37 +127,24 @@ def craig_bampton(model, masters: list[Master], cutoff_hz: float, tol: float = 1
     phi = list(fixed.vectors)
     t2 = time.perf_counter()
 
-    # constraint modes: K_fixed x = -K e_j (b rows zeroed), psi_j = x + e_j
-    ksp = PETSc.KSP().create(K.getComm())
-    ksp.setOperators(K_fixed)
-    ksp.setType("preonly")
-    pc = ksp.getPC()
-    K_fixed.setOption(PETSc.Mat.Option.SPD, True)
-    pc.setType("cholesky")
-    pc.setFactorSolverType("mumps")
-    ksp.setUp()
-    psi = []
-    e = K.createVecRight()
-    rhs = K.createVecLeft()
-    for j in boundary:
-        e.set(0.0)
-        if lo <= j < hi:
-            e.setValue(int(j), 1.0)
-        e.assemble()
-        K.mult(e, rhs)
-        rhs.scale(-1.0)
-        rhs.setValues(mine, np.zeros(len(mine)))
-        rhs.assemble()
-        x = K.createVecRight()
-        ksp.solve(rhs, x)
-        x.axpy(1.0, e)
-        psi.append(x)
-    ksp.destroy()
+    # constraint modes: K_fixed X = -K E (E: unit columns at the master DOFs, its b rows zeroed), psi = X + E;
+    # one MUMPS LDL^T of K_fixed, all right-hand sides in one block
+    from housingfe.solvers.mumps import ldlt
+
+    n_local = hi - lo
+    E = np.zeros((n_local, nb))
+    E[mine - lo, np.searchsorted(boundary, mine)] = 1.0
+    B = -_mat_dense(K, E)
+    B[mine - lo, :] = 0.0
+    factor = ldlt(K_fixed)
+    factor.factorise(K_fixed)
+    psi = factor.solve_block(B) + E
+    factor.destroy()
     t3 = time.perf_counter()
 
-    T = phi + psi
+    T = np.column_stack([v.getArray(readonly=True) for v in phi] + [psi]) if phi else psi
     Kr, Mr = _project(K, T), _project(M, T)
-    for v in (e, rhs, *T):
+    for v in phi:
         v.destroy()
     for A in (K_fixed, M_fixed):
         A.destroy()
@@ -172,19 +159,26 @@ def craig_bampton(model, masters: list[Master], cutoff_hz: float, tol: float = 1
     return out
 
 
-def _project(A: PETSc.Mat, T: list) -> np.ndarray:
-    """T^T A T (dense, the same on every rank): local rows of A T against local rows of T, summed over ranks."""
+def _mat_dense(A: PETSc.Mat, X: np.ndarray) -> np.ndarray:
+    """A X for this rank's rows X (rows x columns) of a distributed basis: this rank's rows of the product."""
+    n_local, m = X.shape
+    comm = A.getComm()
+    D = PETSc.Mat().createDense(((n_local, PETSc.DETERMINE), (PETSc.DECIDE, m)),
+                                array=np.asfortranarray(X, dtype=PETSc.ScalarType), comm=comm)
+    D.assemble()
+    AD = A.matMult(D)
+    out = np.array(AD.getDenseArray(), copy=True)
+    AD.destroy()
+    D.destroy()
+    return out
+
+
+def _project(A: PETSc.Mat, T: np.ndarray) -> np.ndarray:
+    """T^T A T (dense, the same on every rank) from this rank's rows of T: local rows of A T against local rows
+    of T, summed over ranks."""
     from mpi4py import MPI
 
-    y = A.createVecLeft()
-    cols = []
-    for t in T:
-        A.mult(t, y)
-        cols.append(y.getArray(readonly=True).copy())
-    AT = np.column_stack(cols) if cols else np.zeros((0, 0))
-    Tl = np.column_stack([t.getArray(readonly=True) for t in T])
-    y.destroy()
-    local = Tl.T @ AT
+    local = T.T @ _mat_dense(A, T)
     total = np.empty_like(local)
     A.getComm().tompi4py().Allreduce(local, total, op=MPI.SUM)
     return 0.5 * (total + total.T)
