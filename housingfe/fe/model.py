@@ -129,6 +129,9 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
     check_model_size(geometry, mesh, size, comm)
     housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm, grading=mesh.grading,
                          layer_size=mesh.layer_size)
+    if housing.quality["min"] < MIN_ELEMENT_QUALITY and geometry.min_thickness is None:
+        raise InputError(f"{geometry.file}: geometry.file: element quality {housing.quality['min']:.3f} < "
+                         f"{MIN_ELEMENT_QUALITY} ({housing.quality['measure']}); remesh the housing")
     if housing.quality["min"] < MIN_ELEMENT_QUALITY:
         raise InputError(f"mesh: element quality {housing.quality['min']:.3f} < {MIN_ELEMENT_QUALITY} "
                          f"({housing.quality['measure']}); change mesh.size or mesh.element")

@@ -112,6 +112,45 @@ def test_sets_become_named_surfaces_and_supports(comm, tmp_path, suffix):
     assert np.max(np.abs(f_import / f_builtin - 1)) < ROUND_TRIP
 
 
+def test_a_gmsh_file_with_physical_groups(tmp_path, comm):
+    """A .msh 4.1 written by gmsh itself (10-node tetrahedra of a 300 x 200 x 40 mm block, physical volume and
+    a physical surface "BOTTOM"): exact volume, the named surface's and the skin's exact areas, regions by the
+    physical volume's name."""
+    import gmsh
+    import ufl
+    from dolfinx import fem
+
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("block")
+        v = gmsh.model.occ.addBox(0, 0, 0, 300, 200, 40)
+        gmsh.model.occ.synchronize()
+        bottom = [t for _, t in gmsh.model.getBoundary([(3, v)], oriented=False)
+                  if abs(gmsh.model.occ.getCenterOfMass(2, t)[2]) < 1e-9]
+        gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, [v]), "solid")
+        gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, bottom), "BOTTOM")
+        gmsh.option.setNumber("Mesh.MeshSizeMax", 20.0)
+        gmsh.option.setNumber("Mesh.ElementOrder", 2)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.model.mesh.generate(3)
+        gmsh.write(str(tmp_path / "block.msh"))
+    finally:
+        gmsh.finalize()
+    extra = '[[geometry.surfaces]]\nname = "bottom"\nset = "BOTTOM"\n'
+    model = build_model_from_scene(load_housing_scene(str(mesh_scene(tmp_path, "block.msh", extra=extra)))[0], comm)
+    housing = model.housing
+    assert housing.volume == pytest.approx(0.3 * 0.2 * 0.04, rel=1e-12)
+    assert np.allclose(housing.centroid, [0.15, 0.1, 0.02], rtol=0, atol=1e-12)
+    assert "solid" in housing.cell_groups and "tetra10" in housing.quality["mesher"]
+    ds = ufl.Measure("ds", domain=housing.mesh, subdomain_data=housing.facet_tags)
+    area = {n: comm.allreduce(fem.assemble_scalar(fem.form(fem.Constant(housing.mesh, 1.0)
+                                                           * ds(housing.facet_tag_values(n)))))
+            for n in ("bottom", "outer")}
+    assert area["bottom"] == pytest.approx(0.06, rel=1e-12)
+    assert area["outer"] == pytest.approx(2 * (0.06 + 0.012 + 0.008), rel=1e-12)
+
+
 def test_units_are_honoured_and_checked(tmp_path, comm):
     """The same file declared in mm is 1000 x smaller than in m; a size implausible for the unit says which
     unit fits."""
