@@ -150,6 +150,11 @@ def read_mesh_file(path, units: str, key: str = "geometry") -> MeshFile:
         what = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InputError(f"{path}: {key}.file: cannot read as a mesh ({what}); meshio reads Abaqus .inp, "
                          "Nastran .bdf/.nas, gmsh .msh, ...") from None
+    nastran = path.suffix.lower() in (".bdf", ".nas", ".dat", ".fem")
+    if nastran and np.any(np.asarray(raw.point_data.get("nastran:ref", [])) != 0):
+        # meshio reads the coordinates as given: in a local system CP they would be wrong
+        raise InputError(f"{path}: {key}.file: GRID cards with a coordinate system CP other than 0; give the "
+                         "grid coordinates in the basic system")
     volume_blocks = [(i, b) for i, b in enumerate(raw.cells) if b.type in VOLUME_CELLS or b.type in REFUSED_CELLS]
     if not volume_blocks:
         kinds = ", ".join(sorted({b.type for b in raw.cells})) or "no cells"
@@ -242,6 +247,14 @@ def read_mesh_file(path, units: str, key: str = "geometry") -> MeshFile:
                 out.cell_sets.setdefault(name, np.unique(np.concatenate(vol)))
             if surf:
                 out.surface_sets.setdefault(name, surf)
+    if nastran:
+        ids = getattr(raw, "points_id", None)
+        index = {int(g): k for k, g in enumerate(ids)} if ids is not None else {}
+        for name, grids in _nastran_node_sets(path).items():
+            mask = np.zeros(len(used), bool)
+            rows = renumber[[index[g] for g in grids if g in index]]
+            mask[rows[rows >= 0]] = True
+            out.node_sets[name] = mask
     # Nastran property ids and gmsh physical volumes without names
     for data_key, prefix in (("nastran:ref", "PID"), ("gmsh:physical", "physical_")):
         if data_key in raw.cell_data:
@@ -252,6 +265,67 @@ def read_mesh_file(path, units: str, key: str = "geometry") -> MeshFile:
     _CACHE.clear()      # one mesh at a time: a housing mesh can be large
     _CACHE[stamp] = out
     return out
+
+
+def _nastran_cards(path: Path, keywords: tuple[str, ...]):
+    """(keyword, data fields) of the bulk-data cards named `keywords`, in free, small or large field, with their
+    continuations (a line starting with "+", "*" or ",", or a blank first field)."""
+    card = None
+
+    def fields(line: str, large: bool) -> list[str]:
+        if "," in line:
+            parts = [f.strip() for f in line.split(",")]
+            return parts[1:9]
+        width = 16 if large else 8
+        body = line[8:8 + (4 if large else 8) * width]
+        return [body[i:i + width].strip() for i in range(0, len(body), width)]
+
+    with open(path, errors="replace") as f:
+        for raw_line in f:
+            line = raw_line.rstrip("\n").expandtabs(8)
+            if not line.strip() or line.startswith("$"):
+                continue
+            head = line.split(",")[0] if "," in line else line[:8]
+            head = head.strip()
+            continuation = head.startswith(("+", "*")) or head == "" or line.startswith(",")
+            if continuation and card is not None:
+                card[1].extend(fields(line, card[2] or head.startswith("*")))
+                continue
+            if card is not None:
+                yield card[0], card[1]
+                card = None
+            if head.upper().startswith("ENDDATA"):
+                return
+            keyword = head.upper().rstrip("*")
+            if keyword in keywords:
+                card = (keyword, fields(line, head.endswith("*")), head.endswith("*"))
+    if card is not None:
+        yield card[0], card[1]
+
+
+def _nastran_node_sets(path: Path) -> dict[str, list[int]]:
+    """Node sets of a Nastran bulk-data file by GRID id: "SET1_<sid>" (SET1, THRU ranges expanded) and
+    "RBE2_<eid>" (the dependent grids of an RBE2: a bore's spider, as system-tool exports define bores)."""
+    sets: dict[str, list[int]] = {}
+    for keyword, data in _nastran_cards(path, ("SET1", "RBE2")):
+        values = [d for d in data if d]
+        try:
+            if keyword == "SET1":
+                grids, k = [], 1
+                while k < len(values):
+                    if values[k].upper() == "THRU":
+                        grids.extend(range(grids[-1] + 1, int(values[k + 1]) + 1))
+                        k += 2
+                    else:
+                        grids.append(int(values[k]))
+                        k += 1
+                sets.setdefault(f"SET1_{int(values[0])}", []).extend(grids)
+            else:           # RBE2 EID GN CM GM1 ... [ALPHA [TREF]]
+                grids = [int(v) for v in values[3:] if v.lstrip("+-").isdigit()]
+                sets[f"RBE2_{int(values[0])}"] = grids
+        except (ValueError, IndexError):
+            raise InputError(f"{path}: geometry.file: malformed {keyword} card {' '.join(values)}") from None
+    return sets
 
 
 def _hex20_to_hex27(points: np.ndarray, cells: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -507,7 +581,7 @@ def write_mesh_file(housing, path, units: str = "m", order: int | None = None, n
         out.field_data.update({name: np.array([i + 2, 2]) for i, name in enumerate(cell_sets)})
         meshio.write(str(path), out, file_format="gmsh22", binary=False)
     elif path.suffix.lower() in (".bdf", ".nas"):
-        _write_nastran(path, out.points, meshio_type, cells_vtk)
+        _write_nastran(path, out.points, meshio_type, cells_vtk, point_sets)
     else:
         meshio.write(str(path), out)
     return path
@@ -517,9 +591,11 @@ def write_mesh_file(housing, path, units: str = "m", order: int | None = None, n
 _NASTRAN_HEX20 = list(range(12)) + [16, 17, 18, 19, 12, 13, 14, 15]
 
 
-def _write_nastran(path: Path, points: np.ndarray, meshio_type: str, cells_vtk: np.ndarray) -> None:
+def _write_nastran(path: Path, points: np.ndarray, meshio_type: str, cells_vtk: np.ndarray,
+                   node_sets: dict | None = None) -> None:
     """Nastran bulk data: GRID* in large field (16-character reals, 10 significant digits: meshio 5.0's writer
-    overflows the field on negative coordinates) and CTETRA / CHEXA in free field with continuations."""
+    overflows the field on negative coordinates), CTETRA / CHEXA in free field with continuations, and each node
+    set as SET1 <k> (k = 1, 2, ... in the order given; read back as "SET1_<k>")."""
     name = {"tetra": "CTETRA", "tetra10": "CTETRA", "hexahedron": "CHEXA", "hexahedron20": "CHEXA"}[meshio_type]
     cells = cells_vtk[:, _NASTRAN_HEX20] if meshio_type == "hexahedron20" else cells_vtk
     with open(path, "w") as f:
@@ -528,6 +604,12 @@ def _write_nastran(path: Path, points: np.ndarray, meshio_type: str, cells_vtk: 
             f.write(f"GRID*   {i:<16d}{'':16s}{x:16.9E}{y:16.9E}*\n*       {z:16.9E}\n")
         for e, cell in enumerate(cells + 1, start=1):
             fields = [name, str(e), "1"] + [str(n) for n in cell]
+            f.write(",".join(fields[:9]) + "\n")
+            for k in range(9, len(fields), 8):
+                f.write("+," + ",".join(fields[k:k + 8]) + "\n")
+        for sid, (name, nodes) in enumerate((node_sets or {}).items(), start=1):
+            f.write(f"$ SET1 {sid}: {name}\n")
+            fields = ["SET1", str(sid)] + [str(n + 1) for n in nodes]
             f.write(",".join(fields[:9]) + "\n")
             for k in range(9, len(fields), 8):
                 f.write("+," + ",".join(fields[k:k + 8]) + "\n")

@@ -88,15 +88,35 @@ def test_round_trip_gives_the_built_in_modes(comm, tmp_path, element, size, file
         assert_same_modes(frequencies(imported), reference)
 
 
-@pytest.mark.parametrize("suffix", [".inp", ".msh"])
+def _small_field_rbe2(eid: int, independent: int, grids) -> str:
+    """An RBE2 card in small (8-character) fixed field with "+" continuations, as Nastran pre-processors write."""
+    fields = [str(eid), str(independent), "123456"] + [str(g) for g in grids]
+    lines, first = [], fields[:8]
+    lines.append("RBE2    " + "".join(f"{f:<8s}" for f in first) + "+C1")
+    rest = fields[8:]
+    for k in range(0, len(rest), 8):
+        lines.append("+C1     " + "".join(f"{f:<8s}" for f in rest[k:k + 8]) + ("+C1" if k + 8 < len(rest) else ""))
+    return "\n".join(lines) + "\n"
+
+
+@pytest.mark.parametrize("suffix", [".inp", ".msh", ".bdf"])
 def test_sets_become_named_surfaces_and_supports(comm, tmp_path, suffix):
-    """Abaqus node sets and gmsh physical surfaces named in [[geometry.surfaces]] / [[geometry.bores]] become
-    facet groups with the built-in facets; supports on them give the built-in supported box's modes."""
+    """Abaqus node sets, gmsh physical surfaces and Nastran SET1 / RBE2 dependent grids named in
+    [[geometry.surfaces]] / [[geometry.bores]] become facet groups with the built-in facets; supports on them give
+    the built-in supported box's modes."""
     supports = ['supports=[{surface="bolt_1", kind="fixed"}, {surface="bolt_5", kind="fixed"}]']
     model = build_model_from_scene(builtin("hex", 0.06, *supports), comm)
-    write_mesh_file(model.housing, tmp_path / f"box{suffix}", units="m", node_sets=["bolt_1", "bolt_5"])
-    extra = ('[[geometry.bores]]\nname = "bolt_1"\nset = "bolt_1"\n'
-             '[[geometry.surfaces]]\nname = "bolt_5"\nset = "bolt_5"\n'
+    path = write_mesh_file(model.housing, tmp_path / f"box{suffix}", units="m", node_sets=["bolt_1", "bolt_5"])
+    sets = {"bolt_1": "bolt_1", "bolt_5": "bolt_5"}
+    if suffix == ".bdf":        # SET1 1 = bolt_1 (written); bolt_5 as the dependent grids of an RBE2 spider
+        text = path.read_text()
+        head, body = text.split("$ SET1 2: bolt_5\n")
+        grids = [int(g) for line in body.split("ENDDATA")[0].splitlines() for g in line.split(",")[1:] if g]
+        grids = grids[1:]       # the SID
+        path.write_text(head + _small_field_rbe2(99, grids[0], grids) + "ENDDATA\n")
+        sets = {"bolt_1": "SET1_1", "bolt_5": "RBE2_99"}
+    extra = (f'[[geometry.bores]]\nname = "bolt_1"\nset = "{sets["bolt_1"]}"\n'
+             f'[[geometry.surfaces]]\nname = "bolt_5"\nset = "{sets["bolt_5"]}"\n'
              '[[supports]]\nsurface = "bolt_1"\nkind = "fixed"\n[[supports]]\nsurface = "bolt_5"\nkind = "fixed"\n')
     scene = load_housing_scene(str(mesh_scene(tmp_path, f"box{suffix}", units="m", extra=extra)))[0]
     imported = build_model_from_scene(scene, comm)
@@ -110,6 +130,28 @@ def test_sets_become_named_surfaces_and_supports(comm, tmp_path, suffix):
     f_import = frequencies(imported)
     assert len(f_import) == len(f_builtin) and f_builtin[0] > 100.0       # supported: no rigid modes
     assert np.max(np.abs(f_import / f_builtin - 1)) < ROUND_TRIP
+
+
+def test_nastran_set_cards_in_every_field_format(tmp_path):
+    """SET1 (with THRU) and RBE2 in free, small and large field with continuations; CP != 0 is refused."""
+    from housingfe.geometry.imported_mesh import _nastran_node_sets
+
+    path = tmp_path / "sets.bdf"
+    path.write_text("BEGIN BULK\n"
+                    "SET1,7,1,2,5,THRU,8\n"
+                    "SET1    8       20      THRU    23      30                              +S\n"
+                    "+S      31      32\n"
+                    "RBE2*   11              100             123456          40              *R\n"
+                    "*R      41              42\n"
+                    "RBE2,12,100,123456,50,51,,,,\n+,52,1.0e-5\n"
+                    "ENDDATA\n")
+    assert _nastran_node_sets(path) == {"SET1_7": [1, 2, 5, 6, 7, 8], "SET1_8": [20, 21, 22, 23, 30, 31, 32],
+                                        "RBE2_11": [40, 41, 42], "RBE2_12": [50, 51, 52]}
+    local = tmp_path / "local.bdf"
+    local.write_text("BEGIN BULK\nGRID,1,,0.,0.,0.\nGRID,2,1,100.,0.,0.\nGRID,3,,0.,100.,0.\nGRID,4,,0.,0.,100.\n"
+                     "CTETRA,1,1,1,2,3,4\nENDDATA\n")
+    with pytest.raises(InputError, match="local.bdf: geometry.file: GRID cards with a coordinate system CP other"):
+        read_mesh_file(local, "mm")
 
 
 def test_a_gmsh_file_with_physical_groups(tmp_path, comm):
