@@ -469,6 +469,7 @@ def build_imported_mesh(geometry: MeshGeometry, comm, key: str = "geometry"):
         raise InputError(f"{geometry.file}: {key}.file: the mesh has no volume")
     centroid = np.array([comm.allreduce(fem.assemble_scalar(fem.form(xs[i] * ufl.dx(domain=mesh))), op=MPI.SUM)
                          for i in range(3)]) / volume
+    _CACHE.clear()      # the file's arrays are in the dolfinx mesh now
     return dict(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=cell_groups,
                 facet_groups=facet_groups, volume=volume, centroid=centroid, element_size=size,
                 element="tet" if cell_type == "tetrahedron" else "hex", mesh_time_s=time.perf_counter() - t0,

@@ -28,6 +28,7 @@ from housingfe.drivetrain.reduction import (
     MASTER_GRID_BASE,
     MODAL_SPOINT_BASE,
     Master,
+    ReducedHousing,
     craig_bampton,
     read_dmig,
     write_dmig,
@@ -148,6 +149,32 @@ def test_cli_writes_the_folder_and_refuses_unknown_masters(tmp_path, capsys):
                 + [a for s in BOX for a in ("--set", s)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--master: no surface 'bore_9'" in err[0] and not bad.exists()
+
+
+def test_reduce_an_imported_mesh_at_its_bores(tmp_path, box):
+    """`housingfe reduce` on a "mesh" geometry takes its [[geometry.bores]] as masters: the Abaqus file of the
+    same box with the four bolt patches as node sets gives the reduced model of the built-in box (1e-8)."""
+    from housingfe.geometry.imported_mesh import write_mesh_file
+
+    model, masters, red = box
+    write_mesh_file(model.housing, tmp_path / "box.inp", units="mm", node_sets=list(MASTERS))
+    bores = "".join(f'[[geometry.bores]]\nname = "{n}"\nset = "{n}"\n' for n in MASTERS)
+    (tmp_path / "box.toml").write_text('[scene]\nname = "box-inp"\nkind = "housing"\n[geometry]\nkind = "mesh"\n'
+                                       f'file = "box.inp"\nunits = "mm"\n{bores}[mesh]\ndegree = 2\n'
+                                       '[analysis.modal]\nf_max = 2000.0\n')
+    out = tmp_path / "red"
+    assert main(["reduce", str(tmp_path / "box.toml"), "--cutoff", str(CUTOFF), "--out", str(out)]) == 0
+    data = np.load(out / "reduced.npz")
+    assert list(data["master_names"]) == list(MASTERS)
+    assert np.allclose(data["master_xyz"], [m.position for m in masters], rtol=0, atol=1e-12)
+    assert np.allclose(data["fixed_interface_hz"], red.frequencies_hz, rtol=1e-8)
+    n = red.n_modes     # modal coordinates may differ in sign: compare the master blocks and the spectrum
+    assert np.allclose(data["K"][n:, n:], red.K[n:, n:], rtol=1e-8, atol=1e-8 * np.abs(red.K).max())
+    K6s = {m.name: K6 for m in masters}
+    back = ReducedHousing(data["K"], data["M"], data["fixed_interface_hz"],
+                          [Master(str(a), str(b), x) for a, b, x in zip(data["master_names"], data["master_surfaces"],
+                                                                       data["master_xyz"])], CUTOFF)
+    assert np.allclose(back.frequencies_with(K6s), red.frequencies_with(K6s), rtol=1e-8)
 
 
 def mpi_case(comm) -> dict:
