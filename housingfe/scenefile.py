@@ -151,7 +151,8 @@ def parse_table(model_cls, data, path, prefix: str = ""):
     if bad is not None:     # TOML allows inf and nan; pydantic would pass inf as a positive length
         raise InputError(f"{path}: {prefix}{bad[0]}: {bad[1]} is not a finite number")
     try:
-        return model_cls.model_validate(data)
+        # the context lets file-valued keys (a mesh file) be given relative to the scene file
+        return model_cls.model_validate(data, context={"scene_path": Path(path)})
     except ValidationError as exc:
         raise InputError(f"{path}: {prefix}{_first_error(exc)}") from None
 

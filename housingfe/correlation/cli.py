@@ -18,6 +18,9 @@ def register_cli(subparsers) -> None:
     p.add_argument("--measured", default=None, metavar="FILE", help="measured modes: .uff/.unv (15/2411 + 55) or .csv")
     p.add_argument("--export", default=None, metavar="FILE.uff",
                    help="write our modes at --points surface points, their geometry and point FRFs as UFF")
+    p.add_argument("--units", choices=("m", "mm", "cm", "in"), default=None,
+                   help="unit of the measured coordinates where the file has no units dataset (UFF 164); "
+                        "default m")
     p.add_argument("--points", type=int, default=36, help="--export: number of surface points (default 36)")
     p.add_argument("--f-max", type=float, default=None,
                    help="modes below this frequency (Hz; default 1.25 x the highest measured mode, or the scene's)")
@@ -61,7 +64,9 @@ def _cmd_correlate(args: argparse.Namespace) -> int:
     from housingfe.scene import build_model_from_scene, load_housing_scene
     from housingfe.solvers.modal import modes
 
-    measured = uff.read_measured_modes(args.measured) if args.measured else None
+    if args.units is not None and args.measured is None:
+        raise InputError("--units: applies to --measured files only (exports are written in m with UFF 164)")
+    measured = uff.read_measured_modes(args.measured, args.units) if args.measured else None
     scene, scene_path = load_housing_scene(args.scene, args.set or [])
     if measured is not None:     # the folder written at the end: checked and locked before the solve
         reserve_output(args.out or f"results/correlate-{Path(args.scene).stem}", MPI.COMM_WORLD,
@@ -73,13 +78,14 @@ def _cmd_correlate(args: argparse.Namespace) -> int:
     name = Path(args.scene).stem
     out_dir = args.out or f"results/correlate-{name}"
     if measured is not None:
-        correlate_measured(basis, measured, out_dir, args.threshold, args.loss_factor, args.measured)
+        correlate_measured(basis, measured, out_dir, args.threshold, args.loss_factor, args.measured, args.units)
     else:
         export_uff(basis, args.export, args.points, args.loss_factor)
     return 0
 
 
-def correlate_measured(basis, measured, out_dir, threshold: float, loss_factor: float, source: str) -> None:
+def correlate_measured(basis, measured, out_dir, threshold: float, loss_factor: float, source: str,
+                       units: str | None = None) -> None:
     """MAC, pairing and frequency-error table of measured vs computed modes; FRAC of the measured FRFs of a
     UFF file against modal receptances at the same channels.  Writes pairs.csv, mac.csv, mac.png,
     computed.uff (our modes on the measured nodes) and frf.csv (if FRFs were measured) atomically."""
@@ -102,7 +108,7 @@ def correlate_measured(basis, measured, out_dir, threshold: float, loss_factor: 
     say(f"channels: {len(measured.node_ids)} (snapping distance max {np.max(np.linalg.norm(comp.points - measured.points, axis=1)) * 1e3:.2f} mm)")
     frf_rows = []
     if Path(source).suffix.lower() != ".csv":
-        data = uff.read_uff(source)
+        data = uff.read_uff(source, units)
         if data.frfs and data.nodes is not None:
             frf_rows = _frf_correlation(basis, data, loss_factor, frac)
             for row in frf_rows:

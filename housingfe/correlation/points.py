@@ -60,8 +60,11 @@ def computed_modes_at(basis, measured: ModeSet, *, elastic_only: bool = True, su
     """The modes of a housingfe.solvers.modal.ModalBasis sampled on the channels of a measured ModeSet (same
     point ids, snapped points, directions); elastic modes only unless elastic_only is False."""
     structure = basis.structure
-    channels = snap_channels(structure.housing, measured.points, measured.directions, surface=surface,
-                             tolerance=tolerance, source=measured.source or "measured")
+    try:
+        channels = snap_channels(structure.housing, measured.points, measured.directions, surface=surface,
+                                 tolerance=tolerance, source=measured.source or "measured")
+    except InputError as exc:
+        raise InputError(f"{exc}{unit_hint(structure.housing, measured.points, surface, tolerance)}") from None
     start = basis.rigid_count if elastic_only else 0
     vectors = [structure.to_housing(x) for x in basis.vectors[start:]]
     shapes = ChannelSampler(structure.V, channels).sample(vectors)
@@ -79,3 +82,27 @@ def modal_receptance(shapes_response: np.ndarray, shapes_reference: np.ndarray, 
     w2 = (2 * np.pi * np.asarray(lines_hz, float)) ** 2
     den = wr2[None, :] * (1 + 1j * loss_factor) - w2[:, None]            # (lines, modes)
     return np.einsum("ir,jr,fr->ijf", shapes_response, shapes_reference, 1.0 / den)
+
+
+# What a measured file's coordinates may have been written in when they were read as m: factor to m
+UNIT_GUESSES = (("mm", 1e-3), ("cm", 1e-2), ("in", 0.0254))
+
+
+def unit_hint(housing, points: np.ndarray, surface: str | None = None, tolerance: float | None = None) -> str:
+    """"; the points fit the surface if read in mm (--units mm)" when the measured points (m, as read), scaled
+    by one of UNIT_GUESSES, all lie within `tolerance` (default one element size) of the surface; else the
+    largest distances (m) under each guess.  Identical on every rank."""
+    from housingfe.response.observers import _surface_triangles, closest_point_on_triangles
+
+    names = [surface] if surface is not None else sorted(housing.facet_groups)
+    tris, _ = _surface_triangles(housing, names)
+    tol = tolerance if tolerance is not None else housing.element_size
+    pts = np.unique(np.round(np.asarray(points, float).reshape(-1, 3), 9), axis=0)
+    worst = {}
+    for unit, factor in UNIT_GUESSES:
+        worst[unit] = max(float(closest_point_on_triangles(p * factor, tris)[1].min()) for p in pts)
+    fits = [u for u, d in worst.items() if d <= tol]
+    if fits:
+        return f"; the points fit the surface if read in {fits[0]} (--units {fits[0]})"
+    far = ", ".join(f"{u}: {d:.3g} m" for u, d in worst.items())
+    return f"; read in other units they would lie up to ({far}) from it: check the coordinates"

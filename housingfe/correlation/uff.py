@@ -4,7 +4,13 @@ A mode set is held per *channel*: one measured point and one unit direction (glo
 any unit vector in a CSV table).  Shapes are (channels x modes), real or complex, in the units of the file
 (only MAC-type, scale-free comparisons are made with them).  Coordinates are in m, frequencies in Hz.
 
-UFF datasets used: 15 and 2411 (nodes), 55 (modes at nodes, 3 translations per node), 58 (FRFs, one
+Units: coordinates are converted to m by the file's units dataset 164 (SI = file value / its length factor:
+1000 for mm) or, where the file has none, by the `units` a caller gives ("m", "mm", "cm", "in"; `housingfe
+correlate --units`, an update target's `units`); a given unit that contradicts the file's 164 is an error.
+Without either, coordinates are taken as m.  Shapes and FRF values stay in the file's units (MAC and FRAC are
+scale-free).
+
+UFF datasets used: 164 (units), 15 and 2411 (nodes), 55 (modes at nodes, 3 translations per node), 58 (FRFs, one
 response/reference channel pair per dataset).  Writing uses the same datasets, so users' EMA tools read our
 modes, point FRFs and geometry.
 """
@@ -19,6 +25,11 @@ import numpy as np
 from housingfe.errors import InputError
 
 _AXES = np.eye(3)
+# metres per unit of length of a measured file's coordinates
+LENGTH_UNITS = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "in": 0.0254}
+# UFF 164 units codes (1 SI, 2 BG foot, 3 MG metre, 4 BA foot, 5 MM, 6 CM, 7 IN, 8 GM mm, 9 user)
+_UFF_UNITS_NAME = {1: "SI (m)", 2: "BG (ft)", 3: "MG (m)", 4: "BA (ft)", 5: "MM (mm)", 6: "CM (cm)", 7: "IN (in)",
+                   8: "GM (mm)", 9: "user-defined"}
 # UFF 58 direction codes: 1..3 = +x..+z, -1..-3 = -x..-z
 _DIR_CODE = {1: _AXES[0], 2: _AXES[1], 3: _AXES[2], -1: -_AXES[0], -2: -_AXES[1], -3: -_AXES[2]}
 
@@ -103,17 +114,39 @@ def _sets(path: Path) -> list[dict]:
     return sets
 
 
-def read_uff(path: str | Path) -> UffData:
+def length_scale(path: Path, sets: list[dict], units: str | None = None, key: str = "--units") -> float:
+    """Metres per unit of the file's coordinates: from its units dataset 164 (SI = value / length factor), else
+    from `units` (LENGTH_UNITS), else 1.  InputError naming the file and `key` when both are given and differ."""
+    if units is not None and units not in LENGTH_UNITS:
+        raise InputError(f"{path}: {key}: unknown unit {units!r} (one of {', '.join(LENGTH_UNITS)})")
+    given = LENGTH_UNITS[units] if units is not None else None
+    unit_sets = [s for s in sets if s.get("type") == 164]
+    if not unit_sets:
+        return given if given is not None else 1.0
+    factor = float(unit_sets[0].get("length", 1.0) or 1.0)
+    if not np.isfinite(factor) or factor <= 0:
+        raise InputError(f"{path}: UFF 164: length factor {factor} is not a positive number")
+    scale = 1.0 / factor
+    if given is not None and abs(given / scale - 1) > 1e-6:
+        code = int(unit_sets[0].get("units_code", 9) or 9)
+        raise InputError(f"{path}: {key}: {units} contradicts the file's units dataset 164 "
+                         f"({_UFF_UNITS_NAME.get(code, code)}, {scale:g} m per unit); drop {key} or fix the file")
+    return scale
+
+
+def read_uff(path: str | Path, units: str | None = None, key: str = "--units") -> UffData:
     """Read nodes (15/2411), modes (55, analysis type 2/3: normal or complex modes) and FRFs (58) from a
-    universal file.  Nodes are needed to place the mode channels; InputError naming the file otherwise."""
+    universal file, coordinates in m (see length_scale: the file's 164, else `units`, else m).  Nodes are
+    needed to place the mode channels; InputError naming the file otherwise."""
     path = Path(path)
     sets = _sets(path)
+    scale = length_scale(path, sets, units, key)
     nodes = None
     node_sets = [s for s in sets if s.get("type") in (15, 2411)]
     if node_sets:
         ids = np.concatenate([np.asarray(s["node_nums"], int) for s in node_sets])
         xyz = np.concatenate([np.column_stack([s["x"], s["y"], s["z"]]) for s in node_sets])
-        nodes = Nodes(ids, xyz.astype(float))
+        nodes = Nodes(ids, xyz.astype(float) * scale)
     mode_sets = [s for s in sets if s.get("type") == 55]
     modes = None
     if mode_sets:
@@ -159,11 +192,13 @@ def _frf_from_58(s: dict) -> FRF:
 CSV_COLUMNS = ("mode", "frequency_hz", "point", "x", "y", "z", "dx", "dy", "dz", "value")
 
 
-def read_mode_csv(path: str | Path) -> ModeSet:
+def read_mode_csv(path: str | Path, units: str | None = None, key: str = "--units") -> ModeSet:
     """A mode table in long form, one row per mode and channel, columns
-    mode, frequency_hz, point, x, y, z (m), dx, dy, dz (direction, normalised here), value (shape component).
+    mode, frequency_hz, point, x, y, z (m, or in `units`), dx, dy, dz (direction, normalised here), value (shape
+    component).
     Every mode must give the same channels.  InputError naming the file, row and column on bad input."""
     path = Path(path)
+    scale = length_scale(path, [], units, key)
     if not path.is_file():
         raise InputError(f"{path}: file not found")
     try:
@@ -182,7 +217,7 @@ def read_mode_csv(path: str | Path) -> ModeSet:
         try:
             mode = int(row["mode"])
             f = float(row["frequency_hz"])
-            pt = (float(row["x"]), float(row["y"]), float(row["z"]))
+            pt = (float(row["x"]) * scale, float(row["y"]) * scale, float(row["z"]) * scale)
             d = np.array([float(row["dx"]), float(row["dy"]), float(row["dz"])])
             value = complex(row["value"].replace(" ", "").replace("i", "j"))
         except (TypeError, ValueError) as exc:
@@ -213,12 +248,13 @@ def _point_id(name: str, fallback: int) -> int:
         return fallback + 1
 
 
-def read_measured_modes(path: str | Path) -> ModeSet:
-    """Measured modes from a UFF (.uff/.unv, datasets 15/2411 + 55) or a CSV mode table (.csv)."""
+def read_measured_modes(path: str | Path, units: str | None = None, key: str = "--units") -> ModeSet:
+    """Measured modes from a UFF (.uff/.unv, datasets 15/2411 + 55, 164 honoured) or a CSV mode table (.csv);
+    units: the coordinates' unit where the file does not say (LENGTH_UNITS), named `key` in messages."""
     path = Path(path)
     if path.suffix.lower() == ".csv":
-        return read_mode_csv(path)
-    data = read_uff(path)
+        return read_mode_csv(path, units, key)
+    data = read_uff(path, units, key)
     if data.modes is None:
         raise InputError(f"{path}: no UFF 55 mode shapes in the file")
     return data.modes
@@ -226,14 +262,24 @@ def read_measured_modes(path: str | Path) -> ModeSet:
 
 # ------------------------------------------------------------------------------------------------ writing
 def write_uff(path: str | Path, nodes: Nodes, modes: ModeSet | None = None, frfs: list | None = None,
-              description: str = "housingfe") -> None:
-    """Write nodes (UFF 2411), modes (UFF 55, normal modes, 3 translations per node: channels along x, y, z
-    at nodes of `nodes`) and FRFs (UFF 58) to one universal file, replacing it."""
+              description: str = "housingfe", units: str = "m", units_dataset: bool = True) -> None:
+    """Write units (UFF 164, unless units_dataset is False), nodes (UFF 2411; coordinates given in m, written in
+    `units`: "m" or "mm"), modes (UFF 55, normal modes, 3 translations per node: channels along x, y, z at nodes
+    of `nodes`) and FRFs (UFF 58) to one universal file, replacing it."""
     import pyuff
 
-    sets = [pyuff.prepare_2411(node_nums=np.asarray(nodes.ids, int), def_cs=np.ones(len(nodes.ids), int),
-                               disp_cs=np.ones(len(nodes.ids), int), color=np.ones(len(nodes.ids), int),
-                               x=nodes.xyz[:, 0], y=nodes.xyz[:, 1], z=nodes.xyz[:, 2])]
+    if units not in ("m", "mm"):
+        raise InputError(f"write_uff: units {units!r}: write m or mm")
+    xyz = nodes.xyz / LENGTH_UNITS[units]
+    sets = []
+    if units_dataset:       # 164: SI = file value / length factor; code 1 = SI (m, N), 5 = MM (mm, mN)
+        mm = units == "mm"
+        sets.append(pyuff.prepare_164(units_code=5 if mm else 1, units_description="mm" if mm else "SI",
+                                      temp_mode=2, length=1000.0 if mm else 1.0, force=1000.0 if mm else 1.0,
+                                      temp=1.0, temp_offset=273.15))
+    sets.append(pyuff.prepare_2411(node_nums=np.asarray(nodes.ids, int), def_cs=np.ones(len(nodes.ids), int),
+                                   disp_cs=np.ones(len(nodes.ids), int), color=np.ones(len(nodes.ids), int),
+                                   x=xyz[:, 0], y=xyz[:, 1], z=xyz[:, 2]))
     if modes is not None:
         per_node = _node_components(modes, nodes)
         for k, f in enumerate(modes.frequencies_hz):

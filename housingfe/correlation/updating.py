@@ -67,6 +67,8 @@ class TargetSpec(_Strict):
     mode: Optional[int] = Field(None, ge=1)           # frequency: 1 = first elastic mode
     band_hz: Optional[PositiveFloat] = None           # count
     measured: Optional[str] = None                    # paired: UFF or CSV file
+    # paired: the unit of the measured coordinates where the file has no units dataset (UFF 164)
+    units: Optional[Literal["m", "mm", "cm", "in"]] = None
     threshold: float = Field(0.6, ge=0.0, le=1.0)     # paired: MAC threshold
     use_mac: bool = False                             # paired: add (1 - MAC) / sigma_mac residuals
     sigma_mac: PositiveFloat = 0.1
@@ -215,11 +217,11 @@ class SceneEvaluator:
         scenes = sorted({t.scene for t in spec.targets})
         self.scene_data = {s: _scene_data(spec, s) for s in scenes}
         self.measured = {}
-        for t in spec.targets:
+        for i, t in enumerate(spec.targets):
             if t.kind == "paired":
                 from housingfe.correlation.uff import read_measured_modes
 
-                self.measured[t.name] = read_measured_modes(t.measured)
+                self.measured[t.name] = read_measured_modes(t.measured, t.units, f"targets.{i}.units")
 
     def overrides(self, scene: str, values: np.ndarray, extra: list[str]) -> list[str]:
         """The --set overrides of one evaluation: the spec's scene_overrides, `extra` (search or confirmation

@@ -108,6 +108,8 @@ def element_size(mesh, geometry, f_max: float, material: Material) -> float:
     (Hz) divided by mesh.elements_per_wavelength.  mesh: a housingfe.scene.MeshSpec; geometry: a geometry spec."""
     if mesh.size is not None:
         return mesh.size
+    if geometry.min_thickness is None:      # an imported mesh brings its own elements
+        return 0.0
     wavelength = bending_wavelength(f_max, geometry.min_thickness,
                                     material.youngs_modulus, material.poisson_ratio, material.density)
     return wavelength / mesh.elements_per_wavelength
@@ -132,6 +134,9 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
     check_model_size(geometry, mesh, size, comm)
     housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm, grading=mesh.grading,
                          layer_size=mesh.layer_size)
+    if housing.quality["min"] < MIN_ELEMENT_QUALITY and geometry.min_thickness is None:
+        raise InputError(f"{geometry.file}: geometry.file: element quality {housing.quality['min']:.3f} < "
+                         f"{MIN_ELEMENT_QUALITY} ({housing.quality['measure']}); remesh the housing")
     if housing.quality["min"] < MIN_ELEMENT_QUALITY:
         raise InputError(f"mesh: element quality {housing.quality['min']:.3f} < {MIN_ELEMENT_QUALITY} "
                          f"({housing.quality['measure']}); change mesh.size or mesh.element")
@@ -173,6 +178,11 @@ def check_model_size(geometry, mesh, size: float, comm) -> dict:
     need = MEMORY_BASE_BYTES * comm.size + MEMORY_PER_DOF_BYTES * dofs
     available, total = comm.bcast(available_memory_bytes() if comm.rank == 0 else None, root=0)
     estimate = {"dofs": dofs, "memory_bytes": need, "available_bytes": available, "total_bytes": total}
+    if available and need > available and not mesh.allow_large and geometry.min_thickness is None:
+        raise InputError(f"{geometry.file}: mesh.degree: model too large: ~{dofs:,} DOFs at degree {mesh.degree} "
+                         f"need ~{need / 1e9:.1f} GB, this machine has {available / 1e9:.1f} GB available "
+                         f"(MemAvailable, {total / 1e9:.1f} GB total); use a coarser mesh file or a lower "
+                         f"mesh.degree, or set mesh.allow_large = true to run anyway")
     if available and need > available and not mesh.allow_large:
         size_key = "mesh.size" if mesh.size is not None else "mesh.elements_per_wavelength"
         lengths = {k: v for k, v in geometry.model_dump().items()

@@ -9,6 +9,7 @@ import numpy as np
 
 from housingfe.errors import InputError
 from housingfe.geometry.blocks import build_gmsh_model, tet_quality
+from housingfe.geometry.registry import own_mesh_kind
 
 # the registry's lookup, with the built-in kinds registered (specs imports their modules)
 from housingfe.geometry.specs import block_model_for
@@ -73,6 +74,9 @@ def estimate_dofs(geometry, element: str, degree: int, size: float, layers: int,
     estimate within 10 %)."""
     from housingfe.geometry.blocks import divisions
 
+    imported = own_mesh_kind(geometry)
+    if imported is not None:        # the mesh is given: count it
+        return imported.estimate_dofs(geometry, degree)
     model = block_model_for(geometry)
     steps = [np.diff(g) for g in model.grid]
     cells = 0
@@ -90,6 +94,11 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
     layers: elements through a wall thickness (hex meshes); layer_size (m): with it, at least
     ceil(thickness / layer_size) elements through each wall (hex meshes, `blocks.divisions`).
     """
+    imported = own_mesh_kind(geometry)
+    if imported is not None:        # a mesh file: element, size and layers are the file's
+        fields = imported.mesh(geometry, comm)
+        quality = {**element_quality(fields["mesh"]), **fields.pop("quality")}
+        return HousingMesh(**fields, quality=quality)
     import gmsh
     from dolfinx.io import gmshio
 

@@ -26,23 +26,38 @@ class StrictSpec(BaseModel):
 
 @dataclass(frozen=True)
 class GeometryKind:
-    """A registered geometry kind: its scene spec class and its builder (spec -> BlockModel)."""
+    """A registered geometry kind: its scene spec class and its builder (spec -> BlockModel).
+
+    Kinds that bring their own mesh (an imported mesh file) have no block model: `mesh(spec, comm)` returns the
+    fields of the distributed housingfe.geometry.mesh.HousingMesh (a dict; build_mesh adds the quality) and `estimate_dofs(spec, degree)` its displacement DOFs."""
 
     spec: type
-    build: Callable
+    build: Callable | None
+    mesh: Callable | None = None
+    estimate_dofs: Callable | None = None
 
 
 GEOMETRY_KINDS: dict[str, GeometryKind] = {}
 
 
-def register_geometry(spec: type, build: Callable) -> type:
+def register_geometry(spec: type, build: Callable | None, *, mesh: Callable | None = None,
+                      estimate_dofs: Callable | None = None) -> type:
     """Register a geometry kind: `spec` is a pydantic model with `kind: Literal["<name>"]`, `build(spec)` returns
-    its housingfe.geometry.blocks.BlockModel.  Returns spec."""
+    its housingfe.geometry.blocks.BlockModel; a kind with its own mesh gives build=None, `mesh(spec, comm)` ->
+    the HousingMesh fields (dict) and `estimate_dofs(spec, degree)` -> DOFs instead.  Returns spec."""
     (name,) = typing.get_args(spec.model_fields["kind"].annotation)
     if name in GEOMETRY_KINDS:
         raise ValueError(f"geometry kind {name!r} is registered twice")
-    GEOMETRY_KINDS[name] = GeometryKind(spec, build)
+    if (build is None) == (mesh is None):
+        raise ValueError(f"geometry kind {name!r}: give either a block-model builder or a mesher")
+    GEOMETRY_KINDS[name] = GeometryKind(spec, build, mesh, estimate_dofs)
     return spec
+
+
+def own_mesh_kind(geometry) -> GeometryKind | None:
+    """The registered kind of a geometry section if it brings its own mesh (no block model), else None."""
+    kind = GEOMETRY_KINDS.get(geometry.kind)
+    return kind if kind is not None and kind.mesh is not None else None
 
 
 def geometry_union():
@@ -57,4 +72,6 @@ def block_model_for(geometry):
     kind = GEOMETRY_KINDS.get(geometry.kind)
     if kind is None:
         raise InputError(f"geometry.kind: no builder for {geometry.kind!r}")
+    if kind.build is None:
+        raise InputError(f"geometry.kind: a {geometry.kind!r} geometry is a mesh, not a block model")
     return kind.build(geometry)

@@ -7,7 +7,7 @@ scene's geometry section, is the discriminated union (on `kind`) of the register
 """
 from __future__ import annotations
 
-# registration order = the order of the kinds in the scene's messages: box, plate, box-halves, gearbox
+# registration order = the order of the kinds in the scene's messages: box, plate, box-halves, gearbox, mesh
 # isort: off
 from housingfe.geometry.box import BoxGeometry
 from housingfe.geometry.plate import EdgeCondition, PlateEdges, PlateGeometry
@@ -21,11 +21,12 @@ from housingfe.geometry.housings import (
     RibSpec,
     RimSpec,
 )
+from housingfe.geometry.imported_mesh import MeshGeometry, MeshSet
 # isort: on
 from housingfe.geometry.registry import GEOMETRY_KINDS, block_model_for, geometry_union, register_geometry
 
 __all__ = ["GEOMETRY_KINDS", "BearingPlateSpec", "BoreSpec", "BoxGeometry", "BoxHalvesGeometry", "CoverSpec",
-           "EdgeCondition", "FeetSpec", "GearboxGeometry", "Geometry", "PlateEdges", "PlateGeometry", "RibSpec",
+           "EdgeCondition", "FeetSpec", "GearboxGeometry", "Geometry", "MeshGeometry", "MeshSet", "PlateEdges", "PlateGeometry", "RibSpec",
            "RimSpec", "block_model_for", "geometry_union", "register_geometry"]
 
 Geometry = geometry_union()
