@@ -31,6 +31,8 @@ def register_cli(subparsers) -> None:
                                              "(bounded least squares; docs/correlation.md)")
     p.add_argument("spec", help="update spec (TOML): parameters, targets, search and confirmation meshes")
     p.add_argument("--out", default=None, help="result folder (default results/update-<name>)")
+    p.add_argument("--no-resume", action="store_true",
+                   help="do not re-use the evaluations an interrupted run left in <out>.partial/ (docs/progress.md)")
     p.set_defaults(func=_cmd_update)
 
 
@@ -38,7 +40,7 @@ def _cmd_update(args: argparse.Namespace) -> int:
     from housingfe.correlation.updating import load_update_spec, run_update
 
     spec = load_update_spec(args.spec)
-    run_update(spec, args.out or f"results/update-{spec.name}")
+    run_update(spec, args.out or f"results/update-{spec.name}", resume=not args.no_resume)
     return 0
 
 
