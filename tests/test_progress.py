@@ -1,0 +1,101 @@
+"""The progress reporter (housingfe.progress) in real processes: plain rate-limited lines into a pipe, one redrawn
+line on a terminal (a pseudo-terminal), silence on MPI ranks other than 0; and the JSON-lines checkpoint
+(housingfe.checkpoint) surviving a half-written last line."""
+import json
+import os
+import pty
+import subprocess
+import sys
+
+from housingfe.checkpoint import Checkpoint, digest
+
+# five items of 0.3 s each, a note on the third
+SCRIPT = """
+import time
+from housingfe.progress import Progress
+with Progress("bench demo", 5, "cases") as p:
+    for k in range(5):
+        time.sleep(0.3)
+        p.update(note="third" if k == 2 else "")
+        if k == 1:
+            p.write("a result line")
+"""
+
+
+def _run(env_extra, stderr=subprocess.PIPE):
+    env = {k: v for k, v in os.environ.items() if not k.startswith("HOUSINGFE_PROGRESS")}
+    env.update(env_extra)
+    return subprocess.run([sys.executable, "-c", SCRIPT], stdout=subprocess.PIPE, stderr=stderr, text=True,
+                          env=env, timeout=60)
+
+
+def test_plain_lines_in_a_log_one_per_item():
+    proc = _run({"HOUSINGFE_PROGRESS_SECONDS": "0"})
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 5 and "\r" not in proc.stderr
+    assert lines[0].startswith("bench demo: 1/5 cases, 0:00 elapsed, ~0:01 left")   # 4 x 0.3 s left
+    assert lines[2].endswith("(third)")
+    assert lines[4].startswith("bench demo: 5/5 cases, 0:0") and "left" not in lines[4]
+    assert proc.stdout == "a result line\n"
+
+
+def test_log_lines_are_rate_limited():
+    """The default: at most one line per 10 s, plus the first and the last item."""
+    proc = _run({})
+    lines = proc.stderr.splitlines()
+    assert [line.split(",")[0] for line in lines] == ["bench demo: 1/5 cases", "bench demo: 5/5 cases"]
+
+
+def test_terminal_gets_one_redrawn_line():
+    master, slave = pty.openpty()
+    proc = subprocess.Popen([sys.executable, "-c", SCRIPT], stdout=subprocess.PIPE, stderr=slave,
+                            env={k: v for k, v in os.environ.items() if not k.startswith("HOUSINGFE_PROGRESS")},
+                            text=True)
+    os.close(slave)
+    out = proc.stdout.read()
+    proc.wait(timeout=60)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 4096)
+        except OSError:
+            break
+        if not data:
+            break
+        chunks.append(data)
+    os.close(master)
+    tty = b"".join(chunks).decode()
+    assert out == "a result line\n"
+    # every redraw returns to the line's start and clears its rest; one newline at the end (the pty adds \r)
+    assert tty.count("\r\x1b[K") == 1       # cleared once for the result line printed in between
+    assert tty.replace("\r\n", "\n").count("\n") == 1 and tty.endswith("\n")
+    assert tty.count("bench demo: ") >= 5 and "bench demo: 5/5 cases" in tty
+
+
+def test_only_rank_0_reports():
+    proc = _run({"HOUSINGFE_PROGRESS_SECONDS": "0", "OMPI_COMM_WORLD_RANK": "1"})
+    assert proc.stderr == "" and proc.stdout == "a result line\n"
+
+
+def test_checkpoint_survives_a_cut_line(tmp_path):
+    path = tmp_path / "run.partial" / "runs.jsonl"
+    key = digest({"spec": [1, 2.5], "version": "x"})
+    first = Checkpoint(path, key)
+    assert first.status == "new" and first.resumed == 0
+    first.append({"case": "a", "wall_s": 0.1 + 0.2})
+    first.append({"case": "b", "wall_s": 1e-300})
+    with open(path, "ab") as fh:                     # the process killed in the middle of the third record
+        fh.write(b'{"case": "c", "wa')
+    again = Checkpoint(path, key)
+    assert again.status == "resumed" and again.records == [{"case": "a", "wall_s": 0.30000000000000004},
+                                                           {"case": "b", "wall_s": 1e-300}]
+    again.append({"case": "c", "wall_s": 2.0})
+    lines = path.read_text().splitlines()
+    assert [json.loads(x) for x in lines[1:]][-1] == {"case": "c", "wall_s": 2.0} and len(lines) == 4
+    assert Checkpoint(path, digest({"spec": [1, 2.6], "version": "x"})).status == "other-inputs"
+    fresh = Checkpoint(path, key, resume=False)
+    assert fresh.status == "ignored" and fresh.records == []
+    fresh.append({"case": "z"})
+    assert len(path.read_text().splitlines()) == 2
+    fresh.remove()
+    assert not path.parent.exists()
