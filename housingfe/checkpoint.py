@@ -79,7 +79,8 @@ class Checkpoint:
         self.records.append(record)
         if self.rank != 0:
             return
-        line = (json.dumps(record, separators=(",", ":"), allow_nan=True) + "\n").encode()
+        # other objects (paths) as their text
+        line = (json.dumps(record, separators=(",", ":"), default=str) + "\n").encode()
         if not self._open:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             header = json.dumps({"checkpoint": self.key, "what": self.what}) + "\n"

@@ -76,9 +76,12 @@ class Progress:
         return text
 
     # ---------------------------------------------------------------------------------------------- output
-    def update(self, n: int = 1, note: str = "") -> None:
-        """n more items finished; `note`: a short remark shown after the estimate (e.g. the current case)."""
+    def update(self, n: int = 1, note: str = "", resumed: bool = False) -> None:
+        """n more items finished; `note`: a short remark shown after the estimate (e.g. the current case);
+        `resumed`: they were taken from a checkpoint (not counted in the rate of the estimate)."""
         self.done += n
+        if resumed:
+            self.skipped += n
         self.note = note
         if not self.enabled:
             return
