@@ -56,8 +56,12 @@ class Progress:
             self.every = DEFAULT_LOG_SECONDS
         self.done, self.skipped = done, done      # items finished before this run (resumed) do not time the rest
         self.t0 = time.monotonic()
-        self.last_shown, self.shown_count, self.drawn = -1e30, -1, False
+        self.last_shown, self.shown_count, self.drawn, self.visible = -1e30, -1, False, False
         self.note = ""
+        self._stdout = None
+        if self.enabled and self.tty and _same_terminal(sys.stdout, self.stream):
+            # prints to the same terminal clear the progress line first and redraw it after their line
+            self._stdout, sys.stdout = sys.stdout, _LineAwareStdout(self, sys.stdout)
 
     # ---------------------------------------------------------------------------------------------- text
     def line(self) -> str:
@@ -96,7 +100,13 @@ class Progress:
     def _draw(self, now: float) -> None:
         self.stream.write("\r" + self.line() + "\x1b[K")
         self.stream.flush()
-        self.last_shown, self.shown_count, self.drawn = now, self.done, True
+        self.last_shown, self.shown_count, self.drawn, self.visible = now, self.done, True, True
+
+    def _clear(self) -> None:
+        if self.visible:
+            self.stream.write("\r\x1b[K")
+            self.stream.flush()
+            self.visible = False
 
     def _emit(self, now: float) -> None:
         self.stream.write(self.line() + "\n")
@@ -106,14 +116,13 @@ class Progress:
     def write(self, text: str, echo=None) -> None:
         """Print text (with `echo`, default print to stdout) without tearing the terminal's progress line:
         clear it, print, redraw."""
-        if self.enabled and self.tty and self.drawn:
-            self.stream.write("\r\x1b[K")
-            self.stream.flush()
+        if self.enabled and self.tty:
+            self._clear()
         if echo is None:
             print(text, flush=True)
         else:
             echo(text)
-        if self.enabled and self.tty and self.drawn:
+        if self.enabled and self.tty and self.drawn and not self.visible:
             self._draw(time.monotonic())
 
     def close(self) -> None:
@@ -121,6 +130,8 @@ class Progress:
         not written yet."""
         if not self.enabled:
             return
+        if self._stdout is not None and isinstance(sys.stdout, _LineAwareStdout) and sys.stdout.progress is self:
+            sys.stdout = self._stdout
         if self.tty:
             if self.drawn or self.done:
                 self._draw(time.monotonic())
@@ -128,10 +139,41 @@ class Progress:
                 self.stream.flush()
         elif self.shown_count != self.done:
             self._emit(time.monotonic())
-        self.enabled = False
+        self.enabled = self.visible = False
 
     def __enter__(self) -> "Progress":
         return self
 
     def __exit__(self, *exc) -> None:
         self.close()
+
+
+def _same_terminal(a, b) -> bool:
+    """Whether two streams write to the same terminal."""
+    try:
+        return a.isatty() and b.isatty() and os.path.samestat(os.fstat(a.fileno()), os.fstat(b.fileno()))
+    except (AttributeError, ValueError, OSError):
+        return False
+
+
+class _LineAwareStdout:
+    """sys.stdout while a progress line is shown on the same terminal: a write clears the line, a finished
+    line redraws it."""
+
+    def __init__(self, progress: Progress, stream):
+        self.progress, self.stream = progress, stream
+
+    def write(self, text: str) -> int:
+        if self.progress.enabled:
+            self.progress._clear()
+        n = self.stream.write(text)
+        if text.endswith("\n") and self.progress.enabled and self.progress.drawn:
+            self.stream.flush()
+            self.progress._draw(time.monotonic())
+        return n
+
+    def flush(self) -> None:
+        self.stream.flush()
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)

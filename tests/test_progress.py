@@ -72,6 +72,32 @@ def test_terminal_gets_one_redrawn_line():
     assert tty.count("bench demo: ") >= 5 and "bench demo: 5/5 cases" in tty
 
 
+def test_prints_on_the_same_terminal_do_not_tear_the_line():
+    """stdout and stderr on one terminal: a plain print() clears the progress line, prints its own line, and the
+    progress line is drawn again below it."""
+    master, slave = pty.openpty()
+    script = SCRIPT.replace('p.write("a result line")', 'print("a result line")')
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=slave, stderr=slave,
+                            env={k: v for k, v in os.environ.items() if not k.startswith("HOUSINGFE_PROGRESS")})
+    os.close(slave)
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 4096)
+        except OSError:
+            break
+        if not data:
+            break
+        chunks.append(data)
+    proc.wait(timeout=60)
+    os.close(master)
+    tty = b"".join(chunks).decode().replace("\r\n", "\n")
+    before, after = tty.split("a result line\n")
+    assert before.endswith("\r\x1b[K")                      # the progress line cleared first
+    assert after.startswith("\rbench demo: 2/5 cases")       # and drawn again below the printed line
+    assert tty.count("\n") == 2 and tty.endswith("\n")
+
+
 def test_only_rank_0_reports():
     proc = _run({"HOUSINGFE_PROGRESS_SECONDS": "0", "OMPI_COMM_WORLD_RANK": "1"})
     assert proc.stderr == "" and proc.stdout == "a result line\n"

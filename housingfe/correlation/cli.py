@@ -40,7 +40,20 @@ def _cmd_update(args: argparse.Namespace) -> int:
     from housingfe.correlation.updating import load_update_spec, run_update
 
     spec = load_update_spec(args.spec)
-    run_update(spec, args.out or f"results/update-{spec.name}", resume=not args.no_resume)
+    out = args.out or f"results/update-{spec.name}"
+    try:
+        run_update(spec, out, resume=not args.no_resume)
+    except BaseException:
+        import sys
+
+        from housingfe.correlation.updating import checkpoint_path
+
+        path = checkpoint_path(out)
+        if path.is_file():
+            kept = max(path.read_text(errors="replace").count("\n") - 1, 0)
+            print(f"housingfe update: {kept} finished evaluation(s) kept in {path}; the same command resumes "
+                  "from them", file=sys.stderr, flush=True)
+        raise
     return 0
 
 
