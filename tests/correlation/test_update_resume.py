@@ -36,7 +36,7 @@ f_max = 1000.0
 """
 SPEC = """
 name = "plate"
-max_evaluations = 30
+max_evaluations = 20
 [[parameters]]
 name = "E"
 keys = ["material.youngs_modulus"]
@@ -67,7 +67,7 @@ scene = "plate.toml"
 kind = "mass"
 value = 4.9
 """
-PROGRESS = re.compile(r"^update start 1/1: (\d+)/<=30 evaluations, (\d+:\d\d) elapsed")
+PROGRESS = re.compile(r"^update start 1/1: (\d+)/<=20 evaluations, (\d+:\d\d) elapsed")
 
 
 def _env():
@@ -97,7 +97,7 @@ def test_progress_lines_in_a_log(problem):
     folder, summary, proc = problem
     lines = [m for m in map(PROGRESS.match, proc.stderr.splitlines()) if m]
     assert [int(m.group(1)) for m in lines] == list(range(1, len(lines) + 1))
-    assert len(lines) == 30 <= summary["fits"][0]["evaluations"]      # the budget spent (then the final Jacobian)
+    assert len(lines) == 20 <= summary["fits"][0]["evaluations"]      # the budget spent (then the final Jacobian)
     assert "\r" not in proc.stderr
     assert "left" in proc.stderr.splitlines()[0]
     assert not (folder / "whole.partial").exists()
@@ -147,8 +147,12 @@ def test_checkpoint_of_other_inputs_is_not_used(problem, tmp_path):
         if m and int(m.group(1)) >= 4:
             proc.send_signal(signal.SIGINT)
             break
+    rest = proc.stderr.read()
     assert proc.wait(timeout=60) == 130
-    assert not out.exists() and (tmp_path / "out.partial" / "evaluations.jsonl").is_file()
+    checkpoint = tmp_path / "out.partial" / "evaluations.jsonl"
+    assert not out.exists() and checkpoint.is_file()
+    kept = checkpoint.read_text().count("\n") - 1
+    assert f"housingfe update: {kept} finished evaluation(s) kept in {checkpoint}; the same command resumes" in rest
     (tmp_path / "spec.toml").write_text(SPEC.replace("value = 400.0", "value = 410.0"))
     proc = subprocess.run(_update(tmp_path, out, "--no-resume"), capture_output=True, text=True, env=_env(),
                           cwd=tmp_path, timeout=120)
