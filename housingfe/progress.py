@@ -137,7 +137,7 @@ class Progress:
                 self._draw(time.monotonic())
                 self.stream.write("\n")
                 self.stream.flush()
-        elif self.shown_count != self.done:
+        elif self.done and self.shown_count != self.done:
             self._emit(time.monotonic())
         self.enabled = self.visible = False
 

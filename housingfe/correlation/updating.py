@@ -20,6 +20,7 @@ Roles: "calibration" targets drive the fit, "holdout" targets are only evaluated
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -201,6 +202,7 @@ class SceneEvaluator:
         self.checkpoint = None          # housingfe.checkpoint.Checkpoint: every fresh solve is appended
         self.restored: dict = {}        # solves of an interrupted run (from the checkpoint), used in order
         self.resumed_used = 0
+        self.progress = None            # housingfe.progress.Progress counting solves (see counting())
         self.seconds: list[float] = []
         self.f_last: dict[str, float] = {}
         self.isolate, self.pool = isolate, None
@@ -256,6 +258,8 @@ class SceneEvaluator:
             self.f_last[scene] = result.f_max
             self.seconds.append(result.seconds)
             self.cache[key] = result
+            if self.progress is not None:
+                self.progress.update(note=f"{Path(scene).stem} (resumed)", resumed=True)
             return result
         n, f_guess = self.f_needed(scene)
         f_max = max(f_guess, self.f_last.get(scene, 0.0))
@@ -276,7 +280,22 @@ class SceneEvaluator:
         self.cache[key] = result
         if self.checkpoint is not None:
             self.checkpoint.append({"key": _encode(list(key)), "result": _encode(result)})
+        if self.progress is not None:
+            self.progress.update(note=f"{Path(scene).stem}, {result.dofs} DOFs, {result.seconds:.1f} s")
         return result
+
+    @contextlib.contextmanager
+    def counting(self, label: str, at_most: int):
+        """Progress (housingfe.progress) of the scene solves made inside the block, at most `at_most` (cached
+        ones are not solves)."""
+        from housingfe.progress import Progress
+
+        self.progress = Progress(label, at_most, "scene solves", at_most=True, comm=self.comm)
+        try:
+            yield self.progress
+        finally:
+            self.progress.close()
+            self.progress = None
 
     def resume_from(self, checkpoint) -> int:
         """Use the solves recorded in a checkpoint (housingfe.checkpoint.Checkpoint) instead of solving them
@@ -684,9 +703,11 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
     roles = ("calibration", "holdout")
     differs = any(spec.search_overrides.get(s, []) != spec.confirm_overrides.get(s, [])
                   for s in evaluator.scene_data)
-    correction = mesh_correction(evaluator, x0) if (spec.mesh_correction and differs) else {}
-    echo(f"mesh correction at the start: { {k: round(v, 4) for k, v in correction.items()} }")
-    before = evaluate_targets(evaluator, x0, spec.confirm_overrides, roles)
+    n_scenes = len(evaluator.scene_data)
+    with evaluator.counting("update setup", n_scenes * (2 if spec.mesh_correction and differs else 1)):
+        correction = mesh_correction(evaluator, x0) if (spec.mesh_correction and differs) else {}
+        echo(f"mesh correction at the start: { {k: round(v, 4) for k, v in correction.items()} }")
+        before = evaluate_targets(evaluator, x0, spec.confirm_overrides, roles)
     starts = [x0] + [np.array([float(ms.get(n, p.start)) for n, p in zip(names, spec.parameters)])
                      for ms in spec.multistart]
     for k, ms in enumerate(spec.multistart):
@@ -700,11 +721,13 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
         echo(f"    -> cost {fits[-1].cost:.4g}: " + ", ".join(f"{n}={v:.5g}" for n, v in zip(names, fits[-1].values)))
     best = min(fits, key=lambda r: r.cost)
     if correction:
-        correction = mesh_correction(evaluator, best.values)
+        with evaluator.counting("update correction at the best point", 2 * n_scenes):
+            correction = mesh_correction(evaluator, best.values)
         echo(f"mesh correction at the best point: { {k: round(v, 4) for k, v in correction.items()} }")
         best = fit(evaluator, best.values, correction=correction, label="update refit")
         echo("    refit -> cost {:.4g}: ".format(best.cost) + ", ".join(f"{n}={v:.5g}" for n, v in zip(names, best.values)))
-    after = evaluate_targets(evaluator, best.values, spec.confirm_overrides, roles)
+    with evaluator.counting("update confirmation", n_scenes):
+        after = evaluate_targets(evaluator, best.values, spec.confirm_overrides, roles)
     evaluator.close()
     cal = lambda tvs, role: float(sum(0.5 * float(tv.residuals @ tv.residuals) for tv in tvs if tv.role == role))
     summary = {
