@@ -58,10 +58,14 @@ class Progress:
         self.t0 = time.monotonic()
         self.last_shown, self.shown_count, self.drawn, self.visible = -1e30, -1, False, False
         self.note = ""
-        self._stdout = None
+        self._stdout = self._stderr = None
         if self.enabled and self.tty and _same_terminal(sys.stdout, self.stream):
             # prints to the same terminal clear the progress line first and redraw it after their line
-            self._stdout, sys.stdout = sys.stdout, _LineAwareStdout(self, sys.stdout)
+            self._stdout, sys.stdout = sys.stdout, _LineAware(self, sys.stdout, redraw=True)
+        if self.enabled and self.tty and sys.stderr is self.stream:
+            # other writes to stderr (a warning, the error that ends the command) clear it and are not followed
+            # by it: the next update draws it again
+            self._stderr, sys.stderr = sys.stderr, _LineAware(self, sys.stderr, redraw=False)
 
     # ---------------------------------------------------------------------------------------------- text
     def line(self) -> str:
@@ -130,8 +134,10 @@ class Progress:
         not written yet."""
         if not self.enabled:
             return
-        if self._stdout is not None and isinstance(sys.stdout, _LineAwareStdout) and sys.stdout.progress is self:
+        if self._stdout is not None and isinstance(sys.stdout, _LineAware) and sys.stdout.progress is self:
             sys.stdout = self._stdout
+        if self._stderr is not None and isinstance(sys.stderr, _LineAware) and sys.stderr.progress is self:
+            sys.stderr = self._stderr
         if self.tty:
             if self.drawn or self.done:
                 self._draw(time.monotonic())
@@ -156,18 +162,18 @@ def _same_terminal(a, b) -> bool:
         return False
 
 
-class _LineAwareStdout:
-    """sys.stdout while a progress line is shown on the same terminal: a write clears the line, a finished
-    line redraws it."""
+class _LineAware:
+    """sys.stdout or sys.stderr while a progress line is shown on their terminal: a write clears the line; with
+    `redraw`, a finished line draws it again below."""
 
-    def __init__(self, progress: Progress, stream):
-        self.progress, self.stream = progress, stream
+    def __init__(self, progress: Progress, stream, redraw: bool):
+        self.progress, self.stream, self.redraw = progress, stream, redraw
 
     def write(self, text: str) -> int:
         if self.progress.enabled:
             self.progress._clear()
         n = self.stream.write(text)
-        if text.endswith("\n") and self.progress.enabled and self.progress.drawn:
+        if self.redraw and text.endswith("\n") and self.progress.enabled and self.progress.drawn:
             self.stream.flush()
             self.progress._draw(time.monotonic())
         return n

@@ -29,6 +29,20 @@ def _run(env_extra, stderr=subprocess.PIPE):
                           env=env, timeout=60)
 
 
+def _read_all(master: int) -> bytes:
+    """Everything written to a pseudo-terminal until its other side is closed."""
+    chunks = []
+    while True:
+        try:
+            data = os.read(master, 4096)
+        except OSError:          # EIO: every writer closed its end
+            break
+        if not data:
+            break
+        chunks.append(data)
+    return b"".join(chunks)
+
+
 def test_plain_lines_in_a_log_one_per_item():
     proc = _run({"HOUSINGFE_PROGRESS_SECONDS": "0"})
     lines = proc.stderr.splitlines()
@@ -54,17 +68,9 @@ def test_terminal_gets_one_redrawn_line():
     os.close(slave)
     out = proc.stdout.read()
     proc.wait(timeout=60)
-    chunks = []
-    while True:
-        try:
-            data = os.read(master, 4096)
-        except OSError:
-            break
-        if not data:
-            break
-        chunks.append(data)
+    chunks = _read_all(master)
     os.close(master)
-    tty = b"".join(chunks).decode()
+    tty = chunks.decode()
     assert out == "a result line\n"
     # every redraw returns to the line's start and clears its rest; one newline at the end (the pty adds \r)
     assert tty.count("\r\x1b[K") == 1       # cleared once for the result line printed in between
@@ -80,22 +86,32 @@ def test_prints_on_the_same_terminal_do_not_tear_the_line():
     proc = subprocess.Popen([sys.executable, "-c", script], stdout=slave, stderr=slave,
                             env={k: v for k, v in os.environ.items() if not k.startswith("HOUSINGFE_PROGRESS")})
     os.close(slave)
-    chunks = []
-    while True:
-        try:
-            data = os.read(master, 4096)
-        except OSError:
-            break
-        if not data:
-            break
-        chunks.append(data)
+    chunks = _read_all(master)
     proc.wait(timeout=60)
     os.close(master)
-    tty = b"".join(chunks).decode().replace("\r\n", "\n")
+    tty = chunks.decode().replace("\r\n", "\n")
     before, after = tty.split("a result line\n")
     assert before.endswith("\r\x1b[K")                      # the progress line cleared first
     assert after.startswith("\rbench demo: 2/5 cases")       # and drawn again below the printed line
     assert tty.count("\n") == 2 and tty.endswith("\n")
+
+
+def test_an_error_line_on_the_terminal_replaces_the_progress_line():
+    """A command that fails part-way prints its one error line on stderr: it replaces the progress line (cleared
+    first), and the progress line is not drawn again after it."""
+    master, slave = pty.openpty()
+    script = ("import sys\nfrom housingfe.progress import Progress\np = Progress('run-up x', 3, 'steps')\n"
+              "p.update(note='housing model')\nprint('housingfe: solver error: boom', file=sys.stderr)\n"
+              "sys.exit(3)\n")
+    proc = subprocess.Popen([sys.executable, "-c", script], stdout=slave, stderr=slave,
+                            env={k: v for k, v in os.environ.items() if not k.startswith("HOUSINGFE_PROGRESS")})
+    os.close(slave)
+    chunks = _read_all(master)
+    assert proc.wait(timeout=60) == 3
+    os.close(master)
+    tty = chunks.decode().replace("\r\n", "\n")
+    assert tty.startswith("\rrun-up x: 1/3 steps, 0:00 elapsed")
+    assert tty.endswith("\r\x1b[Khousingfe: solver error: boom\n")
 
 
 def test_only_rank_0_reports():
