@@ -5,13 +5,16 @@ each to a file in `<out>.partial/`, beside the result folder `<out>` and never i
 The file's first line is a header naming what the records belong to (a hash of the inputs: the spec, the scenes,
 the package version); a re-run with other inputs does not use them.  Every record is written with one write() and
 fsync'd; a half-written last line (the process killed while writing) is dropped on reading and cut off before
-the next append.  The job deletes its checkpoint after its result folder was written.  Base layer.
+the next append.  A run holds an exclusive lock (flock) on the file: a second run with the same checkpoint stops
+with an InputError before any work.  The job deletes its checkpoint after its result folder was written.  Base
+layer.
 """
 from __future__ import annotations
 
 import hashlib
 import json
 import os
+import weakref
 from pathlib import Path
 
 
@@ -60,19 +63,45 @@ class Checkpoint:
         self.records: list[dict] = []
         self.status = "new"         # new | resumed | other-inputs | ignored (resume=False)
         self._good_end = 0
+        self._fd = None             # the file, open and locked (flock) while this run owns it
+        busy = None
         if self.rank == 0 and self.path.is_file():
-            lines, end = _read_good_lines(self.path)
-            if lines and lines[0].get("checkpoint") == key:
-                if resume:
-                    self.records, self._good_end, self.status = lines[1:], end, "resumed"
-                else:
-                    self.status = "ignored"
+            try:
+                self._lock(os.open(self.path, os.O_RDWR))
+            except BlockingIOError:
+                busy = f"{self.path}: another housingfe run is writing this checkpoint; wait for it or choose " \
+                       "another --out"
             else:
-                self.status = "other-inputs"
+                lines, end = _read_good_lines(self.path)
+                if lines and lines[0].get("checkpoint") == key:
+                    if resume:
+                        self.records, self._good_end, self.status = lines[1:], end, "resumed"
+                    else:
+                        self.status = "ignored"
+                else:
+                    self.status = "other-inputs"
         if comm is not None:
-            self.records, self.status, self._good_end = comm.bcast((self.records, self.status, self._good_end), root=0)
+            self.records, self.status, self._good_end, busy = comm.bcast(
+                (self.records, self.status, self._good_end, busy), root=0)
+        if busy:
+            from housingfe.errors import InputError
+
+            raise InputError(busy)
         self.resumed = len(self.records)
-        self._open = self.status == "resumed"     # appending to the loaded file (else: a new file at first append)
+        self._started = self.status == "resumed"     # appending to the loaded file (else: header first)
+
+    def _lock(self, fd: int) -> None:
+        """Own the open file fd: an exclusive advisory lock, BlockingIOError if another process holds it."""
+        import fcntl
+
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(fd)
+            raise
+        self._fd = fd
+        # released when this object goes (an exception left the job) even if close() is never reached
+        self._release = weakref.finalize(self, os.close, fd)
 
     def append(self, record: dict) -> None:
         """Add one finished item (rank 0 writes; a JSON object; floats round-trip exactly)."""
@@ -81,23 +110,26 @@ class Checkpoint:
             return
         # other objects (paths) as their text
         line = (json.dumps(record, separators=(",", ":"), default=str) + "\n").encode()
-        if not self._open:
+        if self._fd is None:
             self.path.parent.mkdir(parents=True, exist_ok=True)
-            header = json.dumps({"checkpoint": self.key, "what": self.what}) + "\n"
-            tmp = self.path.parent / f".{self.path.name}.tmp-{os.getpid()}"
-            tmp.write_bytes(header.encode())
-            os.replace(tmp, self.path)
-            self._good_end = len(header.encode())
-            self._open = True
-        fd = os.open(self.path, os.O_WRONLY)
-        try:
-            if os.fstat(fd).st_size != self._good_end:
-                os.ftruncate(fd, self._good_end)      # a half-written line of a killed run
-            os.lseek(fd, self._good_end, os.SEEK_SET)
-            os.write(fd, line)
-            os.fsync(fd)
-        finally:
-            os.close(fd)
+            try:
+                self._lock(os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644))
+            except BlockingIOError:
+                from housingfe.errors import InputError
+
+                raise InputError(f"{self.path}: another housingfe run started writing this checkpoint; wait for "
+                                 "it or choose another --out") from None
+        if not self._started:
+            header = (json.dumps({"checkpoint": self.key, "what": self.what}) + "\n").encode()
+            os.ftruncate(self._fd, 0)
+            os.lseek(self._fd, 0, os.SEEK_SET)
+            os.write(self._fd, header)
+            self._good_end, self._started = len(header), True
+        if os.fstat(self._fd).st_size != self._good_end:
+            os.ftruncate(self._fd, self._good_end)      # a half-written line of a killed run
+        os.lseek(self._fd, self._good_end, os.SEEK_SET)
+        os.write(self._fd, line)
+        os.fsync(self._fd)
         self._good_end += len(line)
 
     def remove(self) -> None:
@@ -105,7 +137,14 @@ class Checkpoint:
         if self.rank != 0:
             return
         self.path.unlink(missing_ok=True)
+        self.close()
         try:
             self.path.parent.rmdir()
         except OSError:
             pass
+
+    def close(self) -> None:
+        """Release the file (the records stay; the lock ends with the process anyway)."""
+        if self._fd is not None:
+            self._release()
+            self._fd = None

@@ -7,7 +7,10 @@ import pty
 import subprocess
 import sys
 
+import pytest
+
 from housingfe.checkpoint import Checkpoint, digest
+from housingfe.errors import InputError
 
 # five items of 0.3 s each, a note on the third
 SCRIPT = """
@@ -126,7 +129,11 @@ def test_checkpoint_survives_a_cut_line(tmp_path):
     assert first.status == "new" and first.resumed == 0
     first.append({"case": "a", "wall_s": 0.1 + 0.2})
     first.append({"case": "b", "wall_s": 1e-300})
-    with open(path, "ab") as fh:                     # the process killed in the middle of the third record
+    # a second run while this one writes: one line, before any work (flock; a second process behaves the same)
+    with pytest.raises(InputError, match="runs.jsonl: another housingfe run is writing this checkpoint"):
+        Checkpoint(path, key)
+    first.close()                                    # the process ends
+    with open(path, "ab") as fh:                     # it was killed in the middle of the third record
         fh.write(b'{"case": "c", "wa')
     again = Checkpoint(path, key)
     assert again.status == "resumed" and again.records == [{"case": "a", "wall_s": 0.30000000000000004},
@@ -134,7 +141,10 @@ def test_checkpoint_survives_a_cut_line(tmp_path):
     again.append({"case": "c", "wall_s": 2.0})
     lines = path.read_text().splitlines()
     assert [json.loads(x) for x in lines[1:]][-1] == {"case": "c", "wall_s": 2.0} and len(lines) == 4
-    assert Checkpoint(path, digest({"spec": [1, 2.6], "version": "x"})).status == "other-inputs"
+    again.close()
+    other = Checkpoint(path, digest({"spec": [1, 2.6], "version": "x"}))
+    assert other.status == "other-inputs"
+    other.close()
     fresh = Checkpoint(path, key, resume=False)
     assert fresh.status == "ignored" and fresh.records == []
     fresh.append({"case": "z"})

@@ -83,12 +83,14 @@ class FinishedRuns:
         """End the progress line (the checkpoint stays until finish())."""
         self.progress.close()
 
-    def interrupted(self) -> None:
-        """An interruption or error: end the progress line and say on stderr where the finished runs are kept."""
+    def interrupted(self, exc: BaseException | None = None) -> None:
+        """An interruption or error: end the progress line, release the checkpoint; after Ctrl-C (exc a
+        KeyboardInterrupt) say on stderr where the finished runs are kept (an error stays one line)."""
         import sys
 
         self.progress.close()
-        if self.done:
+        self.checkpoint.close()
+        if self.done and isinstance(exc, KeyboardInterrupt):
             print(f"bench {self.bench}: {len(self.done)} finished run(s) kept in {self.folder}/ (runs.csv); "
                   f"`housingfe bench {self.bench} --resume` re-uses them", file=sys.stderr, flush=True)
 

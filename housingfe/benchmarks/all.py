@@ -344,8 +344,8 @@ def main(out_dir: Path, quick: bool = False, only: list[str] | None = None, note
                            f"{r['wall_s']:.1f} s, {r['peak_gb']:.2f} GB, load {r['load_before']:.2f} -> "
                            f"{r['load_after']:.2f}")
             results.append(r)
-    except BaseException:
-        finished.interrupted()
+    except BaseException as exc:
+        finished.interrupted(exc)
         raise
     finished.close()
     failed = [r["name"] for r in results if r["exit"] != 0]

@@ -372,8 +372,8 @@ def main(out_dir: Path, quick: bool = False, resume: bool = False) -> None:
                 results[name] = {"code": code, **res}
                 finished.write(f"round {rnd + 1}/{repeats}  {name:32s} dofs {res['dofs']:8d}  wall "
                                f"{res['process_wall_s']:7.2f} s  load before {load:.2f}")
-    except BaseException:
-        finished.interrupted()
+    except BaseException as exc:
+        finished.interrupted(exc)
         raise
     finished.close()
     rows = []

@@ -103,8 +103,8 @@ def main(out_dir: Path, quick: bool = False, resume: bool = False) -> None:
                 finished.write(f"round {rnd + 1}/{rounds}  {ranks} rank(s)  dofs {res['dofs']}  wall "
                                f"{res['wall_s']:.1f} s  modal solve {res['modal_solve_s']:.1f} s  sweep "
                                f"{res['sweep_s']:.2f} s  load before {res['load_before']:.2f}")
-    except BaseException:
-        finished.interrupted()
+    except BaseException as exc:
+        finished.interrupted(exc)
         raise
     finished.close()
     header = ["ranks", "dofs", "phase", "min_s", "median_s", "max_s", "speedup_median", "peak_memory_gb",

@@ -68,8 +68,8 @@ def main(out_dir: Path, quick: bool = False, resume: bool = False) -> None:
                             len(scenes) * (1 if quick else 2), resume=resume)
     try:
         rows = _rows(scenes, quick, finished)
-    except BaseException:
-        finished.interrupted()
+    except BaseException as exc:
+        finished.interrupted(exc)
         raise
     finished.close()
     with atomic_output_dir(out_dir) as tmp:

@@ -43,7 +43,7 @@ def _cmd_update(args: argparse.Namespace) -> int:
     out = args.out or f"results/update-{spec.name}"
     try:
         run_update(spec, out, resume=not args.no_resume)
-    except BaseException:
+    except KeyboardInterrupt:       # errors stay one line; an interruption says what it kept
         import sys
 
         from housingfe.correlation.updating import checkpoint_path

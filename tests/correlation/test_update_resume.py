@@ -161,3 +161,24 @@ def test_checkpoint_of_other_inputs_is_not_used(problem, tmp_path):
     assert proc.returncode == 0, proc.stderr
     assert "resuming" not in proc.stdout and "starting afresh" in proc.stdout
     assert json.loads((out / "update.json").read_text())["scene_solves_resumed"] == 0
+
+
+def test_second_run_on_the_same_checkpoint_stops_before_work(problem, tmp_path):
+    """Two updates into one --out at once: the second finds the first's checkpoint locked and stops with one line,
+    exit 2; the first finishes with the uninterrupted answer."""
+    folder, whole, _ = problem
+    out = tmp_path / "out"
+    first = subprocess.Popen(_update(folder, out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                             env=_env(), cwd=folder)
+    for line in first.stderr:
+        m = PROGRESS.match(line)
+        if m and int(m.group(1)) >= 2:
+            break
+    second = subprocess.run(_update(folder, out), capture_output=True, text=True, env=_env(), cwd=folder,
+                            timeout=120)
+    first.stderr.read()
+    assert first.wait(timeout=120) == 0
+    assert second.returncode == 2
+    assert second.stderr == (f"housingfe: error: {tmp_path / 'out.partial' / 'evaluations.jsonl'}: another housingfe "
+                             "run is writing this checkpoint; wait for it or choose another --out\n")
+    assert json.loads((out / "update.json").read_text())["identified"] == whole["identified"]
