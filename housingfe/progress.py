@@ -102,7 +102,11 @@ class Progress:
             self._emit(now)
 
     def _draw(self, now: float) -> None:
-        self.stream.write("\r" + self.line() + "\x1b[K")
+        import shutil
+
+        # a line longer than the terminal would wrap, and "\r" would then redraw only its last part
+        width = shutil.get_terminal_size((120, 24)).columns - 1
+        self.stream.write("\r" + self.line()[:max(width, 20)] + "\x1b[K")
         self.stream.flush()
         self.last_shown, self.shown_count, self.drawn, self.visible = now, self.done, True, True
 
