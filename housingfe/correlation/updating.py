@@ -202,6 +202,7 @@ class SceneEvaluator:
         self.checkpoint = None          # housingfe.checkpoint.Checkpoint: every fresh solve is appended
         self.restored: dict = {}        # solves of an interrupted run (from the checkpoint), used in order
         self.resumed_used = 0
+        self.fresh_solves = 0
         self.progress = None            # housingfe.progress.Progress counting solves (see counting())
         self.seconds: list[float] = []
         self.f_last: dict[str, float] = {}
@@ -278,6 +279,7 @@ class SceneEvaluator:
         self.f_last[scene] = result.f_max
         self.seconds.append(result.seconds)
         self.cache[key] = result
+        self.fresh_solves += 1
         if self.checkpoint is not None:
             self.checkpoint.append({"key": _encode(list(key)), "result": _encode(result)})
         if self.progress is not None:
@@ -546,6 +548,7 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
         if budget and n_eval[0] >= spec.max_evaluations:
             raise _BudgetSpent
         x = lo + u * span
+        fresh, resumed = evaluator.fresh_solves, evaluator.resumed_used
         tvs = evaluate_targets(evaluator, x, spec.search_overrides, ("calibration",), correction)
         if not names_holder:
             names_holder.extend(_residual_names(tvs))
@@ -557,7 +560,10 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
         progress.write(f"eval {n_eval[0]:3d}  cost {0.5 * float(r @ r):10.4g}  x = "
                        + ", ".join(f"{p.name}={v:.5g}" for p, v in zip(spec.parameters, x)), evaluator.log)
         if budget:
-            progress.update(note=f"cost {0.5 * float(r @ r):.4g}")
+            # an evaluation made of solves from the checkpoint does not time the ones still to come
+            from_checkpoint = evaluator.fresh_solves == fresh and evaluator.resumed_used > resumed
+            progress.update(note=f"cost {0.5 * float(r @ r):.4g}" + (", resumed" if from_checkpoint else ""),
+                            resumed=from_checkpoint)
         return r
 
     h = spec.fd_step
