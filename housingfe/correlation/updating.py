@@ -560,10 +560,12 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
         progress.write(f"eval {n_eval[0]:3d}  cost {0.5 * float(r @ r):10.4g}  x = "
                        + ", ".join(f"{p.name}={v:.5g}" for p, v in zip(spec.parameters, x)), evaluator.log)
         if budget:
-            # an evaluation made of solves from the checkpoint does not time the ones still to come
-            from_checkpoint = evaluator.fresh_solves == fresh and evaluator.resumed_used > resumed
+            # an evaluation without a fresh solve (all cached, or from the checkpoint) does not time the ones
+            # still to come
+            no_solve = evaluator.fresh_solves == fresh
+            from_checkpoint = no_solve and evaluator.resumed_used > resumed
             progress.update(note=f"cost {0.5 * float(r @ r):.4g}" + (", resumed" if from_checkpoint else ""),
-                            resumed=from_checkpoint)
+                            resumed=no_solve)
         return r
 
     h = spec.fd_step
