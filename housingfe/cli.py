@@ -53,7 +53,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     from housingfe.benchmarks import _dispatch as bench
 
     only = [n for n in (args.only or "").split(",") if n]
-    bench.main(args.which, out_dir=args.out, quick=args.quick, only=only or None, notes_only=args.notes)
+    bench.main(args.which, out_dir=args.out, quick=args.quick, only=only or None, notes_only=args.notes,
+               resume=args.resume)
     return 0
 
 
@@ -139,6 +140,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--only", default=None, metavar="NAMES",
                    help="with `all`: re-run only these benchmarks (comma-separated) and replace their sections "
                         "of docs/benchmarks.md")
+    p.add_argument("--resume", action="store_true",
+                   help="re-use the runs an interrupted bench left in <out>.partial/ (docs/progress.md)")
     p.add_argument("--notes", action="store_true",
                    help="with `all`: run nothing; put the edited docs/benchmarks-notes.md into docs/benchmarks.md")
     p.set_defaults(func=_cmd_bench)

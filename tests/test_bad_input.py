@@ -520,6 +520,8 @@ COMMAND_CASES = [
     ("bench-only-not-all", ["bench", "modal", "--only", "mpi"], ["--only"]),
     ("bench-notes-not-all", ["bench", "modal", "--notes"], ["--notes"]),
     ("bench-notes-with-only", ["bench", "all", "--notes", "--only", "modal"], ["--notes"]),
+    ("bench-resume-not-kept", ["bench", "frf", "--resume"], ["--resume", "frf does not keep its runs"]),
+    ("bench-resume-with-notes", ["bench", "all", "--notes", "--resume"], ["--resume", "--notes"]),
 ]
 
 

@@ -15,13 +15,25 @@ def available() -> list[str]:
 
 
 def main(which: str, out_dir: str | None = None, quick: bool = False, only: list[str] | None = None,
-         notes_only: bool = False) -> None:
+         notes_only: bool = False, resume: bool = False) -> None:
     """Run one benchmark; results go to out_dir (default results/bench-<which>).  only: for `all`, the subset to
     re-run (their sections of docs/benchmarks.md are replaced).  notes_only: for `all`, run nothing and refresh the
-    page's hand-written notes from docs/benchmarks-notes.md."""
+    page's hand-written notes from docs/benchmarks-notes.md.  resume: re-use the runs an interrupted bench left in
+    <out>.partial/ (the benchmarks that keep their runs: resumable())."""
+    from housingfe.benchmarks._runs import resumable
+
     if which not in available():
         raise InputError(f"bench: unknown benchmark {which!r} (available: {', '.join(available())})")
     module = importlib.import_module(f"housingfe.benchmarks.{which}")
+    if resume:
+        if notes_only:
+            raise InputError("bench: --resume and --notes exclude each other")
+        if not resumable(module.main):
+            keeping = [n for n in available() if resumable(importlib.import_module(f"housingfe.benchmarks.{n}").main)]
+            raise InputError(f"bench: --resume: {which} does not keep its runs (those that do: {', '.join(keeping)})")
+        extra = {"resume": True}
+    else:
+        extra = {}
     if notes_only:
         if which != "all" or only or quick:
             raise InputError("bench: --notes applies to `housingfe bench all` alone (no --only, no --quick)")
@@ -30,9 +42,9 @@ def main(which: str, out_dir: str | None = None, quick: bool = False, only: list
     if only:
         if which != "all":
             raise InputError("bench: --only applies to `housingfe bench all`")
-        module.main(Path(out_dir or f"results/bench-{which}"), quick, only=only)
+        module.main(Path(out_dir or f"results/bench-{which}"), quick, only=only, **extra)
         return
     out = Path(out_dir or f"results/bench-{which}")
     if which != "all":      # `all` writes a folder of result folders (each checked by its own run)
         reserve_output(out)     # a bad or busy output place stops here, before the rounds
-    module.main(out, quick)
+    module.main(out, quick, **extra)

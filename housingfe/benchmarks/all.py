@@ -49,16 +49,23 @@ def benchmarks() -> list[str]:
 
 
 # ------------------------------------------------------------------------------------------------ running
-def run_benchmark(name: str, out_dir: Path, quick: bool, timeout_s: float | None = None) -> dict:
-    """Run `housingfe bench <name>` in a child process; wall time (s), peak RSS (GB), load averages, exit status."""
+def run_benchmark(name: str, out_dir: Path, quick: bool, timeout_s: float | None = None, resume: bool = False) -> dict:
+    """Run `housingfe bench <name>` in a child process; wall time (s), peak RSS (GB), load averages, exit status.
+    resume: the child re-uses the runs its interrupted predecessor kept (benchmarks that keep them)."""
+    import importlib
+
+    from housingfe.benchmarks._runs import resumable
+
     out_dir.parent.mkdir(parents=True, exist_ok=True)
+    resume = resume and resumable(importlib.import_module(f"housingfe.benchmarks.{name}").main)
     code = ("import sys; from housingfe.benchmarks._dispatch import main; "
-            "main(sys.argv[1], sys.argv[2], sys.argv[3] == '1')")
+            "main(sys.argv[1], sys.argv[2], sys.argv[3] == '1', resume=sys.argv[4] == '1')")
     load_before = os.getloadavg()
     t0 = time.perf_counter()
     log = out_dir.parent / f"{name}.log"
     with open(log, "w") as fh:
-        proc = subprocess.Popen([sys.executable, "-c", code, name, str(out_dir), "1" if quick else "0"],
+        proc = subprocess.Popen([sys.executable, "-c", code, name, str(out_dir), "1" if quick else "0",
+                                 "1" if resume else "0"],
                                 stdout=fh, stderr=subprocess.STDOUT)
         try:
             _, status, usage = os.wait4(proc.pid, 0)   # this child's own rusage (ru_maxrss in KiB on Linux)
@@ -69,7 +76,7 @@ def run_benchmark(name: str, out_dir: Path, quick: bool, timeout_s: float | None
     wall = time.perf_counter() - t0
     tail = log.read_text(errors="replace").strip().splitlines()[-1:] if proc.returncode else []
     return {"name": name, "exit": proc.returncode, "wall_s": wall, "peak_gb": usage.ru_maxrss / 1024**2,
-            "load_before": load_before[0], "load_after": os.getloadavg()[0], "log": log,
+            "load_before": load_before[0], "load_after": os.getloadavg()[0], "log": str(log),
             "error": tail[0] if tail else ""}
 
 
@@ -293,10 +300,16 @@ def docs_dir() -> Path:
     return here if here.is_dir() else Path("docs")
 
 
-def main(out_dir: Path, quick: bool = False, only: list[str] | None = None, notes_only: bool = False) -> None:
+def main(out_dir: Path, quick: bool = False, only: list[str] | None = None, notes_only: bool = False,
+         resume: bool = False) -> None:
     """Run every benchmark (quick modes with `quick`) into out_dir/<name>/ and write the page (see module doc).
     only: run just these benchmarks and replace their sections of docs/benchmarks.md (full runs only).
-    notes_only: run nothing, put the current docs/benchmarks-notes.md into docs/benchmarks.md (refresh_notes)."""
+    notes_only: run nothing, put the current docs/benchmarks-notes.md into docs/benchmarks.md (refresh_notes).
+    Each finished benchmark is recorded in <out>.partial/runs.jsonl; resume: a benchmark an interrupted
+    `bench all` finished (its folder still there) is not run again, and the one it was running resumes its
+    own kept runs."""
+    from housingfe.benchmarks._runs import FinishedRuns
+
     if notes_only:
         docs = docs_dir()
         page = docs / "benchmarks.md"
@@ -313,14 +326,28 @@ def main(out_dir: Path, quick: bool = False, only: list[str] | None = None, note
     out_dir.mkdir(parents=True, exist_ok=True)
     docs = docs_dir()
     results = []
-    for name in [n for n in names if not only or n in only]:
-        print(f"bench all: {name} ({'quick' if quick else 'full'}) …", flush=True)
-        r = run_benchmark(name, out_dir / name, quick)
-        r["out"] = out_dir / name
-        print(f"bench all: {name}: {'ok' if r['exit'] == 0 else 'FAILED, see ' + str(r.get('log', out_dir))} "
-              f"{r['wall_s']:.1f} s, {r['peak_gb']:.2f} GB, load {r['load_before']:.2f} -> {r['load_after']:.2f}",
-              flush=True)
-        results.append(r)
+    selected = [n for n in names if not only or n in only]
+    finished = FinishedRuns("all", out_dir, {"names": selected, "quick": quick, "only": only}, len(selected),
+                            resume=resume, unit="benchmarks")
+    for name in [n for n in finished.done if not (out_dir / n).is_dir()]:
+        del finished.done[name]          # its folder is gone: run it again
+    try:
+        for name in selected:
+            if name not in finished.done:
+                finished.write(f"bench all: {name} ({'quick' if quick else 'full'}) …")
+            # resume passed only when asked: run_benchmark's plain signature stays what callers (tests) replace
+            r = dict(finished.run(name, lambda: run_benchmark(name, out_dir / name, quick,
+                                                              **({"resume": True} if resume else {})),
+                                  note=name, keep=lambda r: r["exit"] == 0))
+            r["out"] = out_dir / name
+            finished.write(f"bench all: {name}: {'ok' if r['exit'] == 0 else 'FAILED, see ' + str(r.get('log'))} "
+                           f"{r['wall_s']:.1f} s, {r['peak_gb']:.2f} GB, load {r['load_before']:.2f} -> "
+                           f"{r['load_after']:.2f}")
+            results.append(r)
+    except BaseException as exc:
+        finished.interrupted(exc)
+        raise
+    finished.close()
     failed = [r["name"] for r in results if r["exit"] != 0]
     info = machine_info()
     if quick or failed:
@@ -328,6 +355,7 @@ def main(out_dir: Path, quick: bool = False, only: list[str] | None = None, note
     else:
         page = publish(results, info, docs / "benchmarks-notes.md", docs / "benchmarks.md", docs / "img" / "bench",
                        quick, only=bool(only))
+    finished.finish()
     print(f"bench all: page written to {page}")
     if failed:
         raise SolverError(f"bench all: {len(failed)} benchmark(s) failed ({', '.join(failed)}); logs in {out_dir}; "

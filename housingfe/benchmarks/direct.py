@@ -49,23 +49,28 @@ def main(out_dir: Path, quick: bool = False) -> None:
         forms[f"complex x{cores} workers"] = ("complex", cores)
     if cores > 1:
         forms[f"block, {cores} MPI ranks"] = ("block-ranks", cores)
+    from housingfe.progress import Progress
+
     times: dict[str, list] = {name: [] for name in forms}
     answers = {}
-    for rnd in range(QUICK_ROUNDS if quick else ROUNDS):
+    rounds = QUICK_ROUNDS if quick else ROUNDS
+    progress = Progress("bench direct", rounds * len(forms), "runs")
+    for rnd in range(rounds):
         for method, (form, workers) in forms.items():
             load = os.getloadavg()[0]
             if form == "block-ranks":
                 per_line, answers[method] = _block_on_ranks(workers, n_lines)
-                times[method].append((per_line, load))
-                print(f"round {rnd + 1}  {method:18s} {per_line:.3f} s per line  load before {load:.2f}", flush=True)
-                continue
-            t0 = time.perf_counter()
-            res = harmonic.direct(model.K, model.M, loads, freqs, damping, observer.reduce, method=form,
-                                  workers=workers)
-            per_line = (time.perf_counter() - t0) / n_lines
+            else:
+                t0 = time.perf_counter()
+                res = harmonic.direct(model.K, model.M, loads, freqs, damping, observer.reduce, method=form,
+                                      workers=workers)
+                per_line = (time.perf_counter() - t0) / n_lines
+                answers[method] = responses(res, observer, loads)
             times[method].append((per_line, load))
-            answers[method] = responses(res, observer, loads)
-            print(f"round {rnd + 1}  {method:18s} {per_line:.3f} s per line  load before {load:.2f}", flush=True)
+            progress.update(note=method)
+            progress.write(f"round {rnd + 1}  {method:18s} {per_line:.3f} s per line  load before {load:.2f}",
+                           lambda text: print(text, flush=True))
+    progress.close()
     difference = max(_max_relative_difference(answers["block"], a) for m, a in answers.items() if m != "block")
     header = ["form", "dofs", "lines", "per_line_min_s", "per_line_median_s", "per_line_max_s", "runs",
               "max_load_before", "speedup_median"]

@@ -332,8 +332,12 @@ def load_average() -> float:
     return os.getloadavg()[0]
 
 
-def main(out_dir: Path, quick: bool = False) -> None:
-    """Run all cases interleaved REPEATS times, print the table, write modal_bench.csv and modal_bench.png."""
+def main(out_dir: Path, quick: bool = False, resume: bool = False) -> None:
+    """Run all cases interleaved REPEATS times, print the table, write modal_bench.csv and modal_bench.png.
+    Every finished run is kept in <out>.partial/ (runs.jsonl, runs.csv) until the result folder is written;
+    resume: re-use the runs of an interrupted bench with the same cases (their timings were taken then)."""
+    from housingfe.benchmarks._runs import FinishedRuns
+
     ccx = shutil.which("ccx")
     ref, provenance = load_reference()
     cases = [("housingfe", c) for c in (QUICK_HOUSINGFE if quick else HOUSINGFE_CASES)]
@@ -347,18 +351,31 @@ def main(out_dir: Path, quick: bool = False) -> None:
     repeats = 1 if quick else REPEATS
     runs: dict[str, list] = {label(code, case): [] for code, case in order}
     results: dict[str, dict] = {}
-    for rnd in range(repeats):
-        for code, case in order:
-            name = label(code, case)
-            load = load_average()
-            res = _case_in_subprocess(code, case)
-            if "error" in res:
-                print(f"{name}: failed: {res['error']}")
-                continue
-            runs[name].append((res["process_wall_s"], load))
-            results[name] = {"code": code, **res}
-            print(f"round {rnd + 1}/{repeats}  {name:32s} dofs {res['dofs']:8d}  wall {res['process_wall_s']:7.2f} s"
-                  f"  load before {load:.2f}", flush=True)
+    finished = FinishedRuns("modal", out_dir, {"order": order, "repeats": repeats, "reference": ref.tolist(),
+                                               "ccx": ccx}, repeats * len(order), resume=resume)
+
+    def one_run(code: str, case: dict) -> dict:
+        load = load_average()
+        return {**_case_in_subprocess(code, case), "load_before": load}
+
+    try:
+        for rnd in range(repeats):
+            for code, case in order:
+                name = label(code, case)
+                res = finished.run(f"round {rnd + 1} {name}", lambda: one_run(code, case), note=name,
+                                   keep=lambda r: "error" not in r)
+                if "error" in res:
+                    finished.write(f"{name}: failed: {res['error']}")
+                    continue
+                load = res["load_before"]
+                runs[name].append((res["process_wall_s"], load))
+                results[name] = {"code": code, **res}
+                finished.write(f"round {rnd + 1}/{repeats}  {name:32s} dofs {res['dofs']:8d}  wall "
+                               f"{res['process_wall_s']:7.2f} s  load before {load:.2f}")
+    except BaseException as exc:
+        finished.interrupted(exc)
+        raise
+    finished.close()
     rows = []
     for name, times in runs.items():
         if not times:
@@ -384,7 +401,11 @@ def main(out_dir: Path, quick: bool = False) -> None:
         idle = max((r[7] for r in rows), default=0.0)
         note = (f"{repeats} interleaved round(s); highest 1-min load average before a run: {idle:.2f} "
                 f"({'machine otherwise idle' if idle < 1.0 else 'NOT idle: timings are pessimistic'}; 2 cores)")
+        if finished.checkpoint.resumed:
+            note += (f"; {finished.checkpoint.resumed} of the {repeats * len(order)} runs resumed from an interrupted "
+                     "bench (timed then)")
         (tmp / "modal_bench.txt").write_text(table + "\n" + speedup + "\n" + note + "\n")
+    finished.finish()
     print(f"reference: Richardson extrapolation of Q3 hexahedra at "
           f"{', '.join(f'{1e3 * h:g}' for h in provenance['case']['sizes_m'])} mm ({provenance.get('dofs')} DOFs), "
           f"{len(ref)} elastic modes below {F_MAX:g} Hz, first {ref[0]:.2f} Hz ({REFERENCE_FILE.name})")

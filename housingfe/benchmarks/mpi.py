@@ -79,20 +79,34 @@ def band_difference_db(a: str, b: str) -> float:
     return worst
 
 
-def main(out_dir: Path, quick: bool = False) -> None:
-    """Alternate 1- and 2-rank runs, print the scaling table, write mpi_bench.csv/.txt/.png."""
+def main(out_dir: Path, quick: bool = False, resume: bool = False) -> None:
+    """Alternate 1- and 2-rank runs, print the scaling table, write mpi_bench.csv/.txt/.png.  Every finished run is
+    kept in <out>.partial/ until the result folder is written; resume: re-use them."""
+    from housingfe.benchmarks._runs import FinishedRuns
+
     size = QUICK_SIZE if quick else SIZE
     rounds = QUICK_ROUNDS if quick else ROUNDS
     runs: dict[int, list] = {r: [] for r in RANKS}
-    for rnd in range(rounds):
-        for ranks in RANKS:
-            load = os.getloadavg()[0]
-            res = run_case(ranks, size)
-            res["load_before"] = load
-            runs[ranks].append(res)
-            print(f"round {rnd + 1}/{rounds}  {ranks} rank(s)  dofs {res['dofs']}  wall {res['wall_s']:.1f} s  "
-                  f"modal solve {res['modal_solve_s']:.1f} s  sweep {res['sweep_s']:.2f} s  "
-                  f"load before {load:.2f}", flush=True)
+    finished = FinishedRuns("mpi", out_dir, {"scene": SCENE, "mesh": MESH, "size": size, "rounds": rounds,
+                                             "ranks": RANKS}, rounds * len(RANKS), resume=resume)
+
+    def one_run(ranks: int) -> dict:
+        load = os.getloadavg()[0]
+        return {**run_case(ranks, size), "load_before": load}
+
+    try:
+        for rnd in range(rounds):
+            for ranks in RANKS:
+                res = finished.run(f"round {rnd + 1} {ranks} rank(s)", lambda: one_run(ranks),
+                                   note=f"{ranks} rank(s)")
+                runs[ranks].append(res)
+                finished.write(f"round {rnd + 1}/{rounds}  {ranks} rank(s)  dofs {res['dofs']}  wall "
+                               f"{res['wall_s']:.1f} s  modal solve {res['modal_solve_s']:.1f} s  sweep "
+                               f"{res['sweep_s']:.2f} s  load before {res['load_before']:.2f}")
+    except BaseException as exc:
+        finished.interrupted(exc)
+        raise
+    finished.close()
     header = ["ranks", "dofs", "phase", "min_s", "median_s", "max_s", "speedup_median", "peak_memory_gb",
               "bytes_per_dof", "max_load_before"]
     rows = []
@@ -117,6 +131,7 @@ def main(out_dir: Path, quick: bool = False) -> None:
         (tmp / "timings.json").write_text(dumps_json({str(k): [r["timings"] for r in v] for k, v in runs.items()},
                                                      indent=1))
         _plot(tmp / "mpi_bench.png", rows)
+    finished.finish()
     print(table)
     print(note)
     print(f"results: {out_dir}/")

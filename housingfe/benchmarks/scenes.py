@@ -58,10 +58,33 @@ HEADER = ["scene", "element", "DOFs", "mesh s", "assembly s", "eigensolve s", "w
           "modes < f_max", "min quality", "max err vs finer", "mean err vs finer", "finer DOFs", "finer wall s"]
 
 
-def main(out_dir: Path, quick: bool = False) -> None:
+def main(out_dir: Path, quick: bool = False, resume: bool = False) -> None:
+    """One row per scene (its default run, and a finer one unless quick); every finished run is kept in
+    <out>.partial/ until the result folder is written; resume: re-use them."""
+    from housingfe.benchmarks._runs import FinishedRuns
+
+    scenes = QUICK_SCENES if quick else SCENES
+    finished = FinishedRuns("scenes", out_dir, {"scenes": scenes, "quick": quick, "finer": FINER},
+                            len(scenes) * (1 if quick else 2), resume=resume)
+    try:
+        rows = _rows(scenes, quick, finished)
+    except BaseException as exc:
+        finished.interrupted(exc)
+        raise
+    finished.close()
+    with atomic_output_dir(out_dir) as tmp:
+        write_csv(tmp / "bench-scenes.csv", HEADER, rows)
+        (tmp / "bench-scenes.txt").write_text(format_table(HEADER, rows, "{:.3g}") + "\n")
+        _plot(tmp / "bench-scenes.png", rows)
+    finished.finish()
+    print(format_table(HEADER, rows, "{:.3g}"))
+    print(f"results: {out_dir}/")
+
+
+def _rows(scenes: list[str], quick: bool, finished) -> list[list]:
     rows = []
-    for scene in (QUICK_SCENES if quick else SCENES):
-        s = run_case(scene, [])
+    for scene in scenes:
+        s = finished.run(f"{scene} default", lambda: run_case(scene, []), note=scene)
         t = s["timings_s"]
         eig = t.get("eigensolve_s", 0.0) + t.get("inertia_s", 0.0)
         row = [scene, s["element"], s["dofs"], t.get("mesh_s", float("nan")), t.get("assembly_s", float("nan")),
@@ -69,17 +92,12 @@ def main(out_dir: Path, quick: bool = False) -> None:
         if quick:
             row += [float("nan")] * 4
         else:
-            fine = run_case(scene, [FINER])
+            fine = finished.run(f"{scene} finer", lambda: run_case(scene, [FINER]), note=f"{scene} finer")
             err_max, err_mean = frequency_error(s["frequencies_hz"], fine["frequencies_hz"], 0.9 * s["f_max_hz"])
             row += [err_max, err_mean, fine["dofs"], fine["wall_time_s"]]
         rows.append(row)
-        print(format_table(HEADER, [row], "{:.3g}", width=None).splitlines()[-1], flush=True)
-    with atomic_output_dir(out_dir) as tmp:
-        write_csv(tmp / "bench-scenes.csv", HEADER, rows)
-        (tmp / "bench-scenes.txt").write_text(format_table(HEADER, rows, "{:.3g}") + "\n")
-        _plot(tmp / "bench-scenes.png", rows)
-    print(format_table(HEADER, rows, "{:.3g}"))
-    print(f"results: {out_dir}/")
+        finished.write(format_table(HEADER, [row], "{:.3g}", width=None).splitlines()[-1])
+    return rows
 
 
 def _plot(path: Path, rows: list) -> None:

@@ -34,6 +34,8 @@ def register_cli(subparsers) -> None:
                                              "(bounded least squares; docs/correlation.md)")
     p.add_argument("spec", help="update spec (TOML): parameters, targets, search and confirmation meshes")
     p.add_argument("--out", default=None, help="result folder (default results/update-<name>)")
+    p.add_argument("--no-resume", action="store_true",
+                   help="do not re-use the evaluations an interrupted run left in <out>.partial/ (docs/progress.md)")
     p.set_defaults(func=_cmd_update)
 
 
@@ -46,7 +48,19 @@ def _cmd_update(args: argparse.Namespace) -> int:
     spec = load_update_spec(args.spec)
     out = args.out or f"results/update-{spec.name}"
     reserve_output(out, MPI.COMM_WORLD, inputs=[args.spec])     # before the 30-40 min of fitting
-    run_update(spec, out)
+    try:
+        run_update(spec, out, resume=not args.no_resume)
+    except KeyboardInterrupt:       # errors stay one line; an interruption says what it kept
+        import sys
+
+        from housingfe.correlation.updating import checkpoint_path
+
+        path = checkpoint_path(out)
+        if path.is_file():
+            kept = max(path.read_text(errors="replace").count("\n") - 1, 0)
+            print(f"housingfe update: {kept} finished evaluation(s) kept in {path}; the same command resumes "
+                  "from them", file=sys.stderr, flush=True)
+        raise
     return 0
 
 

@@ -20,9 +20,11 @@ Roles: "calibration" targets drive the fit, "holdout" targets are only evaluated
 """
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Callable, Literal, Optional
 
 import numpy as np
@@ -126,7 +128,6 @@ class UpdateSpec(_Strict):
 def load_update_spec(path: str) -> UpdateSpec:
     """Read an updating spec (TOML); InputError naming the file and key."""
     import tomllib
-    from pathlib import Path
 
     from housingfe.scenefile import parse_table
 
@@ -144,8 +145,6 @@ def load_update_spec(path: str) -> UpdateSpec:
 
 def resolve_measured_paths(spec: UpdateSpec, base) -> UpdateSpec:
     """Measured files relative to the spec's folder."""
-    from pathlib import Path
-
     targets = []
     for t in spec.targets:
         if t.measured is not None and not Path(t.measured).is_absolute():
@@ -211,6 +210,11 @@ class SceneEvaluator:
         self.comm = comm or MPI.COMM_WORLD
         self.log = log or (lambda s: None)
         self.cache: dict = {}
+        self.checkpoint = None          # housingfe.checkpoint.Checkpoint: every fresh solve is appended
+        self.restored: dict = {}        # solves of an interrupted run (from the checkpoint), used in order
+        self.resumed_used = 0
+        self.fresh_solves = 0
+        self.progress = None            # housingfe.progress.Progress counting solves (see counting())
         self.seconds: list[float] = []
         self.f_last: dict[str, float] = {}
         self.isolate, self.pool = isolate, None
@@ -258,6 +262,17 @@ class SceneEvaluator:
         key = (scene, tuple(np.round(values, 12)), tuple(extra))
         if key in self.cache:
             return self.cache[key]
+        if key in self.restored:
+            # a solve an interrupted run finished: it updates the state as the fresh solve did then (f_last), so
+            # the resumed search takes the same path
+            result = self.restored.pop(key)
+            self.resumed_used += 1
+            self.f_last[scene] = result.f_max
+            self.seconds.append(result.seconds)
+            self.cache[key] = result
+            if self.progress is not None:
+                self.progress.update(note=f"{Path(scene).stem} (resumed)", resumed=True)
+            return result
         n, f_guess = self.f_needed(scene)
         f_max = max(f_guess, self.f_last.get(scene, 0.0))
         need_mass = any(t.kind == "mass" and t.scene == scene for t in self.spec.targets)
@@ -275,7 +290,34 @@ class SceneEvaluator:
         self.f_last[scene] = result.f_max
         self.seconds.append(result.seconds)
         self.cache[key] = result
+        self.fresh_solves += 1
+        if self.checkpoint is not None:
+            self.checkpoint.append({"key": _encode(list(key)), "result": _encode(result)})
+        if self.progress is not None:
+            self.progress.update(note=f"{Path(scene).stem}, {result.dofs} DOFs, {result.seconds:.1f} s")
         return result
+
+    @contextlib.contextmanager
+    def counting(self, label: str, at_most: int):
+        """Progress (housingfe.progress) of the scene solves made inside the block, at most `at_most` (cached
+        ones are not solves)."""
+        from housingfe.progress import Progress
+
+        self.progress = Progress(label, at_most, "scene solves", at_most=True, comm=self.comm)
+        try:
+            yield self.progress
+        finally:
+            self.progress.close()
+            self.progress = None
+
+    def resume_from(self, checkpoint) -> int:
+        """Use the solves recorded in a checkpoint (housingfe.checkpoint.Checkpoint) instead of solving them
+        again, and record every new solve in it; returns the number of solves restored."""
+        for rec in checkpoint.records:
+            scene, values, extra = _decode(rec["key"])
+            self.restored[(scene, tuple(values), tuple(extra))] = _decode(rec["result"])
+        self.checkpoint = checkpoint
+        return len(self.restored)
 
     def close(self) -> None:
         if self.pool is not None:
@@ -284,6 +326,54 @@ class SceneEvaluator:
 
 
 WORKER_TASKS = 20
+
+
+def _encode(obj):
+    """A SceneResult (with its ModeSets and arrays) as JSON-able data that _decode turns back into equal objects
+    (floats exactly: JSON keeps Python's shortest round-trip repr)."""
+    import dataclasses
+
+    if isinstance(obj, np.ndarray):
+        if np.iscomplexobj(obj):
+            return {"__complex__": [_encode(obj.real), _encode(obj.imag)]}
+        return {"__array__": obj.tolist(), "dtype": obj.dtype.str, "shape": list(obj.shape)}
+    if dataclasses.is_dataclass(obj):
+        return {"__dataclass__": f"{type(obj).__module__}:{type(obj).__qualname__}",
+                "fields": {f.name: _encode(getattr(obj, f.name)) for f in dataclasses.fields(obj)}}
+    if isinstance(obj, dict):
+        return {"__dict__": {k: _encode(v) for k, v in obj.items()}}
+    if isinstance(obj, (list, tuple)):
+        return [_encode(v) for v in obj]
+    if isinstance(obj, np.generic):
+        return obj.item()
+    return obj
+
+
+_DECODABLE = {"housingfe.correlation.updating:SceneResult", "housingfe.correlation.uff:ModeSet"}
+
+
+def _decode(data):
+    """The inverse of _encode (only the dataclasses of _DECODABLE)."""
+    import importlib
+
+    if isinstance(data, list):
+        return [_decode(v) for v in data]
+    if not isinstance(data, dict):
+        return data
+    if "__array__" in data:
+        return np.array(data["__array__"], dtype=np.dtype(data["dtype"])).reshape(data["shape"])
+    if "__complex__" in data:
+        re, im = (_decode(v) for v in data["__complex__"])
+        return re + 1j * im
+    if "__dict__" in data:
+        return {k: _decode(v) for k, v in data["__dict__"].items()}
+    if "__dataclass__" in data:
+        if data["__dataclass__"] not in _DECODABLE:
+            raise ValueError(f"checkpoint: unexpected record type {data['__dataclass__']}")
+        module, name = data["__dataclass__"].split(":")
+        cls = getattr(importlib.import_module(module), name)
+        return cls(**{k: _decode(v) for k, v in data["fields"].items()})
+    raise ValueError("checkpoint: unexpected record")
 
 
 def solve_scene(scene: str, overrides: list[str], n: int, f_max: float, need_mass: bool, measured: dict,
@@ -442,11 +532,15 @@ def _residual_names(targets: list[TargetValue]) -> list[str]:
     return names
 
 
-def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correction: dict | None = None) -> UpdateResult:
+def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correction: dict | None = None,
+        label: str = "update") -> UpdateResult:
     """Bounded least squares of the calibration residuals over the spec's parameters from `start`
     (default: each parameter's start), forward-difference Jacobian with step fd_step x range; the search
-    uses search_overrides (a coarse mesh) and the search-mesh `correction`."""
+    uses search_overrides (a coarse mesh) and the search-mesh `correction`.  Progress (evaluations of at most
+    max_evaluations, elapsed, estimate) on stderr under `label` (housingfe.progress)."""
     from scipy.optimize import least_squares
+
+    from housingfe.progress import Progress
 
     spec = evaluator.spec
     lo = np.array([p.lower for p in spec.parameters])
@@ -465,6 +559,7 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
         if budget and n_eval[0] >= spec.max_evaluations:
             raise _BudgetSpent
         x = lo + u * span
+        fresh, resumed = evaluator.fresh_solves, evaluator.resumed_used
         tvs = evaluate_targets(evaluator, x, spec.search_overrides, ("calibration",), correction)
         if not names_holder:
             names_holder.extend(_residual_names(tvs))
@@ -473,8 +568,15 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
         history.append((n_eval[0], 0.5 * float(r @ r), x.copy()))
         if 0.5 * float(r @ r) < best[0]:
             best[:] = [0.5 * float(r @ r), u.copy()]
-        evaluator.log(f"eval {n_eval[0]:3d}  cost {0.5 * float(r @ r):10.4g}  x = "
-                      + ", ".join(f"{p.name}={v:.5g}" for p, v in zip(spec.parameters, x)))
+        progress.write(f"eval {n_eval[0]:3d}  cost {0.5 * float(r @ r):10.4g}  x = "
+                       + ", ".join(f"{p.name}={v:.5g}" for p, v in zip(spec.parameters, x)), evaluator.log)
+        if budget:
+            # an evaluation without a fresh solve (all cached, or from the checkpoint) does not time the ones
+            # still to come
+            no_solve = evaluator.fresh_solves == fresh
+            from_checkpoint = no_solve and evaluator.resumed_used > resumed
+            progress.update(note=f"cost {0.5 * float(r @ r):.4g}" + (", resumed" if from_checkpoint else ""),
+                            resumed=no_solve)
         return r
 
     h = spec.fd_step
@@ -490,6 +592,7 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
         return J
 
     u0 = (x0 - lo) / span
+    progress = Progress(label, spec.max_evaluations, "evaluations", at_most=True, comm=evaluator.comm)
     try:
         sol = least_squares(residuals, u0, jac=jacobian, bounds=(0.0, 1.0), method="trf", x_scale=1.0,
                             max_nfev=spec.max_evaluations, xtol=1e-4, ftol=1e-6)
@@ -498,6 +601,8 @@ def fit(evaluator: SceneEvaluator, start: np.ndarray | None = None, *, correctio
             u_best = best[1]
     except _BudgetSpent:
         u_best, message = best[1], f"stopped after max_evaluations = {spec.max_evaluations} model evaluations"
+    finally:
+        progress.close()
     cost = float(best[0]) if u_best is best[1] else None
     J = jacobian(u_best, budget=False)     # the sensitivities at the answer (cached where already computed)
     r = residuals(u_best, budget=False)
@@ -560,24 +665,68 @@ def target_table(targets: list[TargetValue]) -> list[tuple]:
              f"{float(np.sqrt(np.mean(tv.residuals ** 2))):.3g}") for tv in targets]
 
 
-def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], None] = print) -> dict:
+def inputs_digest(spec: UpdateSpec, evaluator: SceneEvaluator) -> str:
+    """The hash that names an update's inputs in its checkpoint: the spec, every scene's data (with the spec's
+    scene_overrides), the measured files' bytes and the package version.  Files a scene refers to (none of the
+    built-in geometry kinds does) are not part of it."""
+    import hashlib
+
+    import housingfe
+    from housingfe.checkpoint import digest
+
+    measured = {}
+    for t in spec.targets:
+        if t.measured is not None:
+            with open(t.measured, "rb") as fh:
+                measured[t.name] = hashlib.sha256(fh.read()).hexdigest()
+    return digest({"spec": spec.model_dump(mode="json"), "scenes": evaluator.scene_data, "measured": measured,
+                   "housingfe": housingfe.__version__})
+
+
+def checkpoint_path(out_dir) -> Path:
+    """Where `housingfe update --out OUT` keeps its finished evaluations: OUT.partial/evaluations.jsonl."""
+    from housingfe.checkpoint import partial_dir
+
+    return partial_dir(out_dir) / "evaluations.jsonl"
+
+
+def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], None] = print,
+               resume: bool = True) -> dict:
     """The whole study: targets before (start, confirmation mesh), a fit from every start point on the search
     mesh (with the mesh correction), a refit after refreshing the correction at the best point, targets after
     (confirmation mesh), identifiability (scaled Jacobian, parameter standard deviations, correlation).
     Writes update.json, history.csv, targets.csv and convergence.png atomically into out_dir (None: nothing
-    written); returns the summary dict."""
+    written); returns the summary dict.
+    With out_dir, every scene solve is checkpointed to checkpoint_path(out_dir) as it finishes; a re-run after
+    an interruption re-uses the solves of a checkpoint with the same inputs (resume=False: starts afresh) and
+    takes the same path to the same answer.  The checkpoint is deleted once out_dir was written."""
+    from housingfe.checkpoint import Checkpoint
     from housingfe.outputs import atomic_output_dir, format_table, write_csv, write_json
 
     check_parameter_keys(spec)
     evaluator = SceneEvaluator(spec, comm, log=echo)
+    checkpoint = None
+    if out_dir is not None:
+        path = checkpoint_path(out_dir)
+        checkpoint = Checkpoint(path, inputs_digest(spec, evaluator), resume=resume, comm=evaluator.comm,
+                                what=f"housingfe update {spec.name}: scene solves")
+        restored = evaluator.resume_from(checkpoint)
+        if restored:
+            echo(f"resuming: {restored} evaluations (scene solves) from {path}")
+        elif checkpoint.status == "other-inputs":
+            echo(f"note: {path} belongs to other inputs (spec, scenes or version changed); starting afresh")
+        elif checkpoint.status == "ignored":
+            echo(f"note: --no-resume: the evaluations in {path} are not used; starting afresh")
     names = [p.name for p in spec.parameters]
     x0 = np.array([p.start for p in spec.parameters])
     roles = ("calibration", "holdout")
     differs = any(spec.search_overrides.get(s, []) != spec.confirm_overrides.get(s, [])
                   for s in evaluator.scene_data)
-    correction = mesh_correction(evaluator, x0) if (spec.mesh_correction and differs) else {}
-    echo(f"mesh correction at the start: { {k: round(v, 4) for k, v in correction.items()} }")
-    before = evaluate_targets(evaluator, x0, spec.confirm_overrides, roles)
+    n_scenes = len(evaluator.scene_data)
+    with evaluator.counting("update setup", n_scenes * (2 if spec.mesh_correction and differs else 1)):
+        correction = mesh_correction(evaluator, x0) if (spec.mesh_correction and differs) else {}
+        echo(f"mesh correction at the start: { {k: round(v, 4) for k, v in correction.items()} }")
+        before = evaluate_targets(evaluator, x0, spec.confirm_overrides, roles)
     starts = [x0] + [np.array([float(ms.get(n, p.start)) for n, p in zip(names, spec.parameters)])
                      for ms in spec.multistart]
     for k, ms in enumerate(spec.multistart):
@@ -587,15 +736,17 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
     fits = []
     for k, s in enumerate(starts):
         echo(f"--- start {k + 1}/{len(starts)}: " + ", ".join(f"{n}={v:.4g}" for n, v in zip(names, s)))
-        fits.append(fit(evaluator, s, correction=correction))
+        fits.append(fit(evaluator, s, correction=correction, label=f"update start {k + 1}/{len(starts)}"))
         echo(f"    -> cost {fits[-1].cost:.4g}: " + ", ".join(f"{n}={v:.5g}" for n, v in zip(names, fits[-1].values)))
     best = min(fits, key=lambda r: r.cost)
     if correction:
-        correction = mesh_correction(evaluator, best.values)
+        with evaluator.counting("update correction at the best point", 2 * n_scenes):
+            correction = mesh_correction(evaluator, best.values)
         echo(f"mesh correction at the best point: { {k: round(v, 4) for k, v in correction.items()} }")
-        best = fit(evaluator, best.values, correction=correction)
+        best = fit(evaluator, best.values, correction=correction, label="update refit")
         echo("    refit -> cost {:.4g}: ".format(best.cost) + ", ".join(f"{n}={v:.5g}" for n, v in zip(names, best.values)))
-    after = evaluate_targets(evaluator, best.values, spec.confirm_overrides, roles)
+    with evaluator.counting("update confirmation", n_scenes):
+        after = evaluate_targets(evaluator, best.values, spec.confirm_overrides, roles)
     evaluator.close()
     cal = lambda tvs, role: float(sum(0.5 * float(tv.residuals @ tv.residuals) for tv in tvs if tv.role == role))
     summary = {
@@ -615,6 +766,7 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
         "after": target_table(after),
         "seconds_per_scene_solve_median": float(np.median(evaluator.seconds)) if evaluator.seconds else None,
         "scene_solves": len(evaluator.seconds),
+        "scene_solves_resumed": evaluator.resumed_used,     # taken from the checkpoint of an interrupted run
         "seconds_per_evaluation": best.seconds_per_evaluation,
         "mesh_correction": correction,
     }
@@ -635,6 +787,7 @@ def run_update(spec: UpdateSpec, out_dir, *, comm=None, echo: Callable[[str], No
             write_csv(out / "targets.csv", ["when"] + header,
                       [("before", *r) for r in summary["before"]] + [("after", *r) for r in summary["after"]])
             _convergence_png(fits, out / "convergence.png")
+    checkpoint.remove()
     echo(f"results: {out_dir}/")
     return summary
 

@@ -203,15 +203,21 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
             dt.to_coupling_spec()
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
+    from housingfe.progress import Progress
+
     timings = {}
+    # steps: the housing model, the coupled model with its basis, the run-up over speed at every torque
+    progress = Progress(f"run-up {scene.scene.name}", 2 + len(spec.torques_nm), "steps", comm=comm)
     t0 = time.perf_counter()
     model = housing_model_for(housing_scene, spec.f_max_hz, comm)
     radiators = radiators_of(scene.radiation, model)
     timings["mesh_s"] = time.perf_counter() - t0
+    progress.update(note=f"housing model, {model.dofs} DOFs")
     reference_torque = max(spec.torques_nm)
     gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
     timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
+    progress.update(note="coupled model and modal basis")
     source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement)
     results = {}
     for torque in spec.torques_nm:
@@ -224,6 +230,8 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         for k, v in res.timings.items():
             timings[k] = timings.get(k, 0.0) + v
         results[torque] = (m, res)
+        progress.update(note=f"{torque:g} N m: {len(spec.speeds)} speeds, {len(lines.frequency)} lines")
+    progress.close()
     check_rows, contributions = checks.evaluate(scene, results, gm)
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start

@@ -217,11 +217,15 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
         raise InputError(f"{scene_name}: bearing-variants needs a scene with [coupling], [analysis.harmonic] and "
                          "analysis.harmonic.angular_velocity_node")
     configs = list(configs or [*configurations(), THESIS_SELF_ALIGNING, APPENDIX_C_MOMENTS])
+    from housingfe.progress import Progress
+
     comm = MPI.COMM_WORLD
     out = Path(out_dir or f"results/bearing-variants-{scene.scene.name}")
     outputs.reserve_output(out, comm, inputs=[scene_path])     # before the model is built
+    progress = Progress(f"bearing-variants {scene.scene.name}", 1 + len(configs), "steps", comm=comm)
     model = build_model_from_scene(scene, comm)
     t_model = time.perf_counter() - t_start
+    progress.update(note=f"housing model, {model.dofs} DOFs")
     spec = scene.analysis.harmonic
     results = {}
     for name in configs:
@@ -238,6 +242,8 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
                                       forces.stiffness, {"total_s": time.perf_counter() - t0, **forced.timings})
         if comm.rank == 0:
             print(f"{name:20s} {solver:15s} {time.perf_counter() - t0:6.1f} s", flush=True)
+        progress.update(note=name)
+    progress.close()
     summary = differences(results, "ball" if "ball" in results else configs[0])
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:

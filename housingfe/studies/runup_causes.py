@@ -97,6 +97,7 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
     """Run the variants (module docstring) of a run-up scene at its highest torque; returns the result folder."""
     from mpi4py import MPI
 
+    from housingfe.progress import Progress
     from housingfe.response.reduced import RitzReduction
     from housingfe.runup.chain import build_gearbox_model, runup, source_lines, unit_loads, with_drivetrain
     from housingfe.runup.scene import drivetrain_of, housing_model_for, load_runup_scene, radiators_of
@@ -109,6 +110,10 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
     comm = MPI.COMM_WORLD
     out = Path(out_dir or f"results/runup-causes-{scene.scene.name}")
     outputs.reserve_output(out, comm, inputs=[scene_path])     # before the model is built
+    # steps: the coupled model, then the run-up of every variant (reference, 2 damping ratios, 2 truncations, and
+    # with ball bearings the re-analyses without moment stiffness and with self-aligning bearings)
+    progress = Progress(f"runup-causes {scene.scene.name}", 6 + 2 * (scene.drivetrain.bearings == "ball"), "steps",
+                        comm=comm)
     housing_scene, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
     model = housing_model_for(housing_scene, spec.f_max_hz, comm)
     dt = drivetrain_of(scene.drivetrain, torque)
@@ -116,11 +121,14 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
                              basis_factor=spec.basis_factor, radiators=radiators_of(scene.radiation, model),
                              surface=spec.surface)
     lines, _ = source_lines(dt.source_model(harmonics=spec.harmonics, engagement=spec.engagement), spec.speeds, [torque], spec.f_max_hz)
+    progress.update(note="coupled model and modal basis")
 
-    def run(m):
-        return runup(m, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
+    def run(m, note: str):
+        out = runup(m, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
+        progress.update(note=note)
+        return out
 
-    base = run(gm)
+    base = run(gm, "reference")
     rows = _rows(f"reference: xi {spec.damping_ratio:g}, modes to {gm.basis.f_max:g} Hz + static vectors, "
                  f"harmonics to {spec.f_max_hz:g} Hz", base, torque, None)
     ref = {(r["route"], r["radiation"]): r["LwA_mean_800_1500_dBA"] for r in rows}
@@ -128,8 +136,8 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
 
     for xi in (0.02, 0.08):
         damping = Damping(lambda f: np.zeros(np.shape(f)), modal_ratio=xi)
-        rows += _rows(f"damping xi {xi:g}", run(dataclasses.replace(gm, reduction=gm.reduction.with_damping(damping))),
-                      torque, ref)
+        rows += _rows(f"damping xi {xi:g}", run(dataclasses.replace(gm, reduction=gm.reduction.with_damping(damping)),
+                                                f"damping xi {xi:g}"), torque, ref)
     loads, _, _ = unit_loads(gm.structure, gm.drivetrain)
     extra = {}
     for radiator in gm.radiators.values():
@@ -138,15 +146,16 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
         red = RitzReduction(_truncated(gm.basis, f_cut), loads, gm.reduction.damping, surface=spec.surface,
                             nodes=(gm.wheel_node,), extra_points=extra,
                             residual=False)
-        rows += _rows(f"modes to {f_cut:g} Hz only, no static vectors", run(dataclasses.replace(gm, reduction=red)),
-                      torque, ref)
+        rows += _rows(f"modes to {f_cut:g} Hz only, no static vectors",
+                      run(dataclasses.replace(gm, reduction=red), f"modes to {f_cut:g} Hz"), torque, ref)
     rows += _rows("tooth frequency line only (harmonic 1)", _tooth_only(base), torque, ref)
     if scene.drivetrain.bearings == "ball":
         rows += _rows("ball bearings without moment stiffness (moment rows and columns zeroed, re-analysed)",
-                      run(with_drivetrain(gm, without_moment_stiffness(dt))), torque, ref)
+                      run(with_drivetrain(gm, without_moment_stiffness(dt)), "no moment stiffness"), torque, ref)
         other = dataclasses.replace(dt, bearing_configuration="self_aligning")
         rows += _rows("self-aligning bearings (spherical roller model: no moment stiffness AND ~5x the radial "
-                      "stiffness, re-analysed)", run(with_drivetrain(gm, other)), torque, ref)
+                      "stiffness, re-analysed)", run(with_drivetrain(gm, other), "self-aligning"), torque, ref)
+    progress.close()
     n = gm.basis.rigid_count
     freqs = gm.basis.frequencies_hz[n:]
     bands = third_octave_bands(125.0, 630.0)

@@ -82,6 +82,8 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     scene with a reference and a modal analysis plus the other modules' rows; quick: the CI subset.
     results_dir: where FE results are cached (default results/).  Raises SolverError (one line) after
     writing the table when a computation failed."""
+    from housingfe.progress import Progress
+
     t0 = time.perf_counter()
     results = Path(results_dir) if results_dir is not None else RESULTS
     if results.resolve() == Path(out_dir).resolve() or Path(out_dir).resolve() in results.resolve().parents:
@@ -94,12 +96,18 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     rows: list[dict] = []
     failures: list[str] = []
     modal: dict[str, dict] = {}
+    # steps: every scene (computed or taken from its up-to-date cache), the bearing-variant study and the run-up
+    # scenes (full run), every row provider
+    steps = len(names) + (0 if scenes else (0 if quick else 1 + len(RUNUP_SCENES)) + len(ROW_PROVIDERS))
+    progress = Progress("validate", steps, "steps")
     for name in names:
         try:
             summary = modal_results(name, results)
         except ComputationFailed as exc:
             failures.append(str(exc))
             continue
+        finally:
+            progress.update(note=name)
         if summary is None:
             continue
         modal[summary["scene"]] = summary
@@ -113,12 +121,15 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
                 rows += bearing_variant_rows(results)
             except ComputationFailed as exc:
                 failures.append(str(exc))
+            progress.update(note="bearing variants")
             for name, overrides in RUNUP_SCENES:
                 try:
                     rows += runup_rows(name, overrides, results)
                 except ComputationFailed as exc:
                     failures.append(str(exc))
-        rows += provider_rows(failures)
+                progress.update(note=name)
+        rows += provider_rows(failures, progress)
+    progress.close()
     write_outputs(rows, Path(out_dir), json_path)
     print(format_rows(rows))
     print(f"{len(rows)} rows in {time.perf_counter() - t0:.0f} s; written to {out_dir}/validate.csv, validate.md "
@@ -429,9 +440,10 @@ def geometry_rows(names: list[str]) -> list[dict]:
     return out
 
 
-def provider_rows(failures: list[str] | None = None) -> list[dict]:
+def provider_rows(failures: list[str] | None = None, progress=None) -> list[dict]:
     """published_rows() of every module in ROW_PROVIDERS.  A provider that fails is reported on one line
-    (appended to `failures`, or raised as SolverError when no list is given); the others still count."""
+    (appended to `failures`, or raised as SolverError when no list is given); the others still count.
+    progress: a housingfe.progress.Progress counting one step per provider."""
     out = []
     for module_name in ROW_PROVIDERS:
         try:
@@ -445,6 +457,9 @@ def provider_rows(failures: list[str] | None = None) -> list[dict]:
                 raise SolverError(message) from exc
             print(f"validate: failed: {message}", file=sys.stderr, flush=True)
             failures.append(message)
+        finally:
+            if progress is not None:
+                progress.update(note=module_name.rsplit(".", 1)[-1])
     return out
 
 

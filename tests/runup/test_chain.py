@@ -112,6 +112,12 @@ def test_one_and_two_ranks_agree(tmp_path):
     assert two.returncode == 0, two.stderr
     a, b = _rows(tmp_path / "one/runup.csv"), _rows(tmp_path / "two/runup.csv")
     assert len(a) == len(b) == 2 * 2 * 3
+    # progress (housingfe.progress): housing model, coupled model, the run-up at the one torque; rank 0 alone
+    for proc in (one, two):
+        steps = [ln for ln in proc.stderr.splitlines() if ln.startswith("run-up test-gearbox-runup: ")]
+        assert steps[0].startswith("run-up test-gearbox-runup: 1/3 steps, ") and "elapsed" in steps[0]
+        assert steps[-1].startswith("run-up test-gearbox-runup: 3/3 steps, ") and "3 speeds, 8 lines" in steps[-1]
+        assert len(steps) == len(set(steps)) <= 3
     for ra, rb in zip(a, b):
         for key in ("Lv_dB", "LwA_dB", "L_omega_dB"):
             assert float(ra[key]) == pytest.approx(float(rb[key]), abs=1e-6)

@@ -147,7 +147,9 @@ def test_failed_computation_is_one_line_and_nonzero_exit(tmp_path, monkeypatch, 
     from housingfe.cli import main
     capsys.readouterr()
     assert main(["validate", "box-free", "--out", str(tmp_path / "v"), "--results", str(tmp_path / "r")]) == 3
-    err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    # the progress line of the step (housingfe.progress) precedes the one error line
+    progress, *err = [line for line in capsys.readouterr().err.splitlines() if line.strip()]
+    assert progress.startswith("validate: 1/1 steps, 0:00 elapsed (box-free)")
     assert len(err) == 1 and "boom" in err[0] and "Traceback" not in err[0]
 
 
