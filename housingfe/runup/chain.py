@@ -178,10 +178,11 @@ class Lines:
     mesh_excitation: np.ndarray
     point: np.ndarray
     points: list
-    # which receptance the source's harmonic balance used (SOURCE_RECEPTANCES); with "coupled" L_omega is the
-    # wheel's on the coupled model and rigid_L_omega_tooth_band the rigid-bore source's per point, for comparison
+    # which receptance the source's harmonic balance used (SOURCE_RECEPTANCES).  With "coupled": mesh_excitation
+    # comes from the balance on the coupled gearbox and L_omega_flexible is the wheel's level on it per line;
+    # L_omega and points stay the rigid-bore source's (the input of the thesis' route tf_omega, eq. 5.5)
     receptance: str = "rigid-bores"
-    rigid_L_omega_tooth_band: list | None = None
+    L_omega_flexible: np.ndarray | None = None
 
 
 def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float) -> tuple[Lines, float]:
@@ -246,13 +247,14 @@ def mesh_receptance(model: GearboxModel, frequencies_hz) -> np.ndarray:
 
 def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max: float, *,
                          first_order: bool = False, harmonics: int | None = None) -> tuple[Lines, float]:
-    """The source's lines (as `source_lines`) with the harmonic balance of the time-varying mesh solved on the
-    coupled gearbox instead of the rigid-bore lumped interior (housingfe.source.dynamics.mesh_harmonic_balance
+    """The source's lines (`source_lines`, the rigid-bore source's L_omega kept for the tf_omega route) with the
+    mesh excitation from the harmonic balance of the time-varying mesh solved on the coupled gearbox instead of the
+    rigid-bore lumped interior (housingfe.source.dynamics.mesh_harmonic_balance
     with the coupled model's mesh receptance, `mesh_receptance`): S(t) and F_e(t) of `source` at each torque, the
     coupled model's mean mesh stiffness k_ref, its static state (the transmitted normal force F: b_0 = F / k_ref,
-    g(0) = 1 / k_ref).  mesh_excitation is W_n - k_ref d_n (what the mesh_force route applies); L_omega is the
-    wheel's on the coupled model.  model: the GearboxModel at the torque (one torque per model: another torque
-    changes the bearings, see `with_drivetrain`).  first_order: the mean-stiffness solve (quasi-static transmission
+    g(0) = 1 / k_ref).  mesh_excitation is W_n - k_ref d_n (what the mesh_force route applies); L_omega_flexible is
+    the wheel's level on the coupled model (what the mesh_force route's L_omega_coupled then is, too).  model: the
+    GearboxModel at the torque (one torque per model: another torque changes the bearings, `with_drivetrain`).  first_order: the mean-stiffness solve (quasi-static transmission
     error on the mean system).  harmonics: H of the balance (default: the source's).  Returns (Lines, seconds)."""
     from housingfe.source.dynamics import mesh_harmonic_balance
     from housingfe.source.stiffness import normal_force_from_torque
@@ -261,40 +263,27 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
     H = int(harmonics or source.harmonics)
     k_ref = mesh_reference_stiffness(model)
     rigid, _ = source_lines(source, speeds_rpm, torques_nm, f_lines_max)
-    cols = {k: [] for k in ("torque", "speed", "harmonic", "frequency", "mesh_excitation", "point")}
-    points = []
+    cols = {k: [] for k in ("frequency", "mesh_excitation")}
     for torque in torques_nm:
         S, shock = source.mesh_stiffness(float(torque))
         F = normal_force_from_torque(source.pair, float(torque))
         f_t = np.array([source.pair.tooth_frequency(float(v)) for v in speeds_rpm])
         nn = np.arange(1, H + 1)
         g = mesh_receptance(model, (f_t[:, None] * nn[None, :]).ravel()).reshape(len(f_t), H)
-        for i, speed in enumerate(speeds_rpm):
+        for i in range(len(f_t)):
             rec = np.concatenate([[1.0 / k_ref], g[i]])
             st = mesh_harmonic_balance(rec, F / k_ref, S, shock, k_ref, f_t[i], first_order=first_order)
             f, exc = st.one_sided(st.excitation)
             keep = f <= f_lines_max * (1 + 1e-12)
-            k = int(keep.sum())
-            cols["torque"] += [float(torque)] * k
-            cols["speed"] += [float(speed)] * k
-            cols["harmonic"] += list(nn[keep])
             cols["frequency"] += list(f[keep])
             cols["mesh_excitation"] += list(exc[keep] / math.sqrt(2.0))
-            cols["point"] += [len(points)] * k
-            points.append([float(torque), float(speed), float(f_t[i]), float("nan"), k_ref])
     freq = np.array(cols["frequency"], float)
+    if freq.shape != rigid.frequency.shape or not np.allclose(freq, rigid.frequency, rtol=1e-12):
+        raise InputError("source_receptance: the coupled and the rigid-bore source have different lines")
     mesh_exc = np.array(cols["mesh_excitation"], complex)
-    point = np.array(cols["point"], int)
     resp = model.reduction.response_of(freq, model.reduction.coefficients(freq, {"mesh": mesh_exc}))
-    L_omega = _wheel_omega_level(model, resp, freq)
-    harm = np.array(cols["harmonic"], int)
-    for p in range(len(points)):
-        tooth = np.flatnonzero((point == p) & (harm == 1))
-        if tooth.size:       # the tooth band holds the tooth line alone (the next line is an octave up)
-            points[p][3] = float(L_omega[tooth[0]])
-    lines = Lines(np.array(cols["torque"], float), np.array(cols["speed"], float), harm, freq, L_omega, mesh_exc,
-                  point, [tuple(p) for p in points], receptance="coupled",
-                  rigid_L_omega_tooth_band=[p[3] for p in rigid.points])
+    lines = replace(rigid, mesh_excitation=mesh_exc, receptance="coupled",
+                    L_omega_flexible=_wheel_omega_level(model, resp, freq))
     return lines, time.perf_counter() - t0
 
 
