@@ -227,7 +227,7 @@ def main(out_dir: Path, quick: bool) -> None:
           f"{len(gm.basis.eigenvalues)} modes, {n_vec} Ritz vectors, basis built in {basis_s:.1f} s; load average "
           f"{load_before[0]:.1f} before, {load_after[0]:.1f} after")
     print(format_table(header, [[r[0], r[1], f"{r[2]:.3g}", f"{r[3]:.3g}", "-" if r[4] is None else f"{r[4]:.2g}",
-                                 r[5], r[6]] for r in rows]))
+                                 r[5], r[6]] for r in rows], width=None))
     with atomic_output_dir(out_dir, comm) as tmp:
         if comm.rank == 0:
             write_csv(tmp / "bench_flexsource.csv", header, rows)

@@ -108,3 +108,23 @@ def test_mesh_force_route_on_the_coupled_source_is_its_wheel_level(coarse):
     np.testing.assert_allclose(res.routes["mesh_force"].L_omega_coupled, lines.L_omega_flexible, atol=1e-9)
     np.testing.assert_array_equal(lines.L_omega, rigid.L_omega)       # tf_omega keeps the thesis' source
     assert lines.receptance == "coupled"
+
+
+def test_source_receptance_key_defaults_to_coupled_and_rejects_unknown(tmp_path):
+    import subprocess
+
+    from housingfe.runup.scene import load_runup_scene
+    from tests.runup.test_scene import HOUSINGFE
+
+    scene, _ = load_runup_scene("test-gearbox-runup")
+    assert scene.runup.source_receptance == "coupled"
+    scene, _ = load_runup_scene("test-gearbox-runup", ['runup.source_receptance="rigid-bores"'])
+    assert scene.runup.source_receptance == "rigid-bores"
+    out = tmp_path / "out"
+    proc = subprocess.run(HOUSINGFE + ["run", "test-gearbox-runup", "--out", str(out), "--set",
+                                       'runup.source_receptance="flexible"'], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 2, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "runup.source_receptance" in lines[0] and "Traceback" not in proc.stderr, proc.stderr
+    assert not out.exists()
