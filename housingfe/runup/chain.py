@@ -37,6 +37,7 @@ import numpy as np
 from housingfe import levels
 from housingfe.errors import InputError
 from housingfe.radiation.power import area_level_db
+from housingfe.response.observers import node_key
 from housingfe.response.reduced import RitzReduction, modal_basis_summary
 from housingfe.solvers import harmonic, modal
 
@@ -178,6 +179,11 @@ class Lines:
     mesh_excitation: np.ndarray
     point: np.ndarray
     points: list
+    # which receptance the source's harmonic balance used (SOURCE_RECEPTANCES).  With "coupled": mesh_excitation
+    # comes from the balance on the coupled gearbox and L_omega_flexible is the wheel's level on it per line;
+    # L_omega and points stay the rigid-bore source's (the input of the thesis' route tf_omega, eq. 5.5)
+    receptance: str = "rigid-bores"
+    L_omega_flexible: np.ndarray | None = None
 
 
 def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float) -> tuple[Lines, float]:
@@ -207,6 +213,93 @@ def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float) -> tuple[Li
     lines.harmonic = lines.harmonic.astype(int)
     lines.point = lines.point.astype(int)
     return lines, time.perf_counter() - t0
+
+
+# ------------------------------------------------------------------------------------------ source on the housing
+# the receptance around the mesh in the source's harmonic balance (scene key runup.source_receptance): the coupled
+# gearbox (housing, bearings, shafts, gear bodies; the Ritz reduction) or the lumped interior on rigid bores (Ch. 2)
+SOURCE_RECEPTANCES = ("coupled", "rigid-bores")
+DEFAULT_SOURCE_RECEPTANCE = "coupled"
+
+
+def mesh_reference_stiffness(model: GearboxModel) -> float:
+    """The mean mesh stiffness k_ref (N/m) that the coupled model's gear-mesh element holds."""
+    meshes = model.structure.spec.gear_meshes
+    if len(meshes) != 1:
+        raise InputError(f"source_receptance: the coupled source needs one gear mesh, the model has {len(meshes)}")
+    return float(meshes[0].stiffness)
+
+
+def mesh_receptance(model: GearboxModel, frequencies_hz) -> np.ndarray:
+    """g(f) = h^T H(f) h (m/N) of the coupled model (holding its mean mesh stiffness) at the gear mesh: the mesh
+    compression per unit compressive mesh-force pair, from the Ritz reduction (the modal basis with its static
+    correction; the reduction's damping), batched over the frequencies (Hz, > 0).  At f = 0 the value is
+    1 / k_ref exactly (`coupled_source_lines`): the gears turn freely apart from the mesh, so only the mesh spring
+    resists a static mesh compression."""
+    red = model.reduction
+    s = red.system
+    f = np.asarray(frequencies_hz, float)
+    j = red.names.index("mesh")
+    eta = np.zeros(len(f)) if s.D is not None else red.damping.hysteretic(f)
+    C = s.Cr if s.D is None else s.Cr + s.D
+    c = harmonic.solve_reduced(s.Kr, s.Mr, C, 2 * math.pi * f, eta, s.Fr[:, j:j + 1])[0]
+    return s.Fr[:, j] @ c
+
+
+def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max: float, *,
+                         first_order: bool = False, harmonics: int | None = None) -> tuple[Lines, float]:
+    """The source's lines (`source_lines`, the rigid-bore source's L_omega kept for the tf_omega route) with the
+    mesh excitation from the harmonic balance of the time-varying mesh solved on the coupled gearbox instead of the
+    rigid-bore lumped interior (housingfe.source.dynamics.mesh_harmonic_balance
+    with the coupled model's mesh receptance, `mesh_receptance`): S(t) and F_e(t) of `source` at each torque, the
+    coupled model's mean mesh stiffness k_ref, its static state (the transmitted normal force F: b_0 = F / k_ref,
+    g(0) = 1 / k_ref).  mesh_excitation is W_n - k_ref d_n (what the mesh_force route applies); L_omega_flexible is
+    the wheel's level on the coupled model (what the mesh_force route's L_omega_coupled then is, too).  model: the
+    GearboxModel at the torque (one torque per model: another torque changes the bearings, `with_drivetrain`).  first_order: the mean-stiffness solve (quasi-static transmission
+    error on the mean system).  harmonics: H of the balance (default: the source's).  Returns (Lines, seconds)."""
+    from housingfe.source.dynamics import mesh_harmonic_balance
+    from housingfe.source.stiffness import normal_force_from_torque
+
+    t0 = time.perf_counter()
+    H = int(harmonics or source.harmonics)
+    k_ref = mesh_reference_stiffness(model)
+    rigid, _ = source_lines(source, speeds_rpm, torques_nm, f_lines_max)
+    cols = {k: [] for k in ("frequency", "mesh_excitation")}
+    for torque in torques_nm:
+        S, shock = source.mesh_stiffness(float(torque))
+        F = normal_force_from_torque(source.pair, float(torque))
+        f_t = np.array([source.pair.tooth_frequency(float(v)) for v in speeds_rpm])
+        nn = np.arange(1, H + 1)
+        g = mesh_receptance(model, (f_t[:, None] * nn[None, :]).ravel()).reshape(len(f_t), H)
+        for i in range(len(f_t)):
+            rec = np.concatenate([[1.0 / k_ref], g[i]])
+            st = mesh_harmonic_balance(rec, F / k_ref, S, shock, k_ref, f_t[i], first_order=first_order)
+            f, exc = st.one_sided(st.excitation)
+            keep = f <= f_lines_max * (1 + 1e-12)
+            cols["frequency"] += list(f[keep])
+            cols["mesh_excitation"] += list(exc[keep] / math.sqrt(2.0))
+    freq = np.array(cols["frequency"], float)
+    if freq.shape != rigid.frequency.shape or not np.allclose(freq, rigid.frequency, rtol=1e-12):
+        raise InputError("source_receptance: the coupled and the rigid-bore source have different lines")
+    mesh_exc = np.array(cols["mesh_excitation"], complex)
+    # the wheel's rotation from its kept node values alone (the surface quantities are the routes' business)
+    c = model.reduction.coefficients(freq, {"mesh": mesh_exc})
+    node = model.reduction.reduced.points[node_key(model.wheel_node)]
+    rot = (model.wheel_axis / np.linalg.norm(model.wheel_axis)) @ (node[3:6] @ c)
+    lines = replace(rigid, mesh_excitation=mesh_exc, receptance="coupled",
+                    L_omega_flexible=levels.level(np.abs(2 * math.pi * freq * rot) ** 2, levels.OMEGA0))
+    return lines, time.perf_counter() - t0
+
+
+def run_source(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max: float,
+               receptance: str = DEFAULT_SOURCE_RECEPTANCE) -> tuple[Lines, float]:
+    """The source's lines with the receptance of `receptance` (SOURCE_RECEPTANCES): `coupled_source_lines` or
+    `source_lines` (the rigid-bore lumped source)."""
+    if receptance == "coupled":
+        return coupled_source_lines(model, source, speeds_rpm, torques_nm, f_lines_max)
+    if receptance == "rigid-bores":
+        return source_lines(source, speeds_rpm, torques_nm, f_lines_max)
+    raise InputError(f"source_receptance: {receptance!r} is not one of {', '.join(SOURCE_RECEPTANCES)}")
 
 
 # ------------------------------------------------------------------------------------------------ routes

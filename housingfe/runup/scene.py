@@ -78,7 +78,8 @@ class RunupSpec(_Strict):
     """Speeds (pinion, rev/min) from speed_min to speed_max in speed_step; torques (pinion, N m); the harmonics of
     the tooth frequency up to f_max_hz; a modal basis to basis_factor x f_max_hz; routes of
     housingfe.runup.chain.ROUTES; modal damping ratio (Sec. 5.4: 0.04); harmonics of the source's harmonic balance;
-    spectra at spectrum_speeds_rpm; the observed (radiating) surface; the source's engagement shock model."""
+    spectra at spectrum_speeds_rpm; the observed (radiating) surface; the source's engagement shock model; the
+    receptance around the mesh in the source's harmonic balance."""
 
     speed_min_rpm: PositiveFloat = 50.0
     speed_max_rpm: PositiveFloat = 1500.0
@@ -94,6 +95,10 @@ class RunupSpec(_Strict):
     # the source's engagement shock (housingfe.source.dynamics.ENGAGEMENT_MODELS): "face-width" distributes
     # Eq. 2.62 over the face-width slices; "thesis-2d" is the thesis' two-dimensional shock (the replica)
     engagement: Literal["face-width", "thesis-2d"] = DEFAULT_ENGAGEMENT
+    # the receptance around the mesh in the source's harmonic balance (housingfe.runup.chain.SOURCE_RECEPTANCES):
+    # "coupled" = the coupled gearbox (housing, bearings, shafts, gear bodies) from the Ritz reduction;
+    # "rigid-bores" = the lumped interior on rigid bores (the thesis' Ch. 2 source)
+    source_receptance: Literal["coupled", "rigid-bores"] = "coupled"
 
     @field_validator("routes")
     @classmethod
@@ -187,7 +192,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
 
     from housingfe import outputs
     from housingfe.runup import checks, report, slopes
-    from housingfe.runup.chain import build_gearbox_model, runup, source_lines, with_drivetrain
+    from housingfe.runup.chain import build_gearbox_model, run_source, runup, with_drivetrain
     from housingfe.scene import load_housing_scene
 
     t_start = time.perf_counter()
@@ -224,7 +229,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         t1 = time.perf_counter()
         m = gm if torque == reference_torque else with_drivetrain(gm, drivetrains[torque])
         timings[f"reanalysis_{torque:g}Nm_s"] = time.perf_counter() - t1 if m is not gm else 0.0
-        lines, t_src = source_lines(source, spec.speeds, [torque], spec.f_max_hz)
+        lines, t_src = run_source(m, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance)
         timings["source_s"] = timings.get("source_s", 0.0) + t_src
         res = runup(m, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
         for k, v in res.timings.items():

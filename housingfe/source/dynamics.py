@@ -396,6 +396,92 @@ def harmonic_balance(mats: Matrices, stiffness: np.ndarray, shock: np.ndarray, p
     return SteadyState(tooth_frequency=tooth_frequency, harmonics=n, Q=Q, mesh_force=mesh)
 
 
+# ------------------------------------------------------------------------------------ harmonic balance on a receptance
+@dataclass
+class MeshSteadyState:
+    """Periodic steady state of the mesh alone (two-sided harmonics n = -H..H of the tooth frequency [Hz]):
+    compression d [m] (the dynamic transmission error d = h^T q), mesh_force W = S(t) d(t) + F_e(t) [N] and the
+    excitation W - k_ref d [N] that the structure holding the reference stiffness k_ref [N/m] is loaded with."""
+
+    tooth_frequency: float
+    harmonics: np.ndarray
+    compression: np.ndarray
+    mesh_force: np.ndarray
+    excitation: np.ndarray
+    reference_stiffness: float
+
+    def one_sided(self, values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Frequencies n f_tooth [Hz] (n >= 1) and one-sided complex amplitudes 2 X_n."""
+        pos = self.harmonics >= 1
+        return self.harmonics[pos] * self.tooth_frequency, 2 * values[pos]
+
+
+def quasi_static_compression(stiffness: np.ndarray, shock: np.ndarray, mean_force: float) -> np.ndarray:
+    """d_qs(t) = (F - F_e(t)) / S(t) [m]: the mesh compression at zero speed, where the mesh force S d + F_e equals
+    the transmitted normal force F [N] at every instant (samples of one period, as stiffness and shock)."""
+    return (mean_force - np.asarray(shock, float)) / np.asarray(stiffness, float)
+
+
+def mesh_harmonic_balance(receptance: np.ndarray, static_compression: float, stiffness: np.ndarray,
+                          shock: np.ndarray, reference_stiffness: float, tooth_frequency: float = float("nan"),
+                          first_order: bool = False) -> MeshSteadyState:
+    """Periodic steady state of the time-varying mesh S(t) on ANY linear structure, from the structure's receptance
+    at the mesh coordinate alone (the rank-one Hill expansion of `harmonic_balance`, generalised).
+
+    The structure (the rigid-bore lumped interior, or the coupled gearbox: housing, bearings, shafts, gear bodies)
+    holds the constant mesh stiffness k_ref = reference_stiffness [N/m]; receptance[n] = g(n Omega) = h^T H(n Omega) h
+    [m/N], n = 0..H (H = len - 1; g(-w) = conj g(w)), its compression under a unit compressive mesh-force pair;
+    static_compression b_0 [m] its static mesh compression under the external mean loads (the torque).  The mesh
+    adds (S(t) - k_ref) d + F_e(t), so per harmonic
+
+        d_n = b_0 delta_n0 - g_n (sum_m (S - k_ref)_{n-m} d_m + E_n),      n = -H..H,
+
+    a (2H+1)^2 Toeplitz solve: exact for the linear periodic system as H grows (what Perret-Liaudet's spectral
+    iterative method converges to).  With receptance of the rigid-bore model this is `harmonic_balance`.
+
+    first_order=True: the mean-stiffness solve (Velex; Eritenel): the structure holding k_ref is loaded by the
+    quasi-static transmission error, W_n - k_ref d_n = -k_ref d_qs,n (n != 0, `quasi_static_compression` with
+    F = k_ref b_0): exact at zero speed, it neglects the parametric feedback of the dynamic compression on the
+    ripple S - k_ref.  stiffness, shock: one period, uniformly sampled [N/m, N]."""
+    g1 = np.asarray(receptance, complex)
+    H = g1.size - 1
+    if H < 1:
+        raise InputError("dynamics: receptance: need g at n = 0..H with H >= 1")
+    n = np.arange(-H, H + 1)
+    g = np.where(n >= 0, g1[np.abs(n)], np.conj(g1[np.abs(n)]))
+    Xs = _fourier_coefficients(np.asarray(stiffness, float), H)
+    Es = _fourier_coefficients(np.asarray(shock, float), H)[H:3 * H + 1]
+    k = float(reference_stiffness)
+    b = np.zeros(n.size, complex)
+    b[H] = static_compression
+    T = Xs[(n[:, None] - n[None, :]) + 2 * H]
+    dT = T - k * np.eye(n.size)
+    if first_order:
+        F = k * float(static_compression)
+        qs = _fourier_coefficients(quasi_static_compression(stiffness, shock, F), H)[H:3 * H + 1]
+        exc = -k * qs
+        exc[H] = 0.0                           # the mean: the mean system's static state, W_0 = k_ref b_0
+        d = b - g * exc
+    else:
+        d = np.linalg.solve(np.eye(n.size) + g[:, None] * dT, b - g * Es)
+        exc = dT @ d + Es
+    return MeshSteadyState(tooth_frequency=float(tooth_frequency), harmonics=n, compression=d,
+                           mesh_force=exc + k * d, excitation=exc, reference_stiffness=k)
+
+
+def lumped_receptance(mats: Matrices, preload: np.ndarray, tooth_frequency: float, H: int,
+                      reference_stiffness: float) -> tuple[np.ndarray, float]:
+    """(g(n Omega) n = 0..H [m/N], static compression b_0 [m]) of the rigid-bore lumped model holding the mesh
+    stiffness reference_stiffness [N/m]: the inputs of `mesh_harmonic_balance` that make it `harmonic_balance`."""
+    Om = 2 * math.pi * tooth_frequency
+    h = mats.h
+    K = mats.K0 + reference_stiffness * np.outer(h, h)
+    g = np.empty(H + 1, complex)
+    for nn in range(H + 1):
+        g[nn] = h @ np.linalg.solve(K - (nn * Om) ** 2 * mats.M + 1j * nn * Om * mats.D, h)
+    return g, float(h @ np.linalg.solve(K, preload))
+
+
 def time_integration(mats: Matrices, stiffness: np.ndarray, shock: np.ndarray, preload: np.ndarray,
                      tooth_frequency: float, periods: int, samples_per_period: int = 64,
                      rtol: float = 1e-8, method: str = "Radau") -> tuple[np.ndarray, np.ndarray]:

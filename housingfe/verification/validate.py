@@ -389,7 +389,7 @@ def runup_rows(name: str, overrides=(), results: Path | None = None) -> list[dic
                                      f"passed: {c['passed']}" if c["passed"] else "",
                                      f"thesis calculated {c['thesis_calculated']}" if c["thesis_calculated"]
                                      is not None else "", c["note"]) if x)
-        unit = "rpm" if c["check"] == "resonant_speeds" else "dB(A)" if c["check"] in (
+        unit = "rpm" if c["check"] in ("resonant_speeds", "L_omega_resonance") else "dB(A)" if c["check"] in (
             "LwA_max", "speed_law", "torque_law") else "dB"
         out.append(row(label, c["quantity"], ours, published, unit, src, note))
     return out

@@ -1,0 +1,130 @@
+"""The source on the flexible housing (housingfe.runup.chain.coupled_source_lines, issue 28 item 2), on the coarse
+coupled test gearbox:
+
+* the mesh receptance of the Ritz reduction tends to 1/k_ref at zero frequency (the gears turn freely apart from
+  the mesh: only the mesh spring resists a static compression) — the static value the balance uses;
+* the rank-one harmonic balance on that receptance equals the full Hill system assembled on every Ritz coordinate
+  of the coupled model (mesh compression per harmonic, 1e-8 of its largest dynamic harmonic);
+* the first-order (mean-stiffness) solve agrees with the full one within the ripple of S(t) on the lines that
+  matter (>= 1 % of the tooth line);
+* the mesh_force route on the coupled lines gives the coupled source's own wheel level (one model, no second
+  interior), and the scene key runup.source_receptance picks the source.
+"""
+import math
+
+import numpy as np
+import pytest
+
+from housingfe.runup.chain import (
+    coupled_source_lines,
+    mesh_receptance,
+    mesh_reference_stiffness,
+    runup,
+    source_lines,
+)
+from housingfe.source.dynamics import _fourier_coefficients, mesh_harmonic_balance
+from housingfe.source.stiffness import normal_force_from_torque
+from tests.runup.conftest import F_LINES, SPEEDS
+
+TORQUE = 2000.0
+
+
+def _full_hill(gm, src, speed, H):
+    """d_n of Z(n Omega) c_n + f sum_k (S - k_ref)_{n-k} f^T c_k = f E_n - F f delta_n0 on the Ritz coordinates
+    (f: the mesh load's projection, d = -f^T c; the zero mode held by a stiffness on it alone)."""
+    red = gm.reduction
+    s = red.system
+    fm = s.Fr[:, red.names.index("mesh")]
+    k = mesh_reference_stiffness(gm)
+    S, shock = src.mesh_stiffness(TORQUE)
+    F = normal_force_from_torque(src.pair, TORQUE)
+    Om = 2 * math.pi * src.pair.tooth_frequency(speed)
+    X = _fourier_coefficients(S, H)
+    X[2 * H] -= k
+    E = _fourier_coefficients(shock, H)[H:3 * H + 1]
+    C = s.Cr + s.D
+    lam = (2 * math.pi * s.frequencies_hz) ** 2
+    rigid = s.Y[:, lam < 1e-6 * lam.max()]
+    assert rigid.shape[1] == 1
+    Ms = 0.5 * (s.Mr + s.Mr.T)
+    m = len(fm)
+    n = np.arange(-H, H + 1)
+    A = np.zeros((n.size * m, n.size * m), complex)
+    rhs = np.zeros(n.size * m, complex)
+    for i, ni in enumerate(n):
+        blk = slice(i * m, (i + 1) * m)
+        A[blk, blk] += s.Kr - (ni * Om) ** 2 * s.Mr + 1j * ni * Om * C
+        if ni == 0:
+            A[blk, blk] += 1e-3 * lam.max() * Ms @ rigid @ rigid.T @ Ms
+        for j, nj in enumerate(n):
+            A[blk, j * m:(j + 1) * m] += X[ni - nj + 2 * H] * np.outer(fm, fm)
+        rhs[blk] = fm * (E[i] - (F if ni == 0 else 0.0))
+    c = np.linalg.solve(A, rhs).reshape(n.size, m)
+    return -(c @ fm)
+
+
+@pytest.mark.slow
+def test_static_mesh_receptance_is_one_over_the_mesh_stiffness(coarse):
+    gm = coarse[0]
+    k = mesh_reference_stiffness(gm)
+    assert mesh_receptance(gm, [1e-3])[0] * k == pytest.approx(1.0, abs=1e-6)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("speed", [500.0, 1100.0])
+def test_rank_one_balance_equals_the_full_hill_system_on_the_ritz_coordinates(coarse, speed):
+    gm, src = coarse[0], coarse[1]
+    H = 8
+    k = mesh_reference_stiffness(gm)
+    S, shock = src.mesh_stiffness(TORQUE)
+    F = normal_force_from_torque(src.pair, TORQUE)
+    f_t = src.pair.tooth_frequency(speed)
+    g = np.concatenate([[1 / k], mesh_receptance(gm, f_t * np.arange(1, H + 1))])
+    d = mesh_harmonic_balance(g, F / k, S, shock, k, f_t).compression
+    d_full = _full_hill(gm, src, speed, H)
+    np.testing.assert_allclose(d, d_full, rtol=0, atol=1e-8 * np.abs(d_full[H + 1:]).max())
+
+
+@pytest.mark.slow
+def test_first_order_agrees_within_the_ripple(coarse):
+    gm, src = coarse[0], coarse[1]
+    full, _ = coupled_source_lines(gm, src, SPEEDS, [TORQUE], F_LINES)
+    first, _ = coupled_source_lines(gm, src, SPEEDS, [TORQUE], F_LINES, first_order=True)
+    S, _ = src.mesh_stiffness(TORQUE)
+    ripple = np.abs(np.fft.rfft(S)[1:]).max() * 2 / S.size / S.mean()
+    for p in range(len(SPEEDS)):
+        sel = full.point == p
+        a, b = first.mesh_excitation[sel], full.mesh_excitation[sel]
+        big = np.abs(b) >= 0.01 * np.abs(b[0])
+        assert np.all(np.abs(a[big] - b[big]) <= ripple * np.abs(b[big]))
+
+
+@pytest.mark.slow
+def test_mesh_force_route_on_the_coupled_source_is_its_wheel_level(coarse):
+    gm, src = coarse[0], coarse[1]
+    lines, _ = coupled_source_lines(gm, src, SPEEDS, [TORQUE], F_LINES)
+    rigid, _ = source_lines(src, SPEEDS, [TORQUE], F_LINES)
+    res = runup(gm, None, SPEEDS, [TORQUE], lines=lines)
+    np.testing.assert_allclose(res.routes["mesh_force"].L_omega_coupled, lines.L_omega_flexible, atol=1e-9)
+    np.testing.assert_array_equal(lines.L_omega, rigid.L_omega)       # tf_omega keeps the thesis' source
+    assert lines.receptance == "coupled"
+
+
+def test_source_receptance_key_defaults_to_coupled_and_rejects_unknown(tmp_path):
+    import subprocess
+
+    from housingfe.runup.scene import load_runup_scene
+    from tests.runup.test_scene import HOUSINGFE
+
+    scene, _ = load_runup_scene("test-gearbox-runup")
+    assert scene.runup.source_receptance == "coupled"
+    scene, _ = load_runup_scene("test-gearbox-runup", ['runup.source_receptance="rigid-bores"'])
+    assert scene.runup.source_receptance == "rigid-bores"
+    out = tmp_path / "out"
+    proc = subprocess.run(HOUSINGFE + ["run", "test-gearbox-runup", "--out", str(out), "--set",
+                                       'runup.source_receptance="flexible"'], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 2, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "runup.source_receptance" in lines[0] and "Traceback" not in proc.stderr, proc.stderr
+    assert not out.exists()
