@@ -35,8 +35,10 @@ def test_committed_reference_is_what_the_schema_generates():
 
 def test_every_geometry_kind_has_its_section_and_picture():
     text = (ROOT / "docs" / "scene-reference.md").read_text()
-    for kind in GEOMETRY_KINDS:
+    for kind, registered in GEOMETRY_KINDS.items():
         assert f'### `kind = "{kind}"`' in text
+        if registered.mesh is not None:     # an imported mesh: its surfaces are the file's sets, no picture
+            continue
         assert f"(img/geometry-{kind}.png)" in text
         assert (ROOT / "docs" / "img" / f"geometry-{kind}.png").stat().st_size > 10_000
 
