@@ -94,6 +94,18 @@ class RunupSpec(_Strict):
     # the source's engagement shock (housingfe.source.dynamics.ENGAGEMENT_MODELS): "face-width" distributes
     # Eq. 2.62 over the face-width slices; "thesis-2d" is the thesis' two-dimensional shock (the replica)
     engagement: Literal["face-width", "thesis-2d"] = DEFAULT_ENGAGEMENT
+    # the mesh misalignment under load in the source's mesh stiffness and load share
+    # (housingfe.drivetrain.misalignment): "rigid-bores" = static tilt of the FE interior (shafts, bearings at their
+    # loaded 6x6 stiffness) on rigid bores at each torque; "lumped" = of the 14-DOF source model; "none" = aligned
+    # (default: "rigid-bores" with the face-width engagement, "none" with the thesis' replica "thesis-2d")
+    misalignment: Optional[Literal["rigid-bores", "lumped", "none"]] = None
+
+    @property
+    def misalignment_model(self) -> str:
+        """The misalignment model in effect (see `misalignment`)."""
+        if self.misalignment is not None:
+            return self.misalignment
+        return "none" if self.engagement == "thesis-2d" else "rigid-bores"
 
     @field_validator("routes")
     @classmethod
@@ -212,7 +224,8 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
     timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
-    source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement)
+    source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement,
+                                                        misalignment=spec.misalignment_model)
     results = {}
     for torque in spec.torques_nm:
         t1 = time.perf_counter()
@@ -224,6 +237,9 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         for k, v in res.timings.items():
             timings[k] = timings.get(k, 0.0) + v
         results[torque] = (m, res)
+        if comm.rank == 0 and spec.misalignment_model != "none":
+            print(f"misalignment ({spec.misalignment_model}) at {torque:g} N m: lead gap "
+                  f"{source.lead_gap(torque) * 1e6:.1f} um/m over the face (MeshModel.lead_gap)")
     check_rows, contributions = checks.evaluate(scene, results, gm)
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
