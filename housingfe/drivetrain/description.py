@@ -240,15 +240,16 @@ class Drivetrain:
                           torque_configuration=self.gears.torque_configuration)
         return interior, geometry, model
 
-    def source_model(self, misalignment: str = "none", **kwargs):
+    def source_model(self, misalignment="none", **kwargs):
         """housingfe.source.operating.SourceModel of the lumped reduction (kwargs: its options).  misalignment: a
         model of housingfe.drivetrain.misalignment.MISALIGNMENT_MODELS ("none", "lumped", "rigid-bores": the FE
-        interior on rigid bores at each torque)."""
+        interior on rigid bores at each torque) or a function torque [N m] -> MeshModel.lead_gap [m/m]."""
         from housingfe.drivetrain.misalignment import lead_gap_law
         from housingfe.source.operating import SourceModel
 
         interior, geometry, model = self.to_lumped()
-        law = misalignment if misalignment in ("none", "lumped") else lead_gap_law(self, misalignment)
+        law = (misalignment if callable(misalignment) or misalignment in ("none", "lumped")
+               else lead_gap_law(self, misalignment))
         return SourceModel(self.gears.pair, self.gears.corrections, interior, geometry, mesh_model=model,
                            misalignment=law, **kwargs)
 

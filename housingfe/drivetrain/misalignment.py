@@ -26,6 +26,8 @@ from housingfe.source import misalignment as mis
 
 MISALIGNMENT_MODELS = (*mis.MISALIGNMENT_MODELS, "rigid-bores")
 DEFAULT_MISALIGNMENT = "rigid-bores"
+# needs the housing model as well (`coupled_misalignment`): the run-up builds it
+COUPLED_MODEL = "coupled"
 
 
 def static_gear_tilts(drivetrain, forces=None) -> tuple[np.ndarray, np.ndarray, object]:
@@ -61,6 +63,72 @@ def static_gear_tilts(drivetrain, forces=None) -> tuple[np.ndarray, np.ndarray, 
         raise InputError("misalignment: the interior on rigid bores is not supported (singular)")
     tilt = {k: u[index[n] + 3:index[n] + 6] for k, n in gear_nodes.items()}
     return tilt["pinion"], tilt["wheel"], forces
+
+
+def _gear_loads(drivetrain, forces) -> tuple[dict, dict]:
+    """({gear node: (6,) load of the mean tooth force without its moment about the shaft axis}, {gear node: unit
+    shaft axis})."""
+    loads = drivetrain.mesh_node_loads(float(np.linalg.norm(forces.force_on_pinion)), forces)
+    out, axes = {}, {}
+    for name in ("pinion", "wheel"):
+        node = f"{name}:{drivetrain.shaft_nodes(name)[1]['gear']}"
+        a = np.asarray(drivetrain.shaft(name).axis, float)
+        a /= np.linalg.norm(a)
+        load = np.real(np.asarray(loads[node], float)).copy()
+        load[3:] -= (load[3:] @ a) * a
+        out[node], axes[node] = load, a
+    return out, axes
+
+
+def coupled_gear_tilts(housing_model, drivetrain, forces=None) -> tuple[np.ndarray, np.ndarray, object]:
+    """As `static_gear_tilts`, with the bores on the flexible housing: the FE interior (no gear-mesh spring) coupled
+    with `housing_model` (a HousingModel with the drivetrain's bores, supported: its feet fixed) as the run-up
+    couples it, the spin of each gear held by a spring to ground that carries no load; one direct (MUMPS) solve.
+    Collective under MPI."""
+    from petsc4py import PETSc
+
+    from housingfe.drivetrain import coupling as cp
+    from housingfe.drivetrain.interior import bore_centres, parts
+
+    forces = forces or drivetrain.gear_forces()
+    spec = drivetrain.to_coupling_spec(forces).model_copy(update={"gear_meshes": []})
+    centres = bore_centres(housing_model, spec)
+    p = parts(spec, centres)
+    loads, axes = _gear_loads(drivetrain, forces)
+    holds = []
+    for node, a in axes.items():
+        k6 = np.zeros((6, 6))
+        k6[3:, 3:] = 1e9 * np.outer(a, a)            # N m/rad; any value: it carries no load
+        holds.append(cp.spring(node, None, k6))
+    system = cp.couple(housing_model, p.connections, p.elements + holds, p.shafts, [])
+    f = system.load(node_loads=loads)
+    ksp = PETSc.KSP().create(system.K.getComm())
+    ksp.setOperators(system.K)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("lu")
+    pc.setFactorSolverType("mumps")
+    u = system.K.createVecRight()
+    try:
+        ksp.solve(f, u)
+    except PETSc.Error:
+        raise InputError("misalignment: the coupled gearbox is singular (a free housing? the coupled model needs "
+                         "the housing's supports)") from None
+    if ksp.getConvergedReason() < 0 or not np.isfinite(u.norm()):
+        raise InputError("misalignment: the coupled gearbox is singular (a free housing? the coupled model needs "
+                         "the housing's supports)")
+    names = list(loads)
+    tilt = [np.asarray(system.node_displacement(u, n), float)[3:6] for n in names]
+    ksp.destroy()
+    return tilt[0], tilt[1], forces
+
+
+def coupled_misalignment(housing_model, drivetrain) -> mis.Misalignment:
+    """The "coupled" Misalignment of a drivetrain at its torque, on the flexible housing (`coupled_gear_tilts`)."""
+    theta_p, theta_w, forces = coupled_gear_tilts(housing_model, drivetrain)
+    a = np.asarray(drivetrain.shaft("pinion").axis, float)
+    return mis.from_tilts(COUPLED_MODEL, drivetrain.torque, theta_p, theta_w, -a, forces.direction,
+                          drivetrain.to_lumped()[2].total_width, drivetrain.gears.pair.base_helix_angle)
 
 
 def rigid_bore_misalignment(drivetrain) -> mis.Misalignment:

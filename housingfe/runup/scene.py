@@ -78,7 +78,8 @@ class RunupSpec(_Strict):
     """Speeds (pinion, rev/min) from speed_min to speed_max in speed_step; torques (pinion, N m); the harmonics of
     the tooth frequency up to f_max_hz; a modal basis to basis_factor x f_max_hz; routes of
     housingfe.runup.chain.ROUTES; modal damping ratio (Sec. 5.4: 0.04); harmonics of the source's harmonic balance;
-    spectra at spectrum_speeds_rpm; the observed (radiating) surface; the source's engagement shock model."""
+    spectra at spectrum_speeds_rpm; the observed (radiating) surface; the source's engagement shock model and
+    the mesh misalignment under load in its mesh stiffness and load share (docs/misalignment.md)."""
 
     speed_min_rpm: PositiveFloat = 50.0
     speed_max_rpm: PositiveFloat = 1500.0
@@ -96,9 +97,10 @@ class RunupSpec(_Strict):
     engagement: Literal["face-width", "thesis-2d"] = DEFAULT_ENGAGEMENT
     # the mesh misalignment under load in the source's mesh stiffness and load share
     # (housingfe.drivetrain.misalignment): "rigid-bores" = static tilt of the FE interior (shafts, bearings at their
-    # loaded 6x6 stiffness) on rigid bores at each torque; "lumped" = of the 14-DOF source model; "none" = aligned
-    # (default: "rigid-bores" with the face-width engagement, "none" with the thesis' replica "thesis-2d")
-    misalignment: Optional[Literal["rigid-bores", "lumped", "none"]] = None
+    # loaded 6x6 stiffness) on rigid bores at each torque; "coupled" = the same on the flexible housing (one static
+    # solve of the coupled model per torque); "lumped" = of the 14-DOF source model; "none" = aligned gears.
+    # Default: "rigid-bores" with the face-width engagement, "none" with the thesis' replica "thesis-2d"
+    misalignment: Optional[Literal["rigid-bores", "coupled", "lumped", "none"]] = None
 
     @property
     def misalignment_model(self) -> str:
@@ -224,8 +226,18 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
     timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
+    misalignment = spec.misalignment_model
+    if misalignment == "coupled":           # the static tilt on the flexible housing, per torque
+        from housingfe.drivetrain.misalignment import coupled_misalignment
+
+        t1 = time.perf_counter()
+        gaps = {float(t): coupled_misalignment(model, dt).lead_gap for t, dt in drivetrains.items()}
+        timings["misalignment_s"] = time.perf_counter() - t1
+
+        def misalignment(torque: float) -> float:
+            return gaps[float(torque)]
     source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement,
-                                                        misalignment=spec.misalignment_model)
+                                                        misalignment=misalignment)
     results = {}
     for torque in spec.torques_nm:
         t1 = time.perf_counter()
