@@ -66,3 +66,22 @@ def test_misalignment_models_and_the_runup_switch():
     assert scene.runup.misalignment_model == "none"                 # the thesis' replica stays aligned
     with pytest.raises(InputError, match="misalignment"):
         load_runup_scene("test-gearbox-runup", ["runup.misalignment=tilted"])
+
+
+def test_coupled_misalignment_on_a_stiff_housing_is_the_rigid_bore_one():
+    """The coupled solve (interior on the housing FE, one MUMPS solve) with the housing 1000x stiffer than steel:
+    the bores stand still and the tilt in the plane of action is the rigid-bore one (to the housing's residual
+    compliance)."""
+    from mpi4py import MPI
+
+    from housingfe.drivetrain.misalignment import coupled_misalignment
+    from housingfe.runup.scene import housing_model_for
+    from housingfe.scene import load_housing_scene
+
+    scene, _ = load_housing_scene("test-gearbox", ["material.youngs_modulus=2.1e14", "mesh.size=0.04"])
+    model = housing_model_for(scene, 300.0, MPI.COMM_WORLD)
+    drivetrain = replace(test_gearbox("A"), coupling_mesh_positions=2)
+    coupled = coupled_misalignment(model, drivetrain)
+    rigid = mesh_misalignment(drivetrain, "rigid-bores")
+    assert coupled.gamma == pytest.approx(rigid.gamma, rel=1e-3)
+    assert abs(rigid.gamma) > 5e-5
