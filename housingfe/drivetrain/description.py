@@ -241,17 +241,14 @@ class Drivetrain:
         return interior, geometry, model
 
     def source_model(self, misalignment="none", **kwargs):
-        """housingfe.source.operating.SourceModel of the lumped reduction (kwargs: its options).  misalignment: a
-        model of housingfe.drivetrain.misalignment.MISALIGNMENT_MODELS ("none", "lumped", "rigid-bores": the FE
-        interior on rigid bores at each torque) or a function torque [N m] -> MeshModel.lead_gap [m/m]."""
-        from housingfe.drivetrain.misalignment import lead_gap_law
+        """housingfe.source.operating.SourceModel of the lumped reduction (kwargs: its options).  misalignment:
+        "none", "lumped" (the 14-DOF model's own static tilt) or a function torque [N m] -> MeshModel.lead_gap [m/m],
+        e.g. housingfe.drivetrain.misalignment.lead_gap_law(drivetrain, "rigid-bores")."""
         from housingfe.source.operating import SourceModel
 
         interior, geometry, model = self.to_lumped()
-        law = (misalignment if callable(misalignment) or misalignment in ("none", "lumped")
-               else lead_gap_law(self, misalignment))
         return SourceModel(self.gears.pair, self.gears.corrections, interior, geometry, mesh_model=model,
-                           misalignment=law, **kwargs)
+                           misalignment=misalignment, **kwargs)
 
     # ------------------------------------------------------------------------- lumped <-> housing frames
     def lumped_frame(self) -> np.ndarray:

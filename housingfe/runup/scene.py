@@ -236,6 +236,10 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
 
         def misalignment(torque: float) -> float:
             return gaps[float(torque)]
+    elif misalignment == "rigid-bores":
+        from housingfe.drivetrain.misalignment import lead_gap_law
+
+        misalignment = lead_gap_law(drivetrains[reference_torque], "rigid-bores")
     source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement,
                                                         misalignment=misalignment)
     results = {}
@@ -251,7 +255,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         results[torque] = (m, res)
         if comm.rank == 0 and spec.misalignment_model != "none":
             print(f"misalignment ({spec.misalignment_model}) at {torque:g} N m: lead gap "
-                  f"{source.lead_gap(torque) * 1e6:.1f} um/m over the face (MeshModel.lead_gap)")
+                  f"{source.lead_gap(torque) * 1e6 + 0.0:.1f} um/m over the face (MeshModel.lead_gap)")
     check_rows, contributions = checks.evaluate(scene, results, gm)
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start

@@ -85,3 +85,34 @@ def test_coupled_misalignment_on_a_stiff_housing_is_the_rigid_bore_one():
     rigid = mesh_misalignment(drivetrain, "rigid-bores")
     assert coupled.gamma == pytest.approx(rigid.gamma, rel=1e-3)
     assert abs(rigid.gamma) > 5e-5
+
+
+def _housingfe(*args):
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    exe = Path(sys.executable).with_name("housingfe")
+    return subprocess.run([str(exe), *args], capture_output=True, text=True, timeout=300,
+                          env=dict(os.environ, OPENBLAS_NUM_THREADS="1"), check=False)
+
+
+def test_misalignment_command(tmp_path):
+    """`housingfe misalignment`: gamma per gear set and torque in a CSV; a bad gear set is one line, exit 2, no
+    folder."""
+    import csv
+
+    out = tmp_path / "mis"
+    bad = _housingfe("misalignment", "--gear-sets", "Z", "--out", str(out))
+    assert bad.returncode == 2 and bad.stderr.startswith("housingfe: error: ") and "'Z'" in bad.stderr
+    assert len(bad.stderr.strip().splitlines()) == 1 and not out.exists()
+    ok = _housingfe("misalignment", "--gear-sets", "A", "--torques", "2000", "--models", "none", "rigid-bores",
+                    "--out", str(out))
+    assert ok.returncode == 0, ok.stderr
+    rows = list(csv.DictReader(open(out / "misalignment.csv")))
+    assert [r["model"] for r in rows] == ["none", "rigid-bores"]
+    assert float(rows[0]["gamma_urad"]) == 0.0
+    rigid = mesh_misalignment(replace(test_gearbox("A"), coupling_mesh_positions=2), "rigid-bores")
+    assert float(rows[1]["gamma_urad"]) == pytest.approx(rigid.gamma * 1e6, rel=1e-9)
+    assert float(rows[1]["contact_loss"]) == 0.0 and float(rows[1]["excitation_n1_N"]) > 0
