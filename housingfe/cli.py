@@ -16,6 +16,7 @@ from housingfe.errors import InputError, SolverError
 _EXTENSIONS = (
     "housingfe.bearings.cli",
     "housingfe.correlation.cli",
+    "housingfe.drivetrain.misalignment",
     "housingfe.radiation",
     "housingfe.reference",
     "housingfe.source.cli",

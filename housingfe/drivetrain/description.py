@@ -240,12 +240,15 @@ class Drivetrain:
                           torque_configuration=self.gears.torque_configuration)
         return interior, geometry, model
 
-    def source_model(self, **kwargs):
-        """housingfe.source.operating.SourceModel of the lumped reduction (kwargs: its options)."""
+    def source_model(self, misalignment="none", **kwargs):
+        """housingfe.source.operating.SourceModel of the lumped reduction (kwargs: its options).  misalignment:
+        "none", "lumped" (the 14-DOF model's own static tilt) or a function torque [N m] -> MeshModel.lead_gap [m/m],
+        e.g. housingfe.drivetrain.misalignment.lead_gap_law(drivetrain, "rigid-bores")."""
         from housingfe.source.operating import SourceModel
 
         interior, geometry, model = self.to_lumped()
-        return SourceModel(self.gears.pair, self.gears.corrections, interior, geometry, mesh_model=model, **kwargs)
+        return SourceModel(self.gears.pair, self.gears.corrections, interior, geometry, mesh_model=model,
+                           misalignment=misalignment, **kwargs)
 
     # ------------------------------------------------------------------------- lumped <-> housing frames
     def lumped_frame(self) -> np.ndarray:

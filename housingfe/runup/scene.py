@@ -79,7 +79,8 @@ class RunupSpec(_Strict):
     the tooth frequency up to f_max_hz; a modal basis to basis_factor x f_max_hz; routes of
     housingfe.runup.chain.ROUTES; modal damping ratio (Sec. 5.4: 0.04); harmonics of the source's harmonic balance;
     spectra at spectrum_speeds_rpm; the observed (radiating) surface; the source's engagement shock model; the
-    receptance around the mesh in the source's harmonic balance."""
+    receptance around the mesh in the source's harmonic balance; the mesh misalignment under load in its mesh
+    stiffness and load share (docs/misalignment.md)."""
 
     speed_min_rpm: PositiveFloat = 50.0
     speed_max_rpm: PositiveFloat = 1500.0
@@ -99,6 +100,19 @@ class RunupSpec(_Strict):
     # "coupled" = the coupled gearbox (housing, bearings, shafts, gear bodies) from the Ritz reduction;
     # "rigid-bores" = the lumped interior on rigid bores (the thesis' Ch. 2 source)
     source_receptance: Literal["coupled", "rigid-bores"] = "coupled"
+    # the mesh misalignment under load in the source's mesh stiffness and load share
+    # (housingfe.drivetrain.misalignment): "rigid-bores" = static tilt of the FE interior (shafts, bearings at their
+    # loaded 6x6 stiffness) on rigid bores at each torque; "coupled" = the same on the flexible housing (one static
+    # solve of the coupled model per torque); "lumped" = of the 14-DOF source model; "none" = aligned gears.
+    # Default: "rigid-bores" with the face-width engagement, "none" with the thesis' replica "thesis-2d"
+    misalignment: Optional[Literal["rigid-bores", "coupled", "lumped", "none"]] = None
+
+    @property
+    def misalignment_model(self) -> str:
+        """The misalignment model in effect (see `misalignment`)."""
+        if self.misalignment is not None:
+            return self.misalignment
+        return "none" if self.engagement == "thesis-2d" else "rigid-bores"
 
     @field_validator("routes")
     @classmethod
@@ -223,7 +237,22 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
                              basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
     timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
     progress.update(note="coupled model and modal basis")
-    source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement)
+    misalignment = spec.misalignment_model
+    if misalignment == "coupled":           # the static tilt on the flexible housing, per torque
+        from housingfe.drivetrain.misalignment import coupled_misalignment
+
+        t1 = time.perf_counter()
+        gaps = {float(t): coupled_misalignment(model, dt).lead_gap for t, dt in drivetrains.items()}
+        timings["misalignment_s"] = time.perf_counter() - t1
+
+        def misalignment(torque: float) -> float:
+            return gaps[float(torque)]
+    elif misalignment == "rigid-bores":
+        from housingfe.drivetrain.misalignment import lead_gap_law
+
+        misalignment = lead_gap_law(drivetrains[reference_torque], "rigid-bores")
+    source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement,
+                                                        misalignment=misalignment)
     results = {}
     for torque in spec.torques_nm:
         t1 = time.perf_counter()
@@ -235,6 +264,9 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         for k, v in res.timings.items():
             timings[k] = timings.get(k, 0.0) + v
         results[torque] = (m, res)
+        if comm.rank == 0 and spec.misalignment_model != "none":
+            print(f"misalignment ({spec.misalignment_model}) at {torque:g} N m: lead gap "
+                  f"{source.lead_gap(torque) * 1e6 + 0.0:.1f} um/m over the face (MeshModel.lead_gap)")
         progress.update(note=f"{torque:g} N m: {len(spec.speeds)} speeds, {len(lines.frequency)} lines")
     progress.close()
     check_rows, contributions = checks.evaluate(scene, results, gm)

@@ -24,6 +24,8 @@ from housingfe.errors import InputError
 from housingfe.levels import OMEGA0, level
 from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair
+from housingfe.source.misalignment import check_model as check_misalignment
+from housingfe.source.misalignment import lumped_misalignment
 from housingfe.source.stiffness import Corrections, MeshModel, ShaftBending
 
 # the run-up range of the thesis' measurements (Sec. 5.3) and of the gearset-* scenes
@@ -74,12 +76,16 @@ class SourceModel:
     pair, corrections: the gears; interior, geometry: the lumped reduction (LumpedInterior, ShaftGeometry);
     mesh_model: the MeshModel of the mesh stiffness (default: from pair, corrections and geometry with n_slices,
     torque_configuration); stiffness_positions: mesh positions per base pitch; harmonics: H of the harmonic
-    balance; speed_range_rpm: the supported pinion speeds (rev/min)."""
+    balance; speed_range_rpm: the supported pinion speeds (rev/min).  misalignment: the mesh misalignment under
+    load (housingfe.source.misalignment) in the stiffness curve and the face-width load share: "none" (aligned
+    gears), "lumped" (the static tilt of this model's own 14-DOF interior) or a function torque [N m] ->
+    MeshModel.lead_gap [m/m] (e.g. housingfe.drivetrain.misalignment.lead_gap_law)."""
 
     def __init__(self, pair: GearPair, corrections: Corrections, interior: dyn.LumpedInterior,
                  geometry: dyn.ShaftGeometry, *, mesh_model: MeshModel | None = None, n_slices: int = 24,
                  torque_configuration: int = 2, stiffness_positions: int = 32, harmonics: int = 30,
-                 speed_range_rpm: tuple[float, float] = SPEED_RANGE_RPM, engagement: str = dyn.DEFAULT_ENGAGEMENT):
+                 speed_range_rpm: tuple[float, float] = SPEED_RANGE_RPM, engagement: str = dyn.DEFAULT_ENGAGEMENT,
+                 misalignment="none"):
         self.pair, self.corrections, self.interior, self.geometry = pair, corrections, interior, geometry
         self.mesh_model = mesh_model or MeshModel(
             pair, shafts=(ShaftBending(*geometry.pinion_spans, geometry.pinion_shaft_diameter),
@@ -91,6 +97,9 @@ class SourceModel:
         if engagement not in dyn.ENGAGEMENT_MODELS:
             raise InputError(f"engagement: {engagement!r} is not one of {', '.join(dyn.ENGAGEMENT_MODELS)}")
         self.engagement = engagement
+        if not callable(misalignment):
+            check_misalignment(misalignment)
+        self.misalignment = misalignment
         self._points: dict[float, object] = {}
 
     @classmethod
@@ -113,8 +122,27 @@ class SourceModel:
 
         if torque not in self._points:
             self._points[torque] = OperatingPoint(self.pair, self.corrections, self.interior, self.mesh_model,
-                                                  torque, self.stiffness_positions, engagement=self.engagement)
+                                                  torque, self.stiffness_positions, engagement=self.engagement,
+                                                  lead_gap=self.lead_gap(torque))
         return self._points[torque]
+
+    def lead_gap(self, torque_nm: float) -> float:
+        """MeshModel.lead_gap [m/m] of the misalignment at a pinion torque [N m] (0 for "none")."""
+        if callable(self.misalignment):
+            return float(self.misalignment(float(torque_nm)))
+        if self.misalignment == "none":
+            return 0.0
+        return self.misalignment_at(torque_nm).lead_gap
+
+    def misalignment_at(self, torque_nm: float):
+        """The "lumped" Misalignment (housingfe.source.misalignment) of this model at a pinion torque [N m]."""
+        from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
+
+        curve = stiffness_curve(self.mesh_model, normal_force_from_torque(self.pair, float(torque_nm)),
+                                self.stiffness_positions)
+        mats = dyn.assemble(self.pair, self.interior, curve.mean)
+        return lumped_misalignment(self.pair, mats, dyn.preload_force(mats, float(torque_nm)), float(torque_nm),
+                                   self.mesh_model.total_width)
 
     def operating_point(self, speed_rpm: float, torque_nm: float) -> Excitation:
         """The excitation at a pinion speed (rev/min, within speed_range_rpm) and pinion torque (N m, > 0)."""

@@ -156,12 +156,18 @@ def build(table: SourceTable, scene_path: str = "scene"):
 class OperatingPoint:
     """Stiffness curve, matrices, shock force and preload for one pinion torque [N m].  engagement: the shock
     model (housingfe.source.dynamics.ENGAGEMENT_MODELS): "face-width" (default) distributes Eq. 2.62 over the
-    face-width slices with the load share of `face_load_share`, "thesis-2d" is the thesis' Eq. 2.62."""
+    face-width slices with the load share of `face_load_share`, "thesis-2d" is the thesis' Eq. 2.62.
+    lead_gap [m/m]: the misalignment under load (MeshModel.lead_gap, housingfe.source.misalignment), in the
+    stiffness curve and the load share (0: aligned gears, exactly as before)."""
 
     def __init__(self, pair, corr, interior, model, torque: float, n_positions: int, n_samples: int = 256,
-                 engagement: str = dyn.DEFAULT_ENGAGEMENT):
+                 engagement: str = dyn.DEFAULT_ENGAGEMENT, lead_gap: float = 0.0):
         self.torque = torque
         self.engagement = engagement
+        self.lead_gap = float(lead_gap)
+        if self.lead_gap != 0.0:
+            model = replace(model, lead_gap=self.lead_gap)
+        self.mesh_model = model
         self.normal_force = normal_force_from_torque(pair, torque)
         self.curve = stiffness_curve(model, self.normal_force, n_positions)
         t = np.arange(n_samples) / n_samples

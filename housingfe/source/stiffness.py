@@ -286,7 +286,13 @@ class MeshModel:
     shaft and torsion influence matrices over the face-width slices.
 
     torque_configuration 1 or 2 (Fig. 2.7): 1 = both torques enter at face w = 0, 2 = the wheel torque
-    leaves at the opposite face.  n_slices: points per contact line (on the part in contact)."""
+    leaves at the opposite face.  n_slices: points per contact line (on the part in contact).
+
+    lead_gap: misalignment of the mesh under load as a linear gap [m per m of w] along the flank normal over the
+    gear's axial position w (housingfe.source.misalignment: sign conventions): gap = lead_gap * w for
+    lead_gap >= 0 (the face w = 0 carries most), lead_gap * (w - total width) otherwise (the far face carries
+    most), added to the gaps of the corrections.  0: perfectly aligned gears (the thesis' Sec. 2.3).
+    include_body_torsion: wheel-body torsion of Sec. 2.2.4 (False only for analytic checks)."""
 
     pair: GearPair
     shafts: tuple[ShaftBending, ShaftBending] | None = None
@@ -294,12 +300,16 @@ class MeshModel:
     n_slices: int = 24
     torque_configuration: int = 2
     include_plate_coupling: bool = True
+    lead_gap: float = 0.0
+    include_body_torsion: bool = True
 
     def __post_init__(self):
         if self.torque_configuration not in (1, 2):
             raise InputError(f"stiffness: torque_configuration: must be 1 or 2, got {self.torque_configuration}")
         if self.n_slices < 2:
             raise InputError("stiffness: n_slices: need at least 2 points per contact line")
+        if not math.isfinite(self.lead_gap):
+            raise InputError(f"stiffness: lead_gap: {self.lead_gap} must be a finite slope (m/m)")
         p = self.pair
         nu, E = p.poisson_ratio, p.youngs_modulus
         self.G_shear = E / (2 * (1 + nu))
@@ -361,8 +371,18 @@ class MeshModel:
         return out
 
     def gaps(self, pts: dict[str, np.ndarray]) -> np.ndarray:
-        """Initial gap [m] along the normal at each contact point from the flank corrections."""
-        return flank_gaps(self.pair, self.corrections, pts["s"], pts["w_local"], pts["w"], pts["helix"])
+        """Initial gap [m] along the normal at each contact point from the flank corrections and the lead gap of
+        the misalignment (`lead_gap`)."""
+        gap = flank_gaps(self.pair, self.corrections, pts["s"], pts["w_local"], pts["w"], pts["helix"])
+        return gap + self.misalignment_gap(pts["w"])
+
+    def misalignment_gap(self, w) -> np.ndarray:
+        """The linear gap [m] of `lead_gap` at axial positions w [m] over the gear, >= 0 (zero at the face that
+        carries most)."""
+        w = np.asarray(w, dtype=float)
+        if self.lead_gap >= 0:
+            return self.lead_gap * w
+        return self.lead_gap * (w - self.total_width)
 
     def body_compliance(self, w: np.ndarray) -> np.ndarray:
         """Compliance [m/N] between axial positions w through shaft bending and wheel-body torsion of
@@ -378,7 +398,8 @@ class MeshModel:
                 twist_length = self.total_width - np.maximum(wi, wj)
             else:
                 twist_length = np.minimum(wi, wj)
-            body += cb2 * rb[g] ** 2 * twist_length / (self.G_shear * Ip)
+            if self.include_body_torsion:
+                body += cb2 * rb[g] ** 2 * twist_length / (self.G_shear * Ip)
             if self.shafts is not None:
                 body += cb2 * beam_influence(w, self.shafts[g], float(p.root_diameter[g]), self.total_width,
                                              0.0, p.youngs_modulus, n_grid=600)
@@ -511,7 +532,7 @@ def stiffness_curve(model: MeshModel, total_force: float, n_positions: int = 32)
 
 
 def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = None,
-                    n_positions: int = 8) -> np.ndarray:
+                    n_positions: int = 8, lead_gap: float | None = None) -> np.ndarray:
     """Relative mesh stiffness per unit face width over the face, (helices, n_bins), mean 1 [-]: bin j of helix
     hx covers w_local in [j, j + 1) * b / n_bins.
 
@@ -519,12 +540,19 @@ def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = N
     UNCORRECTED flanks every point has the same approach delta, so its stiffness is F_i / delta.  Summed per
     bin of the face width and averaged over `n_positions` mesh positions of one base pitch at `total_force`
     [N], this is how the mesh stiffness is distributed across the face: shaft bending, wheel-body torsion and
-    the plate coupling of the teeth make it non-uniform (the profile direction averages out over the pitch)."""
+    the plate coupling of the teeth make it non-uniform (the profile direction averages out over the pitch).
+
+    lead_gap [m/m]: the misalignment under load (MeshModel.lead_gap; None: the model's own).  The uncorrected
+    flanks then carry the linear gap, and F_i / delta (delta: the approach of the face that carries most) is the
+    point's stiffness times its compatibility (delta - gap) / delta: the share is the LOAD share of the misaligned
+    mesh, zero where the gap exceeds the approach (contact loss: `contact_loss_fraction`)."""
     if not total_force > 0:
         raise InputError(f"stiffness: total force must be > 0 N, got {total_force}")
     bare = MeshModel(model.pair, shafts=model.shafts, corrections=Corrections(), n_slices=model.n_slices,
                      torque_configuration=model.torque_configuration,
-                     include_plate_coupling=model.include_plate_coupling)
+                     include_plate_coupling=model.include_plate_coupling,
+                     lead_gap=model.lead_gap if lead_gap is None else float(lead_gap),
+                     include_body_torsion=model.include_body_torsion)
     n_bins = n_bins or model.n_slices
     b = model.pair.contact_width
     acc = np.zeros((bare.helices, n_bins))
@@ -533,7 +561,7 @@ def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = N
     centres = (np.arange(n_bins) + 0.5) / n_bins * b
     for x in np.arange(n_positions) / n_positions:
         pts, F, delta = bare.load_distribution(x * pbt, total_force)
-        density = F / (delta * pts["width"])            # stiffness per unit face width [N/m^2]
+        density = F / (delta * pts["width"])            # stiffness x compatibility per unit face width [N/m^2]
         for key in set(zip(pts["pair"].tolist(), pts["helix"].tolist())):     # one contact line at a time
             idx = np.flatnonzero((pts["pair"] == key[0]) & (pts["helix"] == key[1]))
             idx = idx[np.argsort(pts["w_local"][idx])]
@@ -545,6 +573,13 @@ def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = N
     # jumps between floor and ceil of eps_alpha * n_positions, which is sampling, not stiffness
     share = acc / np.maximum(count, 1)
     return share / share.mean()
+
+
+def contact_loss_fraction(share: np.ndarray, threshold: float = 1e-3) -> float:
+    """Fraction [-] of the face (bins of a `face_load_share`) that carries less than `threshold` of the mean load:
+    where a misalignment's gap exceeds the approach, the flanks separate."""
+    share = np.asarray(share, dtype=float)
+    return float(np.mean(share < threshold))
 
 
 def normal_force_from_torque(pair: GearPair, pinion_torque: float) -> float:
