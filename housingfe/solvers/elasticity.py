@@ -84,13 +84,14 @@ def _mpi_lor():
     return MPI.LOR
 
 
-def stiffness_form(V, materials: MaterialField, weight=None, reduced: bool = False):
+def stiffness_form(V, materials: MaterialField, weight=None, reduced: bool = False, selective: bool = True):
     """Bilinear form of the elastic strain energy, K (N/m); `weight` (e.g. the loss factor field)
     multiplies the integrand, giving the hysteretic damping matrix for weight = eta.  reduced: reduced
     Gauss integration (volume_measure).  Nearly incompressible cells (nu > NEARLY_INCOMPRESSIBLE_NU) get their
-    volumetric term lambda div(u) div(v) integrated at reduced order (against volumetric locking)."""
+    volumetric term lambda div(u) div(v) integrated at reduced order (against volumetric locking) unless
+    selective=False (the fully integrated form, for references)."""
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
-    if reduced or not nearly_incompressible(materials):
+    if reduced or not selective or not nearly_incompressible(materials):
         integrand = ufl.inner(_stress(u, materials.lam, materials.mu), ufl.sym(ufl.grad(v)))
         return fem.form((integrand if weight is None else weight * integrand) * volume_measure(V, reduced))
     lam, mu = materials.lam, materials.mu
@@ -142,11 +143,12 @@ def clamp_bc(V, facets: np.ndarray, components: tuple[int, ...] | None = None) -
 
 
 def assemble_stiffness_mass(V, materials: MaterialField, bcs: list, extra_stiffness: list = (),
-                            reduced: bool = False) -> tuple[PETSc.Mat, PETSc.Mat]:
+                            reduced: bool = False, selective: bool = True) -> tuple[PETSc.Mat, PETSc.Mat]:
     """Assemble K (plus any extra stiffness forms, e.g. foundations) and M.  Constrained rows/columns get 1
     on K's diagonal and 0 on M's, so their eigenvalues go to infinity and never enter the spectrum of
-    interest.  reduced: reduced integration of K (M stays fully integrated)."""
-    K = assemble_matrix(stiffness_form(V, materials, reduced=reduced), bcs=bcs, diagonal=1.0)
+    interest.  reduced: reduced integration of K (M stays fully integrated).  selective: the reduced volumetric
+    integration of nearly incompressible cells (stiffness_form)."""
+    K = assemble_matrix(stiffness_form(V, materials, reduced=reduced, selective=selective), bcs=bcs, diagonal=1.0)
     K.assemble()
     for form in extra_stiffness:
         Ke = assemble_matrix(form, bcs=bcs, diagonal=0.0)

@@ -60,3 +60,29 @@ def test_harmonic_balance_finite_and_mean_force_static(table, rpm, ripple, shock
     assert math.isfinite(c.min_force_N) and c.min_force_N <= c.mean_force_N
     if ripple == 0.0 and shock == 0.0:                 # time-invariant: the static force, no dynamics at all
         assert abs(c.mean_force_N / F - 1) < 0.05 and abs(c.min_force_N / c.mean_force_N - 1) < 1e-9
+
+
+@SETTINGS
+@given(table=gear_tables, rpm=st.floats(50.0, 10000.0), ripple=st.floats(0.0, 0.5), shock=st.floats(0.0, 0.3))
+def test_harmonic_balance_power_flow_balances(table, rpm, ripple, shock):
+    """Energy: over one period the power the mesh puts in, -<d' (S d + F_e)> (shock and parametric stiffness),
+    equals the power the damping takes out, <q'^T D q'> (mass and K0 store and return it): per harmonic,
+    sum n^2 Omega^2 Q_n^H D Q_n = -Re sum conj(i n Omega d_n) F_n.  Exact for the truncated Hill system because d'
+    has no harmonics beyond H."""
+    try:
+        pair = GearPair.from_table(table)
+    except InputError:
+        return
+    mats = dyn.assemble(pair, dyn.derive_interior(pair), 1.4e10 * min(pair.face_width))
+    k0 = mats.mean_mesh_stiffness
+    t = np.arange(64) / 64
+    S = k0 * (1 + ripple * np.cos(2 * math.pi * t))
+    F = normal_force_from_torque(pair, 1000.0)
+    state = dyn.harmonic_balance(mats, S, shock * F * np.sin(2 * math.pi * t) ** 2, dyn.preload_force(mats, 1000.0),
+                                 pair.tooth_frequency(rpm), H=10)
+    w = state.harmonics * 2 * math.pi * state.tooth_frequency
+    dissipated = float(np.sum(w ** 2 * np.real(np.einsum("ni,ij,nj->n", state.Q.conj(), mats.D, state.Q))))
+    d = state.Q @ mats.h
+    supplied = float(-np.real(np.sum(np.conj(1j * w * d) * state.mesh_force)))
+    assert dissipated >= 0 and math.isfinite(supplied)
+    assert abs(supplied - dissipated) <= 1e-8 * abs(dissipated) + 1e-30
