@@ -149,10 +149,12 @@ def test_stiff_bearing_on_light_node_matches_dense_solver():
 
 def test_oil_whirl_onset_named_and_flagged():
     """The rotor's eigenvalues cross Re s = 0 at Lund's threshold (7617 rpm, to 1e-6), whirling at ~0.5x the
-    shaft speed; the message names it; harmonic.projected flags the forced response above, not below."""
+    shaft speed; the message names it; harmonic.projected flags the forced response above, not below; the finite
+    bearing (Reynolds solver, another film model) whirls within 2 % of the same speed."""
     r = stability.oil_whirl()
     assert r.ok, r.details
     assert r.details["message"].startswith("unstable (oil whirl) above 7617")
+    assert r.details["finite_bearing_gap"] < 0.02         # the Reynolds finite-bearing film: 7642 rpm
 
 
 def test_whirl_onset_rejects_bad_sweeps():
