@@ -300,3 +300,79 @@ def journal_bearing_coefficients(bearing: JournalBearing, omega: float, load, *,
     return FluidFilmResult(eccentricity_ratio=eps, attitude_angle=abs(attitude) if abs(attitude) <= math.pi
                            else 2 * math.pi - abs(attitude), min_film=c * (1 - eps), displacement=disp,
                            K=k6, C=c6, sommerfeld=sommerfeld, load=w)
+
+
+# ------------------------------------------------------------------------------------------ stability (oil whirl)
+def rotor_eigenvalues(mass: float, K: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """Eigenvalues s [1/s] of a rigid rotor's translation on its film, mass q'' + C q' + K q = 0 (q = x, y of the
+    journal; mass [kg] carried by this bearing; K, C the 2x2 (or the x/y block of the 6x6) film coefficients).
+    K is not symmetric: s is complex, and Re(s) > 0 is a growing whirl (the film feeds energy in through the
+    cross-coupled stiffness K_xy - K_yx faster than C takes it out)."""
+    k, c = np.asarray(K, float)[:2, :2], np.asarray(C, float)[:2, :2]
+    a = np.block([[np.zeros((2, 2)), np.eye(2)], [-k / mass, -c / mass]])
+    return np.linalg.eigvals(a)
+
+
+def lund_critical_mass(K: np.ndarray, C: np.ndarray) -> tuple[float, float]:
+    """(critical mass [kg], whirl frequency [rad/s]) of a rigid rotor on a film with coefficients K, C (x/y block):
+    the Routh-Hurwitz boundary of rotor_eigenvalues in Lund's form (Lund 1966; Childs, Turbomachinery
+    Rotordynamics, 1993, Sec. 3): K_eq = (Kxx Cyy + Kyy Cxx - Kxy Cyx - Kyx Cxy) / (Cxx + Cyy),
+    w^2 = ((Kxx - K_eq)(Kyy - K_eq) - Kxy Kyx) / (Cxx Cyy - Cxy Cyx); stable iff mass < K_eq / w^2.  An
+    eigenvalue-free check of the growth rates (infinite critical mass where w^2 <= 0: no whirl possible)."""
+    k, c = np.asarray(K, float)[:2, :2], np.asarray(C, float)[:2, :2]
+    k_eq = (k[0, 0] * c[1, 1] + k[1, 1] * c[0, 0] - k[0, 1] * c[1, 0] - k[1, 0] * c[0, 1]) / (c[0, 0] + c[1, 1])
+    w2 = ((k[0, 0] - k_eq) * (k[1, 1] - k_eq) - k[0, 1] * k[1, 0]) / (c[0, 0] * c[1, 1] - c[0, 1] * c[1, 0])
+    if w2 <= 0:
+        return math.inf, 0.0
+    return k_eq / w2, math.sqrt(w2)
+
+
+@dataclass
+class WhirlOnset:
+    """Speed sweep of a rigid rotor on fluid films.  onset_rpm: the lowest speed [rev/min] above which a mode
+    grows (None: stable over the sweep); whirl_ratio: that mode's frequency / shaft speed at the onset (~0.5:
+    half-frequency oil whirl); speeds_rpm, growth_rate [1/s] (max Re s per speed), whirl_hz (its Im s / 2 pi);
+    message: "unstable (oil whirl) above N rpm ..." or "stable up to N rpm"."""
+    onset_rpm: float | None
+    whirl_ratio: float | None
+    eccentricity_ratio: float | None
+    speeds_rpm: np.ndarray
+    growth_rate: np.ndarray
+    whirl_hz: np.ndarray
+    message: str
+
+
+def whirl_onset(bearing: JournalBearing, mass: float, load, speeds_rpm, model: str = "short") -> WhirlOnset:
+    """Where a rigid rotor of `mass` [kg] per bearing, loaded by `load` = (Wx, Wy) [N] per bearing, starts to
+    whirl on its plain journal bearing: the eigenvalues of rotor_eigenvalues at each speed of `speeds_rpm`
+    [rev/min, ascending], then the crossing Re s = 0 between the last stable and the first unstable speed by
+    bisection (brentq).  model: "short" (Ocvirk, fast) or "reynolds" (finite bearing, Reynolds cavitation)."""
+    speeds = np.asarray(speeds_rpm, float)
+    if speeds.ndim != 1 or len(speeds) < 2 or np.any(np.diff(speeds) <= 0) or speeds[0] <= 0:
+        raise InputError(f"whirl_onset: speeds_rpm: need >= 2 ascending positive speeds, got {speeds.tolist()}")
+    if not (mass > 0 and math.isfinite(mass)):
+        raise InputError(f"whirl_onset: mass={mass} kg: must be positive")
+    coefficients = {"short": short_bearing_coefficients, "reynolds": journal_bearing_coefficients}[model]
+
+    def state(rpm):
+        res = coefficients(bearing, rpm * 2 * math.pi / 60, load)
+        s = rotor_eigenvalues(mass, res.K, res.C)
+        top = int(np.argmax(s.real))
+        return float(s[top].real), abs(float(s[top].imag)), res.eccentricity_ratio
+
+    rows = np.array([state(n) for n in speeds])
+    growth, whirl = rows[:, 0], rows[:, 1] / (2 * math.pi)
+    # the film's own scale: Re s is round-off below 1e-9 of |s|
+    unstable = growth > 1e-9 * np.abs(rows[:, 1] + 1.0)
+    if not unstable.any():
+        return WhirlOnset(None, None, None, speeds, growth, whirl, f"stable up to {speeds[-1]:.6g} rpm")
+    i = int(np.argmax(unstable))
+    if i == 0:
+        return WhirlOnset(speeds[0], rows[0, 1] / (speeds[0] * 2 * math.pi / 60), rows[0, 2], speeds, growth, whirl,
+                          f"unstable (oil whirl) at {speeds[0]:.6g} rpm already (the lowest speed swept)")
+    onset = brentq(lambda n: state(n)[0], speeds[i - 1], speeds[i], xtol=1e-9 * speeds[i], rtol=1e-12)
+    _, w, eps = state(onset)
+    ratio = w / (onset * 2 * math.pi / 60)
+    return WhirlOnset(onset, ratio, eps, speeds, growth, whirl,
+                      f"unstable (oil whirl) above {onset:.6g} rpm (whirl at {ratio:.3f} x shaft speed, "
+                      f"eccentricity ratio {eps:.3f})")

@@ -10,7 +10,17 @@ Cases (every one small: seconds each):
 - an eigenvalue exactly at f_max (and 1e-9 either side): the inertia count and the eigensolve agree;
 - two free bodies in one model (12 zero modes): counted and never reported as elastic;
 - the same cube in SI, in mm-t-s and 100x larger: the same (scaled) frequencies;
-- forced response with eta = 1e-6 exactly at a resonance: finite and equal to the single-mode amplitude.
+- forced response with eta = 1e-6 exactly at a resonance: finite and equal to the single-mode amplitude;
+- P2 tetrahedra on the thin plate at t/L = 1/200 (against Kirchhoff), and at 1/1000 with FV12's element size:
+  refused by the quality check with a message naming mesh.size;
+- a nu = 0.499 gasket bonded between steel blocks: volumetric locking of Q2 against a converged Q3 (fixed: selective
+  reduced integration of the volumetric term in nearly incompressible cells, housingfe.solvers.elasticity);
+- stiffness contrast: a soft layer with E ratio 1e6 and 1e9 (zero modes, count, backward error, sqrt(E) scaling)
+  and a 1e11 N/m bearing on a 0.05 kg node (against scipy's dense eigh);
+- a rigid rotor on two short journal bearings through the onset of oil whirl (against Lund's threshold), and the
+  projected forced-response solver flagging the unstable point;
+- the gear source at a load and speed where the teeth separate: flagged (housingfe.source.dynamics.contact_check);
+- a P2 tetrahedral cube with a sliver: refused/warned by the quality check, its effect on the frequencies measured.
 
 `housingfe bench stability [--quick]` prints the table and writes stability.csv, stability.md and stability.png
 (error against cost).  The test suite (tests/benchmarks/test_stability.py) asserts the same cases.
@@ -69,6 +79,7 @@ def free_plate_model(h: float, family: str, size: float = 0.625, a: float = 10.0
     from housingfe.scene import MeshSpec
 
     specs = {"Q1": dict(element="hex", degree=1), "Q2": dict(element="hex", degree=2),
+             "P2": dict(element="tet", degree=2),
              "Q3": dict(element="hex", degree=3),
              "S2R": dict(element="hex", degree=2, family="serendipity", integration="reduced")}
     material = Material(name="fv12", youngs_modulus=200e9, poisson_ratio=0.3, density=8000.0)
@@ -367,13 +378,374 @@ def _value(result) -> complex:
     return complex(np.asarray(block.coeffs)[:, 0] @ reduced[:, 0])
 
 
+# ------------------------------------------------------------------------------------------ issue 30, second part
+def thin_plate_tet(h: float = 0.05, size: float = 0.3) -> CaseResult:
+    """P2 tetrahedra (mesh.element = "tet") on the free 10 m plate, t/L = h/10, against Kirchhoff: the largest
+    relative error of the three lowest elastic frequencies.  ok: < 0.5 %."""
+    from housingfe.solvers.modal import modes
+
+    t0 = time.perf_counter()
+    model, f_ref = free_plate_model(h, "P2", size)
+    basis = modes(model, 1.3 * f_ref[-1])
+    f = basis.frequencies_hz[basis.rigid_count:]
+    err = float(np.max(np.abs(f[:3] / f_ref[:3] - 1))) if len(f) >= 3 else float("inf")
+    return CaseResult(f"thin plate t/L=1/{10 / h:.0f}, P2 tets, {model.dofs} DOFs", "shear locking (tets)",
+                      "Kirchhoff free square plate (FV12 lambda^2)",
+                      f"{len(f)} elastic modes, f1 {f[0]:.4g} Hz, worst tet {model.housing.quality['min']:.3f}",
+                      err, time.perf_counter() - t0, err < 0.005,
+                      {"frequencies_hz": f[:6].tolist(), "reference_hz": f_ref.tolist(),
+                       "quality": model.housing.quality["min"]})
+
+
+def thin_plate_tet_refused(h: float = 0.01, size: float = 0.625) -> CaseResult:
+    """P2 tetrahedra 62 thicknesses wide (t/L = 1/1000 at FV12's element size): the flat tets are refused before
+    any solve, with an InputError naming mesh.size and why.  ok: refused with that message."""
+    from housingfe.errors import InputError
+
+    t0 = time.perf_counter()
+    try:
+        model, _ = free_plate_model(h, "P2", size, f_max=1.0)
+        ours, ok, message = f"meshed: {model.dofs} DOFs", False, ""
+    except InputError as exc:
+        message = str(exc)
+        ours, ok = "refused: " + message[:70] + "...", message.startswith("mesh.size:") and "flat" in message
+    return CaseResult(f"plate t/L=1/{10 / h:.0f}, P2 tets {size / h:.0f} t wide", "flat tets (quality ~0.01)",
+                      "a clear refusal naming mesh.size", ours, None, time.perf_counter() - t0, ok,
+                      {"message": message})
+
+
+def layered_block_matrices(n: int, layers_per_10mm: int, degree: int, gasket_E: float, gasket_nu: float,
+                           integration: str = "full", selective: bool = True):
+    """A 100 x 100 mm stack, steel block 40 mm / gasket layer 10 mm / steel block 40 mm, bonded, free, meshed with
+    n x n x 9 layers_per_10mm Q`degree` bricks; the gasket (E, nu as given, 1200 kg/m^3) as a material region, K
+    and M from the package's own assembly (housingfe.solvers.elasticity: selective reduced integration of the
+    volumetric term where nu > 0.49, unless selective=False).  Returns (K, M, V)."""
+    from dolfinx import mesh
+    from mpi4py import MPI
+
+    from housingfe.materials import Material
+    from housingfe.solvers import elasticity
+
+    domain = mesh.create_box(MPI.COMM_WORLD, [np.zeros(3), np.array([0.1, 0.1, 0.09])],
+                             [n, n, 9 * layers_per_10mm], mesh.CellType.hexahedron)
+    tdim = domain.topology.dim
+    gasket_cells = mesh.locate_entities(domain, tdim, lambda x: (x[2] > 0.04 - 1e-9) & (x[2] < 0.05 + 1e-9))
+    cells_all = np.arange(domain.topology.index_map(tdim).size_local + domain.topology.index_map(tdim).num_ghosts)
+    # locate_entities keeps cells with all vertices inside: exactly the gasket layer's cells
+    markers = np.where(np.isin(cells_all, gasket_cells), 2, 1).astype(np.int32)
+    tags = mesh.meshtags(domain, tdim, cells_all, markers)
+    steel = Material(name="steel", **STEEL)
+    gasket = Material(name="gasket", youngs_modulus=gasket_E, poisson_ratio=gasket_nu, density=1200.0)
+    V = elasticity.displacement_space(domain, degree)
+    materials = elasticity.MaterialField(domain, steel, tags, {2: gasket})
+    K, M = elasticity.assemble_stiffness_mass(V, materials, [], reduced=integration == "reduced", selective=selective)
+    return K, M, V
+
+
+def gasket_locking(nu: float = 0.499) -> CaseResult:
+    """A rubber layer (E = 10 MPa, nu = 0.499) bonded between two steel blocks, one Q2 brick through it (what a
+    scene's `layers = 1` gives): the rocking and bounce modes (4-6) against Q3, 3 x 3 x 9 bricks (within 0.25 % of
+    Q3 with 4 x 4 x 18: 862.2 against 860.2 Hz).  Before the fix (full integration) Q2 gave 2016 Hz against 860 Hz (2.3x:
+    volumetric locking); the package now integrates the volumetric term of nu > 0.49 cells at reduced order.
+    ok: < 2 %, and full integration locking (> 1.5x) as it did."""
+    from housingfe.solvers.modal import solve_modes
+
+    t0 = time.perf_counter()
+    out = {}
+    # the reference fully integrated (no fix in it); "Q2 full" is the package before the fix
+    for name, args, selective in (("Q2", (4, 1, 2), True), ("Q2 full", (4, 1, 2), False),
+                                  ("reference Q3", (3, 1, 3), False)):
+        K, M, _ = layered_block_matrices(*args, gasket_E=10e6, gasket_nu=nu, selective=selective)
+        r = solve_modes(K, M, 3000.0)
+        out[name] = r.frequencies_hz[r.rigid_count:][:6]
+    err = float(np.max(np.abs(out["Q2"] / out["reference Q3"] - 1)))
+    locked = float(np.max(out["Q2 full"][3:6] / out["reference Q3"][3:6]))
+    return CaseResult(f"gasket nu={nu} between steel blocks, Q2 1 layer", "volumetric locking",
+                      "Q3 (converged to 0.25 %)", f"modes 4-6: {', '.join(f'{x:.0f}' for x in out['Q2'][3:6])} Hz "
+                      f"(ref {', '.join(f'{x:.0f}' for x in out['reference Q3'][3:6])}; full integration "
+                      f"x{locked:.2f})", err,
+                      time.perf_counter() - t0, err < 0.02 and locked > 1.5,
+                      {**{k: v.tolist() for k, v in out.items()}, "locking_factor_full": locked})
+
+
+def stiffness_contrast(ratios=(1e6, 1e9)) -> CaseResult:
+    """Steel blocks on a soft layer (nu = 0.3) with E_steel / E_gasket = 1e6 and 1e9: six zero modes (the soft
+    modes must not be counted as rigid), complete, residuals < 1e-8, and the soft modes' frequencies scaling as
+    sqrt(E_gasket) between the two (the steel is rigid to 1e-6 against the layer: the reference)."""
+    from housingfe.solvers.modal import solve_modes
+
+    t0 = time.perf_counter()
+    soft, facts = {}, []
+    for ratio in ratios:
+        E_g = STEEL["youngs_modulus"] / ratio
+        K, M, _ = layered_block_matrices(3, 1, 2, gasket_E=E_g, gasket_nu=0.3)
+        # the soft modes: about sqrt(E_g / E_steel) of the blocks' own; 6 of them (the two blocks' relative motion)
+        f_max = 300.0 * math.sqrt(E_g / 1e6)
+        r = solve_modes(K, M, f_max)
+        soft[ratio] = r.frequencies_hz[r.rigid_count:] / math.sqrt(E_g)
+        # ModalResult.residuals (||Kx - lambda Mx|| / ||Kx||) grows as the contrast (2e-6 at 1e6, 3e-4 at 1e9)
+        # because ||Kx|| of a soft mode is tiny against ||K|| ||x||; the normwise backward error is the measure
+        facts.append((ratio, r.rigid_count, r.complete, _backward_error(K, M, r), len(soft[ratio])))
+    a, b = soft[ratios[0]], soft[ratios[1]]
+    n = min(len(a), len(b))
+    err = float(np.max(np.abs(b[:n] / a[:n] - 1))) if n else float("inf")
+    ok = n >= 6 and len(a) == len(b) and all(rc == 6 and c and res < 1e-12 for _, rc, c, res, _ in facts) and err < 1e-4
+    return CaseResult("soft layer, E ratio 1e6 / 1e9", "stiffness contrast: zero modes, count, residuals",
+                      "6 zero modes; f ~ sqrt(E_gasket) (rigid blocks)",
+                      "; ".join(f"{r:.0e}: {rc} zero, {m} soft, bwd err {res:.0e}" for r, rc, _, res, m in facts),
+                      err, time.perf_counter() - t0, ok, {"facts": facts})
+
+
+def stiff_bearing_light_node(k_bearing: float = 1e11, journal_mass: float = 0.05) -> CaseResult:
+    """A free steel cube (Q2, 375 DOFs) with a 0.05 kg journal node on a 1e11 N/m spring (x, y, z) at a corner:
+    max K_ii / M_ii (eigenvalue_scale) rises with the spring; the zero modes (6), the count and the frequencies
+    must not move.  Reference: scipy's dense eigh of the same matrices (another solver).  ok: 6 zero modes,
+    complete, < 1e-8."""
+    import scipy.linalg
+    from petsc4py import PETSc
+
+    from housingfe.solvers.modal import eigenvalue_scale, solve_modes
+
+    t0 = time.perf_counter()
+    K, M, V = cube_matrices(2)
+    k, m = _dense(K), _dense(M)
+    n = len(k)
+    corner = int(np.argmin(np.linalg.norm(V.tabulate_dof_coordinates(), axis=1)))     # block index of (0, 0, 0)
+    K2, M2 = np.zeros((n + 3, n + 3)), np.zeros((n + 3, n + 3))
+    K2[:n, :n], M2[:n, :n] = k, m
+    for c in range(3):
+        i, j = 3 * corner + c, n + c
+        K2[i, i] += k_bearing
+        K2[j, j] += k_bearing
+        K2[i, j] -= k_bearing
+        K2[j, i] -= k_bearing
+        M2[j, j] = journal_mass
+    ref = np.sqrt(np.abs(scipy.linalg.eigh(K2, M2, eigvals_only=True))) / (2 * math.pi)
+    Kp, Mp = (PETSc.Mat().createAIJ(A.shape, csr=_csr(A), comm=PETSc.COMM_SELF) for A in (K2, M2))
+    for A in (Kp, Mp):
+        A.assemble()
+        A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    f_max = 1.2 * ref[ref < 60000.0].max()
+    r = solve_modes(Kp, Mp, f_max)
+    f = r.frequencies_hz
+    want = ref[ref < f_max]
+    err = float(np.max(np.abs(f[6:] / want[6:len(f)] - 1))) if len(f) == len(want) else float("inf")
+    scale_ratio = eigenvalue_scale(Kp, Mp) / eigenvalue_scale(K, M)
+    ok = r.rigid_count == 6 and r.complete and err < 1e-8 and float(np.max(r.residuals)) < 1e-8
+    return CaseResult(f"1e11 N/m bearing on a {journal_mass} kg node", "stiff spring, light node: scale/classification",
+                      "dense eigh (scipy) of the same matrices",
+                      f"{r.rigid_count} zero, {len(f) - r.rigid_count} elastic of {len(want) - 6}, scale x{scale_ratio:.0f}",
+                      err, time.perf_counter() - t0, ok, {"scale_ratio": scale_ratio})
+
+
+def _backward_error(K, M, r) -> float:
+    """max over the elastic modes of ||K x - lambda M x|| / ((||K||_inf + |lambda| ||M||_inf) ||x||) (Higham)."""
+    nk, nm = K.norm(_norm_inf()), M.norm(_norm_inf())
+    worst = 0.0
+    for lam, x in zip(r.eigenvalues[r.rigid_count:], r.vectors[r.rigid_count:]):
+        y = K.createVecLeft()
+        K.mult(x, y)
+        z = M.createVecLeft()
+        M.mult(x, z)
+        y.axpy(-lam, z)
+        worst = max(worst, y.norm() / ((nk + abs(lam) * nm) * x.norm()))
+    return worst
+
+
+def _norm_inf():
+    from petsc4py import PETSc
+
+    return PETSc.NormType.INFINITY
+
+
+def _dense(A) -> np.ndarray:
+    indptr, indices, data = A.getValuesCSR()
+    import scipy.sparse
+
+    return scipy.sparse.csr_matrix((data, indices, indptr), shape=A.getSize()).toarray()
+
+
+def _csr(A: np.ndarray):
+    import scipy.sparse
+
+    c = scipy.sparse.csr_matrix(A)
+    return c.indptr.astype(np.int32), c.indices.astype(np.int32), c.data
+
+
+def oil_whirl() -> CaseResult:
+    """A rigid rotor (100 kg per bearing, its weight as load) on two short plain bearings (D 100 mm, L 30 mm,
+    C 100 um, 0.02 Pa s) swept 300-30 000 rpm: the complex eigenvalues of M q'' + C q' + K q = 0 with the films'
+    non-symmetric K cross to Re s > 0 at the onset of oil whirl.  Reference: Lund's Routh-Hurwitz stability
+    threshold (critical mass) from the same coefficients, without eigenvalues.  And the forced-response path
+    (harmonic.projected, the solver of non-symmetric stiffness) flags the unstable operating point.
+    Second reference: the same sweep with the finite-bearing Reynolds solver (L/D = 0.3, Reynolds cavitation):
+    7642 rpm against the short bearing's 7617.
+    ok: onsets within 1e-6, whirl ratio 0.4-0.55 (half-frequency whirl), projected flags above, not below, the
+    finite bearing within 2 %."""
+    from scipy.optimize import brentq
+
+    from housingfe.bearings.fluid_film import (
+        JournalBearing,
+        lund_critical_mass,
+        short_bearing_coefficients,
+        whirl_onset,
+    )
+
+    t0 = time.perf_counter()
+    bearing = JournalBearing(diameter=0.1, length=0.03, clearance=100e-6, viscosity=0.02)
+    mass, load = 100.0, (0.0, -100.0 * 9.81)
+    res = whirl_onset(bearing, mass, load, np.geomspace(300.0, 30000.0, 15))
+
+    def margin(rpm):
+        c = short_bearing_coefficients(bearing, rpm * 2 * math.pi / 60, load)
+        return lund_critical_mass(c.K, c.C)[0] - mass
+
+    ref = brentq(margin, 300.0, 30000.0, xtol=1e-6)
+    err = abs(res.onset_rpm / ref - 1) if res.onset_rpm else float("inf")
+    flags = {rpm: _projected_flags(bearing, mass, load, rpm) for rpm in (0.8 * ref, 1.2 * ref)}
+    # another film model: the finite bearing (L/D = 0.3) by the Reynolds solver with Reynolds cavitation
+    finite = whirl_onset(bearing, mass, load, np.geomspace(1000.0, 30000.0, 6), model="reynolds")
+    finite_gap = abs(finite.onset_rpm / res.onset_rpm - 1) if finite.onset_rpm else float("inf")
+    ok = (err < 1e-6 and 0.4 < res.whirl_ratio < 0.55 and not flags[0.8 * ref] and bool(flags[1.2 * ref])
+          and finite_gap < 0.02)
+    return CaseResult("rotor on 2 short journal bearings", "non-symmetric K: instability (oil whirl)",
+                      f"Lund threshold {ref:.0f} rpm; finite bearing {finite.onset_rpm:.0f}", f"unstable (oil whirl) above {res.onset_rpm:.0f} rpm, whirl "
+                      f"{res.whirl_ratio:.3f} x speed; projected solver flags: "
+                      + ("yes" if flags[1.2 * ref] and not flags[0.8 * ref] else "NO"), err, time.perf_counter() - t0, ok,
+                      {"message": res.message, "lund_rpm": ref, "whirl_ratio": res.whirl_ratio,
+                       "finite_bearing": finite.message, "finite_bearing_gap": finite_gap,
+                       "flags": {f"{k:.0f}": v for k, v in flags.items()}})
+
+
+def _projected_flags(bearing, mass, load, rpm) -> list:
+    """harmonic.projected's self-excited modes for the 2-DOF rotor on one film at `rpm` (a forced response)."""
+    from petsc4py import PETSc
+
+    from housingfe.bearings.fluid_film import short_bearing_coefficients
+    from housingfe.solvers import harmonic
+    from housingfe.solvers.modal import solve_modes
+
+    c = short_bearing_coefficients(bearing, rpm * 2 * math.pi / 60, load)
+    k2, c2 = c.K[:2, :2], c.C[:2, :2]
+    mats = []
+    for A in (k2, mass * np.eye(2), c2, 0.5 * (k2 + k2.T)):
+        P = PETSc.Mat().createAIJ((2, 2), csr=_csr(A), comm=PETSc.COMM_SELF)
+        P.assemble()
+        mats.append(P)
+    K, M, C, K_sym = mats
+    for A in (M, K_sym):
+        A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    modal = solve_modes(K_sym, M, 2000.0)
+    f = K.createVecLeft()
+    f.set(0.0)
+    f.setValue(1, 1.0)
+    f.assemble()
+    damping = harmonic.Damping(eta=lambda fr: np.zeros(np.shape(fr)))
+    out = harmonic.projected(K, M, modal, [_Load(f)], [10.0, 50.0], damping, _reduce_dot(f), C=C, K_sym=K_sym)
+    return out.unstable
+
+
+def contact_loss() -> CaseResult:
+    """Gear set D (thesis) at 10 N m near its mesh resonance (7750 rpm, tooth frequency 3.1 kHz): the dynamic
+    mesh force exceeds the mean, the teeth separate.  The steady state must be flagged by
+    housingfe.source.dynamics.contact_check ("contact loss at 10 N m, 7750 rpm"), and the nominal point
+    (2000 N m, 1500 rpm) must not be.  Reference: a contact force cannot be negative."""
+    import tomllib
+
+    from housingfe.scenefile import SCENE_DIR
+    from housingfe.source import dynamics as dyn
+    from housingfe.source import roosmalen
+
+    t0 = time.perf_counter()
+    path = SCENE_DIR / "gearset-D.toml"
+    table = roosmalen.parse(tomllib.loads(path.read_text()), str(path))
+    pair, corr, _, interior, model = roosmalen.build(table)
+    checks = {}
+    for torque, rpm in ((10.0, 7750.0), (2000.0, 1500.0)):
+        op = roosmalen.OperatingPoint(pair, corr, interior, model, torque, 16)
+        checks[(torque, rpm)] = dyn.contact_check(op.steady_state(pair, rpm, 30), torque, rpm)
+    low, nominal = checks[(10.0, 7750.0)], checks[(2000.0, 1500.0)]
+    ok = low.lost and "contact loss at 10 N m, 7750 rpm" in low.message and not nominal.lost
+    return CaseResult("gear set D, 10 N m at 7750 rpm", "teeth separate: linear HB invalid",
+                      "contact force >= 0", f"min/mean mesh force {low.min_force_N / low.mean_force_N:.2f} "
+                      f"(flagged: {low.lost}); nominal {nominal.min_force_N / nominal.mean_force_N:.2f}", None,
+                      time.perf_counter() - t0, ok, {"message": low.message})
+
+
+def sliver(target_quality: float = 0.004) -> CaseResult:
+    """A free steel cube of P2 tetrahedra (4^3 x 6) with one interior node pushed towards the opposite face of one
+    of its tetrahedra until that tet is a sliver of `target_quality`: the package's quality check warns (between
+    0.05 and 0.08) or refuses (below), and the frequencies move by the measured amount (reference: the same mesh
+    without the sliver).  ok: complete, 6 zero modes, all frequencies within 0.5 %, warning/refusal as stated."""
+    from housingfe.errors import InputError
+    from housingfe.fe.model import check_element_quality
+    from housingfe.solvers.modal import solve_modes
+
+    t0 = time.perf_counter()
+    K0, M0, q0 = _sliver_cube(0.0)
+    r0 = solve_modes(K0, M0, 40000.0)
+    f0 = r0.frequencies_hz[r0.rigid_count:]
+    # the push s (fraction of the node's distance to the opposite face) that gives the target quality: q ~ (1 - s) q0
+    s = 1.0 - target_quality / 0.84
+    K, M, q = _sliver_cube(s)
+    r = solve_modes(K, M, 40000.0)
+    f = r.frequencies_hz[r.rigid_count:]
+    err = float(np.max(np.abs(f[:len(f0)] / f0[:len(f)] - 1))) if len(f) == len(f0) else float("inf")
+    try:
+        verdict = check_element_quality({"min": q, "measure": "tet"}, 0.025, None, "tet") or "no warning"
+    except InputError as exc:
+        verdict = str(exc)
+    expected = ("refused" if q < 0.05 else "warned" if q < 0.08 else "passed")
+    flagged = (verdict.startswith("mesh.size:") if expected == "refused" else
+               verdict.startswith("mesh: element quality") if expected == "warned" else verdict == "no warning")
+    ok = r.complete and r.rigid_count == 6 and err < 5e-3 and flagged
+    return CaseResult(f"P2 tet cube with a sliver q={q:.3f}", "slivers (as from CAD)",
+                      "same mesh without the sliver", f"{expected} by the quality check; {len(f)} elastic, complete",
+                      err, time.perf_counter() - t0, ok, {"quality": q, "verdict": verdict})
+
+
+def _sliver_cube(push: float, n: int = 4):
+    """K, M (P2, steel) of a free 0.1 m cube of n^3 x 6 tetrahedra whose node nearest the centre is moved by `push`
+    times its distance towards the opposite face of one of its tetrahedra; returns (K, M, worst quality)."""
+    import ufl
+    from dolfinx import fem, mesh
+    from dolfinx.fem.petsc import assemble_matrix
+    from mpi4py import MPI
+
+    from housingfe.geometry.blocks import tet_quality
+
+    domain = mesh.create_box(MPI.COMM_WORLD, [np.zeros(3), np.full(3, 0.1)], [n] * 3, mesh.CellType.tetrahedron)
+    x = domain.geometry.x
+    cells = domain.geometry.dofmap.array.reshape(-1, 4)
+    node = int(np.argmin(np.linalg.norm(x - 0.05, axis=1)))
+    cell = cells[np.any(cells == node, axis=1)][0]
+    face = x[[j for j in cell if j != node]]
+    normal = np.cross(face[1] - face[0], face[2] - face[0])
+    normal /= np.linalg.norm(normal)
+    x[node] -= push * ((x[node] - face[0]) @ normal) * normal
+    quality = float(tet_quality(x[cells]).min())
+    V = fem.VectorFunctionSpace(domain, ("Lagrange", 2))
+    E, nu, rho = STEEL["youngs_modulus"], STEEL["poisson_ratio"], STEEL["density"]
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    eps = lambda w: ufl.sym(ufl.grad(w))
+    K = assemble_matrix(fem.form(ufl.inner(2 * mu * eps(u) + lam * ufl.tr(eps(u)) * ufl.Identity(3), eps(v)) * ufl.dx))
+    K.assemble()
+    M = assemble_matrix(fem.form(rho * ufl.inner(u, v) * ufl.dx))
+    M.assemble()
+    return K, M, quality
+
+
 CASES = {
     "thin-Q2": lambda: thin_plate("Q2"), "thin-Q3": lambda: thin_plate("Q3"), "thin-S2R": lambda: thin_plate("S2R"),
     "thin-Q1": lambda: thin_plate("Q1"), "thinner-than-double": thinner_than_double,
     "repeated": repeated_eigenvalues, "cutoff": eigenvalue_at_cutoff, "free-bodies": free_bodies,
     "units": unit_systems, "resonance": resonance_light_damping,
+    "thin-P2": thin_plate_tet, "thin-P2-refused": thin_plate_tet_refused, "gasket": gasket_locking,
+    "contrast": stiffness_contrast, "stiff-bearing": stiff_bearing_light_node, "oil-whirl": oil_whirl,
+    "contact-loss": contact_loss, "sliver": sliver,
 }
-QUICK = ("thin-S2R", "repeated", "cutoff", "units")
+QUICK = ("thin-S2R", "repeated", "cutoff", "units", "stiff-bearing", "oil-whirl")
 
 
 def main(out_dir: Path, quick: bool = False) -> None:

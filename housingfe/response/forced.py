@@ -2,6 +2,7 @@
 case, with the solver chosen per problem.  Takes explicit specs (no scene); the sound power is a later stage."""
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import dataclass, field
 
@@ -150,6 +151,15 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
             result = harmonic.projected(K, M, modes, loads, freqs, damping, observer.reduce, C=C, K_sym=K_sym)
             modes.release_solver()
             name = "projected"
+            if result.unstable:
+                # a self-excited mode (oil whirl of a fluid film): the steady-state response is not what happens
+                top = result.unstable[0]
+                facts["unstable_modes"] = result.unstable
+                facts["stability"] = (f"unstable: {len(result.unstable)} self-excited mode(s), the fastest at "
+                                      f"{top['frequency_hz']:.4g} Hz growing at {top['growth_rate_per_s']:.3g} 1/s "
+                                      "(oil whirl of a fluid-film bearing?): the steady-state response is invalid")
+                if K.getComm().getRank() == 0:
+                    print(f"housingfe: warning: {facts['stability']}", file=sys.stderr)
         else:
             result = harmonic.direct(K, M, loads, freqs, damping, observer.reduce, C=C)
             name = "direct"

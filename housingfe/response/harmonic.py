@@ -232,7 +232,7 @@ def harmonic_response(structure_or_basis, loads, damping, frequencies, *, surfac
         reduced = res.blocks[0][0].reduced
         coeffs = sum(a[None, :] * res.blocks[j][0].coeffs for j, a in enumerate(amps))
         total = harmonic.HarmonicResult(f, [[harmonic.Block(reduced, coeffs, every)]], res.solver, res.timings,
-                                        modal_vectors=res.modal_vectors[:1])
+                                        modal_vectors=res.modal_vectors[:1], unstable=res.unstable)
     else:
         blocks = []
         pair = np.array([[1.0], [1j]])

@@ -77,6 +77,8 @@ class HarmonicResult:
     solver: str
     timings: dict = field(default_factory=dict)
     modal_vectors: list | None = None   # Psi of each load case (modal solver), for deflection shapes
+    # self-excited modes of the reduced system (projected solver, non-symmetric K): reduced_stability's report
+    unstable: list = field(default_factory=list)
 
 
 # ------------------------------------------------------------------------------------------ modal
@@ -193,6 +195,7 @@ def projected(K, M, modal_result, loads, frequencies, damping: Damping, reduce, 
     D = modal_damping_matrix(len(basis), n_rigid, lam_e, damping.ratios(len(lam_e)))
     eta = np.zeros(len(omega)) if D is not None else damping.hysteretic(frequencies)
     coeffs = solve_reduced(Kr, Mr, Cr if D is None else Cr + D, omega, eta, Fr)
+    unstable = reduced_stability(Kr, Mr, Cr if D is None else Cr + D, lam_e)
     t2 = time.perf_counter()
     reduced = reduce(basis)
     every = np.arange(len(omega))
@@ -200,7 +203,27 @@ def projected(K, M, modal_result, loads, frequencies, damping: Damping, reduce, 
     return HarmonicResult(np.asarray(frequencies, float), blocks, "projected",
                           {"projected_s": time.perf_counter() - t0, "projected_basis_s": t1 - t0,
                            "projected_lines_s": t2 - t1, "projected_basis_size": len(basis)},
-                          modal_vectors=[basis] * len(loads))
+                          modal_vectors=[basis] * len(loads), unstable=unstable)
+
+
+def reduced_stability(Kr: np.ndarray, Mr: np.ndarray, Cr: np.ndarray, lam_e: np.ndarray) -> list[dict]:
+    """Self-excited modes of the reduced system Mr c'' + Cr c' + Kr c = 0 (a non-symmetric Kr, as from fluid films,
+    can feed energy in: oil whirl): [{"frequency_hz", "growth_rate_per_s"}] of the eigenvalues s with Re s > 0,
+    empty when stable.  Viscous damping only (Cr, modal ratios): a hysteretic loss factor has no time-domain meaning
+    here.  Re s counts as positive above 1e-9 of the basis' highest omega (round-off of the rigid modes' s ~ 0)."""
+    n = len(Kr)
+    if n == 0:
+        return []
+    try:
+        Minv = np.linalg.inv(Mr)
+    except np.linalg.LinAlgError:
+        return []
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ Kr, -Minv @ Cr]])
+    s = np.linalg.eigvals(A)
+    scale = math.sqrt(max(float(np.max(lam_e, initial=0.0)), 1.0))
+    growing = s[(s.real > 1e-9 * scale) & (s.imag >= 0)]
+    return [{"frequency_hz": float(abs(x.imag) / (2 * math.pi)), "growth_rate_per_s": float(x.real)}
+            for x in sorted(growing, key=lambda x: -x.real)]
 
 
 def ritz_basis(K_sym, M, modal_result, load_vectors, *, shift: float | None = None) -> list:

@@ -352,6 +352,37 @@ class SteadyState:
         return f, 0.5 * np.abs(a) ** 2
 
 
+@dataclass
+class ContactCheck:
+    """Whether the teeth stay in contact over one period of a steady state (contact_check).  min_force_N, mean_force_N:
+    the smallest and the mean total mesh force S(t) d(t) + F_e(t) [N]; lost: min_force_N < 0 (the teeth separate
+    and the linear model, which lets the mesh pull, is invalid there); message: "contact loss at ... N m, ... rpm"
+    (when torque and speed were given) or ""."""
+
+    min_force_N: float
+    mean_force_N: float
+    lost: bool
+    message: str
+
+
+def contact_check(state: SteadyState, torque: float | None = None, speed_rpm: float | None = None,
+                  n_samples: int = 1024) -> ContactCheck:
+    """Check a harmonic-balance steady state for contact loss: the mesh force of `state` sampled over one tooth
+    period.  The linear model holds while it is positive; where the dynamic part exceeds the mean (the dynamic mesh
+    deflection exceeds the static one) the real teeth separate and the levels are not what the model says.
+    torque [N m] and speed_rpm [rev/min] only label the message."""
+    t = np.arange(n_samples) / n_samples
+    force = np.real(np.exp(2j * math.pi * np.outer(t, state.harmonics)) @ state.mesh_force)
+    mean = float(np.real(state.mesh_force[state.harmonics == 0][0]))
+    low = float(force.min())
+    lost = low < 0.0
+    where = " at " + ", ".join(x for x in (f"{torque:g} N m" if torque is not None else "",
+                                          f"{speed_rpm:g} rpm" if speed_rpm is not None else "") if x)
+    message = (f"contact loss{where if where != ' at ' else ''}: the mesh force falls to {low:.4g} N (mean "
+               f"{mean:.4g} N); the teeth separate and the linear harmonic balance is invalid there") if lost else ""
+    return ContactCheck(low, mean, lost, message)
+
+
 def _fourier_coefficients(samples: np.ndarray, H: int) -> np.ndarray:
     """Two-sided coefficients c_n, n = -2H..2H, of a periodic real signal sampled uniformly (zero beyond
     the Nyquist limit)."""

@@ -274,8 +274,10 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     # ---- run-up over speed (+ bearing spectra for the housing chain)
     speeds = np.linspace(table.speed_min_rpm, table.speed_max_rpm, table.speed_steps)
     runup, spectra, mesh_rows = [], [], []
+    contact = []            # dyn.contact_check of every operating point: teeth separating invalidate the levels
     for rpm in speeds:
         st = op.steady_state(pair, float(rpm), H)
+        contact.append(dyn.contact_check(st, table.torque_Nm, float(rpm)))
         runup.append([float(rpm), table.torque_Nm, pair.tooth_frequency(rpm), dyn.tooth_band_level(st)])
         bs = dyn.bearing_spectra(st, op.mats, interior, geometry, pair, float(rpm), table.torque_Nm)
         spectra.append(bs)
@@ -302,6 +304,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
         opT = op if T == table.torque_Nm else OperatingPoint(pair, corr, interior, model, T, table.stiffness_positions,
                                                              engagement=table.engagement)
         st = opT.steady_state(pair, table.torque_run_speed_rpm, H)
+        contact.append(dyn.contact_check(st, T, table.torque_run_speed_rpm))
         torque_rows.append([table.torque_run_speed_rpm, T, pair.tooth_frequency(table.torque_run_speed_rpm),
                             dyn.tooth_band_level(st), opT.curve.mean, opT.curve.deflection.mean() * 1e6])
     write_csv(out_dir / "torque_run.csv", ["speed_rpm", "torque_Nm", "tooth_frequency_hz", "L_omega_tooth_band_dB",
@@ -359,9 +362,14 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
                                  floatfmt="{:.1f}")]
         write_csv(out_dir / "L_omega_vs_measured.csv", ["speed_rpm", "measured_dB", "ours_dB", "difference_dB"],
                   comparison)
+    lost = [x.message for x in contact if x.lost]
+    write_json(out_dir / "contact_check.json", {"contact_loss": lost, "min_over_mean_mesh_force": min(
+        x.min_force_N / x.mean_force_N for x in contact)})
+    if lost:
+        summary += ["", f"WARNING: {lost[0]} ({len(lost)} of {len(contact)} operating points: contact_check.json)"]
     (out_dir / "summary.txt").write_text("\n".join(summary) + "\n")
     print("\n".join(summary))
-    return {"runup": runup, "comparison": comparison, "stiffness_mean": c.mean}
+    return {"runup": runup, "comparison": comparison, "stiffness_mean": c.mean, "contact_loss": lost}
 
 
 def correction_study(scenes: tuple[str, ...] = ("gearset-uncorrected", "gearset-A", "gearset-B", "gearset-C",
