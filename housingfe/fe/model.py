@@ -11,7 +11,7 @@ import time
 from dataclasses import dataclass, field
 
 from housingfe.errors import InputError
-from housingfe.fe.resolution import assess, check_resolution, wall_element_sizes
+from housingfe.fe.resolution import assess, check_resolution, wall_element_sizes, walls_of
 from housingfe.geometry import HousingMesh, build_mesh
 from housingfe.geometry.mesh import bending_wavelength
 from housingfe.materials import Material
@@ -135,7 +135,10 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
 
     regions = dict(regions or {})
     size = element_size(mesh, geometry, f_max, material)
-    check_resolution(geometry, mesh, size, f_max, material)
+    # an imported mesh (geometry kind "mesh") has no wall thickness the check could use: its resolution is not assessed
+    walls_known = walls_of(geometry) is not None
+    if walls_known:
+        check_resolution(geometry, mesh, size, f_max, material)
     check_model_size(geometry, mesh, size, comm)
     housing = build_mesh(geometry, mesh.element, size, mesh.layers, comm, grading=mesh.grading,
                          layer_size=mesh.layer_size)
@@ -152,7 +155,7 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
     timings = {"mesh_s": housing.mesh_time_s, "assembly_s": time.perf_counter() - t0}
     free = not bcs and not any(s.kind == "elastic" for s in supports)
     resolution = assess(geometry, mesh, wall_element_sizes(geometry, housing), f_max, material,
-                        "longest cell edge in each wall")
+                        "longest cell edge in each wall") if walls_known else None
     return HousingModel(housing, material, V, bcs, K, M, 6 if free else 0, timings, materials,
                         element_degree=mesh.degree, reduced_integration=reduced, resolution=resolution)
 

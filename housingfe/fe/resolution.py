@@ -203,13 +203,23 @@ def error_at(family: str, x: float) -> tuple[float | None, float | None]:
     return ct * x**q, e0 + cb * x**q
 
 
+def walls_of(geometry) -> dict | None:
+    """{wall name: thickness (m)} of a geometry spec (its wall_thicknesses, else its min_thickness as the thinnest
+    wall), or None when it does not know them (an imported mesh)."""
+    walls = getattr(geometry, "wall_thicknesses", None)
+    if walls:
+        return walls
+    thinnest = getattr(geometry, "min_thickness", None)
+    return {"thinnest wall": thinnest} if thinnest else None
+
+
 def assess(geometry, mesh, element_size, f_max: float, material, measure: str) -> Resolution:
     """The resolution of a mesh of `element_size` (m, the longest cell edge; or a dict wall name -> that of each
     wall, see wall_element_sizes; `measure` says where it comes from) at f_max (Hz) on every wall of a geometry spec (its wall_thicknesses, else its min_thickness), for the
     housing's material (SI) and a scene's mesh spec (element, degree, family, integration)."""
     family = element_family(mesh)
     p = nodes_per_element_edge(mesh)
-    thicknesses = getattr(geometry, "wall_thicknesses", None) or {"thinnest wall": geometry.min_thickness}
+    thicknesses = walls_of(geometry)
     walls = []
     for name, t in thicknesses.items():
         h = element_size[name] if isinstance(element_size, dict) else element_size

@@ -34,6 +34,7 @@ from housingfe.drivetrain.reduction import (
     write_dmig,
     write_npz,
 )
+from housingfe.outputs import MARKER
 from housingfe.scene import build_model_from_scene
 from housingfe.solvers import modal
 from tests.conftest import load_scene
@@ -141,7 +142,7 @@ def test_cli_writes_the_folder_and_refuses_unknown_masters(tmp_path, capsys):
     args = ["reduce", "box-free", "--cutoff", "2000"] + [a for n in MASTERS[:2] for a in ("--master", n)]
     args += [a for s in BOX for a in ("--set", s)]
     assert main(args + ["--out", str(out)]) == 0
-    assert {p.name for p in out.iterdir()} == {"reduced.npz", "reduced.bdf", "summary.json"}
+    assert {p.name for p in out.iterdir()} == {"reduced.npz", "reduced.bdf", "summary.json", MARKER}
     summary = json.loads((out / "summary.json").read_text())
     assert summary["fe_dofs"] == 10557 and summary["reduced_dofs"] == len(summary["fixed_interface_hz"]) + 12
     bad = tmp_path / "bad"
