@@ -11,7 +11,7 @@ from housingfe.errors import InputError
 from housingfe.geometry.blocks import build_gmsh_model, tet_quality
 
 # the registry's lookup, with the built-in kinds registered (specs imports their modules)
-from housingfe.geometry.specs import block_model_for
+from housingfe.geometry.specs import GEOMETRY_KINDS, block_model_for
 
 
 @dataclass
@@ -73,6 +73,9 @@ def estimate_dofs(geometry, element: str, degree: int, size: float, layers: int,
     estimate within 10 %)."""
     from housingfe.geometry.blocks import divisions
 
+    kind = GEOMETRY_KINDS.get(geometry.kind)
+    if kind is not None and kind.estimate_dofs is not None:
+        return kind.estimate_dofs(geometry, element, degree, size, layers, layer_size)
     model = block_model_for(geometry)
     steps = [np.diff(g) for g in model.grid]
     cells = 0
@@ -90,6 +93,9 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
     layers: elements through a wall thickness (hex meshes); layer_size (m): with it, at least
     ceil(thickness / layer_size) elements through each wall (hex meshes, `blocks.divisions`).
     """
+    kind = GEOMETRY_KINDS.get(geometry.kind)
+    if kind is not None and kind.mesh is not None:     # a kind that meshes itself (imported CAD)
+        return kind.mesh(geometry, element, size, layers, comm, grading=grading, layer_size=layer_size)
     import gmsh
     from dolfinx.io import gmshio
 

@@ -26,22 +26,30 @@ class StrictSpec(BaseModel):
 
 @dataclass(frozen=True)
 class GeometryKind:
-    """A registered geometry kind: its scene spec class and its builder (spec -> BlockModel)."""
+    """A registered geometry kind: its scene spec class and its builder (spec -> BlockModel).
+
+    A kind that is no block model (an imported CAD solid) gives `mesh` instead, with build_mesh's signature
+    (spec, element, size, layers, comm, grading=, layer_size=) -> HousingMesh, and `estimate_dofs` with
+    estimate_dofs' signature (spec, element, degree, size, layers, layer_size) -> int."""
 
     spec: type
     build: Callable
+    mesh: Callable | None = None
+    estimate_dofs: Callable | None = None
 
 
 GEOMETRY_KINDS: dict[str, GeometryKind] = {}
 
 
-def register_geometry(spec: type, build: Callable) -> type:
+def register_geometry(spec: type, build: Callable, *, mesh: Callable | None = None,
+                      estimate_dofs: Callable | None = None) -> type:
     """Register a geometry kind: `spec` is a pydantic model with `kind: Literal["<name>"]`, `build(spec)` returns
-    its housingfe.geometry.blocks.BlockModel.  Returns spec."""
+    its housingfe.geometry.blocks.BlockModel; a kind that meshes itself (no block model) gives `mesh` and
+    `estimate_dofs` (see GeometryKind).  Returns spec."""
     (name,) = typing.get_args(spec.model_fields["kind"].annotation)
     if name in GEOMETRY_KINDS:
         raise ValueError(f"geometry kind {name!r} is registered twice")
-    GEOMETRY_KINDS[name] = GeometryKind(spec, build)
+    GEOMETRY_KINDS[name] = GeometryKind(spec, build, mesh, estimate_dofs)
     return spec
 
 

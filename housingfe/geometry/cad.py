@@ -1,0 +1,622 @@
+"""A housing from a CAD file (STEP, IGES, BREP): the geometry kind `cad`.
+
+    [geometry]
+    kind = "cad"
+    file = "housing.step"       # relative to the scene file
+    units = "mm"                # the unit of the coordinates gmsh reads (see below)
+    [[geometry.bores]]          # selectors, lengths in m (housingfe.geometry.selectors)
+    name = "A"; axis = [0, 1, 0]; centre = [0.1, 0, 0.2]
+    [[geometry.surfaces]]
+    name = "feet"; plane = {point = [0, 0, 0], normal = [0, 0, -1]}
+
+The file is read by gmsh's OpenCASCADE kernel (importShapes), healed where it holds no solid (healShapes:
+sewing, small edges and faces, closed shells made solids), scaled to metres and checked: its size must be plausible for the declared
+unit (5 mm to 20 m; a 300 m gearbox is an error that says millimetres fit), it must hold at least one closed
+solid (an open shell is refused), and several solids must touch: they are fragmented into one conforming
+solid (a weld; each keeps its own cell group solid_<n>), pieces that do not touch are refused.
+OpenCASCADE converts STEP and IGES coordinates to millimetres whatever unit the file declares, so STEP and
+IGES files from CAD programs are `units = "mm"`; BREP files carry no unit, and gmsh writes a model's raw
+numbers into STEP (the package's own STEP exports of its built-in housings, in metres, are `units = "m"`).
+
+Regions, never entity numbers: every boundary face is "outer" (the radiating skin: a ray along its outward
+normal leaves the part without hitting it, for most of its sample points) or "inner"; bore selectors add
+bore_<name> and bores (and remove "outer": a bore does not radiate as a plate does); surface selectors add
+their name.  The element size follows the scene's frequency range and the thinnest wall (`thin_walls`),
+unless `thickness` is given.  Meshing: linear tetrahedra of gmsh's Delaunay (reproducible; slivers refined,
+housingfe.geometry.blocks.mesh_tetrahedra), quadratic (or cubic) displacement fields on them (mesh.degree).
+
+How the thinnest wall is estimated (`thin_walls`): the boundary is triangulated coarsely (extent / 40); from
+the centroid of every triangle a ray runs along the inward normal, and the distance to where it leaves the
+material is the wall thickness there.  The thinnest wall is the area-weighted 2 % quantile of those
+distances (the very minimum comes from rays grazing a fillet or starting on an edge); the minimum is
+reported as well.
+"""
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Literal, Optional
+
+import numpy as np
+from pydantic import PositiveFloat, model_validator
+
+from housingfe.errors import InputError
+from housingfe.geometry.registry import StrictSpec, register_geometry
+from housingfe.geometry.selectors import (
+    BoreSelector,
+    Face,
+    SurfaceSelector,
+    select_bore,
+    select_surface,
+)
+
+CAD_SUFFIXES = (".step", ".stp", ".iges", ".igs", ".brep", ".brp")
+# the largest extent of a housing (m): below, the declared unit is too large; above, too small
+PLAUSIBLE_EXTENT_M = (0.005, 20.0)
+UNIT_SCALE = {"mm": 1e-3, "m": 1.0}
+# the coarse triangulation for the face analysis: this fraction of the largest extent
+ANALYSIS_SIZE_FRACTION = 1 / 40
+THIN_WALL_QUANTILE = 0.02
+MAX_THICKNESS_RAYS = 8000
+_RESERVED = {"outer", "inner", "bores"}
+
+
+class CadGeometry(StrictSpec):
+    """A housing imported from a CAD file (see the module docstring).  file: STEP/IGES/BREP path (relative to
+    the scene file); units: "mm" or "m"; heal: OpenCASCADE's shape healing ("auto": only a file without
+    solids, whose faces it may sew into one); bores, surfaces: named regions by
+    geometric selectors (m); thickness (m): the thinnest wall for the element size, instead of the estimate."""
+
+    kind: Literal["cad"]
+    file: str
+    units: Literal["mm", "m"]
+    heal: Literal["auto", "always", "never"] = "auto"
+    bores: list[BoreSelector] = []
+    surfaces: list[SurfaceSelector] = []
+    thickness: Optional[PositiveFloat] = None
+
+    @model_validator(mode="after")
+    def _check(self):
+        path = Path(self.file)
+        if path.suffix.lower() not in CAD_SUFFIXES:
+            raise ValueError(f"file: {self.file}: not a CAD file by its name (expected {', '.join(CAD_SUFFIXES)})")
+        if not path.is_file():
+            raise ValueError(f"file: {self.file}: no such file")
+        names = [b.name for b in self.bores] + [s.name for s in self.surfaces]
+        for name in names:
+            if name in _RESERVED or names.count(name) > 1:
+                raise ValueError(f"surfaces: the name {name!r} is reserved or used twice (outer, inner and bores "
+                                 f"are made by the import)")
+        return self
+
+    @property
+    def min_thickness(self) -> float:
+        """The thinnest wall (m): `thickness`, or the estimate from the CAD file (cached per file)."""
+        return self.thickness if self.thickness is not None else cad_facts(self).thin_wall
+
+
+@dataclass
+class CadFacts:
+    """What an imported CAD file is (lengths in m): solids (before fragmenting), volume (m^3), centroid,
+    bounding box (lo, hi), the thinnest wall (m, THIN_WALL_QUANTILE of the inward ray lengths) and the
+    shortest ray (m), the boundary faces (housingfe.geometry.selectors.Face, outward normals) and which of
+    them are outer skin; import_s / analysis_s: times (s)."""
+
+    path: Path
+    solids: int
+    volumes: list[int]
+    volume: float
+    centroid: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    thin_wall: float
+    thinnest_ray: float
+    faces: list[Face]
+    outer: set[int]
+    import_s: float = 0.0
+    analysis_s: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+
+@contextmanager
+def gmsh_session():
+    """gmsh initialised for the block, finalised after (also on errors); the terminal output off."""
+    import gmsh
+
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        yield gmsh
+    finally:
+        gmsh.finalize()
+
+
+@contextmanager
+def _native_output_captured():
+    """OpenCASCADE writes its statistics and parse errors straight to the process' stdout/stderr; the
+    project's rule is one line per error.  Redirect both file descriptors into a temporary file for the block
+    and yield a function that returns what was written."""
+    import sys
+
+    sys.stdout.flush()
+    sys.stderr.flush()
+    saved = os.dup(1), os.dup(2)
+    with tempfile.TemporaryFile(mode="w+b") as sink:
+        os.dup2(sink.fileno(), 1)
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield lambda: (sink.seek(0), sink.read().decode(errors="replace"))[1]
+        finally:
+            os.dup2(saved[0], 1)
+            os.dup2(saved[1], 2)
+            os.close(saved[0])
+            os.close(saved[1])
+
+
+def import_solid(path: Path, units: str, heal: str = "auto", key: str = "geometry") -> dict:
+    """Import a CAD file into the current (empty) gmsh model, scaled to metres, healed, checked and fragmented
+    into one conforming solid.  Returns {"solids": count in the file, "volumes": volume tags, "scale": factor}.
+    InputError naming `key`.file for an unreadable file, an implausible size for `units`, no closed solid, or
+    solids that do not touch."""
+    import gmsh
+
+    occ = gmsh.model.occ
+    where = f"{key}.file: {path}"
+    gmsh.option.setString("Geometry.OCCTargetUnit", "")   # OCC's default: STEP/IGES in mm (options persist)
+    with _native_output_captured():
+        try:
+            occ.importShapes(str(path))
+        except Exception:   # noqa: BLE001 - gmsh raises a bare Exception; OCC's own message went to the sink
+            raise InputError(f"{where}: not a STEP, IGES or BREP file OpenCASCADE can read") from None
+        occ.synchronize()
+    if not gmsh.model.getEntities():
+        raise InputError(f"{where}: the file holds no geometry")
+    x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(-1, -1)
+    extent = max(x1 - x0, y1 - y0, z1 - z0)
+    check_units(extent, units, f"{where}: units")
+    scale = UNIT_SCALE[units]
+    if scale != 1.0:
+        occ.dilate(gmsh.model.getEntities(), 0.0, 0.0, 0.0, scale, scale, scale)
+        occ.synchronize()
+    solids = gmsh.model.getEntities(3)
+    if heal == "always" or (heal == "auto" and not solids):
+        # the solids if there are any (healing everything turns solids into loose faces in gmsh 4.8), else
+        # the faces, which healing may sew into a closed shell and make a solid of; "auto" heals only a file
+        # without solids (healing valid solids costs as much as reading them)
+        with _native_output_captured():
+            occ.healShapes(solids or gmsh.model.getEntities(2))
+            occ.synchronize()
+    volumes = [t for _, t in gmsh.model.getEntities(3)]
+    if not volumes:
+        faces = len(gmsh.model.getEntities(2))
+        raise InputError(f"{where}: no closed solid ({faces} faces, no volume: an open shell or loose surfaces); "
+                         f"close the housing in the CAD program and export the solid")
+    solids = len(volumes)
+    if solids > 1:
+        # touching solids (a welded-on foot, the boxes of an export) become one conforming solid: shared
+        # faces are meshed once, so the parts are joined as by a weld
+        with _native_output_captured():
+            occ.fragment([(3, volumes[0])], [(3, t) for t in volumes[1:]])
+            occ.synchronize()
+        volumes = [t for _, t in gmsh.model.getEntities(3)]
+        pieces = _connected_pieces(volumes)
+        if len(pieces) > 1:
+            raise InputError(f"{where}: {solids} solids in {len(pieces)} pieces that do not touch (the housing "
+                             f"must be one connected solid); join them in the CAD program or export one part")
+    # free surfaces, curves and points not on a solid are no part of the housing
+    faces = gmsh.model.getBoundary([(3, t) for t in volumes], combined=False, oriented=False)
+    curves = gmsh.model.getBoundary(faces, combined=False, oriented=False)
+    points = gmsh.model.getBoundary(curves, combined=False, oriented=False)
+    keep = {(d, abs(t)) for d, t in faces + curves + points}
+    stray = [(d, t) for d in (2, 1, 0) for _, t in gmsh.model.getEntities(d) if (d, t) not in keep]
+    if stray:
+        occ.remove(stray, recursive=False)
+        occ.synchronize()
+    return {"solids": solids, "volumes": volumes, "scale": scale}
+
+
+def check_units(extent: float, units: str, key: str) -> None:
+    """InputError (naming `key`) when a largest extent of `extent` (in `units`) is implausible for a housing,
+    saying which unit would fit."""
+    metres = extent * UNIT_SCALE[units]
+    lo, hi = PLAUSIBLE_EXTENT_M
+    if lo <= metres <= hi:
+        return
+    fits = [u for u, s in UNIT_SCALE.items() if lo <= extent * s <= hi and u != units]
+    hint = f"; this looks like {'millimetres' if fits == ['mm'] else 'metres'}: set units = \"{fits[0]}\"" \
+        if fits else ""
+    raise InputError(f"{key}: the part is {extent:g} {units} across ({metres:g} m), implausible for a housing "
+                     f"({lo * 1e3:g} mm to {hi:g} m){hint}")
+
+
+def _connected_pieces(volumes: list[int]) -> list[set[int]]:
+    """Volumes grouped into pieces that share faces (union-find)."""
+    import gmsh
+
+    parent = {v: v for v in volumes}
+
+    def root(v):
+        while parent[v] != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return v
+
+    owner: dict[int, int] = {}
+    for v in volumes:
+        for _, f in gmsh.model.getBoundary([(3, v)], combined=False, oriented=False):
+            f = abs(f)
+            if f in owner:
+                parent[root(v)] = root(owner[f])
+            else:
+                owner[f] = v
+    pieces: dict[int, set[int]] = {}
+    for v in volumes:
+        pieces.setdefault(root(v), set()).add(v)
+    return list(pieces.values())
+
+
+# ------------------------------------------------------------------------------------------- face analysis
+def _boundary_triangles(faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles (n, 3, 3) of the current 2-D mesh on the given faces and the face tag of each."""
+    import gmsh
+
+    tags, coords, _ = gmsh.model.mesh.getNodes()
+    xyz = np.zeros((int(tags.max()) + 1, 3))
+    xyz[tags.astype(int)] = coords.reshape(-1, 3)
+    tris, owner = [], []
+    for f in faces:
+        types, _, nodes = gmsh.model.mesh.getElements(2, f)
+        for etype, conn in zip(types, nodes):
+            if etype == 2:   # 3-node triangle
+                t = xyz[conn.astype(int).reshape(-1, 3)]
+                tris.append(t)
+                owner.append(np.full(len(t), f))
+    return np.concatenate(tris), np.concatenate(owner)
+
+
+class RayCaster:
+    """Rays against a triangulated surface through VTK's static cell locator (about 20 us per ray: the
+    face analysis of a housing casts tens of thousands)."""
+
+    def __init__(self, triangles: np.ndarray):
+        import pyvista
+        from vtkmodules.vtkCommonDataModel import vtkStaticCellLocator
+
+        n = len(triangles)
+        cells = np.hstack([np.full((n, 1), 3), np.arange(3 * n).reshape(n, 3)]).ravel()
+        self.surface = pyvista.PolyData(triangles.reshape(-1, 3), cells)
+        self.locator = vtkStaticCellLocator()
+        self.locator.SetDataSet(self.surface)
+        self.locator.BuildLocator()
+        self.reach = 2.0 * float(np.linalg.norm(np.ptp(triangles.reshape(-1, 3), axis=0)))
+
+    def hits(self, origins: np.ndarray, directions: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray]:
+        """For every ray (origin, unit direction, m): the distance to the nearest crossing of the surface
+        farther than eps (inf if none) and the number of such crossings."""
+        from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints
+        from vtkmodules.vtkCommonDataModel import vtkGenericCell
+
+        points, ids, cell = vtkPoints(), vtkIdList(), vtkGenericCell()
+        nearest = np.full(len(origins), np.inf)
+        counts = np.zeros(len(origins), dtype=int)
+        ends = origins + self.reach * directions
+        for k in range(len(origins)):
+            o = origins[k]
+            self.locator.IntersectWithLine(tuple(o), tuple(ends[k]), 1e-12, points, ids, cell)
+            m = points.GetNumberOfPoints()
+            if m:
+                d = np.linalg.norm(np.array([points.GetPoint(i) for i in range(m)]) - o, axis=1)
+                # a ray through a mesh edge or vertex hits every triangle there at one distance: count once
+                d = np.sort(d[d > eps])
+                d = d[np.concatenate([[True], np.diff(d) > eps])] if len(d) else d
+                if len(d):
+                    nearest[k] = d.min()
+                    counts[k] = len(d)
+        return nearest, counts
+
+
+def analyse_faces(volumes: list[int], size: float) -> dict:
+    """Describe the boundary faces of the current gmsh model's solid (a coarse 2-D mesh of `size` m is made
+    and cleared again): outward-oriented triangles, selectors' Face records, the outer skin and the wall
+    thickness samples."""
+    import gmsh
+
+    from housingfe.geometry.blocks import _set_mesh_options
+
+    _set_mesh_options("tet")
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
+    boundary = sorted({abs(t) for _, t in gmsh.model.getBoundary([(3, v) for v in volumes], combined=True,
+                                                                     oriented=False)})
+    gmsh.model.mesh.generate(2)
+    tris, owner = _boundary_triangles(boundary)
+    gmsh.model.mesh.clear()
+    normal = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
+    area = 0.5 * np.linalg.norm(normal, axis=1)
+    normal /= np.maximum(2 * area, 1e-300)[:, None]
+    centroid = tris.mean(axis=1)
+    lo, hi = tris.reshape(-1, 3).min(axis=0), tris.reshape(-1, 3).max(axis=0)
+    diag = float(np.linalg.norm(hi - lo))
+    eps = 1e-7 * diag
+
+    # orientation: per face, a point just off its largest triangles along the normal is inside the solid when
+    # a ray from it crosses the boundary an odd number of times (three skew directions, majority vote)
+    # (five of its largest triangles, five skew directions)
+    probes, probe_face = [], []
+    for f in boundary:
+        idx = np.flatnonzero(owner == f)
+        for i in idx[np.argsort(-area[idx])[:5]]:
+            probes.append(centroid[i] + 1e-4 * diag * normal[i])
+            probe_face.append(f)
+    probes = np.asarray(probes)
+    caster = RayCaster(tris)
+    directions = np.random.default_rng(20261125).normal(size=(5, 3))   # fixed: the same answer every run
+    votes = np.zeros(len(probes))
+    for d in directions / np.linalg.norm(directions, axis=1)[:, None]:
+        _, n_hits = caster.hits(probes, np.broadcast_to(d, probes.shape), eps)
+        votes += n_hits % 2
+    inside = {}
+    for f, v in zip(probe_face, votes):
+        inside.setdefault(f, []).append(v / len(directions))
+    flip = np.array([np.mean(inside[f]) > 0.5 for f in boundary])
+    sign = dict(zip(boundary, np.where(flip, -1.0, 1.0)))
+    normal *= np.array([sign[f] for f in owner])[:, None]
+
+    # wall thickness: along the inward normal to where the ray leaves the material (at most MAX_THICKNESS_RAYS
+    # triangles, every k-th: the estimate needs the area distribution, not every triangle)
+    sample = np.arange(0, len(tris), max(1, len(tris) // MAX_THICKNESS_RAYS))
+    thickness, _ = caster.hits(centroid[sample], -normal[sample], 1e-5 * diag)
+    # outer skin: along the outward normal nothing is hit (up to 8 of a face's largest triangles, majority)
+    escapes, _ = caster.hits(centroid, normal, 1e-5 * diag)
+    faces, outer = [], set()
+    for f in boundary:
+        idx = np.flatnonzero(owner == f)
+        top = idx[np.argsort(-area[idx])[:8]]
+        if np.mean(np.isinf(escapes[top])) > 0.5:
+            outer.add(f)
+        faces.append(_face_record(f, tris[idx].reshape(-1, 3), area[idx], centroid[idx], normal[idx]))
+    finite = np.isfinite(thickness)
+    return {"faces": faces, "outer": outer, "thickness": thickness[finite], "weights": area[sample][finite],
+            "lo": lo, "hi": hi, "triangles": len(tris)}
+
+
+def _face_record(tag: int, points: np.ndarray, areas: np.ndarray, centroids: np.ndarray,
+                 normals: np.ndarray) -> Face:
+    """A selectors.Face from a gmsh face (its triangles' corner points, areas, centroids and outward normals):
+    kind from gmsh.model.getType, cylinder axis/radius from three points on a circle of its parametrisation
+    (OCC cylinders: u the angle, v along the axis)."""
+    import gmsh
+
+    kind = gmsh.model.getType(2, tag)
+    points = np.unique(np.round(points, 12), axis=0)
+    area = float(areas.sum())
+    normal_sum = (areas[:, None] * normals).sum(axis=0)
+    mean_normal = normal_sum / max(np.linalg.norm(normal_sum), 1e-300)
+    if kind == "Plane":
+        return Face(tag, "plane", points, area, normal=mean_normal)
+    if kind == "Cylinder":
+        (u0, v0), (u1, v1) = gmsh.model.getParametrizationBounds(2, tag)
+        vm = 0.5 * (v0 + v1)
+        us = [u0 + (u1 - u0) * s for s in (0.1, 0.5, 0.9)]
+        a, b, c = (np.array(gmsh.model.getValue(2, tag, [u, vm])) for u in us)
+        axis = np.cross(b - a, c - a)
+        axis /= np.linalg.norm(axis)
+        centre, radius = _circumcircle(a, b, c)
+        # a bore: the outward normal of the face points towards the axis (area-weighted over its triangles)
+        radial = (centroids - centre) - np.outer((centroids - centre) @ axis, axis)
+        concave = bool(np.sum(areas * np.einsum("ij,ij->i", normals, radial)) < 0)
+        return Face(tag, "cylinder", points, area, normal=mean_normal, axis=axis, axis_point=centre,
+                    radius=radius, concave=concave)
+    return Face(tag, "other", points, area, normal=mean_normal, extra={"gmsh_type": kind})
+
+
+def _circumcircle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, float]:
+    ab, ac = b - a, c - a
+    n = np.cross(ab, ac)
+    centre = a + (np.dot(ac, ac) * np.cross(n, ab) + np.dot(ab, ab) * np.cross(ac, n)) / (2 * np.dot(n, n))
+    return centre, float(np.linalg.norm(a - centre))
+
+
+def _weighted_quantile(values: np.ndarray, weights: np.ndarray, q: float) -> float:
+    order = np.argsort(values)
+    cum = np.cumsum(weights[order])
+    return float(values[order][np.searchsorted(cum, q * cum[-1])])
+
+
+def read_cad(path: Path, units: str, heal: str = "auto", key: str = "geometry") -> CadFacts:
+    """Import, check and analyse a CAD file in the current gmsh session (see CadFacts); the model stays loaded
+    (fragmented, in metres, no mesh) for meshing."""
+    import gmsh
+
+    t0 = time.perf_counter()
+    imported = import_solid(path, units, heal, key)
+    volumes = imported["volumes"]
+    t1 = time.perf_counter()
+    volume, moment = 0.0, np.zeros(3)
+    for v in volumes:
+        m = gmsh.model.occ.getMass(3, v)
+        volume += m
+        moment += m * np.asarray(gmsh.model.occ.getCenterOfMass(3, v))
+    x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(-1, -1)
+    extent = max(x1 - x0, y1 - y0, z1 - z0)
+    analysis = analyse_faces(volumes, extent * ANALYSIS_SIZE_FRACTION)
+    if len(analysis["thickness"]) == 0:
+        raise InputError(f"{key}.file: {path}: no wall thickness found (rays from the surface leave nothing)")
+    thin = _weighted_quantile(analysis["thickness"], analysis["weights"], THIN_WALL_QUANTILE)
+    notes = []
+    if imported["solids"] > 1:
+        notes.append(f"{imported['solids']} solids fragmented into one conforming solid of {len(volumes)} volumes")
+    return CadFacts(path=path, solids=imported["solids"], volumes=volumes, volume=volume,
+                    centroid=moment / volume, lo=analysis["lo"], hi=analysis["hi"], thin_wall=thin,
+                    thinnest_ray=float(analysis["thickness"].min()), faces=analysis["faces"],
+                    outer=analysis["outer"], import_s=t1 - t0, analysis_s=time.perf_counter() - t1, notes=notes)
+
+
+_FACTS_CACHE: dict[tuple, CadFacts] = {}
+
+
+def cad_facts(spec: CadGeometry) -> CadFacts:
+    """CadFacts of a scene's CAD geometry, read once per file version (path, size, mtime, units, heal)."""
+    path = Path(spec.file).resolve()
+    stat = path.stat()
+    key = (str(path), stat.st_size, stat.st_mtime_ns, spec.units, spec.heal)
+    if key not in _FACTS_CACHE:
+        with gmsh_session():
+            _FACTS_CACHE[key] = read_cad(path, spec.units, spec.heal)
+    return _FACTS_CACHE[key]
+
+
+# ------------------------------------------------------------------------------------------------ regions
+def face_groups(spec: CadGeometry, facts: CadFacts) -> dict[int, tuple[str, ...]]:
+    """Surface names of every boundary face: outer/inner, bore_<name> + bores (never outer), the surface
+    selectors' names.  InputError naming geometry.bores[i] / geometry.surfaces[i] for a selector that
+    matches nothing (or two bores)."""
+    names: dict[int, list[str]] = {f.tag: [] for f in facts.faces}
+    bore_faces: set[int] = set()
+    for i, selector in enumerate(spec.bores):
+        for tag in select_bore(facts.faces, selector, f"geometry.bores[{i}]"):
+            names[tag] += [f"bore_{selector.name}", "bores"]
+            bore_faces.add(tag)
+    for i, selector in enumerate(spec.surfaces):
+        for tag in select_surface(facts.faces, selector, f"geometry.surfaces[{i}]"):
+            names[tag].append(selector.name)
+    out = {}
+    for tag, extra in names.items():
+        skin = [] if tag in bore_faces else ["outer" if tag in facts.outer else "inner"]
+        out[tag] = tuple(dict.fromkeys(skin + extra))
+    return out
+
+
+def bore_points(spec: CadGeometry, facts: CadFacts) -> dict[str, list[tuple[float, float, float]]]:
+    """Named reference points: the centre of each selected bore (middle of its faces along the axis, m)."""
+    from housingfe.geometry.selectors import bore_candidates
+
+    points = {}
+    for selector in spec.bores:
+        tags = set(select_bore(facts.faces, selector, "geometry.bores"))
+        (bore,) = bore_candidates([f for f in facts.faces if f.tag in tags], selector.tolerance) or [None]
+        if bore is not None:
+            points[f"bore_{selector.name}"] = [tuple(float(c) for c in bore["centre"])]
+    return points
+
+
+# ------------------------------------------------------------------------------------------------ meshing
+def estimate_cad_dofs(spec: CadGeometry, element: str, degree: int, size: float, layers: int,
+                      layer_size: float | None = None) -> int:
+    """Displacement DOFs of the tetrahedral mesh, estimated from the volume: cells ~ V / (h^2 min(h, t) / 6
+    sqrt(2)) (regular tetrahedra of edge h, no larger than the thinnest wall t through it), nodes per cell of
+    an unstructured tet mesh 0.18 / 1.36 / 4.5 for degree 1 / 2 / 3.  Good to a factor of about 3."""
+    facts = cad_facts(spec)
+    t = spec.min_thickness
+    cells = facts.volume / (size**2 * min(size, t) / (6 * math.sqrt(2)))
+    nodes_per_cell = {1: 0.18, 2: 1.36, 3: 4.5}[degree]
+    return int(round(3 * nodes_per_cell * cells))
+
+
+def build_cad_mesh(spec: CadGeometry, element: str, size: float, layers: int, comm, grading: float = 1.0,
+                   layer_size: float | None = None):
+    """Import the CAD file on rank 0, tag it, mesh it with tetrahedra of `size` (m) and distribute it as a
+    housingfe.geometry.mesh.HousingMesh (volume and centroid from OpenCASCADE)."""
+    import gmsh
+    from dolfinx.io import gmshio
+
+    from housingfe.geometry.blocks import _tet_qualities, mesh_tetrahedra
+    from housingfe.geometry.mesh import HousingMesh, element_quality
+
+    if element != "tet":
+        raise InputError("mesh.element: an imported CAD housing is meshed with tetrahedra: set element = \"tet\"")
+    t0 = time.perf_counter()
+    facts = cad_facts(spec)      # on every rank: the checks raise everywhere, and the facts are cached
+    payload = None
+    if comm.rank == 0:
+        gmsh.initialize()
+        try:
+            gmsh.option.setNumber("General.Terminal", 0)
+            gmsh.model.add("cad")
+            read = import_solid(facts.path, spec.units, spec.heal)
+            assert read["volumes"] == facts.volumes, "the CAD import is not deterministic"
+            groups = face_groups(spec, facts)
+            payload = {"cells": _volume_groups(facts.volumes), "facets": _surface_groups(groups),
+                       "points": bore_points(spec, facts)}
+            payload["mesher"] = mesh_tetrahedra(size)
+            q = _tet_qualities()[0]
+            payload["quantiles"] = {"q01": float(np.quantile(q, 0.01)), "median": float(np.median(q))}
+        except InputError as exc:
+            gmsh.finalize()
+            payload = {"error": str(exc)}
+        except Exception:
+            gmsh.finalize()
+            comm.bcast({"error": "the CAD mesh failed on rank 0"}, root=0)
+            raise
+    payload = comm.bcast(payload, root=0)
+    if "error" in payload:
+        raise InputError(payload["error"])
+    try:
+        mesh, cell_tags, facet_tags = gmshio.model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0, gdim=3)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()
+    mesh.topology.create_connectivity(2, 3)
+    quality = {**element_quality(mesh), **payload["quantiles"], "mesher": payload["mesher"]}
+    return HousingMesh(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=payload["cells"],
+                       facet_groups=payload["facets"], volume=facts.volume, centroid=facts.centroid,
+                       element_size=size, element="tet", points=payload["points"],
+                       mesh_time_s=time.perf_counter() - t0, quality=quality)
+
+
+def _volume_groups(volumes: list[int]) -> dict[str, int]:
+    import gmsh
+
+    groups = {}
+    for n, v in enumerate(sorted(volumes), start=1):
+        name = "solid" if len(volumes) == 1 else f"solid_{n}"
+        gmsh.model.addPhysicalGroup(3, [v], n)
+        gmsh.model.setPhysicalName(3, n, name)
+        groups[name] = n
+    return groups
+
+
+def _surface_groups(groups: dict[int, tuple[str, ...]]) -> dict[str, list[int]]:
+    """Physical surface groups, one per distinct tuple of names (a facet tag holds one value); every name maps
+    to the tags of the tuples that carry it (as housingfe.geometry.blocks does for the built-in housings)."""
+    import gmsh
+
+    atomic: dict[tuple[str, ...], list[int]] = {}
+    for tag, names in groups.items():
+        atomic.setdefault(names, []).append(tag)
+    out: dict[str, list[int]] = {}
+    for n, names in enumerate(sorted(atomic), start=1):
+        gmsh.model.addPhysicalGroup(2, sorted(atomic[names]), n)
+        gmsh.model.setPhysicalName(2, n, "/".join(names))
+        for name in names:
+            out.setdefault(name, []).append(n)
+    return out
+
+
+def _no_block_model(spec: CadGeometry):
+    raise InputError("geometry.kind: an imported CAD housing has no block model (it meshes itself)")
+
+
+register_geometry(CadGeometry, _no_block_model, mesh=build_cad_mesh, estimate_dofs=estimate_cad_dofs)
+
+
+def write_step(geometry, path: Path) -> Path:
+    """Write a built-in (block-model) housing's OpenCASCADE solid, as its tetrahedral mesh is built from
+    (boxes with the bores cut, fragmented), to a STEP (or BREP, by the suffix) file in metres: gmsh writes the
+    model's raw numbers, so it reads back with units = "m".  For the round trips of tests and docs."""
+    from housingfe.geometry.blocks import _fragmented_blocks
+    from housingfe.geometry.specs import block_model_for
+
+    model = block_model_for(geometry)
+    with gmsh_session() as gmsh:
+        gmsh.model.add("export")
+        _fragmented_blocks(model, "tet")
+        with _native_output_captured():
+            gmsh.write(str(path))
+    return Path(path)
