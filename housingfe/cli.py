@@ -16,6 +16,7 @@ from housingfe.errors import InputError, SolverError
 _EXTENSIONS = (
     "housingfe.bearings.cli",
     "housingfe.correlation.cli",
+    "housingfe.geometry.inspect",
     "housingfe.radiation",
     "housingfe.source.cli",
     "housingfe.studies.bearing_variants",

@@ -121,6 +121,8 @@ class CadFacts:
     import_s: float = 0.0
     analysis_s: float = 0.0
     notes: list[str] = field(default_factory=list)
+    triangles: Optional[np.ndarray] = None     # the coarse boundary triangulation (n, 3, 3), m
+    owner: Optional[np.ndarray] = None         # the face tag of each triangle
 
 
 @contextmanager
@@ -158,15 +160,15 @@ def _native_output_captured():
             os.close(saved[1])
 
 
-def import_solid(path: Path, units: str, heal: str = "auto", key: str = "geometry") -> dict:
+def import_solid(path: Path, units: str, heal: str = "auto", key: str | None = "geometry") -> dict:
     """Import a CAD file into the current (empty) gmsh model, scaled to metres, healed, checked and fragmented
     into one conforming solid.  Returns {"solids": count in the file, "volumes": volume tags, "scale": factor}.
-    InputError naming `key`.file for an unreadable file, an implausible size for `units`, no closed solid, or
+    InputError naming `key`.file (or only the file, key None) for an unreadable file, an implausible size for `units`, no closed solid, or
     solids that do not touch."""
     import gmsh
 
     occ = gmsh.model.occ
-    where = f"{key}.file: {path}"
+    where = f"{key}.file: {path}" if key else str(path)
     gmsh.option.setString("Geometry.OCCTargetUnit", "")   # OCC's default: STEP/IGES in mm (options persist)
     with _native_output_captured():
         try:
@@ -383,7 +385,7 @@ def analyse_faces(volumes: list[int], size: float) -> dict:
         faces.append(_face_record(f, tris[idx].reshape(-1, 3), area[idx], centroid[idx], normal[idx]))
     finite = np.isfinite(thickness)
     return {"faces": faces, "outer": outer, "thickness": thickness[finite], "weights": area[sample][finite],
-            "lo": lo, "hi": hi, "triangles": len(tris)}
+            "lo": lo, "hi": hi, "triangles": tris, "owner": owner}
 
 
 def _face_record(tag: int, points: np.ndarray, areas: np.ndarray, centroids: np.ndarray,
@@ -429,7 +431,7 @@ def _weighted_quantile(values: np.ndarray, weights: np.ndarray, q: float) -> flo
     return float(values[order][np.searchsorted(cum, q * cum[-1])])
 
 
-def read_cad(path: Path, units: str, heal: str = "auto", key: str = "geometry") -> CadFacts:
+def read_cad(path: Path, units: str, heal: str = "auto", key: str | None = "geometry") -> CadFacts:
     """Import, check and analyse a CAD file in the current gmsh session (see CadFacts); the model stays loaded
     (fragmented, in metres, no mesh) for meshing."""
     import gmsh
@@ -447,7 +449,8 @@ def read_cad(path: Path, units: str, heal: str = "auto", key: str = "geometry") 
     extent = max(x1 - x0, y1 - y0, z1 - z0)
     analysis = analyse_faces(volumes, extent * ANALYSIS_SIZE_FRACTION)
     if len(analysis["thickness"]) == 0:
-        raise InputError(f"{key}.file: {path}: no wall thickness found (rays from the surface leave nothing)")
+        where = f"{key}.file: {path}" if key else str(path)
+        raise InputError(f"{where}: no wall thickness found (no ray from the surface crosses material)")
     thin = _weighted_quantile(analysis["thickness"], analysis["weights"], THIN_WALL_QUANTILE)
     notes = []
     if imported["solids"] > 1:
@@ -455,7 +458,8 @@ def read_cad(path: Path, units: str, heal: str = "auto", key: str = "geometry") 
     return CadFacts(path=path, solids=imported["solids"], volumes=volumes, volume=volume,
                     centroid=moment / volume, lo=analysis["lo"], hi=analysis["hi"], thin_wall=thin,
                     thinnest_ray=float(analysis["thickness"].min()), faces=analysis["faces"],
-                    outer=analysis["outer"], import_s=t1 - t0, analysis_s=time.perf_counter() - t1, notes=notes)
+                    outer=analysis["outer"], import_s=t1 - t0, analysis_s=time.perf_counter() - t1, notes=notes,
+                    triangles=analysis["triangles"], owner=analysis["owner"])
 
 
 _FACTS_CACHE: dict[tuple, CadFacts] = {}
