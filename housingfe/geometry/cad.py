@@ -170,21 +170,23 @@ def import_solid(path: Path, units: str, heal: str = "auto", key: str | None = "
     occ = gmsh.model.occ
     where = f"{key}.file: {path}" if key else str(path)
     gmsh.option.setString("Geometry.OCCTargetUnit", "")   # OCC's default: STEP/IGES in mm (options persist)
-    with _native_output_captured():
-        try:
-            occ.importShapes(str(path))
-        except Exception:   # noqa: BLE001 - gmsh raises a bare Exception; OCC's own message went to the sink
-            raise InputError(f"{where}: not a STEP, IGES or BREP file OpenCASCADE can read") from None
-        occ.synchronize()
+    # scaled by OpenCASCADE on reading: occ.dilate would turn planes and cylinders into B-splines (volume off
+    # by 1e-3, no cylinders left for the bore selectors)
+    scale = UNIT_SCALE[units]
+    gmsh.option.setNumber("Geometry.OCCScaling", scale)
+    try:
+        with _native_output_captured():
+            try:
+                occ.importShapes(str(path))
+            except Exception:   # noqa: BLE001 - gmsh raises a bare Exception; OCC's own message went to the sink
+                raise InputError(f"{where}: not a STEP, IGES or BREP file OpenCASCADE can read") from None
+            occ.synchronize()
+    finally:
+        gmsh.option.setNumber("Geometry.OCCScaling", 1.0)
     if not gmsh.model.getEntities():
         raise InputError(f"{where}: the file holds no geometry")
     x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(-1, -1)
-    extent = max(x1 - x0, y1 - y0, z1 - z0)
-    check_units(extent, units, f"{where}: units")
-    scale = UNIT_SCALE[units]
-    if scale != 1.0:
-        occ.dilate(gmsh.model.getEntities(), 0.0, 0.0, 0.0, scale, scale, scale)
-        occ.synchronize()
+    check_units(max(x1 - x0, y1 - y0, z1 - z0) / scale, units, f"{where}: units")
     solids = gmsh.model.getEntities(3)
     if heal == "always" or (heal == "auto" and not solids):
         # the solids if there are any (healing everything turns solids into loose faces in gmsh 4.8), else
@@ -396,12 +398,13 @@ def _face_record(tag: int, points: np.ndarray, areas: np.ndarray, centroids: np.
     import gmsh
 
     kind = gmsh.model.getType(2, tag)
+    triangles = points.reshape(-1, 3, 3)
     points = np.unique(np.round(points, 12), axis=0)
     area = float(areas.sum())
     normal_sum = (areas[:, None] * normals).sum(axis=0)
     mean_normal = normal_sum / max(np.linalg.norm(normal_sum), 1e-300)
     if kind == "Plane":
-        return Face(tag, "plane", points, area, normal=mean_normal)
+        return Face(tag, "plane", points, area, normal=mean_normal, triangles=triangles)
     if kind == "Cylinder":
         (u0, v0), (u1, v1) = gmsh.model.getParametrizationBounds(2, tag)
         vm = 0.5 * (v0 + v1)
@@ -414,8 +417,8 @@ def _face_record(tag: int, points: np.ndarray, areas: np.ndarray, centroids: np.
         radial = (centroids - centre) - np.outer((centroids - centre) @ axis, axis)
         concave = bool(np.sum(areas * np.einsum("ij,ij->i", normals, radial)) < 0)
         return Face(tag, "cylinder", points, area, normal=mean_normal, axis=axis, axis_point=centre,
-                    radius=radius, concave=concave)
-    return Face(tag, "other", points, area, normal=mean_normal, extra={"gmsh_type": kind})
+                    radius=radius, concave=concave, triangles=triangles)
+    return Face(tag, "other", points, area, normal=mean_normal, extra={"gmsh_type": kind}, triangles=triangles)
 
 
 def _circumcircle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, float]:
@@ -525,17 +528,16 @@ def estimate_cad_dofs(spec: CadGeometry, element: str, degree: int, size: float,
 
 def build_cad_mesh(spec: CadGeometry, element: str, size: float, layers: int, comm, grading: float = 1.0,
                    layer_size: float | None = None):
-    """Import the CAD file on rank 0, tag it, mesh it with tetrahedra of `size` (m) and distribute it as a
-    housingfe.geometry.mesh.HousingMesh (volume and centroid from OpenCASCADE)."""
+    """Import the CAD file on rank 0, tag it, mesh it with tetrahedra of `size` (m) and distribute it: the
+    parts of a housingfe.geometry.mesh.HousingMesh (registry.GeometryKind.mesh; volume and centroid from
+    OpenCASCADE, quality: the 1 % quantile and median of the shape ratio and the mesher)."""
     import gmsh
     from dolfinx.io import gmshio
 
     from housingfe.geometry.blocks import _tet_qualities, mesh_tetrahedra
-    from housingfe.geometry.mesh import HousingMesh, element_quality
 
     if element != "tet":
         raise InputError("mesh.element: an imported CAD housing is meshed with tetrahedra: set element = \"tet\"")
-    t0 = time.perf_counter()
     facts = cad_facts(spec)      # on every rank: the checks raise everywhere, and the facts are cached
     payload = None
     if comm.rank == 0:
@@ -567,11 +569,9 @@ def build_cad_mesh(spec: CadGeometry, element: str, size: float, layers: int, co
         if comm.rank == 0:
             gmsh.finalize()
     mesh.topology.create_connectivity(2, 3)
-    quality = {**element_quality(mesh), **payload["quantiles"], "mesher": payload["mesher"]}
-    return HousingMesh(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=payload["cells"],
-                       facet_groups=payload["facets"], volume=facts.volume, centroid=facts.centroid,
-                       element_size=size, element="tet", points=payload["points"],
-                       mesh_time_s=time.perf_counter() - t0, quality=quality)
+    return {"mesh": mesh, "cell_tags": cell_tags, "facet_tags": facet_tags, "cell_groups": payload["cells"],
+            "facet_groups": payload["facets"], "volume": facts.volume, "centroid": facts.centroid,
+            "points": payload["points"], "quality": {**payload["quantiles"], "mesher": payload["mesher"]}}
 
 
 def _volume_groups(volumes: list[int]) -> dict[str, int]:
@@ -615,7 +615,7 @@ def write_step(geometry, path: Path) -> Path:
     (boxes with the bores cut, fragmented), to a STEP (or BREP, by the suffix) file in metres: gmsh writes the
     model's raw numbers, so it reads back with units = "m".  For the round trips of tests and docs."""
     from housingfe.geometry.blocks import _fragmented_blocks
-    from housingfe.geometry.specs import block_model_for
+    from housingfe.geometry.registry import block_model_for
 
     model = block_model_for(geometry)
     with gmsh_session() as gmsh:

@@ -93,13 +93,16 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
     layers: elements through a wall thickness (hex meshes); layer_size (m): with it, at least
     ceil(thickness / layer_size) elements through each wall (hex meshes, `blocks.divisions`).
     """
+    t0 = time.perf_counter()
     kind = GEOMETRY_KINDS.get(geometry.kind)
     if kind is not None and kind.mesh is not None:     # a kind that meshes itself (imported CAD)
-        return kind.mesh(geometry, element, size, layers, comm, grading=grading, layer_size=layer_size)
+        parts = kind.mesh(geometry, element, size, layers, comm, grading=grading, layer_size=layer_size)
+        quality = {**element_quality(parts["mesh"]), **parts.pop("quality", {})}
+        return HousingMesh(**parts, element_size=size, element=element, quality=quality,
+                           mesh_time_s=time.perf_counter() - t0)
     import gmsh
     from dolfinx.io import gmshio
 
-    t0 = time.perf_counter()
     model = block_model_for(geometry)
     groups = None
     if comm.rank == 0:

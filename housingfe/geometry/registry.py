@@ -29,7 +29,9 @@ class GeometryKind:
     """A registered geometry kind: its scene spec class and its builder (spec -> BlockModel).
 
     A kind that is no block model (an imported CAD solid) gives `mesh` instead, with build_mesh's signature
-    (spec, element, size, layers, comm, grading=, layer_size=) -> HousingMesh, and `estimate_dofs` with
+    (spec, element, size, layers, comm, grading=, layer_size=) -> dict of the HousingMesh fields mesh,
+    cell_tags, facet_tags, cell_groups, facet_groups, volume, centroid, points and quality (extra entries;
+    build_mesh adds the element size, timing and the element quality), and `estimate_dofs` with
     estimate_dofs' signature (spec, element, degree, size, layers, layer_size) -> int."""
 
     spec: type

@@ -110,6 +110,14 @@ class Face:
     radius: Optional[float] = None
     concave: bool = True
     extra: dict = field(default_factory=dict)
+    triangles: Optional[np.ndarray] = None   # (n, 3, 3): a triangulation of the face, for exact distances
+
+    def distance(self, point) -> float:
+        """Distance (m) from a point to the face: to its triangles if it has any, else to its sample points."""
+        p = np.asarray(point, dtype=float)
+        if self.triangles is None or not len(self.triangles):
+            return float(np.linalg.norm(self.points - p, axis=1).min())
+        return float(point_triangle_distance(p, self.triangles).min())
 
     @property
     def lo(self) -> np.ndarray:
@@ -177,7 +185,7 @@ def select_surface(faces: list[Face], selector: SurfaceSelector, key: str) -> li
         what = f"inside the box {_fmt(selector.box.min)} .. {_fmt(selector.box.max)} m"
     else:
         p = np.asarray(selector.nearest, dtype=float)
-        best = min(faces, key=lambda f: float(np.linalg.norm(f.points - p, axis=1).min()))
+        best = min(faces, key=lambda f: f.distance(p))
         return [best.tag]
     if not hits:
         raise InputError(f"{key}: no face {what} (tolerance {tol:g} m; housingfe inspect lists the flat faces)")
@@ -228,6 +236,26 @@ def flat_candidates(faces: list[Face], tol: float) -> list[dict]:
         out.append({"normal": g["normal"], "point": point, "area": area, "min": pts.min(axis=0),
                     "max": pts.max(axis=0), "tags": sorted(f.tag for f in g["faces"])})
     return sorted(out, key=lambda p: -p["area"])
+
+
+def point_triangle_distance(p: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Distance (m) from point p to each triangle (n, 3, 3): to its plane where the foot lies inside it, else
+    to the nearest of its three edges."""
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    n = np.cross(b - a, c - a)
+    nn = np.einsum("ij,ij->i", n, n)
+    nn = np.where(nn > 0, nn, 1.0)
+    foot = p - (np.einsum("ij,ij->i", p - a, n) / nn)[:, None] * n
+    inside = np.ones(len(triangles), dtype=bool)
+    for u, v in ((a, b), (b, c), (c, a)):
+        inside &= np.einsum("ij,ij->i", np.cross(v - u, foot - u), n) >= 0
+    best = np.where(inside, np.linalg.norm(p - foot, axis=1), np.inf)
+    for u, v in ((a, b), (b, c), (c, a)):
+        e = v - u
+        ee = np.einsum("ij,ij->i", e, e)
+        t = np.clip(np.einsum("ij,ij->i", p - u, e) / np.where(ee > 0, ee, 1.0), 0.0, 1.0)
+        best = np.minimum(best, np.linalg.norm(p - (u + t[:, None] * e), axis=1))
+    return best
 
 
 def _canonical(axis: np.ndarray) -> np.ndarray:
