@@ -63,6 +63,9 @@ UNIT_SCALE = {"mm": 1e-3, "m": 1.0}
 ANALYSIS_SIZE_FRACTION = 1 / 40
 THIN_WALL_QUANTILE = 0.02
 MAX_THICKNESS_RAYS = 8000
+# wall-thickness rays ignore crossings at less than ~17 degrees to the surface (cos 73 deg): a ray along the
+# axis of a drilled hole, started beside it, grazes the facets of the hole's coarse triangulation
+GRAZING_COS = 0.3
 _RESERVED = {"outer", "inner", "bores"}
 
 
@@ -265,22 +268,62 @@ def _connected_pieces(volumes: list[int]) -> list[set[int]]:
 
 
 # ------------------------------------------------------------------------------------------- face analysis
-def _boundary_triangles(faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
-    """Triangles (n, 3, 3) of the current 2-D mesh on the given faces and the face tag of each."""
+def _boundary_triangles(faces: list[int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Triangles (n, 3, 3) of the current 2-D mesh on the given faces, their node tags (n, 3) and the face
+    tag of each."""
     import gmsh
 
     tags, coords, _ = gmsh.model.mesh.getNodes()
     xyz = np.zeros((int(tags.max()) + 1, 3))
     xyz[tags.astype(int)] = coords.reshape(-1, 3)
-    tris, owner = [], []
+    conns, owner = [], []
     for f in faces:
         types, _, nodes = gmsh.model.mesh.getElements(2, f)
         for etype, conn in zip(types, nodes):
             if etype == 2:   # 3-node triangle
-                t = xyz[conn.astype(int).reshape(-1, 3)]
-                tris.append(t)
-                owner.append(np.full(len(t), f))
-    return np.concatenate(tris), np.concatenate(owner)
+                c = conn.astype(int).reshape(-1, 3)
+                conns.append(c)
+                owner.append(np.full(len(c), f))
+    conn = np.concatenate(conns)
+    return xyz[conn], conn, np.concatenate(owner)
+
+
+def _relative_face_signs(conn: np.ndarray, owner: np.ndarray, faces: list[int]) -> tuple[dict, list[list[int]]]:
+    """Orient the faces consistently: two faces sharing a mesh edge must run along it in opposite directions
+    (gmsh orients the triangles within a face alike).  Breadth-first over the faces; returns each face's sign
+    (+1 keeps its triangles' orientation) relative to the first face of its connected shell, and the shells."""
+    edges = np.concatenate([conn[:, [0, 1]], conn[:, [1, 2]], conn[:, [2, 0]]])
+    faces_of = np.tile(owner, 3)
+    forward = edges[:, 0] < edges[:, 1]
+    key = np.sort(edges, axis=1)
+    _, group, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    group = group.ravel()
+    pairs = np.flatnonzero(counts[group] == 2)
+    order = pairs[np.argsort(group[pairs], kind="stable")]
+    a, b = order[0::2], order[1::2]
+    neighbours: dict[int, dict[int, int]] = {f: {} for f in faces}
+    for i, j in zip(a, b):
+        fa, fb = int(faces_of[i]), int(faces_of[j])
+        if fa != fb:    # a seam of a cylinder joins a face to itself
+            # same direction along the shared edge: one of the two faces is reversed
+            neighbours[fa][fb] = -1 if forward[i] == forward[j] else 1
+            neighbours[fb][fa] = neighbours[fa][fb]
+    sign: dict[int, int] = {}
+    shells = []
+    for start in faces:
+        if start in sign:
+            continue
+        sign[start] = 1
+        shell, queue = [start], [start]
+        while queue:
+            f = queue.pop()
+            for g, relation in neighbours[f].items():
+                if g not in sign:
+                    sign[g] = sign[f] * relation
+                    shell.append(g)
+                    queue.append(g)
+        shells.append(shell)
+    return sign, shells
 
 
 class RayCaster:
@@ -298,10 +341,16 @@ class RayCaster:
         self.locator.SetDataSet(self.surface)
         self.locator.BuildLocator()
         self.reach = 2.0 * float(np.linalg.norm(np.ptp(triangles.reshape(-1, 3), axis=0)))
+        normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
+        self.normals = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
 
-    def hits(self, origins: np.ndarray, directions: np.ndarray, eps: float) -> tuple[np.ndarray, np.ndarray]:
+    def hits(self, origins: np.ndarray, directions: np.ndarray, eps: float,
+             min_incidence: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
         """For every ray (origin, unit direction, m): the distance to the nearest crossing of the surface
-        farther than eps (inf if none) and the number of such crossings."""
+        farther than eps (inf if none) and the number of such crossings.  min_incidence: ignore crossings where
+        |cos| of the angle between ray and triangle normal is smaller (grazing hits on the facets of a coarsely
+        triangulated hole, next to which a ray parallel to the hole's axis starts)."""
+        from vtkmodules.util.numpy_support import vtk_to_numpy
         from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints
         from vtkmodules.vtkCommonDataModel import vtkGenericCell
 
@@ -314,7 +363,10 @@ class RayCaster:
             self.locator.IntersectWithLine(tuple(o), tuple(ends[k]), 1e-12, points, ids, cell)
             m = points.GetNumberOfPoints()
             if m:
-                d = np.linalg.norm(np.array([points.GetPoint(i) for i in range(m)]) - o, axis=1)
+                d = np.linalg.norm(vtk_to_numpy(points.GetData()) - o, axis=1)
+                if min_incidence > 0.0:
+                    cells = [ids.GetId(i) for i in range(ids.GetNumberOfIds())]
+                    d = d[np.abs(self.normals[cells] @ directions[k]) >= min_incidence]
                 # a ray through a mesh edge or vertex hits every triangle there at one distance: count once
                 d = np.sort(d[d > eps])
                 d = d[np.concatenate([[True], np.diff(d) > eps])] if len(d) else d
@@ -333,13 +385,14 @@ def analyse_faces(volumes: list[int], size: float) -> dict:
     from housingfe.geometry.blocks import _set_mesh_options
 
     _set_mesh_options("tet")
+    gmsh.option.setNumber("Mesh.Algorithm", 5)   # 2-D Delaunay: 25 % less time than Frontal-Delaunay here
     gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
     boundary = sorted({abs(t) for _, t in gmsh.model.getBoundary([(3, v) for v in volumes], combined=True,
                                                                      oriented=False)})
     gmsh.model.mesh.generate(2)
-    tris, owner = _boundary_triangles(boundary)
+    tris, conn, owner = _boundary_triangles(boundary)
     gmsh.model.mesh.clear()
     normal = np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0])
     area = 0.5 * np.linalg.norm(normal, axis=1)
@@ -348,41 +401,38 @@ def analyse_faces(volumes: list[int], size: float) -> dict:
     lo, hi = tris.reshape(-1, 3).min(axis=0), tris.reshape(-1, 3).max(axis=0)
     diag = float(np.linalg.norm(hi - lo))
     eps = 1e-7 * diag
-
-    # orientation: per face, a point just off its largest triangles along the normal is inside the solid when
-    # a ray from it crosses the boundary an odd number of times (three skew directions, majority vote)
-    # (five of its largest triangles, five skew directions)
-    probes, probe_face = [], []
-    for f in boundary:
-        idx = np.flatnonzero(owner == f)
-        for i in idx[np.argsort(-area[idx])[:5]]:
-            probes.append(centroid[i] + 1e-4 * diag * normal[i])
-            probe_face.append(f)
-    probes = np.asarray(probes)
     caster = RayCaster(tris)
-    directions = np.random.default_rng(20261125).normal(size=(5, 3))   # fixed: the same answer every run
-    votes = np.zeros(len(probes))
-    for d in directions / np.linalg.norm(directions, axis=1)[:, None]:
-        _, n_hits = caster.hits(probes, np.broadcast_to(d, probes.shape), eps)
-        votes += n_hits % 2
-    inside = {}
-    for f, v in zip(probe_face, votes):
-        inside.setdefault(f, []).append(v / len(directions))
-    flip = np.array([np.mean(inside[f]) > 0.5 for f in boundary])
-    sign = dict(zip(boundary, np.where(flip, -1.0, 1.0)))
-    normal *= np.array([sign[f] for f in owner])[:, None]
+
+    # orientation: consistent over each closed shell by the shared edges; then per shell, a point just off
+    # its largest triangles along the normal is inside the solid when a ray from it crosses the boundary an
+    # odd number of times (up to 9 probes, three fixed skew directions, majority vote)
+    relative, shells = _relative_face_signs(conn, owner, boundary)
+    normal *= np.array([relative[f] for f in owner])[:, None]
+    directions = np.random.default_rng(20261125).normal(size=(3, 3))   # fixed: the same answer every run
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    flip = {}
+    for n, shell in enumerate(shells):
+        idx = np.flatnonzero(np.isin(owner, shell))
+        top = idx[np.argsort(-area[idx], kind="stable")[:9]]
+        probes = centroid[top] + 1e-4 * diag * normal[top]
+        votes = sum(caster.hits(probes, np.broadcast_to(d, probes.shape), eps)[1] % 2 for d in directions)
+        flip[n] = np.mean(votes >= 2) > 0.5
+    shell_of = {f: n for n, shell in enumerate(shells) for f in shell}
+    normal *= np.array([-1.0 if flip[shell_of[f]] else 1.0 for f in owner])[:, None]
 
     # wall thickness: along the inward normal to where the ray leaves the material (at most MAX_THICKNESS_RAYS
     # triangles, every k-th: the estimate needs the area distribution, not every triangle)
     sample = np.arange(0, len(tris), max(1, len(tris) // MAX_THICKNESS_RAYS))
-    thickness, _ = caster.hits(centroid[sample], -normal[sample], 1e-5 * diag)
+    thickness, _ = caster.hits(centroid[sample], -normal[sample], 1e-5 * diag, min_incidence=GRAZING_COS)
     # outer skin: along the outward normal nothing is hit (up to 8 of a face's largest triangles, majority)
-    escapes, _ = caster.hits(centroid, normal, 1e-5 * diag)
+    by_face = {f: np.flatnonzero(owner == f) for f in boundary}
+    top = {f: idx[np.argsort(-area[idx], kind="stable")[:8]] for f, idx in by_face.items()}
+    rays = np.concatenate(list(top.values()))
+    escapes = dict(zip(rays, np.isinf(caster.hits(centroid[rays], normal[rays], 1e-5 * diag)[0])))
     faces, outer = [], set()
     for f in boundary:
-        idx = np.flatnonzero(owner == f)
-        top = idx[np.argsort(-area[idx])[:8]]
-        if np.mean(np.isinf(escapes[top])) > 0.5:
+        idx = by_face[f]
+        if np.mean([escapes[i] for i in top[f]]) > 0.5:
             outer.add(f)
         faces.append(_face_record(f, tris[idx].reshape(-1, 3), area[idx], centroid[idx], normal[idx]))
     finite = np.isfinite(thickness)

@@ -20,6 +20,7 @@ from housingfe.errors import InputError
 
 FLAT_SHOWN = 6          # the largest plane groups listed
 FLAT_IN_SKELETON = 3    # and written into the skeleton as surface selectors
+BORES_SHOWN = 12        # the largest candidate bores listed, labelled and written into the skeleton
 
 
 def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir: Path | None = None,
@@ -42,7 +43,8 @@ def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir:
         facts = read_cad(path, units, key=None)
     read_s = time.perf_counter() - t0
     tol = 1e-4 * max(1.0, float(np.linalg.norm(facts.hi - facts.lo)))
-    bores = bore_candidates(facts.faces, tol)
+    all_bores = bore_candidates(facts.faces, tol)     # largest radius first
+    bores = all_bores[:BORES_SHOWN]
     # feet and bolt faces are on the outer skin: the inside of a wall is no candidate
     flats = flat_candidates([f for f in facts.faces if f.tag in facts.outer], tol)[:FLAT_SHOWN]
     density = LIBRARY[material].density
@@ -50,6 +52,7 @@ def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir:
               "min": facts.lo, "max": facts.hi, "volume_m3": facts.volume, "material": material,
               "density": density, "mass_kg": density * facts.volume, "centroid": facts.centroid,
               "thin_wall_m": facts.thin_wall, "thinnest_ray_m": facts.thinnest_ray, "bores": bores,
+              "bore_count": len(all_bores),
               "flats": flats, "notes": facts.notes, "read_s": read_s}
     out = Path(out_dir) if out_dir is not None else path.parent
     out.mkdir(parents=True, exist_ok=True)
@@ -117,7 +120,8 @@ def summary_text(report: dict) -> str:
              f"{report['density']:g} kg/m^3), centre of mass {_v(report['centroid'])} m",
              f"thinnest wall {report['thin_wall_m'] * 1e3:.3g} mm (2 % area quantile of inward ray lengths; "
              f"shortest ray {report['thinnest_ray_m'] * 1e3:.3g} mm)",
-             f"candidate bores (concave cylindrical faces by axis): {len(report['bores'])}"]
+             f"candidate bores (concave cylindrical faces by axis): {report['bore_count']}"
+             + (f", the {len(report['bores'])} largest shown" if report["bore_count"] > len(report["bores"]) else "")]
     for n, b in enumerate(report["bores"], start=1):
         lines.append(f"  B{n}: centre {_v(b['centre'])} m, axis {_v(b['axis'])}, radius {b['radius'] * 1e3:.4g} mm, "
                      f"length {b['length'] * 1e3:.4g} mm, {len(b['tags'])} face(s)")

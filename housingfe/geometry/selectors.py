@@ -195,16 +195,17 @@ def select_surface(faces: list[Face], selector: SurfaceSelector, key: str) -> li
 def bore_candidates(faces: list[Face], tol: float) -> list[dict]:
     """Concave cylindrical faces grouped by axis line and radius: one entry per candidate bore with its axis,
     a centre (the middle of its extent along the axis), radius, length along the axis (m) and face tags."""
-    groups: list[dict] = []
+    # key: the canonical axis, the axis line's point nearest the origin and the radius, on a grid of tol
+    # (a dictionary, not a pairwise search: castings have hundreds of bolt holes)
+    groups: dict[tuple, dict] = {}
     for f in sorted((f for f in faces if f.kind == "cylinder" and f.concave), key=lambda f: f.tag):
-        for g in groups:
-            if (_parallel(g["axis"], f.axis) and distance_to_line(f.axis_point, g["axis_point"], g["axis"]) <= tol
-                    and abs(g["radius"] - f.radius) <= tol):
-                g["faces"].append(f)
-                break
-        else:
-            groups.append({"axis": _canonical(f.axis), "axis_point": f.axis_point, "radius": f.radius,
-                           "faces": [f]})
+        axis = _canonical(f.axis)
+        foot = f.axis_point - np.dot(f.axis_point, axis) * axis
+        key = (tuple(np.round(axis / np.sin(ANGLE_TOLERANCE)).astype(int)), tuple(np.round(foot / tol).astype(int)),
+               int(round(f.radius / tol)))
+        g = groups.setdefault(key, {"axis": axis, "axis_point": f.axis_point, "radius": f.radius, "faces": []})
+        g["faces"].append(f)
+    groups = list(groups.values())
     out = []
     for g in groups:
         s = np.concatenate([(f.points - g["axis_point"]) @ g["axis"] for f in g["faces"]])
@@ -218,15 +219,12 @@ def bore_candidates(faces: list[Face], tol: float) -> list[dict]:
 def flat_candidates(faces: list[Face], tol: float) -> list[dict]:
     """Plane faces grouped by plane (outward normal and offset): each with its normal, a point (the area
     centre), total area (m^2), bounding box and face tags; largest first."""
-    groups: list[dict] = []
+    groups: dict[tuple, dict] = {}
     for f in sorted((f for f in faces if f.kind == "plane"), key=lambda f: f.tag):
         offset = float(np.mean(f.points @ f.normal))
-        for g in groups:
-            if np.dot(g["normal"], f.normal) >= np.cos(ANGLE_TOLERANCE) and abs(g["offset"] - offset) <= tol:
-                g["faces"].append(f)
-                break
-        else:
-            groups.append({"normal": f.normal, "offset": offset, "faces": [f]})
+        key = (tuple(np.round(f.normal / np.sin(ANGLE_TOLERANCE)).astype(int)), int(round(offset / tol)))
+        groups.setdefault(key, {"normal": f.normal, "offset": offset, "faces": []})["faces"].append(f)
+    groups = list(groups.values())
     out = []
     for g in groups:
         area = sum(f.area for f in g["faces"])
