@@ -269,3 +269,31 @@ def test_the_test_gearbox_from_step_has_the_built_in_modes_on_the_same_mesh_sett
     assert dofs_cad == pytest.approx(dofs_builtin, rel=0.05)
     assert len(f_cad) == len(f_builtin) >= 3
     assert f_cad == pytest.approx(f_builtin, rel=5e-3)
+
+
+@pytest.mark.mpi
+@pytest.mark.slow
+def test_a_cad_housing_gives_the_same_modes_on_one_and_two_ranks(files, tmp_path):
+    import json
+    import os
+    import shutil
+
+    if not shutil.which("mpirun"):
+        pytest.skip("mpirun not installed")
+    shutil.copy(files["block_mm"], tmp_path / "block.step")
+    scene = _scene(tmp_path / "block-mpi.toml", {"kind": "cad", "file": "block.step", "units": "mm",
+                                                "bores": BORES, "surfaces": [FEET]},
+                   supports=[{"surface": "base", "kind": "fixed"}], f_max=8000.0)
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMPI_ALLOW_RUN_AS_ROOT": "1",
+           "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1"}
+    runs = []
+    for ranks in (1, 2):
+        out = tmp_path / f"r{ranks}"
+        cmd = [sys.executable, "-m", "housingfe", "run", str(scene), "--out", str(out)]
+        proc = subprocess.run((["mpirun", "-n", "2"] if ranks == 2 else []) + cmd, capture_output=True, text=True,
+                              timeout=900, env=env)
+        assert proc.returncode == 0, proc.stderr
+        runs.append(json.loads((out / "modes.json").read_text()))
+    assert runs[1]["dofs"] == runs[0]["dofs"] and runs[1]["mpi_ranks"] == 2
+    assert len(runs[0]["frequencies_hz"]) >= 1
+    assert runs[1]["frequencies_hz"] == pytest.approx(runs[0]["frequencies_hz"], rel=1e-9)
