@@ -237,7 +237,8 @@ def check_units(extent: float, units: str, key: str) -> None:
     fits = [u for u, s in UNIT_SCALE.items() if lo <= extent * s <= hi and u != units]
     hint = f"; this looks like {'millimetres' if fits == ['mm'] else 'metres'}: set units = \"{fits[0]}\"" \
         if fits else ""
-    raise InputError(f"{key}: the part is {extent:g} {units} across ({metres:g} m), implausible for a housing "
+    # 3 digits: OpenCASCADE's bounding box carries the shape tolerance (0.2002 mm for a 0.2 mm part)
+    raise InputError(f"{key}: the part is {extent:.3g} {units} across ({metres:.3g} m), implausible for a housing "
                      f"({lo * 1e3:g} mm to {hi:g} m){hint}")
 
 
