@@ -74,6 +74,12 @@ def files(tmp_path_factory) -> dict[str, Path]:
         occ.remove([(3, box)])
         occ.remove([faces[0]])
     out["open"] = _write(d / "open.step", open_shell)
+
+    def closed_shell(occ, s):   # the six faces of a box, no solid
+        box = occ.addBox(0, 0, 0, 0.3, 0.2, 0.1)
+        occ.synchronize()
+        occ.remove([(3, box)])
+    out["shell"] = _write(d / "shell.step", closed_shell)
     out["junk"] = d / "junk.step"
     out["junk"].write_text("ISO-10303-21;\nthis is no STEP file\n")
     return out
@@ -191,6 +197,15 @@ def test_bad_cad_input_is_one_line_naming_the_file_and_key(files, tmp_path, caps
     code = cli.main(["run", str(scene), "--out", str(out)])
     assert code == 2 and "mesh.element: an imported CAD housing is meshed with tetrahedra" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_healing_makes_a_solid_of_a_closed_shell(files):
+    facts = cad_facts(CadGeometry(kind="cad", file=str(files["shell"]), units="m"))       # heal = "auto"
+    assert facts.solids == 1 and facts.volume == pytest.approx(0.3 * 0.2 * 0.1, rel=1e-9)
+    from housingfe.errors import InputError
+
+    with pytest.raises(InputError, match="shell.step: no closed solid"):
+        cad_facts(CadGeometry(kind="cad", file=str(files["shell"]), units="m", heal="never"))
 
 
 def test_touching_solids_are_joined_into_one(files):
