@@ -233,6 +233,11 @@ def test_a_supported_cad_block_runs_from_the_command_line(files, tmp_path):
     assert modes["mass_kg"] == pytest.approx(7850.0 * BLOCK_VOLUME, rel=1e-9)
     assert modes["complete"] and modes["rigid_body_frequencies_hz"] == []
     assert modes["mesh_quality"]["mesher"].startswith("gmsh") and modes["mesh_quality"]["q01"] > 0.1
+    # the memory guard's estimate before meshing (P1, 30 mm) is within a factor 2 of the mesh made
+    from housingfe.geometry.cad import estimate_cad_dofs
+
+    estimate = estimate_cad_dofs(load_housing_scene(str(scene))[0].geometry, "tet", 1, 0.03, 1)
+    assert 0.5 < estimate / modes["dofs"] < 2.0
 
 
 def test_inspect_lists_the_bores_and_writes_a_skeleton_that_validates(files, tmp_path):
