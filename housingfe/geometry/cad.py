@@ -454,11 +454,13 @@ def _face_record(tag: int, points: np.ndarray, areas: np.ndarray, centroids: np.
     kind = gmsh.model.getType(2, tag)
     triangles = points.reshape(-1, 3, 3)
     points = np.unique(np.round(points, 12), axis=0)
-    area = float(areas.sum())
+    # area and centre of mass exact from OpenCASCADE (the triangles only approximate curved edges)
+    area = float(gmsh.model.occ.getMass(2, tag))
+    centre = np.asarray(gmsh.model.occ.getCenterOfMass(2, tag))
     normal_sum = (areas[:, None] * normals).sum(axis=0)
     mean_normal = normal_sum / max(np.linalg.norm(normal_sum), 1e-300)
     if kind == "Plane":
-        return Face(tag, "plane", points, area, normal=mean_normal, triangles=triangles)
+        return Face(tag, "plane", points, area, normal=mean_normal, triangles=triangles, centre=centre)
     if kind == "Cylinder":
         (u0, v0), (u1, v1) = gmsh.model.getParametrizationBounds(2, tag)
         vm = 0.5 * (v0 + v1)
@@ -471,8 +473,9 @@ def _face_record(tag: int, points: np.ndarray, areas: np.ndarray, centroids: np.
         radial = (centroids - centre) - np.outer((centroids - centre) @ axis, axis)
         concave = bool(np.sum(areas * np.einsum("ij,ij->i", normals, radial)) < 0)
         return Face(tag, "cylinder", points, area, normal=mean_normal, axis=axis, axis_point=centre,
-                    radius=radius, concave=concave, triangles=triangles)
-    return Face(tag, "other", points, area, normal=mean_normal, extra={"gmsh_type": kind}, triangles=triangles)
+                    radius=radius, concave=concave, triangles=triangles, centre=centre)
+    return Face(tag, "other", points, area, normal=mean_normal, extra={"gmsh_type": kind}, triangles=triangles,
+                centre=centre)
 
 
 def _circumcircle(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> tuple[np.ndarray, float]:

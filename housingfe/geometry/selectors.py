@@ -111,6 +111,7 @@ class Face:
     concave: bool = True
     extra: dict = field(default_factory=dict)
     triangles: Optional[np.ndarray] = None   # (n, 3, 3): a triangulation of the face, for exact distances
+    centre: Optional[np.ndarray] = None      # the centre of mass of the face (m), where the importer knows it
 
     def distance(self, point) -> float:
         """Distance (m) from a point to the face: to its triangles if it has any, else to its sample points."""
@@ -229,7 +230,8 @@ def flat_candidates(faces: list[Face], tol: float) -> list[dict]:
     for g in groups:
         area = sum(f.area for f in g["faces"])
         pts = np.vstack([f.points for f in g["faces"]])
-        point = sum(f.area * f.points.mean(axis=0) for f in g["faces"]) / area if area else pts.mean(axis=0)
+        point = (sum(f.area * (f.centre if f.centre is not None else f.points.mean(axis=0)) for f in g["faces"])
+                 / area if area else pts.mean(axis=0))
         point = point - (point @ g["normal"] - g["offset"]) * g["normal"]
         out.append({"normal": g["normal"], "point": point, "area": area, "min": pts.min(axis=0),
                     "max": pts.max(axis=0), "tags": sorted(f.tag for f in g["faces"])})

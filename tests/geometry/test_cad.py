@@ -249,6 +249,10 @@ def test_inspect_lists_the_bores_and_writes_a_skeleton_that_validates(files, tmp
     assert f"mass {7850 * BLOCK_VOLUME:.5g} kg" in text
     assert "radius 25 mm, length 60 mm" in text and "radius 20 mm, length 40 mm" in text
     assert "radius 20 mm, length 100 mm" in text
+    # flat faces with OpenCASCADE's exact areas: top and base 200 x 100 mm, the y = 0 face minus two 20 mm
+    # holes, the y = 100 mm face minus a 25 and a 20 mm hole
+    for area in (200.0, 1e4 * (0.02 - math.pi * 2 * 0.02**2), 1e4 * (0.02 - math.pi * (0.025**2 + 0.02**2))):
+        assert f"area {area:.4g} cm^2" in text
     assert (tmp_path / "block_mm-inspect.png").stat().st_size > 10_000
     skeleton = tmp_path / "block_mm-scene.toml"
     data = tomllib.loads(skeleton.read_text())
