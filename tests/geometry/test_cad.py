@@ -192,6 +192,13 @@ def test_bad_cad_input_is_one_line_naming_the_file_and_key(files, tmp_path, caps
     for n, (geometry, extra, pieces) in enumerate(cases):
         scene = _scene(tmp_path / f"case{n}.toml", {"kind": "cad", **geometry}, **extra)
         _fails(capsys, scene, out, *pieces)
+    for args, piece in (([str(files["junk"])], "junk.step: not a STEP, IGES or BREP file"),
+                        ([str(files["block"]), "--units", "mm"], "block.step: units: the part is 0.2 mm across"),
+                        ([str(files["open"]), "--units", "m"], "open.step: no closed solid")):
+        code = cli.main(["inspect", *args, "--out", str(out)])
+        err = capsys.readouterr().err
+        assert code == 2 and err.count("\n") == 1 and piece in err, err
+        assert not out.exists()
     scene = _scene(tmp_path / "hex.toml", {"kind": "cad", "file": str(files["block"]), "units": "m"},
                    mesh={"element": "hex", "degree": 1, "size": 0.03})
     code = cli.main(["run", str(scene), "--out", str(out)])
