@@ -17,6 +17,7 @@ _EXTENSIONS = (
     "housingfe.bearings.cli",
     "housingfe.correlation.cli",
     "housingfe.drivetrain.misalignment",
+    "housingfe.geometry.inspect",
     "housingfe.radiation",
     "housingfe.reference",
     "housingfe.source.cli",

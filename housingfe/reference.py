@@ -325,9 +325,10 @@ def geometry_sections(img_dir: str = "img") -> list[str]:
             lines += [f"**Origin and axes.** {note}", ""]
         lines += model_sections(spec, "geometry", heading=f'[geometry] kind = "{kind}"', with_doc=False)
         if registered.mesh is not None:     # brings its own mesh: its surfaces are the file's sets
-            lines += ["**Surfaces.** `outer` is the mesh's whole boundary skin; the others are the file's node sets or "
-                      "physical groups named in `[[geometry.surfaces]]` and `[[geometry.bores]]` (docs/imported-meshes.md); "
-                      "the origin and axes are the file's.", ""]
+            lines += ["**Surfaces.** `outer` is the housing's outer skin; the other surfaces and the bores are named in "
+                      "`[[geometry.surfaces]]` and `[[geometry.bores]]`: a mesh file's node sets or physical groups "
+                      "(docs/imported-meshes.md), a CAD file's faces by geometric selectors (docs/cad.md; "
+                      "`housingfe inspect FILE` lists the candidates).  The origin and axes are the file's.", ""]
             continue
         example = examples.get(kind)
         if example is None:

@@ -363,7 +363,17 @@ def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) ->
     if kind == "runup":
         raise InputError(f"{path}: scene.kind: this is a run-up scene, not a housing scene; run it with "
                          "`housingfe run`")
+    _resolve_geometry_file(data, path)
     return parse_table(HousingScene, data, path), path
+
+
+def _resolve_geometry_file(data: dict, path: Path) -> None:
+    """An imported geometry's `file` (CAD, mesh) is relative to the scene file: make it absolute."""
+    geometry = data.get("geometry")
+    if isinstance(geometry, dict) and isinstance(geometry.get("file"), str):
+        file = Path(geometry["file"]).expanduser()
+        if not file.is_absolute():
+            geometry["file"] = str(Path(path).parent / file)
 
 
 def build_model_from_scene(scene: HousingScene, comm):

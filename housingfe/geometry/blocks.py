@@ -231,21 +231,29 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int,
         cell_groups[name] = n
     facet_groups = _facet_groups(atomic)
 
-    _set_mesh_options(element)
-    if element == "hex":
-        _make_transfinite(model, size, layers, grading, layer_size)
-    else:
-        gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
-        gmsh.option.setNumber("Mesh.MeshSizeMax", size)
-        gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
-    gmsh.model.mesh.generate(3)
-    mesher = "transfinite hexahedra (reproducible)"
     if element == "tet":
-        mesher = "gmsh Delaunay (reproducible)"
-        if _refine_slivers(size) < DELAUNAY_MIN_QUALITY:
-            _hxt_fallback(size)
-            mesher = "gmsh HXT (Delaunay left slivers; HXT is not reproducible run to run)"
-    return {"cells": cell_groups, "facets": facet_groups, "mesher": mesher}
+        return {"cells": cell_groups, "facets": facet_groups, "mesher": mesh_tetrahedra(size)}
+    _set_mesh_options(element)
+    _make_transfinite(model, size, layers, grading, layer_size)
+    gmsh.model.mesh.generate(3)
+    return {"cells": cell_groups, "facets": facet_groups, "mesher": "transfinite hexahedra (reproducible)"}
+
+
+def mesh_tetrahedra(size: float) -> str:
+    """Mesh the current gmsh model with linear tetrahedra of `size` (m) the project's way: every option set,
+    Delaunay on one thread (reproducible), slivers refined away, HXT only where that fails.  Returns the
+    mesher's description for the reports.  Any OCC solid can be meshed so (block models, imported CAD)."""
+    import gmsh
+
+    _set_mesh_options("tet")
+    gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+    gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+    gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
+    gmsh.model.mesh.generate(3)
+    if _refine_slivers(size) < DELAUNAY_MIN_QUALITY:
+        _hxt_fallback(size)
+        return "gmsh HXT (Delaunay left slivers; HXT is not reproducible run to run)"
+    return "gmsh Delaunay (reproducible)"
 
 
 

@@ -511,7 +511,11 @@ def _estimate_on_root(geometry: MeshGeometry, degree: int) -> int:
     return estimate_imported_dofs(geometry, degree)
 
 
-register_geometry(MeshGeometry, None, mesh=build_imported_mesh, estimate_dofs=_estimate_on_root)
+# a mesh file brings its own element, size and layers: the registry's signatures (GeometryKind) ignore them here
+register_geometry(MeshGeometry, None,
+                  mesh=lambda spec, element, size, layers, comm, **_: build_imported_mesh(spec, comm),
+                  estimate_dofs=lambda spec, element, degree, size, layers, layer_size=None: _estimate_on_root(spec,
+                                                                                                           degree))
 
 
 def write_mesh_file(housing, path, units: str = "m", order: int | None = None, node_sets=()) -> Path:

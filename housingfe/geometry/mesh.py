@@ -9,10 +9,9 @@ import numpy as np
 
 from housingfe.errors import InputError
 from housingfe.geometry.blocks import build_gmsh_model, tet_quality
-from housingfe.geometry.registry import own_mesh_kind
 
 # the registry's lookup, with the built-in kinds registered (specs imports their modules)
-from housingfe.geometry.specs import block_model_for
+from housingfe.geometry.specs import GEOMETRY_KINDS, block_model_for
 
 
 @dataclass
@@ -74,9 +73,9 @@ def estimate_dofs(geometry, element: str, degree: int, size: float, layers: int,
     estimate within 10 %)."""
     from housingfe.geometry.blocks import divisions
 
-    imported = own_mesh_kind(geometry)
-    if imported is not None:        # the mesh is given: count it
-        return imported.estimate_dofs(geometry, degree)
+    kind = GEOMETRY_KINDS.get(geometry.kind)
+    if kind is not None and kind.estimate_dofs is not None:     # imported CAD or a mesh file
+        return kind.estimate_dofs(geometry, element, degree, size, layers, layer_size)
     model = block_model_for(geometry)
     steps = [np.diff(g) for g in model.grid]
     cells = 0
@@ -94,15 +93,18 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
     layers: elements through a wall thickness (hex meshes); layer_size (m): with it, at least
     ceil(thickness / layer_size) elements through each wall (hex meshes, `blocks.divisions`).
     """
-    imported = own_mesh_kind(geometry)
-    if imported is not None:        # a mesh file: element, size and layers are the file's
-        fields = imported.mesh(geometry, comm)
-        quality = {**element_quality(fields["mesh"]), **fields.pop("quality")}
-        return HousingMesh(**fields, quality=quality)
+    t0 = time.perf_counter()
+    kind = GEOMETRY_KINDS.get(geometry.kind)
+    if kind is not None and kind.mesh is not None:     # a kind that meshes itself (imported CAD, a mesh file)
+        parts = kind.mesh(geometry, element, size, layers, comm, grading=grading, layer_size=layer_size)
+        quality = {**element_quality(parts["mesh"]), **parts.pop("quality", {})}
+        parts.setdefault("element_size", size)          # a mesh file gives its own element, size and timing
+        parts.setdefault("element", element)
+        parts.setdefault("mesh_time_s", time.perf_counter() - t0)
+        return HousingMesh(**parts, quality=quality)
     import gmsh
     from dolfinx.io import gmshio
 
-    t0 = time.perf_counter()
     model = block_model_for(geometry)
     groups = None
     if comm.rank == 0:

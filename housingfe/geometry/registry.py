@@ -28,8 +28,12 @@ class StrictSpec(BaseModel):
 class GeometryKind:
     """A registered geometry kind: its scene spec class and its builder (spec -> BlockModel).
 
-    Kinds that bring their own mesh (an imported mesh file) have no block model: `mesh(spec, comm)` returns the
-    fields of the distributed housingfe.geometry.mesh.HousingMesh (a dict; build_mesh adds the quality) and `estimate_dofs(spec, degree)` its displacement DOFs."""
+    A kind that is no block model (an imported CAD solid, a mesh file) gives `mesh` instead, with build_mesh's
+    signature (spec, element, size, layers, comm, grading=, layer_size=) -> dict of the HousingMesh fields mesh,
+    cell_tags, facet_tags, cell_groups, facet_groups, volume, centroid, points and quality (extra entries;
+    build_mesh adds the element size, element and timing unless given, and the element quality), and
+    `estimate_dofs` with estimate_dofs' signature (spec, element, degree, size, layers, layer_size) -> int; its
+    `build` may be None."""
 
     spec: type
     build: Callable | None
@@ -43,13 +47,13 @@ GEOMETRY_KINDS: dict[str, GeometryKind] = {}
 def register_geometry(spec: type, build: Callable | None, *, mesh: Callable | None = None,
                       estimate_dofs: Callable | None = None) -> type:
     """Register a geometry kind: `spec` is a pydantic model with `kind: Literal["<name>"]`, `build(spec)` returns
-    its housingfe.geometry.blocks.BlockModel; a kind with its own mesh gives build=None, `mesh(spec, comm)` ->
-    the HousingMesh fields (dict) and `estimate_dofs(spec, degree)` -> DOFs instead.  Returns spec."""
+    its housingfe.geometry.blocks.BlockModel; a kind that meshes itself (no block model) gives `mesh` and
+    `estimate_dofs` (see GeometryKind) and may give build=None.  Returns spec."""
     (name,) = typing.get_args(spec.model_fields["kind"].annotation)
     if name in GEOMETRY_KINDS:
         raise ValueError(f"geometry kind {name!r} is registered twice")
-    if (build is None) == (mesh is None):
-        raise ValueError(f"geometry kind {name!r}: give either a block-model builder or a mesher")
+    if build is None and mesh is None:
+        raise ValueError(f"geometry kind {name!r}: give a block-model builder or a mesher")
     GEOMETRY_KINDS[name] = GeometryKind(spec, build, mesh, estimate_dofs)
     return spec
 

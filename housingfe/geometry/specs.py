@@ -7,7 +7,7 @@ scene's geometry section, is the discriminated union (on `kind`) of the register
 """
 from __future__ import annotations
 
-# registration order = the order of the kinds in the scene's messages: box, plate, box-halves, gearbox, mesh
+# registration order = the order of the kinds in the scene's messages: box, plate, box-halves, gearbox, mesh, cad
 # isort: off
 from housingfe.geometry.box import BoxGeometry
 from housingfe.geometry.plate import EdgeCondition, PlateEdges, PlateGeometry
@@ -22,10 +22,11 @@ from housingfe.geometry.housings import (
     RimSpec,
 )
 from housingfe.geometry.imported_mesh import MeshGeometry, MeshSet
+from housingfe.geometry.cad import CadGeometry
 # isort: on
 from housingfe.geometry.registry import GEOMETRY_KINDS, block_model_for, geometry_union, register_geometry
 
-__all__ = ["GEOMETRY_KINDS", "BearingPlateSpec", "BoreSpec", "BoxGeometry", "BoxHalvesGeometry", "CoverSpec",
+__all__ = ["GEOMETRY_KINDS", "BearingPlateSpec", "BoreSpec", "BoxGeometry", "BoxHalvesGeometry", "CadGeometry", "CoverSpec",
            "EdgeCondition", "FeetSpec", "GearboxGeometry", "Geometry", "MeshGeometry", "MeshSet", "PlateEdges", "PlateGeometry", "RibSpec",
            "RimSpec", "block_model_for", "geometry_union", "register_geometry"]
 

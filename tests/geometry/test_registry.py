@@ -14,8 +14,8 @@ from housingfe.scenefile import parse_table
 
 
 def test_built_in_kinds_in_order_and_the_scene_knows_exactly_them():
-    assert list(GEOMETRY_KINDS) == ["box", "plate", "box-halves", "gearbox", "mesh"]
-    with pytest.raises(InputError, match="expected tags: 'box', 'plate', 'box-halves', 'gearbox', 'mesh'$"):
+    assert list(GEOMETRY_KINDS) == ["box", "plate", "box-halves", "gearbox", "mesh", "cad"]
+    with pytest.raises(InputError, match="expected tags: 'box', 'plate', 'box-halves', 'gearbox', 'mesh', 'cad'$"):
         parse_table(HousingScene, {"scene": {"name": "x", "kind": "housing"}, "geometry": {"kind": "sphere"},
                                    "analysis": {"modal": {"f_max": 100.0}}}, "toy.toml")
 
