@@ -35,10 +35,10 @@ class BoreSelector(StrictSpec):
     Every matched face gets the surface groups `bore_<name>` and `bores`."""
 
     name: str = Field(pattern=_NAME)
-    axis: Vector = Field(min_length=3, max_length=3)
-    centre: Vector = Field(min_length=3, max_length=3)
-    radius: Optional[PositiveFloat] = None
-    tolerance: PositiveFloat = 1e-4
+    axis: Vector = Field(min_length=3, max_length=3, json_schema_extra={"unit": "-"})
+    centre: Vector = Field(min_length=3, max_length=3, json_schema_extra={"unit": "m"})
+    radius: Optional[PositiveFloat] = Field(None, json_schema_extra={"unit": "m"})
+    tolerance: PositiveFloat = Field(1e-4, json_schema_extra={"unit": "m"})
 
     @model_validator(mode="after")
     def _axis(self):
@@ -50,8 +50,8 @@ class BoreSelector(StrictSpec):
 class PlaneSelector(StrictSpec):
     """A plane by a point on it (m) and the outward normal of the faces wanted (a foot's underside: 0, 0, -1)."""
 
-    point: Vector = Field(min_length=3, max_length=3)
-    normal: Vector = Field(min_length=3, max_length=3)
+    point: Vector = Field(min_length=3, max_length=3, json_schema_extra={"unit": "m"})
+    normal: Vector = Field(min_length=3, max_length=3, json_schema_extra={"unit": "-"})
 
     @model_validator(mode="after")
     def _normal(self):
@@ -63,8 +63,8 @@ class PlaneSelector(StrictSpec):
 class BoxSelector(StrictSpec):
     """An axis-aligned box (m): the faces that lie wholly inside it."""
 
-    min: Vector = Field(min_length=3, max_length=3)
-    max: Vector = Field(min_length=3, max_length=3)
+    min: Vector = Field(min_length=3, max_length=3, json_schema_extra={"unit": "m"})
+    max: Vector = Field(min_length=3, max_length=3, json_schema_extra={"unit": "m"})
 
     @model_validator(mode="after")
     def _ordered(self):
@@ -81,7 +81,7 @@ class SurfaceSelector(StrictSpec):
     name: str = Field(pattern=_NAME)
     plane: Optional[PlaneSelector] = None
     box: Optional[BoxSelector] = None
-    nearest: Optional[Vector] = Field(None, min_length=3, max_length=3)
+    nearest: Optional[Vector] = Field(None, min_length=3, max_length=3, json_schema_extra={"unit": "m"})
     tolerance: PositiveFloat = 1e-4
 
     @model_validator(mode="after")
