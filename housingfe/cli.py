@@ -21,6 +21,7 @@ _EXTENSIONS = (
     "housingfe.source.cli",
     "housingfe.source.studies",
     "housingfe.studies.bearing_variants",
+    "housingfe.studies.design_variants",
     "housingfe.studies.runup_causes",
 )
 
