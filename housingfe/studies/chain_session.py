@@ -45,6 +45,16 @@ class ModelEntry:
 
 
 @dataclass
+class ModelPool:
+    """Housing models and coupled gearbox models shared by sessions (e.g. the same family with another engagement
+    shock, or two families on one layout): keyed by what they depend on (the housing and its mesh for the highest
+    line and radiators; the basis' span, damping and observed surface; the layout)."""
+
+    housings: dict = field(default_factory=dict)
+    models: dict = field(default_factory=dict)
+
+
+@dataclass
 class ChainSession:
     """A run-up scene (housingfe.runup.scene.RunupScene) with its housing FE model and radiators, the coupled
     models built so far per layout, the sources and their lines (see the module docstring)."""
@@ -55,17 +65,19 @@ class ChainSession:
     housing_model: object = None
     radiators: dict = field(default_factory=dict)
     fresh_basis: bool = False
+    pool: ModelPool = field(default_factory=ModelPool)
     log: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
-    _models: dict = field(default_factory=dict)
     _sources: dict = field(default_factory=dict)
     _lines: dict = field(default_factory=dict)
     _drivetrains: dict = field(default_factory=dict)
     _layouts: dict = field(default_factory=dict)
 
     @classmethod
-    def from_scene(cls, name_or_path: str, overrides=(), comm=None, fresh_basis: bool = False) -> "ChainSession":
-        """Read and validate a run-up scene (InputError naming the file and key); nothing is built yet."""
+    def from_scene(cls, name_or_path: str, overrides=(), comm=None, fresh_basis: bool = False,
+                   pool: ModelPool | None = None) -> "ChainSession":
+        """Read and validate a run-up scene (InputError naming the file and key); nothing is built yet.  pool: the
+        housing and coupled models of other sessions, reused where they fit this scene."""
         from housingfe.runup.scene import load_runup_scene
 
         if comm is None:
@@ -73,7 +85,7 @@ class ChainSession:
 
             comm = MPI.COMM_WORLD
         scene, path = load_runup_scene(name_or_path, list(overrides))
-        return cls(scene, path, comm, fresh_basis=fresh_basis)
+        return cls(scene, path, comm, fresh_basis=fresh_basis, pool=pool if pool is not None else ModelPool())
 
     @property
     def spec(self):
@@ -102,17 +114,25 @@ class ChainSession:
             self._drivetrains[key] = dt
         return self._drivetrains[key]
 
-    def housing(self):
-        """The housing FE model (built on first use) and the radiators on it."""
-        if self.housing_model is None:
-            from housingfe.runup.scene import housing_model_for, radiators_of
-            from housingfe.scene import load_housing_scene
+    def _housing_key(self) -> str:
+        sc = self.scene
+        return json.dumps([sc.housing.model_dump(mode="json"), sc.radiation.model_dump(mode="json"),
+                           self.spec.f_max_hz], sort_keys=True)
 
-            t0 = time.perf_counter()
-            hs, _ = load_housing_scene(self.scene.housing.scene, list(self.scene.housing.set))
-            self.housing_model = housing_model_for(hs, self.spec.f_max_hz, self.comm)
-            self.radiators = radiators_of(self.scene.radiation, self.housing_model)
-            self.timings["mesh_s"] = time.perf_counter() - t0
+    def housing(self):
+        """The housing FE model (built on first use, or the pool's) and the radiators on it."""
+        if self.housing_model is None:
+            key = self._housing_key()
+            if key not in self.pool.housings:
+                from housingfe.runup.scene import housing_model_for, radiators_of
+                from housingfe.scene import load_housing_scene
+
+                t0 = time.perf_counter()
+                hs, _ = load_housing_scene(self.scene.housing.scene, list(self.scene.housing.set))
+                model = housing_model_for(hs, self.spec.f_max_hz, self.comm)
+                self.pool.housings[key] = (model, radiators_of(self.scene.radiation, model))
+                self.timings["mesh_s"] = time.perf_counter() - t0
+            self.housing_model, self.radiators = self.pool.housings[key]
         return self.housing_model
 
     def model(self, drivetrain, label: str = ""):
@@ -121,15 +141,16 @@ class ChainSession:
         from housingfe.runup.chain import build_gearbox_model, with_drivetrain
 
         housing = self.housing()
-        key = self._layouts.get(id(drivetrain)) or layout_key(drivetrain)
+        spec = self.spec
+        key = json.dumps([self._housing_key(), spec.basis_factor, spec.damping_ratio, spec.surface,
+                          self._layouts.get(id(drivetrain)) or layout_key(drivetrain)])
         t0 = time.perf_counter()
-        base = None if self.fresh_basis else self._models.get(key)
+        base = None if self.fresh_basis else self.pool.models.get(key)
         if base is None:
-            spec = self.spec
             model = build_gearbox_model(housing, drivetrain, spec.f_max_hz, damping_ratio=spec.damping_ratio,
                                         basis_factor=spec.basis_factor, radiators=self.radiators,
                                         surface=spec.surface)
-            self._models.setdefault(key, model)
+            self.pool.models.setdefault(key, model)
             how = "built"
         else:
             model = base if base.drivetrain is drivetrain else with_drivetrain(base, drivetrain)

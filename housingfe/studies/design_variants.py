@@ -21,7 +21,8 @@ itself (gear set, bearings, torques) are refused.
 
 Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route) and
 study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
-(default results/study-<family>-<engagement>).
+(default results/study-<family>-<engagement>); several families in one command share the housing model and the
+bases that fit (profile-corrections and bearings are one layout) and go to <out>/<family>/.
 """
 from __future__ import annotations
 
@@ -477,47 +478,75 @@ def summary_text(result: StudyResult, wall_s: float | None = None) -> str:
     return "\n".join(out)
 
 
-def run_study(family: str, out_dir: str | None = None, overrides=(), fresh_basis: bool = False) -> Path:
-    """`housingfe study <family>`: run the family's variants through the chain and write its comparison (module
-    docstring) atomically; returns the result folder.  Bad input (unknown family, a bad or family-controlled
-    --set, speeds that miss 800-1500 rev/min) stops with InputError before any folder is made."""
+def run_studies(jobs, out_dir: str | None = None, fresh_basis: bool = False) -> Path:
+    """Run families through the chain and write their comparisons (module docstring) atomically; returns the result
+    folder.  jobs: [(family, overrides, subfolder)]: the family's run-up scene with --set overrides, written into
+    out_dir/subfolder (None: into out_dir itself; default out_dir results/study-<family>-<engagement> for one job).
+    The jobs share the housing model and every modal basis that fits (one ModelPool): families on the same layout,
+    or one family with another engagement shock, re-analyse the first one's basis.  Bad input (unknown family, a
+    bad or family-controlled --set, speeds that miss 800-1500 rev/min, a bearing that cannot carry its load) stops
+    with InputError before any folder is made."""
     from housingfe import outputs
+    from housingfe.studies.chain_session import ModelPool
 
     t_start = time.perf_counter()
-    fam = family_of(family)
-    check_overrides(fam, overrides)
-    session = ChainSession.from_scene(fam.scene, overrides, fresh_basis=fresh_basis)
-    speeds = session.spec.speeds
-    if not np.any((speeds >= MEAN_RANGE_RPM[0]) & (speeds <= MEAN_RANGE_RPM[1])):
-        raise InputError(f"{session.scene_path}: runup.speed_min_rpm/speed_max_rpm: no speed inside "
-                         f"{MEAN_RANGE_RPM[0]:g}-{MEAN_RANGE_RPM[1]:g} rev/min, where the thesis states its mean "
-                         "differences")
-    comm = session.comm
-    out = Path(out_dir or f"results/study-{fam.name}-{session.spec.engagement}")
-    outputs.reserve_output(out, comm, inputs=[session.scene_path])     # before the model is built
-    for v in fam.variants:                     # a bearing that cannot carry its load stops here, before any FE
-        session.drivetrain(v.gear_set, v.bearings, v.torque)
-    result = run_family(fam, session, progress=(lambda s: print(s, flush=True)) if comm.rank == 0 else
-                        (lambda s: None))
+    pool = ModelPool()
+    planned = []
+    for family, overrides, sub in jobs:
+        fam = family_of(family)
+        check_overrides(fam, overrides)
+        session = ChainSession.from_scene(fam.scene, overrides, fresh_basis=fresh_basis, pool=pool)
+        speeds = session.spec.speeds
+        if not np.any((speeds >= MEAN_RANGE_RPM[0]) & (speeds <= MEAN_RANGE_RPM[1])):
+            raise InputError(f"{session.scene_path}: runup.speed_min_rpm/speed_max_rpm: no speed inside "
+                             f"{MEAN_RANGE_RPM[0]:g}-{MEAN_RANGE_RPM[1]:g} rev/min, where the thesis states its "
+                             "mean differences")
+        planned.append((fam, session, sub))
+    if len({sub for *_, sub in planned}) < len(planned):
+        raise InputError("study: two jobs write into the same folder (a family named twice?)")
+    fam0, session0, _ = planned[0]
+    comm = session0.comm
+    out = Path(out_dir or f"results/study-{fam0.name}-{session0.spec.engagement}")
+    outputs.reserve_output(out, comm, inputs=[s.scene_path for _, s, _ in planned])     # before any model is built
+    for fam, session, _ in planned:          # a bearing that cannot carry its load stops here, before any FE
+        for v in fam.variants:
+            session.drivetrain(v.gear_set, v.bearings, v.torque)
+    say = (lambda text: print(text, flush=True)) if comm.rank == 0 else (lambda text: None)
+    results = []
+    for fam, session, sub in planned:
+        t0 = time.perf_counter()
+        results.append((run_family(fam, session, progress=say), sub, time.perf_counter() - t0))
     wall = time.perf_counter() - t_start
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
-            write(tmp, result, wall)
+            for result, sub, seconds in results:
+                folder = tmp / sub if sub else tmp
+                folder.mkdir(exist_ok=True)
+                write(folder, result, seconds if len(results) > 1 else wall)
     if comm.rank == 0:
-        print(summary_text(result, wall))
-        print(f"results: {out}/")
+        for result, _, seconds in results:
+            print(summary_text(result, seconds if len(results) > 1 else wall))
+        print(f"total wall time {wall:.1f} s; results: {out}/")
     return out
+
+
+def run_study(family: str, out_dir: str | None = None, overrides=(), fresh_basis: bool = False) -> Path:
+    """`housingfe study <family>`: one family (run_studies with one job)."""
+    return run_studies([(family, list(overrides), None)], out_dir, fresh_basis)
 
 
 # --------------------------------------------------------------------------------------------------- CLI
 def register_cli(subparsers) -> None:
-    """Add `housingfe study <family> [--out DIR] [--set KEY=VALUE] [--fresh-basis]`."""
+    """Add `housingfe study <family> [<family> ...] [--out DIR] [--set KEY=VALUE] [--fresh-basis]`."""
     p = subparsers.add_parser("study", help="design variants through the chain beside the thesis' measurements "
                                             "(profile-corrections, bearings, double-helical)")
-    p.add_argument("family", help="profile-corrections | bearings | double-helical")
-    p.add_argument("--out", default=None, help="result folder (default results/study-<family>-<engagement>)")
+    p.add_argument("families", nargs="+", metavar="family",
+                   help="profile-corrections | bearings | double-helical (several: they share the housing model and "
+                        "the bases that fit, each written to <out>/<family>/)")
+    p.add_argument("--out", default=None, help="result folder (default results/study-<family>-<engagement>, for "
+                                               "several families results/study-<engagement>)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
-                   help="override a value of the family's run-up scene, e.g. runup.engagement=thesis-2d "
+                   help="override a value of the families' run-up scenes, e.g. runup.engagement=thesis-2d "
                         "(repeatable; not the gear set, bearings or torques, which the family sets)")
     p.add_argument("--fresh-basis", action="store_true",
                    help="compute a modal basis for every variant instead of re-analysing the layout's (slower; "
@@ -526,5 +555,13 @@ def register_cli(subparsers) -> None:
 
 
 def _cmd(args: argparse.Namespace) -> int:
-    run_study(args.family, args.out, args.set or [], args.fresh_basis)
+    overrides = args.set or []
+    if len(args.families) == 1:
+        run_study(args.families[0], args.out, overrides, args.fresh_basis)
+        return 0
+    out = args.out
+    if out is None:
+        engagement = ChainSession.from_scene(family_of(args.families[0]).scene, overrides).spec.engagement
+        out = f"results/study-{engagement}"
+    run_studies([(f, overrides, f) for f in args.families], out, args.fresh_basis)
     return 0
