@@ -362,7 +362,7 @@ def markdown(result: StudyResult, wall_s: float | None = None) -> str:
               f"{result.basis_builds} modal basis computed for {len(result.runs)} variants; per variant (s): "
               + ", ".join(f"{k} {p['basis']} {p['model_s']:.1f} + run-up {p['runup_s']:.1f}" for k, p in per.items())
               + f"; housing mesh {result.timings.get('mesh_s', 0.0):.1f} s"
-              + (f"; wall time {wall_s:.0f} s end to end." if wall_s is not None else "."), "",
+              + (f"; wall time {wall_s:.0f} s (this family; a command of one family: end to end)." if wall_s is not None else "."), "",
               "## Notes", ""] + [f"* {n}" for n in result.family.notes] + [""]
     return "\n".join(lines)
 
