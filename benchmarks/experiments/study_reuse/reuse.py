@@ -36,8 +36,11 @@ for v in order:
         out.append(({r: res.series(r, session.radiation, v.torque, "LwA_dB")[1] for r in session.spec.routes},
                     seconds, model))
     f_reused, f_fresh = out[0][2].reduction.frequencies_hz, out[1][2].reduction.frequencies_hz
-    keep = (f_fresh > 1.0) & (f_fresh < reuse.spec.f_max_hz)
-    rel = np.abs(f_reused[keep] - f_fresh[keep]) / f_fresh[keep]
+    # the elastic frequencies below f_max of both reduced systems, in order (their sizes may differ: a static vector
+    # that the basis already spans is dropped)
+    a, b = (f[(f > 1.0) & (f < reuse.spec.f_max_hz)] for f in (f_reused, f_fresh))
+    n = min(len(a), len(b))
+    rel = np.abs(a[:n] - b[:n]) / b[:n] if len(a) == len(b) else np.array([np.inf])
     print(v.key, f"model re-analysed {out[0][1]:.1f} s, fresh {out[1][1]:.1f} s;",
           " ".join(f"{r}: max|dL_WA| {np.abs(out[0][0][r] - out[1][0][r]).max():.3f} dB" for r in out[0][0]),
           f"; frequencies below f_max: max relative {rel.max():.1e}", flush=True)
