@@ -24,6 +24,7 @@ _EXTENSIONS = (
     "housingfe.source.studies",
     "housingfe.studies.bearing_variants",
     "housingfe.studies.reduce",
+    "housingfe.studies.design_variants",
     "housingfe.studies.runup_causes",
 )
 

@@ -31,6 +31,7 @@ import numpy as np
 
 from housingfe import outputs
 from housingfe.levels import third_octave_bands
+from housingfe.studies.chain_session import ChainSession, energy_mean_db, lwa_curve, maximum
 
 COLUMNS = ("variant", "route", "radiation", "LwA_max_dBA", "at_rpm", "peaks_rpm", "speed_law_dBA_per_doubling",
            "LwA_mean_800_1500_dBA", "change_vs_reference_dB")
@@ -65,12 +66,12 @@ def _rows(variant: str, res, torque: float, reference: dict | None) -> list[dict
     out = []
     for route in res.routes:
         for rad in res.radiators:
-            s, lwa = res.series(route, rad, torque, "LwA_dB")
-            i = int(np.argmax(lwa))
-            mean = float(10 * np.log10(np.mean(10 ** (lwa[s >= 800.0] / 10))))
+            s, lwa = lwa_curve(res, route, rad, torque)
+            top, at = maximum(s, lwa)
+            mean = energy_mean_db(s, lwa)
             ref = reference.get((route, rad)) if reference else None
-            out.append({"variant": variant, "route": route, "radiation": rad, "LwA_max_dBA": round(float(lwa[i]), 1),
-                        "at_rpm": float(s[i]), "peaks_rpm": " ".join(f"{x:g}" for x in peaks(s, lwa)),
+            out.append({"variant": variant, "route": route, "radiation": rad, "LwA_max_dBA": round(top, 1),
+                        "at_rpm": at, "peaks_rpm": " ".join(f"{x:g}" for x in peaks(s, lwa)),
                         "speed_law_dBA_per_doubling": round(speed_law_slope(s, lwa), 2),
                         "LwA_mean_800_1500_dBA": round(mean, 1),
                         "change_vs_reference_dB": "" if ref is None else round(mean - ref, 1)})
@@ -95,36 +96,27 @@ def _tooth_only(res):
 
 def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None, overrides=()) -> Path:
     """Run the variants (module docstring) of a run-up scene at its highest torque; returns the result folder."""
-    from mpi4py import MPI
-
     from housingfe.progress import Progress
     from housingfe.response.reduced import RitzReduction
-    from housingfe.runup.chain import build_gearbox_model, runup, source_lines, unit_loads, with_drivetrain
-    from housingfe.runup.scene import drivetrain_of, housing_model_for, load_runup_scene, radiators_of
-    from housingfe.scene import load_housing_scene
+    from housingfe.runup.chain import unit_loads
 
     t0 = time.perf_counter()
-    scene, scene_path = load_runup_scene(scene_name, list(overrides))
-    spec = scene.runup
+    session = ChainSession.from_scene(scene_name, overrides)
+    scene, spec, comm = session.scene, session.spec, session.comm
     torque = max(spec.torques_nm)
-    comm = MPI.COMM_WORLD
     out = Path(out_dir or f"results/runup-causes-{scene.scene.name}")
-    outputs.reserve_output(out, comm, inputs=[scene_path])     # before the model is built
+    outputs.reserve_output(out, comm, inputs=[session.scene_path])     # before the model is built
     # steps: the coupled model, then the run-up of every variant (reference, 2 damping ratios, 2 truncations, and
     # with ball bearings the re-analyses without moment stiffness and with self-aligning bearings)
     progress = Progress(f"runup-causes {scene.scene.name}", 6 + 2 * (scene.drivetrain.bearings == "ball"), "steps",
                         comm=comm)
-    housing_scene, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
-    model = housing_model_for(housing_scene, spec.f_max_hz, comm)
-    dt = drivetrain_of(scene.drivetrain, torque)
-    gm = build_gearbox_model(model, dt, spec.f_max_hz, damping_ratio=spec.damping_ratio,
-                             basis_factor=spec.basis_factor, radiators=radiators_of(scene.radiation, model),
-                             surface=spec.surface)
-    lines, _ = source_lines(dt.source_model(harmonics=spec.harmonics, engagement=spec.engagement), spec.speeds, [torque], spec.f_max_hz)
+    dt = session.drivetrain(scene.drivetrain.gear_set, scene.drivetrain.bearings, torque)
+    gm = session.model(dt, "reference")
+    lines = session.lines(dt, torque)
     progress.update(note="coupled model and modal basis")
 
     def run(m, note: str):
-        out = runup(m, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
+        out = session.runup(m, torque, lines)
         progress.update(note=note)
         return out
 
@@ -151,10 +143,11 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
     rows += _rows("tooth frequency line only (harmonic 1)", _tooth_only(base), torque, ref)
     if scene.drivetrain.bearings == "ball":
         rows += _rows("ball bearings without moment stiffness (moment rows and columns zeroed, re-analysed)",
-                      run(with_drivetrain(gm, without_moment_stiffness(dt)), "no moment stiffness"), torque, ref)
+                      run(session.model(without_moment_stiffness(dt), "no moments"), "no moment stiffness"), torque,
+                      ref)
         other = dataclasses.replace(dt, bearing_configuration="self_aligning")
         rows += _rows("self-aligning bearings (spherical roller model: no moment stiffness AND ~5x the radial "
-                      "stiffness, re-analysed)", run(with_drivetrain(gm, other), "self-aligning"), torque, ref)
+                      "stiffness, re-analysed)", run(session.model(other, "self-aligning"), "self-aligning"), torque, ref)
     progress.close()
     n = gm.basis.rigid_count
     freqs = gm.basis.frequencies_hz[n:]

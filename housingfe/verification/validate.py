@@ -128,7 +128,7 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
                 except ComputationFailed as exc:
                     failures.append(str(exc))
                 progress.update(note=name)
-        rows += provider_rows(failures, progress)
+        rows += provider_rows(failures, progress, results=results, quick=quick)
     progress.close()
     write_outputs(rows, Path(out_dir), json_path)
     print(format_rows(rows))
@@ -172,6 +172,9 @@ try:
     if job["kind"] == "run":
         from housingfe.run import run_scene
         run_scene(job["scene"], out_dir=job["out"], overrides=job["overrides"])
+    elif job["kind"] == "study":
+        from housingfe.studies.design_variants import run_studies
+        run_studies([tuple(j) for j in job["jobs"]], job["out"])
     else:
         from housingfe.studies.bearing_variants import run_study
         run_study(job["scene"], job["configs"], job["out"], job["overrides"])
@@ -440,15 +443,22 @@ def geometry_rows(names: list[str]) -> list[dict]:
     return out
 
 
-def provider_rows(failures: list[str] | None = None, progress=None) -> list[dict]:
-    """published_rows() of every module in ROW_PROVIDERS.  A provider that fails is reported on one line
-    (appended to `failures`, or raised as SolverError when no list is given); the others still count.
-    progress: a housingfe.progress.Progress counting one step per provider."""
+def provider_rows(failures: list[str] | None = None, progress=None, *, results: Path | None = None,
+                  quick: bool = False) -> list[dict]:
+    """published_rows() of every module in ROW_PROVIDERS; a provider whose published_rows takes `results` (the FE
+    result cache) and `quick` (validate --quick: compute nothing heavy) gets them.  A provider that fails is
+    reported on one line (appended to `failures`, or raised as SolverError when no list is given); the others
+    still count.  progress: a housingfe.progress.Progress counting one step per provider."""
+    import inspect
+
     out = []
     for module_name in ROW_PROVIDERS:
         try:
             t0 = time.perf_counter()
-            rows = importlib.import_module(module_name).published_rows()
+            provide = importlib.import_module(module_name).published_rows
+            accepted = inspect.signature(provide).parameters
+            options = {k: v for k, v in (("results", results), ("quick", quick)) if k in accepted}
+            rows = provide(**options)
             print(f"validate: {module_name}: {len(rows)} rows in {time.perf_counter() - t0:.1f} s", flush=True)
             out += rows
         except Exception as exc:  # noqa: BLE001 - reported on one line, the exit code says it failed

@@ -1,0 +1,244 @@
+"""Variants of a run-up scene through the noise chain, each reusing what it shares with the others.
+
+The machinery of the run-up studies (`housingfe study`, `housingfe runup-causes`):
+
+    session = ChainSession.from_scene("test-gearbox-runup", overrides)   # the scene, its housing model (once)
+    model = session.model(session.drivetrain("B", "self_aligning", 2000.0))
+    result = session.runup(model, torque=2000.0)                          # RunupResult at the scene's speeds
+
+* the housing FE model is meshed once per session (the scene's [housing] at runup.f_max_hz);
+* the coupled gearbox's modal basis and Ritz reduction are computed once per **layout** — the FE interior without
+  its bearing matrices and mean mesh stiffness (shafts, gear discs, bores, bearing seats, the gear-mesh point and
+  normal) — by `housingfe.runup.chain.build_gearbox_model`; another drivetrain of the same layout (gear set of the
+  same geometry, bearing configuration, torque) is a Rayleigh-Ritz re-analysis on the same Ritz vectors
+  (`with_drivetrain`: seconds; its Ritz space holds the static responses to unit pairs across every bearing and to
+  the mesh load, docs/runup.md).  `fresh_basis=True` computes a basis per variant instead (to measure what the
+  reuse costs in accuracy);
+* the source's lines (housingfe.runup.chain.source_lines) are computed once per source (the lumped model depends on
+  the gear set, shafts and Appendix C's bearing diagonal, not on the FE bearings) and torque.
+
+`session.log` records per model whether its basis was built or re-used, and the times.
+"""
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from housingfe.errors import InputError
+
+# the speed range over which the thesis states its mean differences (Secs. 5.7-5.9)
+MEAN_RANGE_RPM = (800.0, 1500.0)
+
+
+@dataclass
+class ModelEntry:
+    """One coupled model of a session: its layout key, the drivetrain it holds, whether its basis was built here
+    ("built") or re-used from the layout's first model ("re-analysed"), and the wall time (s) that took."""
+
+    label: str
+    layout: str
+    how: str
+    seconds: float
+
+
+@dataclass
+class ModelPool:
+    """Housing models and coupled gearbox models shared by sessions (e.g. the same family with another engagement
+    shock, or two families on one layout): keyed by what they depend on (the housing and its mesh for the highest
+    line and radiators; the basis' span, damping and observed surface; the layout)."""
+
+    housings: dict = field(default_factory=dict)
+    models: dict = field(default_factory=dict)
+
+
+@dataclass
+class ChainSession:
+    """A run-up scene (housingfe.runup.scene.RunupScene) with its housing FE model and radiators, the coupled
+    models built so far per layout, the sources and their lines (see the module docstring)."""
+
+    scene: object
+    scene_path: object
+    comm: object
+    housing_model: object = None
+    radiators: dict = field(default_factory=dict)
+    fresh_basis: bool = False
+    pool: ModelPool = field(default_factory=ModelPool)
+    log: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+    _sources: dict = field(default_factory=dict)
+    _lines: dict = field(default_factory=dict)
+    _drivetrains: dict = field(default_factory=dict)
+    _layouts: dict = field(default_factory=dict)
+
+    @classmethod
+    def from_scene(cls, name_or_path: str, overrides=(), comm=None, fresh_basis: bool = False,
+                   pool: ModelPool | None = None) -> "ChainSession":
+        """Read and validate a run-up scene (InputError naming the file and key); nothing is built yet.  pool: the
+        housing and coupled models of other sessions, reused where they fit this scene."""
+        from housingfe.runup.scene import load_runup_scene
+
+        if comm is None:
+            from mpi4py import MPI
+
+            comm = MPI.COMM_WORLD
+        scene, path = load_runup_scene(name_or_path, list(overrides))
+        return cls(scene, path, comm, fresh_basis=fresh_basis, pool=pool if pool is not None else ModelPool())
+
+    @property
+    def spec(self):
+        """The scene's [runup] (speeds, f_max_hz, routes, damping, engagement, ...)."""
+        return self.scene.runup
+
+    @property
+    def radiation(self) -> str:
+        """The radiation model the checks and studies compare (the scene's first)."""
+        return self.scene.radiation.models[0]
+
+    def drivetrain(self, gear_set: str, bearings: str, torque: float):
+        """The scene's drivetrain description with another gear set / bearing configuration, at a pinion torque
+        (N m), made once per session.  A bearing that cannot carry its load is an InputError naming the scene file
+        (raised here, before any FE)."""
+        from housingfe.runup.scene import drivetrain_of
+
+        key = (gear_set, bearings, float(torque))
+        if key not in self._drivetrains:
+            spec = self.scene.drivetrain.model_copy(update={"gear_set": gear_set, "bearings": bearings})
+            try:
+                dt = drivetrain_of(spec, float(torque))
+                self._layouts[id(dt)] = layout_key(dt)      # builds the coupling spec: bearings at their loads
+            except InputError as exc:
+                raise InputError(f"{self.scene_path}: {exc}") from None
+            self._drivetrains[key] = dt
+        return self._drivetrains[key]
+
+    def _housing_key(self) -> str:
+        sc = self.scene
+        return json.dumps([sc.housing.model_dump(mode="json"), sc.radiation.model_dump(mode="json"),
+                           self.spec.f_max_hz], sort_keys=True)
+
+    def housing(self):
+        """The housing FE model (built on first use, or the pool's) and the radiators on it."""
+        if self.housing_model is None:
+            key = self._housing_key()
+            if key not in self.pool.housings:
+                from housingfe.runup.scene import housing_model_for, radiators_of
+                from housingfe.scene import load_housing_scene
+
+                t0 = time.perf_counter()
+                hs, _ = load_housing_scene(self.scene.housing.scene, list(self.scene.housing.set))
+                model = housing_model_for(hs, self.spec.f_max_hz, self.comm)
+                self.pool.housings[key] = (model, radiators_of(self.scene.radiation, model))
+                self.timings["mesh_s"] = time.perf_counter() - t0
+            self.housing_model, self.radiators = self.pool.housings[key]
+        return self.housing_model
+
+    def model(self, drivetrain, label: str = ""):
+        """The coupled GearboxModel of `drivetrain`: a new basis for the first drivetrain of its layout (or for
+        every drivetrain with fresh_basis), else a Rayleigh-Ritz re-analysis of that layout's model."""
+        from housingfe.runup.chain import build_gearbox_model, with_drivetrain
+
+        housing = self.housing()
+        spec = self.spec
+        key = json.dumps([self._housing_key(), spec.basis_factor, spec.damping_ratio, spec.surface,
+                          self._layouts.get(id(drivetrain)) or layout_key(drivetrain)])
+        t0 = time.perf_counter()
+        base = None if self.fresh_basis else self.pool.models.get(key)
+        if base is None:
+            model = build_gearbox_model(housing, drivetrain, spec.f_max_hz, damping_ratio=spec.damping_ratio,
+                                        basis_factor=spec.basis_factor, radiators=self.radiators,
+                                        surface=spec.surface)
+            self.pool.models.setdefault(key, model)
+            how = "built"
+        else:
+            model = base if base.drivetrain is drivetrain else with_drivetrain(base, drivetrain)
+            how = "re-analysed"
+        self.log.append(ModelEntry(label, key, how, time.perf_counter() - t0))
+        return model
+
+    def source(self, drivetrain):
+        """The lumped source (housingfe.source.operating.SourceModel) of a drivetrain with the scene's options,
+        one per gear set and lumped reduction (the FE bearings play no part in it)."""
+        key = source_key(drivetrain)
+        if key not in self._sources:
+            self._sources[key] = drivetrain.source_model(harmonics=self.spec.harmonics,
+                                                         engagement=self.spec.engagement)
+        return self._sources[key]
+
+    def lines(self, drivetrain, torque: float):
+        """The source's lines (housingfe.runup.chain.Lines) at the scene's speeds and one torque (N m)."""
+        from housingfe.runup.chain import source_lines
+
+        key = (source_key(drivetrain), float(torque))
+        if key not in self._lines:
+            lines, seconds = source_lines(self.source(drivetrain), self.spec.speeds, [float(torque)],
+                                          self.spec.f_max_hz)
+            self._lines[key] = lines
+            self.timings["source_s"] = self.timings.get("source_s", 0.0) + seconds
+        return self._lines[key]
+
+    def runup(self, model, torque: float, lines=None):
+        """The run-up (RunupResult) of a coupled model at one torque (N m) over the scene's speeds and routes;
+        lines: the source's (default: the model's drivetrain's, cached)."""
+        from housingfe.runup.chain import runup
+
+        lines = self.lines(model.drivetrain, torque) if lines is None else lines
+        return runup(model, None, self.spec.speeds, [float(torque)], routes=tuple(self.spec.routes), lines=lines)
+
+    @property
+    def basis_builds(self) -> int:
+        """How many modal bases this session computed."""
+        return sum(e.how == "built" for e in self.log)
+
+
+def layout_key(drivetrain) -> str:
+    """What a Ritz basis is tied to: the FE interior of `drivetrain` without its bearing matrices and mean mesh
+    stiffness (shafts, gear discs, bores, bearing seats and nodes, the mesh's nodes, point and normal), as text."""
+    spec = drivetrain.to_coupling_spec().model_dump(mode="json")
+    bearing_keys = ("name", "shaft_node", "bore", "axis")
+    spec["bearings"] = [{k: b.get(k) for k in bearing_keys} for b in spec["bearings"]]
+    for mesh in spec["gear_meshes"]:
+        mesh.pop("stiffness", None)
+        mesh["point"] = [round(x, 9) for x in mesh["point"]]
+        mesh["direction"] = [round(x, 9) for x in mesh["direction"]]
+    return json.dumps(spec, sort_keys=True)
+
+
+def source_key(drivetrain) -> str:
+    """What the lumped source depends on: the drivetrain without its FE bearings and torque, as text."""
+    return repr((drivetrain.gears, drivetrain.shafts, drivetrain.quill_shafts, drivetrain.couplings,
+                 drivetrain.loss_factor, drivetrain.lumped_bearing_stiffness, drivetrain.lumped_bearing_spans))
+
+
+# ------------------------------------------------------------------------------------------------ statistics
+def lwa_curve(result, route: str, radiation: str, torque: float) -> tuple[np.ndarray, np.ndarray]:
+    """(speeds rev/min, L_WA dB(A)) of a run-up's total over speed."""
+    return result.series(route, radiation, float(torque), "LwA_dB")
+
+
+def energy_mean_db(speeds, levels_db, speed_range=MEAN_RANGE_RPM) -> float:
+    """Energy (power) mean of levels (dB) over a speed range (rev/min, inclusive)."""
+    s, v = np.asarray(speeds, float), np.asarray(levels_db, float)
+    keep = (s >= speed_range[0]) & (s <= speed_range[1])
+    return float(10.0 * np.log10(np.mean(10.0 ** (v[keep] / 10.0))))
+
+
+def difference_stats(speeds, levels_db, reference_db, speed_range=MEAN_RANGE_RPM) -> tuple[float, float, int]:
+    """(mean, standard deviation, count) of levels - reference (dB) at the speeds inside speed_range (rev/min,
+    inclusive): the thesis' measure of a variant against its reference over 800-1500 rev/min (Secs. 5.7-5.9),
+    speed by speed (population s.d.)."""
+    s = np.asarray(speeds, float)
+    d = np.asarray(levels_db, float) - np.asarray(reference_db, float)
+    keep = (s >= speed_range[0]) & (s <= speed_range[1])
+    if not keep.any():
+        raise InputError(f"runup speeds: none inside {speed_range[0]:g}-{speed_range[1]:g} rev/min, where the "
+                         "thesis states its mean differences")
+    return float(d[keep].mean()), float(d[keep].std()), int(keep.sum())
+
+
+def maximum(speeds, levels_db) -> tuple[float, float]:
+    """(largest level, the speed where it is)."""
+    i = int(np.argmax(levels_db))
+    return float(levels_db[i]), float(np.asarray(speeds)[i])

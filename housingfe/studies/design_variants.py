@@ -1,0 +1,567 @@
+"""`housingfe study <family>`: design variants of the Ch. 5 test gearbox as run-ups through the chain (issue 28).
+
+A family is a set of drivetrain variants measured by van Roosmalen (1994), each a run-up of a built-in run-up scene
+with the gear set, bearing configuration and torque of the variant; every variant of the same layout re-uses the
+family's modal basis (housingfe.studies.chain_session: one basis per layout, the others Rayleigh-Ritz
+re-analyses).
+
+* `profile-corrections` (Sec. 5.7): gear sets A (reference), B, C, D and uncorrected, ball bearings, 2000 N m;
+* `bearings` (Sec. 5.8): gear set B with ball (reference), angular contact, self-aligning and tapered roller
+  bearings, 2000 N m;
+* `double-helical` (Sec. 5.9): the double helical set with cylindrical roller (reference at 2000 N m) and
+  fluid-film bearings at 500, 1000, 1500 and 2000 N m; its torque law is the only measured one.
+
+Per variant and route (housingfe.runup.chain.ROUTES) on the scene's first radiation model (sigma = 1 for the
+built-in scenes): the mean and standard deviation over 800-1500 rev/min of L_WA(variant) - L_WA(reference), speed
+by speed (the thesis' measure), and the largest L_WA over the run-up with its speed; beside them the measured
+values and the thesis' calculated ones (housingfe/data/roosmalen1994.toml), and the ranking of the variants
+(quietest first) ours against measured.  The run-up scene's options pass through `--set` as for `housingfe run`
+(e.g. `--set runup.engagement=thesis-2d`, the thesis' two-dimensional engagement shock); the keys a family sets
+itself (gear set, bearings, torques) are refused.
+
+Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route) and
+study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
+(default results/study-<family>-<engagement>); several families in one command share the housing model and the
+bases that fit (profile-corrections and bearings are one layout) and go to <out>/<family>/.
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from housingfe.errors import InputError
+from housingfe.studies.chain_session import (
+    MEAN_RANGE_RPM,
+    ChainSession,
+    difference_stats,
+    energy_mean_db,
+    lwa_curve,
+    maximum,
+)
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One design variant: key (its name in the tables), gear set, bearing configuration, pinion torque (N m),
+    and the published numbers beside it: measured mean and s.d. of the difference to the family's reference
+    (dB, 800-1500 rev/min), measured maximum L_WA (dB(A)), the thesis' calculated mean, s.d. and maximum."""
+
+    key: str
+    gear_set: str
+    bearings: str
+    torque: float
+    measured_mean: float | None = None
+    measured_sd: float | None = None
+    measured_max: float | None = None
+    calc_mean: float | None = None
+    calc_sd: float | None = None
+    calc_max: float | None = None
+
+
+@dataclass(frozen=True)
+class Family:
+    """A family of variants on a run-up scene; `reference` is the key of the variant the differences are taken to;
+    `source` names where in the thesis the published numbers are; `notes` what the comparison rests on."""
+
+    name: str
+    scene: str
+    title: str
+    variants: tuple
+    reference: str
+    source: str
+    notes: tuple = ()
+    controlled: tuple = ("drivetrain.gear_set", "drivetrain.bearings", "runup.torques_nm")
+
+    def variant(self, key: str) -> Variant:
+        return next(v for v in self.variants if v.key == key)
+
+
+def families() -> dict[str, Family]:
+    """The families (registry: name -> Family), their published numbers read from housingfe/data/roosmalen1994.toml."""
+    from housingfe.data import thesis
+    from housingfe.verification.published import thesis_source
+
+    tg = thesis()["test_gearbox"]
+    pc, br, dh = tg["profile_corrections"], tg["bearings"], tg["double_helical"]
+    corrections = [Variant("A", "A", "ball", 2000.0, measured_max=pc["meas_Lw_max_dBA"]["A"],
+                           calc_max=tg["calc_Lw_max_dBA"])]
+    corrections += [Variant(s, s, "ball", 2000.0, pc["meas_mean_dB"][s], pc["meas_sd_dB"][s], pc["meas_Lw_max_dBA"][s],
+                            pc["calc_mean_dB"][s], pc["calc_sd_dB"][s]) for s in ("B", "C", "D")]
+    corrections.append(Variant("uncorrected", "uncorrected", "ball", 2000.0, calc_mean=pc["calc_uncorrected_vs_A_dB"]))
+    bearings = [Variant("ball", "B", "ball", 2000.0, measured_max=br["meas_Lw_max_dBA"]["ball"])]
+    bearings += [Variant(b, "B", b, 2000.0, br["meas_mean_dB"][b], br["meas_sd_dB"][b], br["meas_Lw_max_dBA"][b])
+                 for b in ("angular_contact", "self_aligning", "tapered_roller")]
+    helical = []
+    for b, key in (("cylindrical_roller", "roller"), ("fluid_film", "fluid_film")):
+        for torque in DOUBLE_HELICAL_TORQUES_NM:
+            top = torque == max(DOUBLE_HELICAL_TORQUES_NM)
+            measured_mean = dh["fluid_film_vs_roller_mean_dB"] if top and b == "fluid_film" else None
+            measured_sd = dh["fluid_film_vs_roller_sd_dB"] if top and b == "fluid_film" else None
+            helical.append(Variant(f"{b}@{torque:g}", "double_helical", b, torque, measured_mean, measured_sd,
+                                   dh["meas_Lw_max_dBA"][key] if top else None))
+    return {
+        "profile-corrections": Family(
+            "profile-corrections", "test-gearbox-runup",
+            "profile corrections: gear sets A-D and uncorrected, ball bearings, 2000 N m", tuple(corrections), "A",
+            thesis_source("test_gearbox.profile_corrections", "Fig. 5.15, thesis lines 2062-2079"),
+            ("measured: Fig. 5.15, mean differences of L_W over 800-1500 rev/min to set A; the uncorrected set was "
+             "not measured, its +3.5 dB is the thesis' calculation",
+             "thesis calculated: L_omega at the tooth frequency of each set with the same TF_omega and sigma "
+             "(its Sec. 5.7: 'the vibration transmission ... is not influenced by changing the tooth profile "
+             "correction'); its maximum 89.4 dB(A) is set A's (Fig. 5.10)")),
+        "bearings": Family(
+            "bearings", "test-gearbox-runup",
+            "bearings on gear set B: ball, angular contact, self-aligning, tapered roller, 2000 N m", tuple(bearings),
+            "ball", thesis_source("test_gearbox.bearings", "Figs. 5.16, 5.17, thesis lines 2109-2130"),
+            ("measured: Figs. 5.16/5.17, mean differences of L_W over 800-1500 rev/min to ball bearings",
+             "thesis calculated: no run-up; its FE gave TF_omega ball - self-aligning +7.3 dB (s.d. 4.5) over "
+             "320-600 Hz with the ball bearings' moment terms zeroed (Fig. 5.18; `housingfe bearing-variants`)",
+             "the lumped source uses Appendix C's bearing diagonal for every configuration (the FE bearings do not "
+             "enter it), so the bearings change only the coupled model here")),
+        "double-helical": Family(
+            "double-helical", "test-gearbox-runup-double-helical",
+            "double helical set: cylindrical roller vs fluid-film bearings, 500-2000 N m", tuple(helical),
+            f"cylindrical_roller@{max(DOUBLE_HELICAL_TORQUES_NM):g}",
+            thesis_source("test_gearbox.double_helical", "Figs. 5.19, 5.21, thesis lines 2157-2183"),
+            ("measured: Fig. 5.19 (2000 N m, fluid film - roller -1.9 dB mean, s.d. 3.0, over 800-1500 rev/min; "
+             "maxima 91.0 / 87.7 dB(A)) and Fig. 5.21 (torque law: 1000 -> 2000 N m +3.4 / +2.7 dB(A))",
+             "thesis calculated: none (its TF_omega differences of Fig. 5.20 were 'not satisfactory at all')",
+             "fluid films at the pinion speed drivetrain.bearing_speed_rpm for the whole run-up (docs/runup.md)")),
+    }
+
+
+DOUBLE_HELICAL_TORQUES_NM = (500.0, 1000.0, 1500.0, 2000.0)
+TORQUE_LAW_NM = (1000.0, 2000.0)                 # the measured torque step (Sec. 5.9)
+TORQUE_LAW_MEASURED = {"cylindrical_roller": "roller", "fluid_film": "fluid_film"}
+
+
+# ------------------------------------------------------------------------------------------------ running
+@dataclass
+class VariantRun:
+    """A variant's run-up: per route the speeds (rev/min) and L_WA (dB(A)) of the total; how its basis was
+    obtained ("built" / "re-analysed"); wall times (s): the coupled model, the run-up (source lines + routes)."""
+
+    variant: Variant
+    curves: dict
+    basis: str
+    model_s: float
+    runup_s: float
+
+
+@dataclass
+class StudyResult:
+    """A family's runs and what is compared (rows per route and variant, rankings, torque law), with timings."""
+
+    family: Family
+    engagement: str
+    radiation: str
+    routes: tuple
+    runs: dict
+    rows: list = field(default_factory=list)
+    rankings: list = field(default_factory=list)
+    torque_law: list = field(default_factory=list)
+    timings: dict = field(default_factory=dict)
+    basis_builds: int = 0
+
+
+def check_overrides(family: Family, overrides) -> None:
+    """InputError for a --set of a key the family sets itself."""
+    for item in overrides:
+        key = item.split("=", 1)[0].strip()
+        for controlled in family.controlled:
+            if key == controlled or key.startswith(controlled + "."):
+                raise InputError(f"--set {key}: the study {family.name} sets it per variant (its variants: "
+                                 f"{', '.join(v.key for v in family.variants)})")
+
+
+def family_of(name: str) -> Family:
+    known = families()
+    if name not in known:
+        raise InputError(f"study: family {name!r}: unknown (known: {', '.join(known)})")
+    return known[name]
+
+
+def run_family(family: Family, session: ChainSession, progress=print) -> StudyResult:
+    """Run every variant of `family` on `session` (reference first, so that the basis is the reference's) and
+    compare; progress(str) is told about each variant."""
+    t_start = time.perf_counter()
+    order = [family.variant(family.reference)] + [v for v in family.variants if v.key != family.reference]
+    drivetrains = {v.key: session.drivetrain(v.gear_set, v.bearings, v.torque) for v in order}   # bad input first
+    routes = tuple(session.spec.routes)
+    rad = session.radiation
+    runs = {}
+    for v in order:
+        t0 = time.perf_counter()
+        model = session.model(drivetrains[v.key], v.key)
+        t1 = time.perf_counter()
+        res = session.runup(model, v.torque)
+        t2 = time.perf_counter()
+        runs[v.key] = VariantRun(v, {r: lwa_curve(res, r, rad, v.torque) for r in routes}, session.log[-1].how,
+                                 t1 - t0, t2 - t1)
+        progress(f"{family.name}: {v.key:22s} basis {session.log[-1].how:11s} model {t1 - t0:5.1f} s, "
+                 f"run-up {t2 - t1:5.1f} s")
+    out = StudyResult(family, session.spec.engagement, rad, routes, {v.key: runs[v.key] for v in family.variants})
+    out.rows = compare(out)
+    out.rankings = rankings(out)
+    if family.name == "double-helical":
+        out.torque_law = torque_law(out)
+    out.basis_builds = session.basis_builds
+    out.timings = {**session.timings, "variants_s": time.perf_counter() - t_start,
+                   "per_variant": {k: {"basis": r.basis, "model_s": r.model_s, "runup_s": r.runup_s}
+                                   for k, r in runs.items()}}
+    return out
+
+
+def compare(result: StudyResult) -> list[dict]:
+    """One row per route and variant: ours beside measured and the thesis' calculation."""
+    fam = result.family
+    ref = result.runs[fam.reference]
+    rows = []
+    for route in result.routes:
+        s_ref, l_ref = ref.curves[route]
+        for key, run in result.runs.items():
+            v = run.variant
+            s, lwa = run.curves[route]
+            mean, sd, n = difference_stats(s, lwa, l_ref)
+            top, at = maximum(s, lwa)
+            rows.append({"family": fam.name, "engagement": result.engagement, "route": route,
+                         "radiation": result.radiation, "variant": key, "gear_set": v.gear_set,
+                         "bearings": v.bearings, "torque_nm": v.torque,
+                         "mean_diff_dB": round(mean, 2), "sd_diff_dB": round(sd, 2), "speeds_in_mean": n,
+                         "measured_mean_dB": v.measured_mean, "measured_sd_dB": v.measured_sd,
+                         "thesis_calc_mean_dB": v.calc_mean, "thesis_calc_sd_dB": v.calc_sd,
+                         "LwA_max_dBA": round(top, 1), "at_rpm": at, "measured_max_dBA": v.measured_max,
+                         "thesis_calc_max_dBA": v.calc_max,
+                         "LwA_energy_mean_800_1500_dBA": round(energy_mean_db(s, lwa), 1),
+                         "basis": run.basis, "model_s": round(run.model_s, 2), "runup_s": round(run.runup_s, 2)})
+    return rows
+
+
+def _order(values: dict) -> list[str]:
+    return [k for k, _ in sorted(values.items(), key=lambda kv: kv[1])]
+
+
+def rankings(result: StudyResult) -> list[dict]:
+    """Per route and measure (mean difference, maximum): the variants that were measured, quietest first, ours
+    against measured; `matches` when the orders are equal, `quietest`/`loudest` when those agree."""
+    fam = result.family
+    measured_mean = {v.key: (0.0 if v.key == fam.reference else v.measured_mean) for v in fam.variants
+                     if v.key == fam.reference or v.measured_mean is not None}
+    measured_max = {v.key: v.measured_max for v in fam.variants if v.measured_max is not None}
+    out = []
+    for route in result.routes:
+        rows = {r["variant"]: r for r in result.rows if r["route"] == route}
+        for measure, measured, column in (("mean difference 800-1500 rpm", measured_mean, "mean_diff_dB"),
+                                          ("maximum L_WA", measured_max, "LwA_max_dBA")):
+            if len(measured) < 2:
+                continue
+            ours = _order({k: rows[k][column] for k in measured})
+            theirs = _order(measured)
+            out.append({"route": route, "measure": measure, "ours": " < ".join(ours), "measured": " < ".join(theirs),
+                        "matches": ours == theirs, "quietest": ours[0] == theirs[0],
+                        "loudest": ours[-1] == theirs[-1]})
+    return out
+
+
+def torque_law(result: StudyResult) -> list[dict]:
+    """Double helical: per bearing configuration and route, L_WA(2000 N m) - L_WA(1000 N m) speed by speed over
+    800-1500 rev/min (mean, s.d.) and at 1500 rev/min, and the least-squares slope of the energy mean
+    (800-1500 rev/min) against log2 of the torque over every torque run (dB(A) per doubling), beside the measured
+    step (Fig. 5.21)."""
+    from housingfe.data import thesis
+
+    measured = thesis()["test_gearbox"]["double_helical"]["torque_doubling_1000_to_2000Nm_dBA"]
+    lo, hi = TORQUE_LAW_NM
+    out = []
+    for bearings in TORQUE_LAW_MEASURED:
+        runs = {r.variant.torque: r for r in result.runs.values() if r.variant.bearings == bearings}
+        if lo not in runs or hi not in runs:
+            continue
+        for route in result.routes:
+            s, high = runs[hi].curves[route]
+            _, low = runs[lo].curves[route]
+            mean, sd, _ = difference_stats(s, high, low)
+            at = float(high[np.argmin(np.abs(s - 1500.0))] - low[np.argmin(np.abs(s - 1500.0))])
+            torques = sorted(runs)
+            means = [energy_mean_db(*runs[t].curves[route]) for t in torques]
+            slope = float(np.polyfit(np.log2(torques), means, 1)[0]) if len(torques) > 2 else float("nan")
+            out.append({"bearings": bearings, "route": route, "step_mean_dB": round(mean, 2),
+                        "step_sd_dB": round(sd, 2), "step_at_1500rpm_dB": round(at, 2),
+                        "slope_dB_per_doubling": round(slope, 2),
+                        "torques_nm": " ".join(f"{t:g}" for t in torques),
+                        "energy_means_dBA": " ".join(f"{m:.1f}" for m in means),
+                        "measured_step_dBA": measured[TORQUE_LAW_MEASURED[bearings]]})
+    return out
+
+
+# ------------------------------------------------------------------------------------------------ outputs
+COLUMNS = ("family", "engagement", "route", "radiation", "variant", "gear_set", "bearings", "torque_nm",
+           "mean_diff_dB", "sd_diff_dB", "speeds_in_mean", "measured_mean_dB", "measured_sd_dB", "thesis_calc_mean_dB",
+           "thesis_calc_sd_dB", "LwA_max_dBA", "at_rpm", "measured_max_dBA", "thesis_calc_max_dBA",
+           "LwA_energy_mean_800_1500_dBA", "basis", "model_s", "runup_s")
+
+
+def _pm(mean, sd) -> str:
+    if mean is None:
+        return "-"
+    return f"{mean:+.1f}" + (f" ± {sd:.1f}" if sd is not None else "")
+
+
+def _num(x, fmt="{:.1f}") -> str:
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else fmt.format(x)
+
+
+def markdown(result: StudyResult, wall_s: float | None = None) -> str:
+    """The family's comparison table, rankings and (double helical) torque law as Markdown."""
+    fam = result.family
+    lo, hi = MEAN_RANGE_RPM
+    lines = [f"# `housingfe study {fam.name}`: {fam.title}", "",
+             f"Engagement shock `runup.engagement = \"{result.engagement}\"`; radiation `{result.radiation}`; "
+             f"differences L_WA(variant) − L_WA({fam.reference}) speed by speed, mean ± s.d. over {lo:g}–{hi:g} "
+             f"rev/min; maxima over the whole run-up. Published numbers: {fam.source}.", ""]
+    for route in result.routes:
+        lines += [f"## Route `{route}`", "",
+                  "| variant | Δ mean ± s.d., ours, dB | measured | thesis calc. | max L_WA ours, dB(A) (rpm) "
+                  "| measured | thesis calc. | basis |",
+                  "|---|---|---|---|---|---|---|---|"]
+        for r in (r for r in result.rows if r["route"] == route):
+            ref = r["variant"] == fam.reference
+            lines.append(f"| {r['variant']}{' (reference)' if ref else ''} | "
+                         f"{'0' if ref else _pm(r['mean_diff_dB'], r['sd_diff_dB'])} | "
+                         f"{'0' if ref else _pm(r['measured_mean_dB'], r['measured_sd_dB'])} | "
+                         f"{'0' if ref and r['thesis_calc_mean_dB'] is None and fam.name == 'profile-corrections' else _pm(r['thesis_calc_mean_dB'], r['thesis_calc_sd_dB'])} | "
+                         f"{r['LwA_max_dBA']:.1f} ({r['at_rpm']:g}) | {_num(r['measured_max_dBA'])} | "
+                         f"{_num(r['thesis_calc_max_dBA'])} | {r['basis']} |")
+        lines.append("")
+    if result.rankings:
+        lines += ["## Ranking (quietest first, the measured variants)", "",
+                  "| route | by | ours | measured | same order | quietest | loudest |", "|---|---|---|---|---|---|---|"]
+        for k in result.rankings:
+            yn = {True: "yes", False: "no"}
+            lines.append(f"| {k['route']} | {k['measure']} | {k['ours']} | {k['measured']} | {yn[k['matches']]} | "
+                         f"{yn[k['quietest']]} | {yn[k['loudest']]} |")
+        lines.append("")
+    if result.torque_law:
+        lines += ["## Torque law (Sec. 5.9, Fig. 5.21)", "",
+                  "| bearings | route | L_WA(2000) − L_WA(1000 N m), mean ± s.d. 800–1500 rpm | at 1500 rpm | measured "
+                  "| slope over torques, dB(A) per doubling | energy means 800–1500 rpm, dB(A) |",
+                  "|---|---|---|---|---|---|---|"]
+        for t in result.torque_law:
+            lines.append(f"| {t['bearings']} | {t['route']} | {_pm(t['step_mean_dB'], t['step_sd_dB'])} | "
+                         f"{t['step_at_1500rpm_dB']:+.1f} | {t['measured_step_dBA']:+.1f} | "
+                         f"{_num(t['slope_dB_per_doubling'], '{:+.1f}')} | {t['energy_means_dBA']} "
+                         f"(at {t['torques_nm']} N m) |")
+        lines.append("")
+    per = result.timings.get("per_variant", {})
+    lines += ["## Cost", "",
+              f"{result.basis_builds} modal basis computed for {len(result.runs)} variants; per variant (s): "
+              + ", ".join(f"{k} {p['basis']} {p['model_s']:.1f} + run-up {p['runup_s']:.1f}" for k, p in per.items())
+              + f"; housing mesh {result.timings.get('mesh_s', 0.0):.1f} s"
+              + (f"; wall time {wall_s:.0f} s (this family; a command of one family: end to end)." if wall_s is not None else "."), "",
+              "## Notes", ""] + [f"* {n}" for n in result.family.notes] + [""]
+    return "\n".join(lines)
+
+
+def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> None:
+    """<family>.csv, <family>.md, <family>.png, <family>_runup.csv and study.json in `folder`."""
+    from housingfe.outputs import write_csv, write_json
+
+    name = result.family.name
+    write_csv(folder / f"{name}.csv", COLUMNS, ([r[c] for c in COLUMNS] for r in result.rows))
+    keys = list(result.runs)
+    first = result.runs[keys[0]].curves[result.routes[0]][0]
+    header = ["speed_rpm"] + [f"LwA_{route}_{k}_dBA" for route in result.routes for k in keys]
+    write_csv(folder / f"{name}_runup.csv", header,
+              ([s] + [round(float(result.runs[k].curves[route][1][i]), 3) for route in result.routes for k in keys]
+               for i, s in enumerate(first)))
+    (folder / f"{name}.md").write_text(markdown(result, wall_s))
+    write_json(folder / "study.json", {
+        "family": name, "scene": result.family.scene, "engagement": result.engagement,
+        "radiation": result.radiation, "reference": result.family.reference, "source": result.family.source,
+        "notes": list(result.family.notes), "rows": result.rows, "rankings": result.rankings,
+        "torque_law": result.torque_law, "basis_builds": result.basis_builds, "timings_s": result.timings,
+        "wall_s": wall_s})
+    plot(folder / f"{name}.png", result)
+
+
+def plot(path: Path, result: StudyResult) -> None:
+    """L_WA over speed per variant and route (top), mean differences and maxima ours / measured / thesis (bottom)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fam = result.family
+    routes = result.routes
+    fig, axes = plt.subplots(2, max(2, len(routes)), figsize=(6 * max(2, len(routes)), 8.5), squeeze=False)
+    for j, route in enumerate(routes):
+        ax = axes[0, j]
+        for k, run in result.runs.items():
+            s, lwa = run.curves[route]
+            ax.plot(s, lwa, lw=1.8 if k == fam.reference else 1.0, label=k)
+            if run.variant.measured_max is not None:
+                ax.plot([s[-1] + 25], [run.variant.measured_max], marker="<", color=ax.lines[-1].get_color(), ms=7)
+        ax.axvspan(*MEAN_RANGE_RPM, color="0.93", zorder=0)
+        ax.set_title(f"{route}: L_WA over speed (◁ measured maxima)", fontsize=10)
+        ax.set_xlabel("pinion speed [rev/min]")
+        ax.set_ylabel("L_WA [dB(A)]")
+        ax.legend(fontsize=7, ncol=2)
+    others = [k for k in result.runs if k != fam.reference]
+    x = np.arange(len(others))
+    width = 0.8 / (len(routes) + 2)
+    ax = axes[1, 0]
+    for j, route in enumerate(routes):
+        rows = {r["variant"]: r for r in result.rows if r["route"] == route}
+        ax.bar(x + j * width, [rows[k]["mean_diff_dB"] for k in others], width,
+               yerr=[rows[k]["sd_diff_dB"] for k in others], capsize=2, label=f"ours, {route}")
+    for j, (label, attr, sd) in enumerate((("measured", "measured_mean", "measured_sd"),
+                                           ("thesis calculated", "calc_mean", "calc_sd"))):
+        vals = [getattr(result.runs[k].variant, attr) for k in others]
+        sds = [getattr(result.runs[k].variant, sd) for k in others]
+        ax.bar(x + (len(routes) + j) * width, [np.nan if v is None else v for v in vals], width,
+               yerr=[0.0 if v is None else v for v in sds], capsize=2, label=label,
+               color="k" if label == "measured" else "0.6")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xticks(x + width * (len(routes) + 1) / 2, others, rotation=20, fontsize=8)
+    ax.set_ylabel(f"L_WA − L_WA({fam.reference}), mean ± s.d. 800–1500 rpm [dB]")
+    ax.legend(fontsize=7)
+    ax = axes[1, 1]
+    keys = list(result.runs)
+    x = np.arange(len(keys))
+    for j, route in enumerate(routes):
+        rows = {r["variant"]: r for r in result.rows if r["route"] == route}
+        ax.bar(x + j * width, [rows[k]["LwA_max_dBA"] for k in keys], width, label=f"ours, {route}")
+    for j, (label, attr) in enumerate((("measured", "measured_max"), ("thesis calculated", "calc_max"))):
+        vals = [getattr(result.runs[k].variant, attr) for k in keys]
+        ax.bar(x + (len(routes) + j) * width, [np.nan if v is None else v for v in vals], width, label=label,
+               color="k" if label == "measured" else "0.6")
+    lo = min(r["LwA_max_dBA"] for r in result.rows) - 10
+    ax.set_ylim(bottom=max(0.0, lo))
+    ax.set_xticks(x + width * (len(routes) + 1) / 2, keys, rotation=20, fontsize=8)
+    ax.set_ylabel("max L_WA [dB(A)]")
+    ax.legend(fontsize=7)
+    for extra in axes.flat[len(routes) + 2:] if len(routes) > 2 else []:
+        extra.axis("off")
+    fig.suptitle(f"housingfe study {fam.name} (engagement {result.engagement}, radiation {result.radiation})")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def summary_text(result: StudyResult, wall_s: float | None = None) -> str:
+    """The console summary: per route the table ours | measured | thesis, and the rankings."""
+    from housingfe.outputs import format_table
+
+    fam = result.family
+    out = [f"study {fam.name} (engagement {result.engagement}, radiation {result.radiation}); differences to "
+           f"{fam.reference}, mean ± s.d. over {MEAN_RANGE_RPM[0]:g}-{MEAN_RANGE_RPM[1]:g} rpm"]
+    out.append(format_table(["route", "variant", "diff ours", "measured", "thesis", "max ours (rpm)", "measured max",
+                             "basis"],
+                            [[r["route"], r["variant"], _pm(r["mean_diff_dB"], r["sd_diff_dB"]),
+                              _pm(r["measured_mean_dB"], r["measured_sd_dB"]),
+                              _pm(r["thesis_calc_mean_dB"], r["thesis_calc_sd_dB"]),
+                              f"{r['LwA_max_dBA']:.1f} ({r['at_rpm']:g})", _num(r["measured_max_dBA"]), r["basis"]]
+                             for r in result.rows]))
+    for k in result.rankings:
+        out.append(f"ranking {k['route']}, {k['measure']}: ours {k['ours']}; measured {k['measured']}; "
+                   f"{'same order' if k['matches'] else 'different order'}")
+    for t in result.torque_law:
+        out.append(f"torque law {t['bearings']}, {t['route']}: 1000 -> 2000 N m {t['step_mean_dB']:+.1f} ± "
+                   f"{t['step_sd_dB']:.1f} dB(A) (measured {t['measured_step_dBA']:+.1f})")
+    out.append(f"{result.basis_builds} basis for {len(result.runs)} variants"
+               + (f"; wall time {wall_s:.1f} s" if wall_s is not None else ""))
+    return "\n".join(out)
+
+
+def run_studies(jobs, out_dir: str | None = None, fresh_basis: bool = False) -> Path:
+    """Run families through the chain and write their comparisons (module docstring) atomically; returns the result
+    folder.  jobs: [(family, overrides, subfolder)]: the family's run-up scene with --set overrides, written into
+    out_dir/subfolder (None: into out_dir itself; default out_dir results/study-<family>-<engagement> for one job).
+    The jobs share the housing model and every modal basis that fits (one ModelPool): families on the same layout,
+    or one family with another engagement shock, re-analyse the first one's basis.  Bad input (unknown family, a
+    bad or family-controlled --set, speeds that miss 800-1500 rev/min, a bearing that cannot carry its load) stops
+    with InputError before any folder is made."""
+    from housingfe import outputs
+    from housingfe.studies.chain_session import ModelPool
+
+    t_start = time.perf_counter()
+    pool = ModelPool()
+    planned = []
+    for family, overrides, sub in jobs:
+        fam = family_of(family)
+        check_overrides(fam, overrides)
+        session = ChainSession.from_scene(fam.scene, overrides, fresh_basis=fresh_basis, pool=pool)
+        speeds = session.spec.speeds
+        if not np.any((speeds >= MEAN_RANGE_RPM[0]) & (speeds <= MEAN_RANGE_RPM[1])):
+            raise InputError(f"{session.scene_path}: runup.speed_min_rpm/speed_max_rpm: no speed inside "
+                             f"{MEAN_RANGE_RPM[0]:g}-{MEAN_RANGE_RPM[1]:g} rev/min, where the thesis states its "
+                             "mean differences")
+        planned.append((fam, session, sub))
+    if len({sub for *_, sub in planned}) < len(planned):
+        raise InputError("study: two jobs write into the same folder (a family named twice?)")
+    fam0, session0, _ = planned[0]
+    comm = session0.comm
+    out = Path(out_dir or f"results/study-{fam0.name}-{session0.spec.engagement}")
+    outputs.reserve_output(out, comm, inputs=[s.scene_path for _, s, _ in planned])     # before any model is built
+    for fam, session, _ in planned:          # a bearing that cannot carry its load stops here, before any FE
+        for v in fam.variants:
+            session.drivetrain(v.gear_set, v.bearings, v.torque)
+    say = (lambda text: print(text, flush=True)) if comm.rank == 0 else (lambda text: None)
+    results = []
+    for fam, session, sub in planned:
+        t0 = time.perf_counter()
+        results.append((run_family(fam, session, progress=say), sub, time.perf_counter() - t0))
+    wall = time.perf_counter() - t_start
+    with outputs.atomic_output_dir(out, comm) as tmp:
+        if comm.rank == 0:
+            for result, sub, seconds in results:
+                folder = tmp / sub if sub else tmp
+                folder.mkdir(exist_ok=True)
+                write(folder, result, seconds if len(results) > 1 else wall)
+    if comm.rank == 0:
+        for result, _, seconds in results:
+            print(summary_text(result, seconds if len(results) > 1 else wall))
+        print(f"total wall time {wall:.1f} s; results: {out}/")
+    return out
+
+
+def run_study(family: str, out_dir: str | None = None, overrides=(), fresh_basis: bool = False) -> Path:
+    """`housingfe study <family>`: one family (run_studies with one job)."""
+    return run_studies([(family, list(overrides), None)], out_dir, fresh_basis)
+
+
+# --------------------------------------------------------------------------------------------------- CLI
+def register_cli(subparsers) -> None:
+    """Add `housingfe study <family> [<family> ...] [--out DIR] [--set KEY=VALUE] [--fresh-basis]`."""
+    p = subparsers.add_parser("study", help="design variants through the chain beside the thesis' measurements "
+                                            "(profile-corrections, bearings, double-helical)")
+    p.add_argument("families", nargs="+", metavar="family",
+                   help="profile-corrections | bearings | double-helical (several: they share the housing model and "
+                        "the bases that fit, each written to <out>/<family>/)")
+    p.add_argument("--out", default=None, help="result folder (default results/study-<family>-<engagement>, for "
+                                               "several families results/study-<engagement>)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE",
+                   help="override a value of the families' run-up scenes, e.g. runup.engagement=thesis-2d "
+                        "(repeatable; not the gear set, bearings or torques, which the family sets)")
+    p.add_argument("--fresh-basis", action="store_true",
+                   help="compute a modal basis for every variant instead of re-analysing the layout's (slower; "
+                        "measures what the reuse costs)")
+    p.set_defaults(func=_cmd)
+
+
+def _cmd(args: argparse.Namespace) -> int:
+    overrides = args.set or []
+    if len(args.families) == 1:
+        run_study(args.families[0], args.out, overrides, args.fresh_basis)
+        return 0
+    out = args.out
+    if out is None:
+        engagement = ChainSession.from_scene(family_of(args.families[0]).scene, overrides).spec.engagement
+        out = f"results/study-{engagement}"
+    run_studies([(f, overrides, f) for f in args.families], out, args.fresh_basis)
+    return 0

@@ -1,0 +1,137 @@
+"""Design variants through the chain (`housingfe study`, issue 28 item 4) against the thesis' Secs. 5.7-5.9.
+
+Rows, per route (tf_omega, mesh_force; sigma = 1), with the default engagement shock (face width):
+* every measured variant's mean L_WA difference to its family's reference over 800-1500 rev/min (goal: within 3 dB
+  of the measured mean, read against the measured s.d. given in the note) and its maximum L_WA;
+* the ranking of the measured variants by mean difference and by maximum, ours against measured;
+* profile correction D: whether ours reproduces the measured near-zero difference (-0.3 dB) better than the
+  thesis' calculation (-5.1 dB);
+* the double helical set's torque law (L_WA(2000 N m) - L_WA(1000 N m), mean over 800-1500 rev/min; goal within
+  1.5 dB of the measured +3.4 / +2.7 dB(A));
+and the thesis replica's check on the profile corrections (engagement `thesis-2d`, tf_omega): the thesis'
+calculated differences -0.4/+2.9/-5.1 dB within 1.5 dB.
+
+The four studies run as one cached computation (`housingfe.studies.design_variants.run_studies`: one process, so
+the single helical families and both engagements share one modal basis and the double helical family has its
+own) in <results>/study-validate/, reused while its key holds (housingfe.verification.validate: the resolved scenes
+and the content of every file the run imported).  From an empty cache it takes a few minutes (two bases, 17
+re-analyses), so `housingfe validate --quick` computes nothing here: it takes the rows from a valid cached result
+or leaves them out with a note.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+FOLDER = "study-validate"
+# (family, --set overrides, subfolder): the default engagement for every family, and the thesis replica's shock for
+# the profile corrections (its calculated differences are the replica check)
+JOBS = (("profile-corrections", (), "profile-corrections-face-width"),
+        ("bearings", (), "bearings-face-width"),
+        ("double-helical", (), "double-helical-face-width"),
+        ("profile-corrections", ("runup.engagement=thesis-2d",), "profile-corrections-thesis-2d"))
+MEAN_GOAL_DB = 3.0          # issue 28: mean differences within 3 dB where the measured s.d. allows
+REPLICA_GOAL_DB = 1.5       # issue 28: the replica's correction differences within 1.5 dB of the thesis' calculation
+TORQUE_LAW_GOAL_DB = 1.5
+
+
+def published_rows(results: Path | None = None, quick: bool = False) -> list[dict]:
+    """The rows (module docstring) from the cached study result in <results>/study-validate/, computed first when
+    stale (not with quick: then no rows, and a note on the console)."""
+    from housingfe.verification import validate
+
+    results = validate.RESULTS if results is None else Path(results)
+    folder = results / FOLDER
+    scene, extra = cache_identity()
+    last = f"{JOBS[-1][2]}/study.json"
+    reason = validate.stale_reason(folder, scene, last, extra)
+    if reason:
+        if quick:
+            print(f"validate: study rows left out with --quick (no valid cached {folder}/: {reason}; "
+                  "`housingfe validate` computes it)", flush=True)
+            return []
+        validate.compute({"kind": "study", "jobs": [[f, list(o), sub] for f, o, sub in JOBS]}, scene, folder, results,
+                         "housingfe study (profile-corrections, bearings, double-helical; thesis-2d profile "
+                         "corrections)", extra, reason)
+    rows = []
+    for family, overrides, sub in JOBS:
+        data = json.loads((folder / sub / "study.json").read_text())
+        rows += study_rows(data)
+    return rows
+
+
+def cache_identity():
+    """(the first job's resolved run-up scene, the others' and the jobs as JSON-able extra): what the cached result
+    depends on besides the code."""
+    from housingfe.runup.scene import load_runup_scene
+    from housingfe.scene import load_housing_scene
+    from housingfe.studies.design_variants import family_of
+
+    scenes = []
+    for family, overrides, sub in JOBS:
+        scene, _ = load_runup_scene(family_of(family).scene, list(overrides))
+        housing, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
+        scenes.append((scene, {"family": family, "overrides": list(overrides), "folder": sub,
+                               "scene": scene.model_dump(mode="json"), "housing": housing.model_dump(mode="json")}))
+    return scenes[0][0], {"jobs": [e for _, e in scenes]}
+
+
+def _yes(flag: bool) -> str:
+    return "yes" if flag else "no"
+
+
+def study_rows(data: dict) -> list[dict]:
+    """Validate rows of one study result (study.json of housingfe.studies.design_variants)."""
+    from housingfe.verification.published import row
+
+    family, engagement, src = data["family"], data["engagement"], data["source"]
+    label = f"study {family} ({engagement})"
+    ref = data["reference"]
+    replica = engagement == "thesis-2d"
+    out = []
+    for r in data["rows"]:
+        route, v = r["route"], r["variant"]
+        if replica:       # the thesis' calculation: L_omega differences on one TF_omega (tf_omega route)
+            if route == "tf_omega" and r["thesis_calc_mean_dB"] is not None:
+                ok = abs(r["mean_diff_dB"] - r["thesis_calc_mean_dB"]) <= REPLICA_GOAL_DB
+                out.append(row(label, f"{route}: {v} - {ref}, mean L_WA difference 800-1500 rpm (thesis replica)",
+                               r["mean_diff_dB"], r["thesis_calc_mean_dB"], "dB", src,
+                               f"published = the thesis' CALCULATED mean (s.d. {r['thesis_calc_sd_dB']}); ours s.d. "
+                               f"{r['sd_diff_dB']}; goal: within {REPLICA_GOAL_DB:g} dB; passed: {_yes(ok)}"))
+            continue
+        if r["measured_mean_dB"] is not None:
+            ok = abs(r["mean_diff_dB"] - r["measured_mean_dB"]) <= MEAN_GOAL_DB
+            calc = ("" if r["thesis_calc_mean_dB"] is None else
+                    f"; thesis calculated {r['thesis_calc_mean_dB']:+g} (s.d. {r['thesis_calc_sd_dB']})")
+            out.append(row(label, f"{route}: {v} - {ref}, mean L_WA difference 800-1500 rpm", r["mean_diff_dB"],
+                           r["measured_mean_dB"], "dB", src,
+                           f"s.d. ours {r['sd_diff_dB']}, measured {r['measured_sd_dB']}{calc}; goal: within "
+                           f"{MEAN_GOAL_DB:g} dB; passed: {_yes(ok)}"))
+        if r["measured_max_dBA"] is not None:
+            out.append(row(label, f"{route}: {v}: max L_WA ({r['at_rpm']:g} rpm)", r["LwA_max_dBA"],
+                           r["measured_max_dBA"], "dB(A)", src,
+                           "" if r["thesis_calc_max_dBA"] is None else
+                           f"thesis calculated {r['thesis_calc_max_dBA']}"))
+    if replica:
+        return out
+    for k in data["rankings"]:
+        out.append(row(label, f"{k['route']}: ranking by {k['measure']}, quietest first", k["ours"], k["measured"],
+                       "-", src, f"same order: {_yes(k['matches'])}; quietest: {_yes(k['quietest'])}; loudest: "
+                                 f"{_yes(k['loudest'])}"))
+    if family == "profile-corrections":
+        for r in (r for r in data["rows"] if r["variant"] == "D"):
+            ours = abs(r["mean_diff_dB"] - r["measured_mean_dB"])
+            thesis_miss = abs(r["thesis_calc_mean_dB"] - r["measured_mean_dB"])
+            out.append(row(label, f"{r['route']}: correction D, |ours - measured| of the mean difference vs the "
+                                  "thesis' |calculated - measured|", round(ours, 2), round(thesis_miss, 2), "dB", src,
+                           f"ours {r['mean_diff_dB']:+.2f}, measured {r['measured_mean_dB']:+g}, thesis calculated "
+                           f"{r['thesis_calc_mean_dB']:+g}; goal: ours below the thesis'; passed: "
+                           f"{_yes(ours < thesis_miss)}"))
+    for t in data.get("torque_law", []):
+        ok = abs(t["step_mean_dB"] - t["measured_step_dBA"]) <= TORQUE_LAW_GOAL_DB
+        out.append(row(label, f"{t['route']}: {t['bearings']}: L_WA(2000 N m) - L_WA(1000 N m), mean 800-1500 rpm",
+                       t["step_mean_dB"], t["measured_step_dBA"], "dB(A)", src,
+                       f"s.d. {t['step_sd_dB']}, at 1500 rpm {t['step_at_1500rpm_dB']:+.2f}; slope over "
+                       f"{t['torques_nm']} N m {t['slope_dB_per_doubling']:+.2f} dB(A) per doubling; goal: within "
+                       f"{TORQUE_LAW_GOAL_DB:g} dB; passed: {_yes(ok)}"))
+    return out
