@@ -78,7 +78,8 @@ def fit_cylinder(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, 
     """(unit axis, point on the axis, radius, rms deviation of the corners) of the circular cylinder through the
     facets `triangles` (m, (n, 3, 3)): the axis is the direction the facet normals are most nearly perpendicular
     to (the smallest principal direction of the area-weighted sum of n n^T), the circle an algebraic
-    least-squares fit (Kasa) of the corners projected across it."""
+    least-squares fit (Kasa) of the corners projected across it; both refined by least squares on the corners'
+    distances to the axis."""
     n = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])   # length: 2 x area
     area = np.linalg.norm(n, axis=1)
     n = n / np.maximum(area, 1e-300)[:, None]
@@ -92,8 +93,24 @@ def fit_cylinder(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, 
     A = np.column_stack([2 * u, 2 * v, np.ones_like(u)])
     (a, b, d), *_ = np.linalg.lstsq(A, u**2 + v**2, rcond=None)
     radius = math.sqrt(max(d + a * a + b * b, 0.0))
-    dev = float(np.sqrt(np.mean((np.hypot(u - a, v - b) - radius) ** 2)))
-    return axis, c + a * e1 + b * e2, radius, dev
+    # refined by least squares on the distances to the axis (the facet normals of a coarse mesh tilt a little
+    # off the cylinder's; the corners lie on it): axis a0 + p e1 + q e2, point c0 + r e1 + t e2, radius
+    from scipy.optimize import least_squares
+
+    c0 = c + a * e1 + b * e2
+
+    def residuals(z):
+        ax = axis + z[0] * e1 + z[1] * e2
+        ax = ax / np.linalg.norm(ax)
+        d = points - (c0 + z[2] * e1 + z[3] * e2)
+        return np.linalg.norm(d - np.outer(d @ ax, ax), axis=1) - z[4]
+
+    fit = least_squares(residuals, np.array([0.0, 0.0, 0.0, 0.0, radius]), x_scale=[1.0, 1.0, radius, radius, radius])
+    z = fit.x
+    ax = axis + z[0] * e1 + z[1] * e2
+    ax = ax / np.linalg.norm(ax)
+    dev = float(np.sqrt(np.mean(fit.fun ** 2)))
+    return ax, c0 + z[2] * e1 + z[3] * e2, float(z[4]), dev
 
 
 def bore_shape(model, name: str, surface: str) -> BoreShape:
