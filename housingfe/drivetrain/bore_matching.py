@@ -49,9 +49,17 @@ class BoreShape:
 
 
 def bore_surfaces(model) -> dict[str, str]:
-    """{bore name: surface group} of every `bore_<name>` group of a housing model (the group "bores" is the union
-    of all, not a bore)."""
-    return {g[len(BORE_PREFIX):]: g for g in sorted(model.housing.facet_groups) if g.startswith(BORE_PREFIX)}
+    """{bore name: surface group} of a housing model: every `bore_<name>` group (built-in housings, the `cad`
+    kind's selectors; the group "bores" is the union of all, not a bore), and the `[[geometry.bores]]` of its scene
+    that are groups by their own name (the `mesh` kind's sets)."""
+    groups = model.housing.facet_groups
+    out = {g[len(BORE_PREFIX):]: g for g in sorted(groups) if g.startswith(BORE_PREFIX)}
+    geometry = getattr(getattr(model, "scene", None), "geometry", None)
+    for entry in getattr(geometry, "bores", None) or []:
+        name = getattr(entry, "name", None)
+        if isinstance(name, str) and name in groups and name not in out:
+            out[name] = name
+    return dict(sorted(out.items()))
 
 
 def surface_triangles(model, surface: str) -> np.ndarray:
@@ -184,7 +192,8 @@ def match_bores(model, drivetrain, mapping: dict | None = None, match: str = "na
         point = shaft.point(seat.position)
         if seat.name in mapping:
             name = str(mapping[seat.name])
-            name = name[len(BORE_PREFIX):] if name.startswith(BORE_PREFIX) and name not in surfaces else name
+            if name not in surfaces and name.startswith(BORE_PREFIX):
+                name = name[len(BORE_PREFIX):]
             if name not in surfaces:
                 raise InputError(f"{key}.{seat.name}: the housing has no bore {name!r} (its bores: {known})")
         elif match == "name":
@@ -222,7 +231,7 @@ def matched_bores_summary(model, matched: dict[str, str]) -> list[dict]:
     (collective)."""
     rows = []
     for bearing, surface in matched.items():
-        b = bore_shape(model, surface[len(BORE_PREFIX):], surface)
+        b = bore_shape(model, surface, surface)
         rows.append({"bearing": bearing, "surface": surface, "centre_m": [float(x) for x in b.centre],
                      "axis": [float(x) for x in b.axis], "radius_m": b.radius, "length_m": 2 * b.s_hi,
                      "rms_deviation_m": b.deviation})

@@ -130,3 +130,35 @@ def test_cli_a_bore_mapped_off_its_shaft_is_exit_2_one_line_no_folder(imported, 
     assert lines[0] == (f"housingfe: error: {runup}: housing.bores: bore 'A_front' (centre (-0.126, -0.1075, 0.2) m) "
                         f"lies 200 mm off the wheel shaft's axis (tolerance 1 mm) (bearing 'wheel_front')"), lines[0]
     assert not out.exists() and not list(tmp_path.glob(".out*"))
+
+
+def test_a_mesh_housing_matches_its_bore_sets_by_position(tmp_path, comm):
+    """The `mesh` kind names its bores by their own name (no bore_ prefix): the built-in gearbox mesh written to
+    gmsh .msh with its four bearing bores as node sets, read back with other names, matched by position."""
+    from housingfe.drivetrain.bore_matching import match_bores
+    from housingfe.drivetrain.description import test_gearbox
+    from housingfe.geometry.imported_mesh import write_mesh_file
+    from housingfe.runup.scene import housing_model_for
+    from housingfe.scene import load_housing_scene
+
+    hs, _ = load_housing_scene("test-gearbox", ["mesh.size=0.06"])
+    built_in = housing_model_for(hs, 1500.0, comm)
+    seats = ["pinion_front", "pinion_back", "wheel_front", "wheel_back"]
+    write_mesh_file(built_in.housing, tmp_path / "gearbox.msh", units="m", node_sets=[f"bore_{s}" for s in seats])
+    bores = "".join(f'[[geometry.bores]]\nname = "seat_{i}"\nset = "bore_{s}"\n' for i, s in enumerate(seats))
+    (tmp_path / "housing.toml").write_text(f"""[scene]
+name = "mesh-gearbox"
+kind = "housing"
+[geometry]
+kind = "mesh"
+file = "gearbox.msh"
+units = "m"
+{bores}
+[mesh]
+degree = 2
+[analysis.modal]
+f_max = 1500.0
+""")
+    hm, _ = load_housing_scene(str(tmp_path / "housing.toml"))
+    model = housing_model_for(hm, 1500.0, comm)
+    assert match_bores(model, test_gearbox("A"), match="position") == {s: f"seat_{i}" for i, s in enumerate(seats)}
