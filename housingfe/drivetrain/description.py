@@ -201,6 +201,11 @@ class Drivetrain:
     def shaft(self, name: str) -> ShaftLine:
         return self.shafts[SHAFTS.index(name)]
 
+    def with_bores(self, surfaces: dict[str, str]) -> "Drivetrain":
+        """The same drivetrain with its bearings' housing bores renamed: {bearing name: housing surface group}
+        (housingfe.drivetrain.bore_matching.match_bores); bearings not named keep theirs."""
+        return replace(self, bearings=tuple(replace(b, bore=surfaces.get(b.name, b.bore)) for b in self.bearings))
+
     # ---------------------------------------------------------------------------------- gear properties
     def gear_inertia(self, gear: int) -> tuple[float, float, float]:
         """Mass (kg), polar and diametral inertia (kg m^2, about the gear centre) of the gear body alone (solid

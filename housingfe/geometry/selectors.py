@@ -31,19 +31,24 @@ ANGLE_TOLERANCE = np.radians(1.0)
 
 class BoreSelector(StrictSpec):
     """A bore: the cylindrical faces whose axis is parallel to `axis` and passes within `tolerance` (m) of
-    `centre` (m, any point on the axis); with `radius` (m) only faces of that radius (within tolerance).
+    `centre` (m, any point on the axis); with `radius` (m) only faces of that radius (within tolerance); with
+    `span` = [s0, s1] (m, along the axis from `centre`) only faces lying wholly between s0 and s1 (within
+    tolerance): one bearing seat of a shaft whose bore runs through two bearing plates.
     Every matched face gets the surface groups `bore_<name>` and `bores`."""
 
     name: str = Field(pattern=_NAME)
     axis: Vector = Field(min_length=3, max_length=3, json_schema_extra={"unit": "-"})
     centre: Vector = Field(min_length=3, max_length=3, json_schema_extra={"unit": "m"})
     radius: Optional[PositiveFloat] = Field(None, json_schema_extra={"unit": "m"})
+    span: Optional[list[float]] = Field(None, min_length=2, max_length=2, json_schema_extra={"unit": "m"})
     tolerance: PositiveFloat = Field(1e-4, json_schema_extra={"unit": "m"})
 
     @model_validator(mode="after")
     def _axis(self):
         if float(np.linalg.norm(self.axis)) == 0.0:
             raise ValueError("axis: must be a non-zero vector")
+        if self.span is not None and self.span[0] >= self.span[1]:
+            raise ValueError("span: [s0, s1] with s0 < s1 (m along the axis from centre)")
         return self
 
 
@@ -151,7 +156,8 @@ def select_bore(faces: list[Face], selector: BoreSelector, key: str) -> list[int
     tol = selector.tolerance
     hits = [f for f in faces if f.kind == "cylinder" and f.concave and _parallel(f.axis, axis)
             and distance_to_line(selector.centre, f.axis_point, f.axis) <= tol
-            and (selector.radius is None or abs(f.radius - selector.radius) <= tol)]
+            and (selector.radius is None or abs(f.radius - selector.radius) <= tol)
+            and (selector.span is None or _within_span(f, selector, axis))]
     if not hits:
         near = [f for f in faces if f.kind == "cylinder" and f.concave and _parallel(f.axis, axis)]
         hint = ""
@@ -161,13 +167,22 @@ def select_bore(faces: list[Face], selector: BoreSelector, key: str) -> list[int
                     f"{distance_to_line(selector.centre, best.axis_point, best.axis) * 1e3:.4g} mm from centre "
                     f"(housingfe inspect lists the bores)")
         raise InputError(f"{key}: no cylindrical face on the axis {_fmt(axis)} through {_fmt(selector.centre)} m"
-                         + (f" with radius {selector.radius:g} m" if selector.radius else "") + hint)
+                         + (f" with radius {selector.radius:g} m" if selector.radius else "")
+                         + (f" between {selector.span[0]:g} and {selector.span[1]:g} m along it" if selector.span
+                            else "") + hint)
     radii = sorted({round(f.radius / tol) for f in hits})
     if len(radii) > 1:
         shown = ", ".join(f"{r * tol * 1e3:.4g}" for r in radii)
         raise InputError(f"{key}: matches {len(radii)} bores of different radius ({shown} mm) on that axis; "
                          f"give radius to pick one")
     return sorted(f.tag for f in hits)
+
+
+def _within_span(face: Face, selector: BoreSelector, axis: np.ndarray) -> bool:
+    """Whether every sample point of `face` lies between span[0] and span[1] (m, +- tolerance) along `axis`
+    from the selector's centre."""
+    s = (face.points - np.asarray(selector.centre, dtype=float)) @ axis
+    return bool(s.min() >= selector.span[0] - selector.tolerance and s.max() <= selector.span[1] + selector.tolerance)
 
 
 def select_surface(faces: list[Face], selector: SurfaceSelector, key: str) -> list[int]:

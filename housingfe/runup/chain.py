@@ -74,6 +74,7 @@ class GearboxModel:
     f_lines_max: float
     interior_share: np.ndarray
     timings: dict = field(default_factory=dict)
+    bores: list = field(default_factory=list)     # the bearings' housing bores (bore_matching summary rows)
 
     @property
     def area(self) -> float:
@@ -90,6 +91,8 @@ class GearboxModel:
         out["area_m2"] = self.area
         out["f_lines_max_hz"] = self.f_lines_max
         out["ritz_frequencies_hz"] = [float(x) for x in self.reduction.frequencies_hz]
+        if self.bores:
+            out["bores"] = self.bores
         return out
 
 

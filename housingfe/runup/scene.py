@@ -2,7 +2,10 @@
 L_omega, L_v, L_W, L_WA over speed.  `housingfe run test-gearbox-runup`.
 
     [scene]        name, kind = "runup", description
-    [housing]      scene = "test-gearbox" (a housing scene with the drivetrain's bores), set = [overrides]
+    [housing]      scene = "test-gearbox" (a housing scene with the drivetrain's bores; a .toml path is taken
+                   relative to this scene's file), set = [overrides], match = "name" | "position",
+                   bores = {bearing = "housing bore"}, bore_tolerance (m): the drivetrain's bearings matched to
+                   the housing's bores and checked against the shafts (housingfe.drivetrain.bore_matching)
     [drivetrain]   gearbox = "test_gearbox", gear_set = "A", bearings = "ball", bearing_speed_rpm = 1500
     [runup]        speeds, torques, f_max_hz (highest harmonic line), basis_factor, routes, damping_ratio, ...
     [radiation]    models = ["erp", "foller"], plates = [...]  (the housing's radiating plates)
@@ -33,10 +36,17 @@ def _gearboxes() -> dict:
 
 
 class HousingRef(_Strict):
-    """The housing: a housing scene (built-in name or path) with optional --set style overrides."""
+    """The housing: a housing scene (built-in name or path) with optional --set style overrides, and how the
+    drivetrain's bearings find its bores (housingfe.drivetrain.bore_matching): match = "name" (each bearing's own
+    bore surface, e.g. bore_pinion_front on the built-in gearbox) or "position" (the one bore on the bearing's
+    shaft that holds it); bores = {bearing name: housing bore name} for single bearings; bore_tolerance (m): how
+    far a bore's centre may lie off its shaft's axis (and a bearing beyond the bore's ends)."""
 
     scene: str = "test-gearbox"
     set: list[str] = []
+    match: Literal["name", "position"] = "name"
+    bores: dict[str, str] = {}
+    bore_tolerance: PositiveFloat = Field(1e-3, json_schema_extra={"unit": "m"})
 
 
 class DrivetrainSpec(_Strict):
@@ -188,6 +198,12 @@ def load_runup_scene(name_or_path: str, overrides: list[str] | None = None) -> t
     """Read and validate a run-up scene; InputError naming the file and key on any problem."""
     data, path = read_scene_dict(name_or_path)
     apply_overrides(data, overrides or [])
+    housing = data.get("housing")
+    if isinstance(housing, dict) and isinstance(housing.get("scene"), str):
+        # a housing scene file beside the run-up scene (an imported housing) is found from anywhere
+        ref = Path(housing["scene"]).expanduser()
+        if ref.suffix == ".toml" and not ref.is_absolute() and (path.parent / ref).is_file():
+            housing["scene"] = str(path.parent / ref)
     return parse_table(RunupScene, data, path), path
 
 
@@ -233,8 +249,14 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     timings["mesh_s"] = time.perf_counter() - t0
     progress.update(note=f"housing model, {model.dofs} DOFs")
     reference_torque = max(spec.torques_nm)
+    drivetrains, bores = matched_drivetrains(scene.housing, model, drivetrains, path)
+    if comm.rank == 0:
+        for row in bores:
+            print(f"bearing {row['bearing']} -> {row['surface']}: centre "
+                  f"[{', '.join(f'{x + 0.0:.4g}' for x in row['centre_m'])}] m, radius {row['radius_m'] * 1e3:.4g} mm")
     gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
+    gm.bores = bores
     timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
     progress.update(note="coupled model and modal basis")
     misalignment = spec.misalignment_model
@@ -279,6 +301,21 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         print(report.summary_text(scene, results, gm, check_rows, timings, decompositions))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
+
+
+def matched_drivetrains(ref: HousingRef, model, drivetrains: dict, path) -> tuple[dict, list[dict]]:
+    """The drivetrains (per torque) with their bearings on the housing model's bores as `ref` matches them
+    (housingfe.drivetrain.bore_matching.match_bores; InputError "<path>: housing.bores...: ..."), and a report row
+    per bearing (matched_bores_summary)."""
+    from housingfe.drivetrain.bore_matching import match_bores, matched_bores_summary
+
+    first = next(iter(drivetrains.values()))
+    try:
+        surfaces = match_bores(model, first, ref.bores, ref.match, ref.bore_tolerance)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
+    return ({t: dt.with_bores(surfaces) for t, dt in drivetrains.items()},
+            matched_bores_summary(model, surfaces))
 
 
 def housing_model_for(housing_scene, f_lines_max: float, comm):
