@@ -3,7 +3,7 @@ CalculiX (C3D10 on the very same mesh), the Craig–Bampton export beside the mo
 
 The housing: the package's test gearbox (565 x 300 x 375 mm, 10 mm walls, two bores of 170 mm) written to STEP
 by its own OpenCASCADE model (housingfe.geometry.cad.write_step, metres) and read back as geometry kind "cad",
-P2 on gmsh's linear tetrahedra of mesh.size (full: 30 mm, ~0.1 M DOFs; --quick: 60 mm).
+P2 on gmsh's linear tetrahedra of mesh.size (full: 13.5 mm, ~0.3 M DOFs; --quick: 60 mm, 28 k).
 
 Cases, each in its own process (wall time includes start-up, import, meshing, assembly, solve; peak memory is the
 process's own, summed over ranks):
@@ -37,7 +37,7 @@ from housingfe.benchmarks.modal import load_average, parse_calculix_frequencies
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 F_MAX = 4000.0          # Hz
-SIZE = 0.03             # m: ~0.11 M P2 DOFs on the test gearbox (0.3 M at 17 mm: CalculiX would take hours here)
+SIZE = 0.0135           # m: ~0.3 M P2 DOFs on the test gearbox (30 mm: 61 k)
 QUICK_SIZE = 0.06       # m: ~25 k DOFs
 REPEATS = 2             # interleaved rounds (--quick: 1)
 HOLES, QUICK_HOLES = 1250, 200    # bolt holes of the synthetic housing inspected: 5.1 MB, 0.83 MB of STEP

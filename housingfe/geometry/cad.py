@@ -173,9 +173,6 @@ def import_solid(path: Path, units: str, heal: str = "auto", key: str | None = "
     occ = gmsh.model.occ
     where = f"{key}.file: {path}" if key else str(path)
     gmsh.option.setString("Geometry.OCCTargetUnit", "")   # OCC's default: STEP/IGES in mm (options persist)
-    # the plain STEP/IGES reader, not the one that also reads names and colours (XCAF): nothing here uses them,
-    # and it halves the read (5.1 MB STEP with 1250 holes: 26.2 -> 11.2 s on a loaded machine, same solid)
-    gmsh.option.setNumber("Geometry.OCCImportLabels", 0)
     # scaled by OpenCASCADE on reading: occ.dilate would turn planes and cylinders into B-splines (volume off
     # by 1e-3, no cylinders left for the bore selectors)
     scale = UNIT_SCALE[units]
