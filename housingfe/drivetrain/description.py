@@ -38,6 +38,7 @@ from typing import Literal
 import numpy as np
 
 from housingfe.errors import InputError
+from housingfe.solvers.blas import single_thread_blas
 from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair
 from housingfe.source.stiffness import (
@@ -50,6 +51,7 @@ from housingfe.source.stiffness import (
 
 Vector3 = tuple[float, float, float]
 SHAFTS = ("pinion", "wheel")
+_GEAR_FORCES: dict = {}        # Drivetrain.gear_forces per repr(drivetrain)
 
 
 # ------------------------------------------------------------------------------------------------ parts
@@ -305,7 +307,20 @@ class Drivetrain:
         """Mean tooth force and mean mesh stiffness at `torque`, placed in the housing: the line of action in the
         transverse plane at the operating pressure angle from the common tangent, tilted out of it by the base
         helix angle (0 for a double helical set, whose halves cancel axially); contact at the operating pitch
-        point."""
+        point.  Remembered per drivetrain (its full description is the key): the mean mesh stiffness is a
+        stiffness curve (0.2-0.8 s), and one run-up asks for it five times (coupling spec, unit loads,
+        misalignment, re-analysis)."""
+        key = repr(self)
+        cached = _GEAR_FORCES.get(key)
+        if cached is None:
+            with single_thread_blas():
+                cached = self._gear_forces()
+            if len(_GEAR_FORCES) >= 64:             # studies make many drivetrains: keep the newest
+                _GEAR_FORCES.pop(next(iter(_GEAR_FORCES)))
+            _GEAR_FORCES[key] = cached
+        return cached
+
+    def _gear_forces(self) -> GearForces:
         pair = self.gears.pair
         lumped_model = self.to_lumped()[2]
         normal = normal_force_from_torque(pair, self.torque)
@@ -322,7 +337,10 @@ class Drivetrain:
         z1, z2 = pair.teeth
         point = np.asarray(p.centre, float) + pair.centre_distance * z1 / (z1 + z2) * e_c
         # the wheel pushes the pinion along -n
-        return GearForces(-normal * n, stiffness, n, point)
+        arrays = [np.array(a, float) for a in (-normal * n, n, point)]
+        for a in arrays:                    # shared by every caller (gear_forces remembers it): read-only
+            a.setflags(write=False)
+        return GearForces(arrays[0], stiffness, arrays[1], arrays[2])
 
     def bearing_loads(self, forces: GearForces | None = None) -> dict:
         """{bearing name: (Fx, Fy, Fz, Mx, My)} (N) in each bearing's frame (housingfe.drivetrain.coupling.axis_frame

@@ -33,6 +33,7 @@ from housingfe.errors import InputError
 from housingfe.response.harmonic import Load, StructureObserver, loss_factor
 from housingfe.response.observers import node_key, responses
 from housingfe.solvers import harmonic
+from housingfe.solvers.blas import single_thread
 
 
 @dataclass
@@ -89,6 +90,7 @@ class RitzReduction:
                         "projection_s": time.perf_counter() - t2}
 
     # ------------------------------------------------------------------------------------------- projection
+    @single_thread
     def _project(self, structure, loads: dict) -> ReducedSystem:
         Kr, Mr, Cr = harmonic.project(self.vectors, structure.K, structure.M, structure.C)
         Fr = np.array([[b.dot(loads[name]) for name in self.names] for b in self.vectors])

@@ -40,6 +40,7 @@ from housingfe.radiation.power import area_level_db
 from housingfe.response.observers import node_key
 from housingfe.response.reduced import RitzReduction, modal_basis_summary
 from housingfe.solvers import harmonic, modal
+from housingfe.solvers.blas import single_thread
 
 ROUTES: dict = {}
 
@@ -189,6 +190,7 @@ class Lines:
     L_omega_flexible: np.ndarray | None = None
 
 
+@single_thread
 def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float) -> tuple[Lines, float]:
     """The source's lines up to f_lines_max (Hz) at every speed (rev/min) and torque (N m); also the time (s)."""
     t0 = time.perf_counter()
@@ -249,6 +251,7 @@ def mesh_receptance(model: GearboxModel, frequencies_hz) -> np.ndarray:
     return s.Fr[:, j] @ c
 
 
+@single_thread
 def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max: float, *,
                          first_order: bool = False, harmonics: int | None = None) -> tuple[Lines, float]:
     """The source's lines (`source_lines`, the rigid-bore source's L_omega kept for the tf_omega route) with the

@@ -27,6 +27,7 @@ import numpy as np
 from petsc4py import PETSc
 
 from housingfe.errors import SolverError
+from housingfe.solvers.blas import single_thread
 
 EtaFunction = Callable[[np.ndarray], np.ndarray]
 
@@ -229,26 +230,97 @@ def reduced_stability(Kr: np.ndarray, Mr: np.ndarray, Cr: np.ndarray, lam_e: np.
 def ritz_basis(K_sym, M, modal_result, load_vectors, *, shift: float | None = None) -> list:
     """The modes of modal_result plus, per load vector, the static residual vector of the modes left out,
     M-orthonormalised against the basis (Ritz vectors: exact for the loads' static response).  K_sym: a symmetric
-    positive semi-definite stiffness (the modes' own)."""
+    positive semi-definite stiffness (the modes' own).
+
+    All residual vectors come from one block solve (MUMPS with every load as a right-hand side: 26 loads on the
+    65 k-DOF gearbox 0.1 s instead of 1.7 s one by one) and are M-orthogonalised as a block (dense products
+    instead of one dot product per pair); a load whose residual is dependent on the others (the Cholesky
+    factor's pivot below the drop threshold) sends the block back to the one-by-one Gram-Schmidt, which drops it."""
     lam = modal_result.eigenvalues
     n_rigid = modal_result.rigid_count
     phis = list(modal_result.vectors)
     lam_e = lam[n_rigid:]
     ksp, shift, own = _residual_solver(K_sym, M, modal_result, lam_e, shift, "projected_")
+    try:
+        if not load_vectors:
+            return list(phis)
+        block = _residual_block(ksp, M, load_vectors, phis, n_rigid, lam_e, shift)
+    finally:
+        if own:
+            ksp.destroy()
+    return phis + block
+
+
+def _residual_block(solver, M, load_vectors, phis, n_rigid: int, lam_e, shift: float) -> list:
+    """The M-orthonormal residual vectors of `load_vectors` (see ritz_basis), as PETSc Vecs."""
+    from housingfe.solvers.block_eigen import _Operators
+
+    if hasattr(solver, "getPC"):                     # a KSP of our own: its MUMPS factor solves the block
+        solver.setUp()
+        factor = solver.getPC().getFactorMatrix()
+    else:                                            # the eigensolve's kept ShiftedSolver
+        factor = solver.factor
+    ops = _Operators(factor, M)
+    try:
+        Phi = np.column_stack([p.getArray(readonly=True) for p in phis]) if phis else None
+        F = np.column_stack([f.getArray(readonly=True) for f in load_vectors])
+        P = F
+        if n_rigid:                                  # P f = f - M phi_r (phi_r^T f)
+            Pr = Phi[:, :n_rigid]
+            P = F - ops.mass(Pr) @ ops.gram(Pr, F)
+        R = ops.solve(P)
+        if len(lam_e):                               # minus the kept elastic modes' static part
+            Pe = Phi[:, n_rigid:]
+            R -= Pe @ (ops.gram(Pe, F) / (np.asarray(lam_e) - shift)[:, None])
+        if n_rigid:                                  # M-orthogonal to the rigid modes (round-off)
+            R -= Pr @ ops.gram(Pr, ops.mass(R))
+        norms_f = np.sqrt(np.maximum(ops.mpi.allreduce(np.sum(F * F, axis=0)), 1e-300))
+        for _ in range(2):                           # against the modes: classical Gram-Schmidt, twice (CGS2)
+            if Phi is not None:
+                R -= Phi @ ops.gram(Phi, ops.mass(R))
+        MR = ops.mass(R)
+        G = ops.gram(R, MR)
+        try:
+            L = np.linalg.cholesky(0.5 * (G + G.T))
+            ok = bool(np.all(np.diag(L) > 1e-12 * np.sqrt(norms_f)))
+        except np.linalg.LinAlgError:
+            ok = False
+        if not ok:
+            return _residual_one_by_one(R, M, phis, norms_f)
+        R = np.linalg.solve(L, R.T).T                # sequential Gram-Schmidt among the loads, as one solve
+        for _ in range(2):                           # round-off: once more against the modes, then CholQR
+            if Phi is not None:
+                R -= Phi @ ops.gram(Phi, ops.mass(R))
+            G = ops.gram(R, ops.mass(R))
+            R = np.linalg.solve(np.linalg.cholesky(0.5 * (G + G.T)), R.T).T
+        out = []
+        for j in range(R.shape[1]):
+            v = M.createVecRight()
+            v.getArray()[:] = R[:, j]
+            out.append(v)
+        return out
+    finally:
+        ops.mass_products.destroy()
+
+
+def _residual_one_by_one(R: np.ndarray, M, phis: list, norms_f: np.ndarray) -> list:
+    """Gram-Schmidt (CGS2) of the residual columns R one by one against the growing basis, dropping a vector
+    whose M-norm falls below 1e-12 sqrt(|f|) (a load dependent on the others)."""
     basis = list(phis)
-    for f in load_vectors:
-        r = _residual_vector(ksp, M, f, phis[:n_rigid], phis[n_rigid:], lam_e, shift)
-        for _ in range(2):                      # M-orthogonal to the basis: classical Gram-Schmidt, twice (CGS2)
+    out = []
+    for j in range(R.shape[1]):
+        r = M.createVecRight()
+        r.getArray()[:] = R[:, j]
+        for _ in range(2):
             Mr = _mult(M, r)
             for b, c in [(b, b.dot(Mr)) for b in basis]:
                 r.axpy(-c, b)
         norm = math.sqrt(max(r.dot(_mult(M, r)), 0.0))
-        if norm > 1e-12 * math.sqrt(max(f.norm(), 1e-300)):
+        if norm > 1e-12 * math.sqrt(norms_f[j]):
             r.scale(1.0 / norm)
             basis.append(r)
-    if own:
-        ksp.destroy()
-    return basis
+            out.append(r)
+    return out
 
 
 def project(basis, K, M, C=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -294,6 +366,7 @@ def modal_damping_matrix(size: int, n_rigid: int, lam_e: np.ndarray, xi: np.ndar
     return D
 
 
+@single_thread
 def solve_reduced(Kr, Mr, Cr, omega, eta, Fr) -> np.ndarray:
     """(loads, n, lines) solutions c of (Kr (1 + i eta) + i omega Cr - omega^2 Mr) c = Fr per line (omega rad/s, eta
     per line; Fr (n, loads)), batched."""
