@@ -464,13 +464,18 @@ class CoupledInterior:
     def interior_fraction(self, vectors) -> np.ndarray:
         """Share of each mass-normalised coupled mode's kinetic energy in the interior (shafts, gears, rods):
         1 - u_fe^T M_fe u_fe."""
-        out = []
-        for q in vectors:
-            u = self.fe_vector(q)
-            y = self.model.M.createVecLeft()
-            self.model.M.mult(u, y)
-            out.append(1.0 - y.dot(u) / q.dot(_mult(self.system.M, q)))
-        return np.array(out)
+        from housingfe.solvers import blocks
+
+        if not len(vectors):
+            return np.zeros(0)
+        comm = self.system.M.getComm()
+        Q = blocks.columns(vectors)
+        U = blocks.columns([self.fe_vector(q) for q in vectors])
+        housing = np.einsum("ij,ij->j", U, blocks.mat_block(self.model.M, U))
+        total = np.einsum("ij,ij->j", Q, blocks.mat_block(self.system.M, Q))
+        if comm.getSize() > 1:
+            housing, total = comm.tompi4py().allreduce(np.array([housing, total]))
+        return 1.0 - housing / total
 
     def shaft_axis(self, node: str) -> np.ndarray:
         """Unit axis of the shaft a node "<shaft>:<i>" belongs to."""
@@ -496,12 +501,6 @@ def nearest_psd(K: np.ndarray) -> np.ndarray:
     symmetric part."""
     lam, vec = np.linalg.eigh((K + K.T) / 2)
     return (vec * np.clip(lam, 0.0, None)) @ vec.T
-
-
-def _mult(A, x):
-    y = A.createVecLeft()
-    A.mult(x, y)
-    return y
 
 
 def build_interior(model, spec: CouplingSpec, f_max: float) -> CoupledInterior:

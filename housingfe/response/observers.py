@@ -20,6 +20,7 @@ from mpi4py import MPI
 
 from housingfe import levels
 from housingfe.errors import InputError
+from housingfe.solvers import blocks
 
 
 # ------------------------------------------------------------------------------ sample points
@@ -354,12 +355,11 @@ class SurfaceObserver:
         n = len(vectors)     # may be 0: a modal basis without modes below its limit and without residual
         loads = np.array([[f.dot(x) for x in vectors] for f in self.load_vectors]).reshape(len(self.load_vectors), n)
         vectors = vectors if housing_vectors is None else housing_vectors
-        Wv = []
-        for x in vectors:
-            y = self.W.createVecLeft()
-            self.W.mult(x, y)
-            Wv.append(y)
-        gram = np.array([[a.dot(b) for b in Wv] for a in vectors]).reshape(n, n)
+        if n:           # the Gram matrix X^T W X as one block product (n^2 dot products took 0.3 s at n = 91)
+            X = blocks.columns(vectors)
+            gram = blocks.gram(X, blocks.mat_block(self.W, X), self.W.getComm())
+        else:
+            gram = np.zeros((0, 0))
         points = {N: np.array([ev.normal_values(x) for x in vectors]).reshape(n, len(ev.samples.points)).T
                   for N, ev in self.evaluators.items()}
         return Reduced(gram, points, loads)
