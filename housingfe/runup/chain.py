@@ -121,6 +121,7 @@ def bearing_pairs(structure) -> list:
     return out
 
 
+@single_thread
 def build_gearbox_model(housing_model, drivetrain, f_lines_max: float, *, damping_ratio: float = 0.04,
                         basis_factor: float = 1.5, radiators: dict | None = None,
                         surface: str = "outer") -> GearboxModel:
@@ -150,6 +151,7 @@ def build_gearbox_model(housing_model, drivetrain, f_lines_max: float, *, dampin
                         float(f_lines_max), share, timings)
 
 
+@single_thread
 def with_drivetrain(model: GearboxModel, drivetrain) -> GearboxModel:
     """The same housing and Ritz vectors with another drivetrain of the same layout (gear set, torque, bearings):
     its coupled K, M, C projected on the vectors (a Rayleigh-Ritz re-analysis, seconds instead of a new basis)."""

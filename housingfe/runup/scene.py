@@ -24,6 +24,7 @@ from pydantic import Field, PositiveFloat, PositiveInt, field_validator, model_v
 from housingfe.errors import InputError
 from housingfe.scene import RadiationPlate
 from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table, read_scene_dict
+from housingfe.solvers.blas import single_thread
 from housingfe.source.dynamics import DEFAULT_ENGAGEMENT
 from housingfe.source.operating import SPEED_RANGE_RPM
 
@@ -215,6 +216,7 @@ def drivetrain_of(spec: DrivetrainSpec, torque: float):
     return replace(dt, bearing_speed_rpm=spec.bearing_speed_rpm)
 
 
+@single_thread
 def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
     """`housingfe run <runup scene>`: build the coupled gearbox once, run the source and the routes over speed and
     torque, write runup.csv, runup_harmonics.csv, spectra, plots, checks and runup.json atomically."""
