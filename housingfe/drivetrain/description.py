@@ -51,7 +51,7 @@ from housingfe.source.stiffness import (
 
 Vector3 = tuple[float, float, float]
 SHAFTS = ("pinion", "wheel")
-_GEAR_FORCES: dict = {}        # Drivetrain.gear_forces per repr(drivetrain)
+_GEAR_FORCES: dict = {}        # Drivetrain.gear_forces per what it depends on (repr)
 
 
 # ------------------------------------------------------------------------------------------------ parts
@@ -307,10 +307,12 @@ class Drivetrain:
         """Mean tooth force and mean mesh stiffness at `torque`, placed in the housing: the line of action in the
         transverse plane at the operating pressure angle from the common tangent, tilted out of it by the base
         helix angle (0 for a double helical set, whose halves cancel axially); contact at the operating pitch
-        point.  Remembered per drivetrain (its full description is the key): the mean mesh stiffness is a
+        point.  Remembered per gear set, shaft lines, lumped spans, torque and mesh positions (what it depends
+        on; not the FE bearings, so another bearing configuration shares it): the mean mesh stiffness is a
         stiffness curve (0.2-0.8 s), and one run-up asks for it five times (coupling spec, unit loads,
         misalignment, re-analysis)."""
-        key = repr(self)
+        key = repr((self.gears, self.shafts, self.lumped_bearing_spans, float(self.torque),
+                    self.coupling_mesh_positions))
         cached = _GEAR_FORCES.get(key)
         if cached is None:
             with single_thread_blas():

@@ -32,7 +32,7 @@ import scipy.linalg
 from housingfe.errors import InputError
 from housingfe.response.harmonic import Load, StructureObserver, loss_factor
 from housingfe.response.observers import node_key, responses
-from housingfe.solvers import harmonic
+from housingfe.solvers import blocks, harmonic
 from housingfe.solvers.blas import single_thread
 
 
@@ -49,6 +49,10 @@ class ReducedSystem:
     D: np.ndarray | None
     frequencies_hz: np.ndarray
     Y: np.ndarray
+
+
+# a re-analysis projects the change of the matrices when it touches at most this share of the rows
+CHANGE_SHARE = 0.05
 
 
 class RitzReduction:
@@ -91,8 +95,8 @@ class RitzReduction:
 
     # ------------------------------------------------------------------------------------------- projection
     @single_thread
-    def _project(self, structure, loads: dict) -> ReducedSystem:
-        Kr, Mr, Cr = harmonic.project(self.vectors, structure.K, structure.M, structure.C)
+    def _project(self, structure, loads: dict, matrices=None) -> ReducedSystem:
+        Kr, Mr, Cr = matrices or harmonic.project(self.vectors, structure.K, structure.M, structure.C)
         Fr = np.array([[b.dot(loads[name]) for name in self.names] for b in self.vectors])
         Ks = 0.5 * (Kr + Kr.T)
         Ms = 0.5 * (Mr + Mr.T)
@@ -118,9 +122,38 @@ class RitzReduction:
         other.__dict__.update(self.__dict__)
         other.structure = structure
         other.loads = dict(loads)
-        other.system = other._project(structure, loads)
+        other.system = other._project(structure, loads, self._projected_change(structure))
         other.timings = {**self.timings, "reanalysis_s": time.perf_counter() - t0}
         return other
+
+    def _projected_change(self, structure):
+        """(Kr, Mr, Cr) of `structure` as this reduction's plus the projection of the difference of the
+        matrices, or None (project afresh).  Another drivetrain of the same layout changes only the rows of
+        the interior (bearing matrices, mesh stiffness, gear bodies: ~300 of 65 k DOFs): X_R^T dA_RC X_C on
+        those rows instead of two products with the whole matrix (1.1-1.4 s -> ~0.2 s on the 65 k-DOF
+        gearbox).  One MPI rank only (the columns of the rows would have to be gathered); more than
+        CHANGE_SHARE of the rows changed (another housing, another mesh) projects afresh."""
+        if structure.K.getComm().getSize() > 1:
+            return None
+        old = self.structure
+        if not hasattr(self, "_columns"):
+            self._columns = blocks.columns(self.vectors)      # shared with the re-analyses (copied __dict__)
+        X = self._columns
+        s = self.system
+        out = []
+        for A_old, A_new, R in ((old.K, structure.K, s.Kr), (old.M, structure.M, s.Mr), (old.C, structure.C, s.Cr)):
+            dA = blocks.csr_difference(A_old, A_new, X.shape[0])
+            if dA is None:
+                return None
+            rows = np.flatnonzero(np.diff(dA.indptr))
+            if len(rows) > CHANGE_SHARE * X.shape[0]:
+                return None
+            if len(rows):
+                sub = dA[rows]
+                cols = np.unique(sub.indices)
+                R = R + X[rows].T @ (sub[:, cols] @ X[cols])
+            out.append(np.array(R, dtype=float, copy=True))
+        return tuple(out)
 
     def with_damping(self, damping) -> "RitzReduction":
         """The same reduction with another damping (Damping or loss factor): only the small system changes."""

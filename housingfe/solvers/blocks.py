@@ -31,3 +31,28 @@ def gram(X: np.ndarray, Y: np.ndarray, comm) -> np.ndarray:
     local = X.T @ Y
     mpi = comm.tompi4py() if hasattr(comm, "tompi4py") else comm
     return mpi.allreduce(local) if mpi.Get_size() > 1 else local
+
+
+def csr_difference(A_old, A_new, rows: int):
+    """A_new - A_old (scipy CSR, zeros dropped) of two PETSc AIJ matrices on one rank (None counts as zero), or
+    None when either is not an AIJ matrix of `rows` rows."""
+    import scipy.sparse as sp
+
+    def csr(A):
+        if A is None:
+            return sp.csr_matrix((rows, rows))
+        try:
+            ptr, idx, val = A.getValuesCSR()
+        except PETSc.Error:
+            return None
+        return sp.csr_matrix((val, idx, ptr), shape=A.getSize())
+
+    a, b = csr(A_old), csr(A_new)
+    if a is None or b is None or a.shape != (rows, rows) or b.shape != (rows, rows):
+        return None
+    if a.nnz == b.nnz and np.array_equal(a.indptr, b.indptr) and np.array_equal(a.indices, b.indices):
+        d = sp.csr_matrix((b.data - a.data, a.indices, a.indptr), shape=a.shape)
+    else:
+        d = b - a
+    d.eliminate_zeros()
+    return d
