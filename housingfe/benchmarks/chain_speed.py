@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -62,7 +63,7 @@ def _baseline_tree(where: Path) -> Path:
 
 def _run(version: str, tree: Path, work: Path, tag: str, overrides: list[str]) -> dict:
     """One fresh process of the driver on `tree`: its result dict plus wall, CPU and load."""
-    driver = Path(__file__).with_name("_chain_driver.py")
+    driver = work / "new" / "housingfe" / "benchmarks" / "_chain_driver.py"
     out, result = work / f"{tag}-out", work / f"{tag}.json"
     env = dict(os.environ, PYTHONPATH=str(tree))
     load = os.getloadavg()[0]
@@ -161,7 +162,11 @@ def main(out_dir: Path, quick: bool) -> None:
     runs, raw = [], {"old": [], "new": []}
     with tempfile.TemporaryDirectory(prefix="chain-speed-") as tmp:
         work = Path(tmp)
-        trees = {"old": _baseline_tree(work), "new": new_tree}
+        # a copy of this tree: editing it while the rounds run must not change the "new" code under test
+        new_copy = work / "new"
+        shutil.copytree(new_tree / "housingfe", new_copy / "housingfe",
+                        ignore=shutil.ignore_patterns("__pycache__"))
+        trees = {"old": _baseline_tree(work), "new": new_copy}
         for rnd in range(rounds):
             order = ("old", "new") if rnd % 2 == 0 else ("new", "old")
             for version in order:
