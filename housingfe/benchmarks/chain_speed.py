@@ -133,13 +133,13 @@ def _plot(path: Path, rows: list[dict]) -> None:
         left = 0.0
         for i, (k, v) in enumerate(med.items()):
             axes[0].barh([dx], [v], left=left, height=0.35, color=plt.cm.tab10(i),
-                         label=k.replace("_s", "") if version == "new" else None)
+                         label=k.removesuffix("_s") if version == "new" else None)
             left += v
         axes[0].plot([float(np.median([r["chain_wall_s"] for r in sel]))], [dx], "k|", ms=18)
         keys = [k for k in sel[0] if k.startswith("reanalysis_")]
         axes[1].bar(np.arange(len(keys)) + dx, [float(np.median([r[k] for r in sel])) for k in keys], 0.4,
                     color=colour, label=version)
-        axes[1].set_xticks(np.arange(len(keys)), [k.replace("reanalysis_", "").replace("_s", "") for k in keys])
+        axes[1].set_xticks(np.arange(len(keys)), [k.removeprefix("reanalysis_").removesuffix("_s") for k in keys])
     axes[0].set_yticks([-0.2, 0.2], ["old", "new"])
     axes[0].set_xlabel("median wall time [s] (stages; | = whole chain from process start)")
     axes[0].legend(fontsize=7, ncol=3)
