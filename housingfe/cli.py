@@ -21,7 +21,7 @@ _EXTENSIONS = (
     "housingfe.radiation",
     "housingfe.reference",
     "housingfe.source.cli",
-    "housingfe.source.studies",
+    "housingfe.source.roosmalen.studies",
     "housingfe.studies.bearing_variants",
     "housingfe.studies.reduce",
     "housingfe.studies.design_variants",

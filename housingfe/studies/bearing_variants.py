@@ -63,7 +63,7 @@ def gear_forces(gear_set: str, torque: float, point, pinion_centre, wheel_centre
     common tangent, tilted out of it by the base helix angle (0 for a double helical set, whose two halves
     cancel axially)."""
     from housingfe.scenefile import read_scene_dict
-    from housingfe.source import roosmalen
+    from housingfe.source.roosmalen import run as roosmalen
     from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
 
     data, path = read_scene_dict(GEAR_SCENES[gear_set])

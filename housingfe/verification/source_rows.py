@@ -2,12 +2,12 @@
 
 - van Roosmalen (1994) Appendix F: gear geometry, contact ratios, loads of the single and double helical test
   gears (housingfe.source.gears), Sec. 5.2 tooth deflection, Sec. 5.3 L_omega of gear set A, Sec. 5.7 effect
-  of the profile corrections (housingfe.source.roosmalen); published values from housingfe/data/roosmalen1994.toml;
-- issue 28: the quasi-static excitation's envelope over the tooth harmonics (housingfe.source.studies);
-- Trueman (1974) Table 6.1 and Sec. 6.9 critical speeds (housingfe.source.trueman); published values from
-  housingfe.source.trueman_data;
+  of the profile corrections (housingfe.source.roosmalen.run); published values from housingfe/data/roosmalen1994.toml;
+- issue 28: the quasi-static excitation's envelope over the tooth harmonics (housingfe.source.roosmalen.studies);
+- Trueman (1974) Table 6.1 and Sec. 6.9 critical speeds (housingfe.source.trueman.response); published values from
+  housingfe.source.trueman.data;
 - Fukuma et al. (1973) Table 1 shaft stiffness from the equivalent radius and the Sec. 4.2 tilt resonance
-  (housingfe.source.fukuma); published values from the fukuma-series-a/-b scenes, which carry Table 1.
+  (housingfe.source.fukuma.model); published values from the fukuma-series-a/-b scenes, which carry Table 1.
 
 `published_rows()` returns them in the `housingfe.verification.published.row` format (about 40 s on one core).
 """
@@ -82,8 +82,8 @@ def appendix_f_rows() -> list[dict]:
 
 def _gear_set(name: str):
     """(pair, corrections, interior, mesh model, table) of a built-in roosmalen source scene."""
-    from housingfe.source import roosmalen as rs
     from housingfe.source.cli import load_scene
+    from housingfe.source.roosmalen import run as rs
 
     scene, path = load_scene(name)
     table = rs.parse(scene, str(path))
@@ -93,8 +93,8 @@ def _gear_set(name: str):
 
 def roosmalen_source_rows() -> list[dict]:
     """Sec. 5.2 tooth deflection, Sec. 5.3 L_omega of gear set A at 2000 N m, Sec. 5.7 profile corrections."""
-    from housingfe.source import dynamics as dyn
-    from housingfe.source import roosmalen as rs
+    from housingfe.source.roosmalen import dynamics as dyn
+    from housingfe.source.roosmalen import run as rs
     from housingfe.source.stiffness import stiffness_curve
 
     out = []
@@ -145,8 +145,13 @@ def roosmalen_source_rows() -> list[dict]:
 def excitation_rows() -> list[dict]:
     """Issue 28 check "quasi-static excitation: the harmonics' envelope decays at least as 1/n with no flat range
     for every set": for every gear set and both engagement models, the smallest octave drop of the upper envelope
-    of k_m (d - mean d) over the harmonics 1-15 (housingfe.source.studies.envelope_decay; 1/n gives 6.0 dB)."""
-    from housingfe.source.studies import FLAT_OCTAVE_DB, SPECTRUM_SCENES, envelope_decay, excitation_spectrum
+    of k_m (d - mean d) over the harmonics 1-15 (housingfe.source.roosmalen.studies.envelope_decay; 1/n gives 6.0 dB)."""
+    from housingfe.source.roosmalen.studies import (
+        FLAT_OCTAVE_DB,
+        SPECTRUM_SCENES,
+        envelope_decay,
+        excitation_spectrum,
+    )
 
     rows = excitation_spectrum(SPECTRUM_SCENES, harmonics=15)
     out = []
@@ -170,8 +175,8 @@ def excitation_rows() -> list[dict]:
 def trueman_rows() -> list[dict]:
     """Table 6.1 critical speeds of the 10-box drives (drawroll rpm; the configurations the model cannot
     represent as rows without a value) and the 4-box rig of Sec. 6.9."""
-    from housingfe.source import trueman as tr
-    from housingfe.source import trueman_data as data
+    from housingfe.source.trueman import data
+    from housingfe.source.trueman import response as tr
 
     out = []
     for name, published in data.TABLE_6_1_RPM.items():
@@ -202,9 +207,9 @@ def fukuma_rows() -> list[dict]:
     against the printed K_s; Sec. 4.2: the phi_V tilt natural frequency of series A near 3 f_z at 650 rpm."""
     import scipy.linalg as sl
 
-    from housingfe.source import fukuma as fk
     from housingfe.source.cli import load_scene
-    from housingfe.source.fukuma_run import build_pair, parse_scene
+    from housingfe.source.fukuma import model as fk
+    from housingfe.source.fukuma.run import build_pair, parse_scene
 
     out = []
     for series in ("a", "b"):

@@ -214,7 +214,7 @@ def test_radiation_rows_carry_appendix_e_and_reproduce_it():
 
 @pytest.mark.slow
 def test_source_rows_carry_appendix_f_trueman_and_fukuma():
-    from housingfe.source import trueman_data
+    from housingfe.source.trueman import data as trueman_data
     from housingfe.verification import source_rows as validation
 
     rows = validation.published_rows()

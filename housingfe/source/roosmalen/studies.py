@@ -10,7 +10,7 @@
   excitation spectrum (issue 28): the quasi-static engagement shock F_e and excitation k_m (d - mean d) per
       tooth harmonic of the built-in gear sets, both engagement models (`housingfe source-spectrum`).
 
-Run: `python -m housingfe.source.studies [out_dir]` (default results/source-studies); writes CSV + PNG.
+Run: `python -m housingfe.source.roosmalen.studies [out_dir]` (default results/source-studies); writes CSV + PNG.
 """
 from __future__ import annotations
 
@@ -56,7 +56,7 @@ def main(out_dir: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from housingfe.source.roosmalen import correction_study
+    from housingfe.source.roosmalen.run import correction_study
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -118,9 +118,9 @@ def excitation_spectrum(scenes=SPECTRUM_SCENES, harmonics: int = 15, torque_nm: 
     and excitation_N: one-sided amplitude of k_m (d - mean d) with d = (F - F_e) / S(t) the quasi-static mesh
     compression (what mesh stiffness variation and shock together impose on a structure that holds the mean
     stiffness k_m: the load of the run-up's mesh_force route at low speed), N."""
-    from housingfe.source import dynamics as dyn
-    from housingfe.source import roosmalen as rs
     from housingfe.source.cli import load_scene
+    from housingfe.source.roosmalen import dynamics as dyn
+    from housingfe.source.roosmalen import run as rs
 
     rows = []
     for name in scenes:

@@ -10,8 +10,8 @@ from scipy.integrate import solve_ivp
 
 import housingfe
 from housingfe.levels import OMEGA0
-from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair
+from housingfe.source.roosmalen import dynamics as dyn
 from housingfe.source.stiffness import (
     Corrections,
     MeshModel,

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from housingfe.source import dynamics as dyn
+from housingfe.source.roosmalen import dynamics as dyn
 from tests.source.test_dynamics import GEOMETRY, K_MEAN, PAIR
 
 H = 12

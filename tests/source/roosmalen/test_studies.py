@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from housingfe.source.studies import envelope_decay
+from housingfe.source.roosmalen.studies import envelope_decay
 
 HOUSINGFE = [sys.executable, "-m", "housingfe"]
 ENV = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2]), "OPENBLAS_NUM_THREADS": "1"}
