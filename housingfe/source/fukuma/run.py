@@ -259,7 +259,7 @@ def bench_rows(quick: bool) -> list[dict]:
 
     from housingfe.source.fukuma import model as fk
 
-    path = Path(__file__).parents[1] / "scenes" / "fukuma-series-a.toml"
+    path = Path(__file__).parents[2] / "scenes" / "fukuma-series-a.toml"
     scene = tomllib.loads(path.read_text())
     sc = parse_scene(scene, str(path))
     pair, _ = build_pair(sc)

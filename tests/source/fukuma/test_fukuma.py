@@ -127,7 +127,7 @@ def test_bearing_loads_balance_the_gear_load():
 
 
 def _load(name):
-    path = Path(fk.__file__).parents[1] / "scenes" / f"{name}.toml"
+    path = Path(fk.__file__).parents[2] / "scenes" / f"{name}.toml"
     return tomllib.loads(path.read_text()), str(path)
 
 

@@ -16,7 +16,7 @@ import pytest
 import scipy.linalg as sla
 
 from housingfe.source.roosmalen import dynamics as dyn
-from tests.source.test_dynamics import GEOMETRY, K_MEAN, PAIR
+from tests.source.roosmalen.test_dynamics import GEOMETRY, K_MEAN, PAIR
 
 H = 12
 

@@ -225,7 +225,7 @@ def _load_scene(name):
     import tomllib
     from pathlib import Path
 
-    path = Path(tr.__file__).parents[1] / "scenes" / f"{name}.toml"
+    path = Path(tr.__file__).parents[2] / "scenes" / f"{name}.toml"
     return tomllib.loads(path.read_text()), str(path)
 
 
