@@ -4,12 +4,13 @@ housingfe/data/roosmalen1994.toml).
 
 Computes, on rigid bores, the periodic steady state of the 15-DOF lumped gearbox interior under the time-varying
 mesh stiffness and the engagement shock (harmonic balance): mesh force, transmission error, bearing force spectra
-and the wheel's angular acceleration level L_omega (dB) per tooth harmonic, over speed and torque.
+and the wheel's angular velocity level L_omega (dB) per tooth harmonic, over speed and torque.
 
   `dynamics`   the lumped interior (Sec. 2.5-2.7, Appendix C), engagement shock, harmonic balance, levels
   `operating`  the source as a stage of the chain: `SourceModel.operating_point(speed_rpm, torque_nm)`
   `run`        scene schema and `run_scene` for `housingfe source gearset-*`, `correction_study`
-  `studies`    overlap-ratio and correction studies, excitation spectrum (`housingfe source-spectrum`)
+  `studies`    overlap-ratio and correction studies, excitation spectrum (`housingfe source-spectrum`); not
+               imported here, so that `python -m housingfe.source.roosmalen.studies` runs it without a warning
 """
 from housingfe.source.roosmalen.dynamics import (
     ENGAGEMENT_MODELS,
@@ -26,7 +27,6 @@ from housingfe.source.roosmalen.dynamics import (
 )
 from housingfe.source.roosmalen.operating import Excitation, SourceModel
 from housingfe.source.roosmalen.run import OperatingPoint, build, correction_study, parse, run_scene
-from housingfe.source.roosmalen.studies import envelope_decay, excitation_spectrum, overlap_study
 
 __all__ = [
     "ENGAGEMENT_MODELS",
@@ -42,11 +42,8 @@ __all__ = [
     "correction_study",
     "derive_interior",
     "engagement_shock",
-    "envelope_decay",
-    "excitation_spectrum",
     "harmonic_balance",
     "mesh_harmonic_balance",
-    "overlap_study",
     "parse",
     "run_scene",
     "tooth_band_level",
