@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -265,4 +264,10 @@ def register_cli(subparsers) -> None:
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("results/source-studies"))
+
+    # argparse, so that `--help` prints help instead of becoming the name of the output folder
+    parser = argparse.ArgumentParser(prog="python -m housingfe.source.roosmalen.studies",
+                                     description="Overlap-ratio study (Fig. 2.9) and correction study (Fig. 2.18): "
+                                                 "CSV + PNG into OUT_DIR.")
+    parser.add_argument("out_dir", nargs="?", default="results/source-studies", type=Path)
+    main(parser.parse_args().out_dir)
