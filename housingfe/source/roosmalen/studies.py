@@ -264,7 +264,6 @@ def register_cli(subparsers) -> None:
 
 
 if __name__ == "__main__":
-
     # argparse, so that `--help` prints help instead of becoming the name of the output folder
     parser = argparse.ArgumentParser(prog="python -m housingfe.source.roosmalen.studies",
                                      description="Overlap-ratio study (Fig. 2.9) and correction study (Fig. 2.18): "
