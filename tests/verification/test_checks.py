@@ -212,3 +212,31 @@ def test_rows_reach_validate_from_a_cached_default_runup(tmp_path):
     validate.write_outputs(rows, tmp_path / "out", None)
     table = (tmp_path / "out" / "checks.md").read_text()
     assert f"| 28.default.peaks.{ROUTE} |" in table and table.rstrip().endswith("0 reported")
+
+
+def test_only_with_scene_names_is_bad_input_one_line(tmp_path):
+    """`housingfe validate --only runup-checks box-free`: one error line, exit 2, nothing written."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "housingfe", "validate", "--only", "runup-checks", "box-free",
+                           "--out", str(tmp_path / "v"), "--results", str(tmp_path / "r")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [
+        "housingfe: error: validate: --only and scene names: give one or the other"]
+    assert not (tmp_path / "v").exists()
+
+
+def test_bands_reach_the_json_and_checks_csv(tmp_path):
+    r = ck.check_row("28.replica.max_lwa", "s", "q", 88.6, "dB(A)", "src", measured=100.5, thesis_calculated=89.4,
+                     tolerance="1.5 dB", passed=True)
+    ck.attach_bands([r], {"28.replica.max_lwa": (86.0, 91.0)})
+    validate.write_outputs([r, {"scene": "x", "quantity": "y", "ours": 1.0, "published": 1.0, "unit": "-",
+                                "source": "z"}], tmp_path / "out", tmp_path / "rows.json")
+    stored = json.loads((tmp_path / "rows.json").read_text())
+    assert stored[0]["band"] == [86.0, 91.0] and stored[0]["check_id"] == "28.replica.max_lwa"
+    assert "check_id" not in stored[1]
+    with open(tmp_path / "out" / "checks.csv") as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert row["band"] == "86 … 91: measured outside" and row["passed"] == "yes"
