@@ -97,6 +97,29 @@ def attach_bands(rows, bands) -> int:
     return n
 
 
+def read_bands(path) -> dict[str, tuple[float, float]]:
+    """Bands from a JSON file {check_id: [low, high]} (`housingfe validate --bands FILE`); InputError naming the file
+    and key for anything else."""
+    import json
+
+    from housingfe.errors import InputError
+
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: cannot read a JSON object of bands: {exc}") from None
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: must be a JSON object {{check_id: [low, high]}}")
+    out = {}
+    for key, value in data.items():
+        ok = (isinstance(value, list) and len(value) == 2
+              and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value))
+        if not ok or value[0] > value[1]:
+            raise InputError(f"{path}: {key}: must be [low, high] with finite numbers, low <= high, not {value!r}")
+        out[key] = (float(value[0]), float(value[1]))
+    return out
+
+
 def band_text(row: dict) -> str:
     """"—" without a band; else "low … high" and whether the measured value is inside it."""
     band = row.get("band")

@@ -81,19 +81,24 @@ ONLY = ("runup-checks",)     # `housingfe validate --only ...`: a subset compute
 
 def main(out_dir: str | Path = "results/validate", json_path: str | Path | None = None,
          scenes: list[str] | None = None, quick: bool = False, results_dir: str | Path | None = None,
-         only: str | None = None) -> list[dict]:
+         only: str | None = None, bands: str | Path | None = None) -> list[dict]:
     """Collect the rows, print them, write validate.csv and validate.md to out_dir, and the check rows of issue 28
     (housingfe.verification.checks) to checks.csv and checks.md (and the JSON list of rows to json_path if
     given).  scenes: names or paths (only their rows); default every built-in housing scene with a reference and a
     modal analysis plus the other modules' rows; quick: the CI subset; only="runup-checks": the check rows of
-    issue 28 alone (runup_check_rows).  results_dir: where FE results are cached (default results/).  Raises
-    SolverError (one line) after writing the table when a computation failed."""
+    issue 28 alone (runup_check_rows).  results_dir: where FE results are cached (default results/).  bands: a JSON
+    file {check_id: [low, high]} of the model's uncertainty bands, attached to the check rows (checks.attach_bands;
+    without it every band is "—").  Raises SolverError (one line) after writing the table when a computation
+    failed."""
     from housingfe.progress import Progress
 
     if only is not None and only not in ONLY:
         raise InputError(f"validate: --only: {only!r} is not one of {', '.join(ONLY)}")
     if only is not None and scenes:
         raise InputError("validate: --only and scene names: give one or the other")
+    from housingfe.verification.checks import attach_bands, read_bands
+
+    band_table = read_bands(bands) if bands is not None else {}
 
     t0 = time.perf_counter()
     results = Path(results_dir) if results_dir is not None else RESULTS
@@ -106,6 +111,7 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     if only == "runup-checks":
         failures: list[str] = []
         rows = runup_check_rows(results, quick, failures)
+        attach_bands(rows, band_table)
         write_outputs(rows, Path(out_dir), json_path)
         from housingfe.verification.checks import checks_markdown
 
@@ -154,6 +160,7 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
                 progress.update(note=name)
         rows += provider_rows(failures, progress, results=results, quick=quick)
     progress.close()
+    attach_bands(rows, band_table)
     write_outputs(rows, Path(out_dir), json_path)
     print(format_rows(rows))
     print(f"{len(rows)} rows in {time.perf_counter() - t0:.0f} s; written to {out_dir}/validate.csv, validate.md "

@@ -240,3 +240,20 @@ def test_bands_reach_the_json_and_checks_csv(tmp_path):
     with open(tmp_path / "out" / "checks.csv") as fh:
         (row,) = list(csv.DictReader(fh))
     assert row["band"] == "86 … 91: measured outside" and row["passed"] == "yes"
+
+
+def test_a_bad_bands_file_is_one_error_line(tmp_path):
+    import subprocess
+    import sys
+
+    good = tmp_path / "good.json"
+    good.write_text(json.dumps({"28.replica.max_lwa": [86, 91.5]}))
+    assert ck.read_bands(good) == {"28.replica.max_lwa": (86.0, 91.5)}
+    bad = tmp_path / "bands.json"
+    bad.write_text(json.dumps({"28.replica.max_lwa": [91.0, 86.0]}))
+    proc = subprocess.run([sys.executable, "-m", "housingfe", "validate", "--only", "runup-checks", "--bands", str(bad),
+                           "--out", str(tmp_path / "v"), "--results", str(tmp_path / "r")], capture_output=True, text=True)
+    assert proc.returncode == 2 and not (tmp_path / "v").exists()
+    assert proc.stderr.strip().splitlines() == [
+        f"housingfe: error: {bad}: 28.replica.max_lwa: must be [low, high] with finite numbers, low <= high, not "
+        "[91.0, 86.0]"]
