@@ -182,10 +182,11 @@ def runup_check_rows(results: Path, quick: bool = False, failures: list[str] | N
 
     failures = [] if failures is None else failures
     rows: list[dict] = []
+    # in the order of the full validate (its run-up rows, then the providers by name), so both give one table
     for what, make in ((DEFAULT_RUNUP, lambda: runup_rows(DEFAULT_RUNUP, (), results, quick)),
-                       ("study rows", lambda: study_rows.published_rows(results, quick)),
+                       ("runup_checks_rows", lambda: runup_checks_rows.published_rows(results, quick)),
                        ("quasi-static excitation", source_rows.excitation_rows),
-                       ("runup_checks_rows", lambda: runup_checks_rows.published_rows(results, quick))):
+                       ("study rows", lambda: study_rows.published_rows(results, quick))):
         try:
             rows += make()
         except ComputationFailed as exc:
