@@ -195,7 +195,12 @@ def test_rows_reach_validate_from_a_cached_default_runup(tmp_path):
                "passed": "yes", "note": ""},
               {"check": "speed_law", "quantity": "mesh_force: speed law", "ours": 5.5, "measured": 6.0,
                "thesis_calculated": None, "goal": "within 2 dB of 6, term named", "passed": "yes",
-               "note": "made by transfer (+5.88), held back by A_weighting (-0.36); total: ..."}]
+               "note": "made by transfer (+5.88), held back by A_weighting (-0.36); total: ..."},
+              {"check": "L_omega", "quantity": "source (rigid bores): L_omega tooth band dB at 500 rpm", "ours": 88.2,
+               "measured": 109.9, "thesis_calculated": None, "goal": "report", "passed": "", "note": ""},
+              {"check": "L_omega_flexible", "quantity": "flexible housing: L_omega tooth band dB at 500 rpm",
+               "ours": 84.6, "measured": 109.9, "thesis_calculated": None, "goal": "within 6 dB of measured",
+               "passed": "no", "note": "how"}]
     folder = tmp_path / validate.DEFAULT_RUNUP
     folder.mkdir()
     _write_runup(folder, checks)
@@ -209,6 +214,11 @@ def test_rows_reach_validate_from_a_cached_default_runup(tmp_path):
     assert f"28.speed_law.{ROUTE}" in ids and f"28.default.tooth_band.L_W.{ROUTE}" in ids
     speed = next(r for r in rows if r.get("check_id") == f"28.speed_law.{ROUTE}")
     assert speed["why"] == "made by transfer (+5.88), held back by A_weighting (-0.36)"
+    flexible = next(r for r in rows if r.get("check_id") == "28.l_omega.flexible.500rpm")
+    assert flexible["passed"] == "no" and "moves it by -3.6 dB" in flexible["why"]
+    top = next(r for r in rows if r.get("check_id") == f"28.default.max_lwa.{ROUTE}")
+    assert "is -25.3 dB from the measured (mean over" in top["why"]   # mesh_force: the flexible L_omega
+    assert not any(r["quantity"].startswith("source (rigid") and r.get("check_id") for r in rows)
     validate.write_outputs(rows, tmp_path / "out", None)
     table = (tmp_path / "out" / "checks.md").read_text()
     assert f"| 28.default.peaks.{ROUTE} |" in table and table.rstrip().endswith("0 reported")
