@@ -15,7 +15,7 @@ unit, source, note) with these fields added (`tag`):
 
 Rows of other providers that already are an issue-28 check (the study rows, the default run-up's rows, the
 quasi-static excitation rows) are tagged where they are made, not repeated here; the rows no provider had are made
-by housingfe.verification.runup_checks_rows.  `checks_table` / `write_checks` give the checks alone
+by housingfe.verification.runup_checks_rows.  `checks_markdown` / `write_checks` give the checks alone
 (validate's checks.csv / checks.md; `housingfe validate --only runup-checks`).
 
 The pure pass/fail logic of the checks lives here too (tested on synthetic inputs with known answers in

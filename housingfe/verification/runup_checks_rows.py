@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from housingfe.errors import SolverError
 from housingfe.verification import checks as ck
 
 SOURCE = "van Roosmalen 1994, Ch. 5 (Secs. 5.4-5.6, Figs. 5.6, 5.7, 5.10) [test_gearbox]; issue 28"
@@ -49,6 +50,30 @@ def published_rows(results: Path | None = None, quick: bool = False) -> list[dic
     if folder is not None:
         out += replica_rows(folder)
     return out
+
+
+def only_rows(results: Path, quick: bool = False, failures: list[str] | None = None) -> list[dict]:
+    """The check rows of issue 28 alone (`housingfe validate --only runup-checks`): the default run-up's tagged rows,
+    the design-variant study's (study_rows), the quasi-static excitation's (source_rows.excitation_rows) and the
+    checks no other provider makes (runup_checks_rows), each from the same cached computation the full validate
+    uses.  A failed computation is appended to failures (its rows are missing)."""
+    from housingfe.verification import source_rows, study_rows, validate
+    from housingfe.verification.checks import check_rows
+
+    failures = [] if failures is None else failures
+    rows: list[dict] = []
+    # in the order of the full validate (its run-up rows, then the providers by name), so both give one table
+    for what, make in ((validate.DEFAULT_RUNUP, lambda: validate.runup_rows(validate.DEFAULT_RUNUP, (), results, quick)),
+                       ("runup_checks_rows", lambda: published_rows(results, quick)),
+                       ("quasi-static excitation", source_rows.excitation_rows),
+                       ("study rows", lambda: study_rows.published_rows(results, quick))):
+        try:
+            rows += make()
+        except validate.ComputationFailed as exc:
+            failures.append(str(exc))
+        except SolverError as exc:
+            failures.append(f"{what}: {exc}")
+    return check_rows(rows)
 
 
 def _read_csv(path: Path) -> list[dict]:

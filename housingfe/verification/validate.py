@@ -76,7 +76,9 @@ class ComputationFailed(Exception):
     """A subprocess of validate failed; the message is one line."""
 
 
-ONLY = ("runup-checks",)     # `housingfe validate --only ...`: a subset computed alone
+# `housingfe validate --only NAME`: a subset computed alone, by the only_rows(results, quick, failures) of a row
+# provider (found by name like the providers themselves)
+ONLY = {"runup-checks": "housingfe.verification.runup_checks_rows"}
 
 
 def main(out_dir: str | Path = "results/validate", json_path: str | Path | None = None,
@@ -86,7 +88,7 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     (housingfe.verification.checks) to checks.csv and checks.md (and the JSON list of rows to json_path if
     given).  scenes: names or paths (only their rows); default every built-in housing scene with a reference and a
     modal analysis plus the other modules' rows; quick: the CI subset; only="runup-checks": the check rows of
-    issue 28 alone (runup_check_rows).  results_dir: where FE results are cached (default results/).  bands: a JSON
+    issue 28 alone (runup_checks_rows.only_rows).  results_dir: where FE results are cached (default results/).  bands: a JSON
     file {check_id: [low, high]} of the model's uncertainty bands, attached to the check rows (checks.attach_bands;
     without it every band is "—").  Raises SolverError (one line) after writing the table when a computation
     failed."""
@@ -108,9 +110,9 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     # checked and locked before minutes of computation; validate.csv and validate.md alone are an older
     # validate's output (written before result folders carried a marker)
     reserve_output(out_dir, own_files=OWN_FILES)
-    if only == "runup-checks":
+    if only is not None:
         failures: list[str] = []
-        rows = runup_check_rows(results, quick, failures)
+        rows = importlib.import_module(ONLY[only]).only_rows(results, quick, failures)
         attach_bands(rows, band_table)
         write_outputs(rows, Path(out_dir), json_path)
         from housingfe.verification.checks import checks_markdown
@@ -170,30 +172,6 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
         raise SolverError(f"validate: {len(failures)} computation(s) failed, their rows are missing: "
                           + "; ".join(failures))
     return rows
-
-
-def runup_check_rows(results: Path, quick: bool = False, failures: list[str] | None = None) -> list[dict]:
-    """The check rows of issue 28 alone (`housingfe validate --only runup-checks`): the default run-up's tagged rows,
-    the design-variant study's (study_rows), the quasi-static excitation's (source_rows.excitation_rows) and the
-    checks no other provider makes (runup_checks_rows), each from the same cached computation the full validate
-    uses.  A failed computation is appended to failures (its rows are missing)."""
-    from housingfe.verification import runup_checks_rows, source_rows, study_rows
-    from housingfe.verification.checks import check_rows
-
-    failures = [] if failures is None else failures
-    rows: list[dict] = []
-    # in the order of the full validate (its run-up rows, then the providers by name), so both give one table
-    for what, make in ((DEFAULT_RUNUP, lambda: runup_rows(DEFAULT_RUNUP, (), results, quick)),
-                       ("runup_checks_rows", lambda: runup_checks_rows.published_rows(results, quick)),
-                       ("quasi-static excitation", source_rows.excitation_rows),
-                       ("study rows", lambda: study_rows.published_rows(results, quick))):
-        try:
-            rows += make()
-        except ComputationFailed as exc:
-            failures.append(str(exc))
-        except SolverError as exc:
-            failures.append(f"{what}: {exc}")
-    return check_rows(rows)
 
 
 def default_scenes(quick: bool = False) -> list[str]:
