@@ -20,7 +20,8 @@ and from the design-variant study's cached result (<results>/study-validate/, ho
   sigma = 1, gear set A, ball bearings, 2000 N m): max L_WA within 1.5 dB of the thesis' calculated 89.4 dB(A).
 
 Nothing is computed here that validate does not compute anyway: with both caches valid these rows take well under
-a second; with quick and a stale cache they are left out (a note on the console).
+a second; with quick and a stale cache they are left out (a note on the console).  `only_rows` collects every check
+row of issue 28 (these and the ones tagged by the other providers) for `housingfe validate --only runup-checks`.
 """
 from __future__ import annotations
 
