@@ -322,3 +322,20 @@ def test_spherical_roller_radial_stiffness_is_stribeck_palmgren(designation, loa
     delta = 2 * 3.84e-5 * q_max**0.9 / (b.roller_length * 1e3) ** 0.8 * 1e-3
     k_closed = fr / (0.9 * delta / math.cos(b.contact_angle))
     assert k_model == pytest.approx(k_closed, rel=0.03)
+
+
+@pytest.mark.parametrize("fz", [8000.0, -8000.0])
+def test_axially_loaded_ball_bearing_couplings_are_the_load_centre_offset(fz):
+    """Under an axial load every ball's contact line (through the two groove curvature centres, at the loaded
+    contact angle alpha) meets the shaft axis at z_c = -sign(delta_z) r tan(alpha), r the radius of the inner
+    groove centre: a radial force acts there, so k_(theta_y, x) / k_xx = z_c (M_y = z_c F_x) and
+    k_(theta_x, y) / k_yy = -z_c.  These force-tilt couplings are what "zero moment terms" removes in the test
+    gearbox (docs/interior.md, Sec. 5.8); their sign sets whether the bearing's reaction acts inboard or outboard."""
+    b = lookup("6316")
+    res = bearing_stiffness(b, [0.0, 0.0, fz, 0.0, 0.0], fixed_tilt=(0.0, 0.0))
+    alpha = res.contact_angles
+    assert np.ptp(alpha) < 1e-9 and abs(alpha[0]) > math.radians(5)
+    z_c = -math.copysign(1.0, res.displacement[2]) * make_model(b).moment_arm() * math.tan(abs(alpha[0]))
+    k = res.K
+    assert k[4, 0] / k[0, 0] == pytest.approx(z_c, rel=0.03)
+    assert k[3, 1] / k[1, 1] == pytest.approx(-z_c, rel=0.03)
