@@ -33,6 +33,14 @@ JOBS = (("profile-corrections", (), "profile-corrections-face-width"),
 MEAN_GOAL_DB = 3.0          # issue 28: mean differences within 3 dB where the measured s.d. allows
 REPLICA_GOAL_DB = 1.5       # issue 28: the replica's correction differences within 1.5 dB of the thesis' calculation
 TORQUE_LAW_GOAL_DB = 1.5
+# what the failing checks were traced to, measured one factor at a time (benchmarks/experiments/replica_d)
+_CAUSES = "docs/design-variants.md, 'Why correction D and the torque law fail'"
+REPLICA_D_CAUSE = ("; cause measured: D's data read right; in the 2-D shock D sits on the steep flank of its optimum "
+                   "(1750 N m), sensitive to the load and the ramp shape; the 2-D shock cannot represent D's 3-D "
+                   f"triangle ({_CAUSES})")
+TORQUE_LAW_CAUSE = ("; cause measured: the source's tooth harmonic grows faster than linear (the reliefs make the "
+                    "mesh stiffness ripple load-dependent), not the bearings' stiffness nor the max-picking "
+                    f"({_CAUSES})")
 
 
 def published_rows(results: Path | None = None, quick: bool = False) -> list[dict]:
@@ -120,7 +128,8 @@ def study_rows(data: dict) -> list[dict]:
                                    f"s.d. {r['sd_diff_dB']}; goal: within {REPLICA_GOAL_DB:g} dB; passed: {_yes(ok)}"),
                                f"28.replica.correction.{_id(v)}", measured=r["measured_mean_dB"],
                                thesis_calculated=r["thesis_calc_mean_dB"], tolerance=f"{REPLICA_GOAL_DB:g} dB of the "
-                               "thesis' calculation", passed=ok, why=f"ours s.d. {r['sd_diff_dB']} dB over speed"))
+                               "thesis' calculation", passed=ok, why=f"ours s.d. {r['sd_diff_dB']} dB over speed"
+                               + (REPLICA_D_CAUSE if v == "D" else "")))
             continue
         if r["measured_mean_dB"] is not None:
             ok = abs(r["mean_diff_dB"] - r["measured_mean_dB"]) <= MEAN_GOAL_DB
@@ -179,5 +188,5 @@ def study_rows(data: dict) -> list[dict]:
                        f"28.variants.torque_law.{t['bearings']}.{t['route']}", measured=t["measured_step_dBA"],
                        tolerance=f"{TORQUE_LAW_GOAL_DB:g} dB", passed=ok,
                        why=f"slope over {t['torques_nm']} N m {t['slope_dB_per_doubling']:+.2f} dB(A) per doubling "
-                           f"(measured law: +3 per doubling)"))
+                           f"(measured law: +3 per doubling){TORQUE_LAW_CAUSE}"))
     return out

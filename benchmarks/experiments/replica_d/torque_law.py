@@ -70,6 +70,21 @@ def quasi_static_tooth(source, torque):
     return amp(exc), amp(op.shock), op.normal_force / km
 
 
+def stiffness_part(source, torque):
+    """(k_m (F/S - mean) at n = 1 [N]: the excitation of the stiffness variation alone (F_e = 0); |S_1| / S_0 of the
+    mesh stiffness as read; the same without any relief) at a torque [N m]."""
+    from dataclasses import replace
+
+    from housingfe.source.stiffness import Corrections, stiffness_curve
+
+    op = source._point(float(torque))
+    S, F = op.S, op.normal_force
+    c1 = lambda x: 2 * abs(np.fft.rfft(x)[1]) / x.size  # noqa: E731
+    free = stiffness_curve(replace(source.mesh_model, corrections=Corrections()), F, source.stiffness_positions)
+    Sf = np.interp(np.arange(S.size) / S.size, free.position, free.stiffness, period=1.0)
+    return c1(S.mean() * (F / S - np.mean(F / S))), c1(S) / S.mean(), c1(Sf) / Sf.mean()
+
+
 def main(out: Path) -> None:
     from housingfe.outputs import format_table, write_csv
     from housingfe.studies.chain_session import ChainSession, ModelPool, energy_mean_db, lwa_curve, maximum
@@ -127,22 +142,29 @@ def main(out: Path) -> None:
                 print(f"  {b} {e} {route}: total {rows[-1]['total_mean_dB']:+.2f} = source "
                       f"{rows[-1]['source_mean_dB']:+.2f} + structure {rows[-1]['structure_mean_dB']:+.2f} "
                       f"({time.perf_counter() - t0:.0f} s)", flush=True)
-    # the source's tooth harmonic over torque (quasi-static, both engagements), like Fig. 2.18
+    # the source's tooth harmonic over torque (quasi-static, both engagements), like Fig. 2.18, split into the
+    # stiffness variation's part (F_e = 0) and the shock's; the relative ripple |S_1| / S_0 of the mesh stiffness
+    # with the reliefs as read and without any relief (is the stiffness's ripple load-dependent?)
     spec_rows = []
     for e, ses in sessions.items():
         src_model = ses.source(ses.drivetrain("double_helical", BEARINGS[0], TORQUES[0]))
         for T in SPECTRUM_TORQUES:
             exc, shock, d = quasi_static_tooth(src_model, T)
-            spec_rows.append([e, T, exc, shock, d * 1e6, float(np.mean(src_model._point(T).S))])
+            stiff, ripple, ripple_free = stiffness_part(src_model, T)
+            spec_rows.append([e, T, exc, shock, stiff, ripple, ripple_free, d * 1e6,
+                              float(np.mean(src_model._point(T).S))])
     write_csv(out / "torque_law_spectrum.csv", ["engagement", "torque_nm", "excitation_n1_N", "shock_n1_N",
-                                                "mean_compression_um", "mean_mesh_stiffness_N_per_m"], spec_rows)
+                                                "stiffness_only_excitation_n1_N", "S1_over_S0",
+                                                "S1_over_S0_without_relief", "mean_compression_um",
+                                                "mean_mesh_stiffness_N_per_m"], spec_rows)
     cols = list(rows[0])
     write_csv(out / "torque_law.csv", cols, [[r[c] for c in cols] for r in rows])
     short = ["bearings", "engagement", "route", "total_mean_dB", "source_mean_dB", "structure_mean_dB",
              "tooth_line_total_mean_dB", "lines_mesh_excitation_n1_mean_dB", "quasi_static_excitation_n1_dB",
              "quasi_static_shock_n1_dB", "max_picking_dB", "energy_mean_diff_dB", "measured_dBA"]
     print(format_table(short, [[r[c] for c in short] for r in rows], floatfmt="{:+.2f}"))
-    print(format_table(["engagement", "torque", "exc n1 N", "shock n1 N", "d_mean um", "k_m N/m"], spec_rows,
+    print(format_table(["engagement", "torque", "exc n1 N", "shock n1 N", "stiff-only n1 N", "S1/S0",
+                        "S1/S0 no relief", "d_mean um", "k_m N/m"], spec_rows,
                        floatfmt="{:.4g}"))
     plot(out / "torque_law.png", curves, spec_rows, rows)
     print(f"wall {time.perf_counter() - t0:.0f} s; results in {out}/")
@@ -159,7 +181,10 @@ def plot(path, curves, spec_rows, rows):
     for e in ENGAGEMENTS:
         sel = [r for r in spec_rows if r[0] == e]
         T = np.array([r[1] for r in sel])
-        for k, (lab, ls) in enumerate((("k_m(d_qs - mean), n=1", "-"), ("F_e, n=1", "--"))):
+        for k, (lab, ls) in enumerate((("k_m(d_qs - mean), n=1", "-"), ("F_e, n=1", "--"),
+                                       ("stiffness variation alone (F_e = 0), n=1", ":"))):
+            if k == 2 and e != ENGAGEMENTS[0]:
+                continue        # the same for both engagements
             y = 20 * np.log10(np.array([r[2 + k] for r in sel]))
             ax.semilogx(T, y, ls, marker="o", label=f"{e}: {lab}")
     Tl = np.array([500.0, 2500.0])
