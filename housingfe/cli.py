@@ -21,7 +21,7 @@ _EXTENSIONS = (
     "housingfe.radiation",
     "housingfe.reference",
     "housingfe.source.cli",
-    "housingfe.source.studies",
+    "housingfe.source.roosmalen.studies",
     "housingfe.studies.bearing_variants",
     "housingfe.studies.reduce",
     "housingfe.studies.design_variants",
@@ -48,7 +48,8 @@ def _cmd_validate(args: argparse.Namespace) -> int:
     from housingfe.verification import validate
 
     validate.main(out_dir=args.out, json_path=args.json, scenes=args.scenes, quick=args.quick,
-                  results_dir=args.results)
+                  results_dir=args.results, only=args.only,
+                  bands=args.bands)
     return 0
 
 
@@ -132,6 +133,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="the CI subset: small FE scenes and every row that needs no FE (docs/verification.md)")
     p.add_argument("--results", default=None, metavar="DIR",
                    help="folder of the cached FE results (default results/)")
+    p.add_argument("--only", default=None, choices=("runup-checks",),
+                   help="runup-checks: the check rows of issue 28 alone (checks.md; docs/runup.md)")
+    p.add_argument("--bands", default=None, metavar="FILE",
+                   help="JSON {check_id: [low, high]}: the model's uncertainty band of each check (checks.md)")
     p.set_defaults(func=_cmd_validate)
 
     p = sub.add_parser("bench", help="speed-against-error benchmarks (tables, CSV, PNG)")

@@ -370,10 +370,10 @@ def geometry_pictures(out_dir: Path) -> list[Path]:
 SCENE_ROOTS = (
     ("Housing scenes (`kind = \"housing\"`, `housingfe run`)", "housingfe.scene", "HousingScene", ""),
     ("Run-up scenes (`kind = \"runup\"`, `housingfe run`)", "housingfe.runup.scene", "RunupScene", ""),
-    ("Source scenes, model \"roosmalen\" (`kind = \"source\"`, `housingfe source`)", "housingfe.source.roosmalen",
+    ("Source scenes, model \"roosmalen\" (`kind = \"source\"`, `housingfe source`)", "housingfe.source.roosmalen.run",
      "SourceTable", "source"),
-    ("Source scenes, model \"fukuma\"", "housingfe.source.fukuma_run", "FukumaScene", ""),
-    ("Source scenes, model \"trueman\"", "housingfe.source.trueman_run", "TruemanScene", ""),
+    ("Source scenes, model \"fukuma\"", "housingfe.source.fukuma.run", "FukumaScene", ""),
+    ("Source scenes, model \"trueman\"", "housingfe.source.trueman.run", "TruemanScene", ""),
 )
 
 

@@ -1,7 +1,7 @@
 """`housingfe bench flexsource`: the source on the flexible housing (issue 28 item 2), cost against accuracy.
 
 The source's harmonic balance of the time-varying mesh stiffness is solved on the coupled gearbox's receptance at
-the gear mesh (housingfe.runup.chain.coupled_source_lines: housingfe.source.dynamics.mesh_harmonic_balance with
+the gear mesh (housingfe.runup.chain.coupled_source_lines: housingfe.source.roosmalen.dynamics.mesh_harmonic_balance with
 the Ritz reduction's mesh receptance).  On the test-gearbox-runup scene's coupled model (set A, ball bearings,
 2000 N m; --quick: a 50 mm housing mesh, 6 speeds, lines to 2 kHz):
 
@@ -59,7 +59,7 @@ def modal_mesh_receptance(model, frequencies_hz, f_cut_hz: float, static_correct
 def _solve_speeds(model, source, speeds, torque, H, receptance_fn, first_order=False):
     """Per speed the MeshSteadyState with the receptance of receptance_fn(frequencies) -> g; also the seconds."""
     from housingfe.runup.chain import mesh_reference_stiffness
-    from housingfe.source.dynamics import mesh_harmonic_balance
+    from housingfe.source.roosmalen.dynamics import mesh_harmonic_balance
     from housingfe.source.stiffness import normal_force_from_torque
 
     S, shock = source.mesh_stiffness(torque)
@@ -94,7 +94,7 @@ def full_hill_on_ritz(model, source, speed_rpm: float, torque: float, H: int) ->
     mesh load's projection, d = -f^T c; the zero mode (the gear pair turning freely, not loaded and not compressing
     the mesh) is held by a stiffness on it alone.  Also the seconds."""
     from housingfe.runup.chain import mesh_reference_stiffness
-    from housingfe.source.dynamics import _fourier_coefficients
+    from housingfe.source.roosmalen.dynamics import _fourier_coefficients
     from housingfe.source.stiffness import normal_force_from_torque
 
     red = model.reduction

@@ -21,8 +21,8 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
-from housingfe.source import dynamics as dyn
-from housingfe.source.roosmalen import OperatingPoint, build, parse
+from housingfe.source.roosmalen import dynamics as dyn
+from housingfe.source.roosmalen.run import OperatingPoint, build, parse
 
 SCENE = Path(__file__).resolve().parent.parent / "scenes" / "gearset-A.toml"
 
@@ -113,7 +113,7 @@ def dynamics_rows(quick: bool) -> list[dict]:
 def other_rows(quick: bool) -> list[dict]:
     """Rows of the Fukuma / Trueman modules, if they provide `bench_rows(quick)`."""
     rows = []
-    for name in ("housingfe.source.fukuma_run", "housingfe.source.trueman_run"):
+    for name in ("housingfe.source.fukuma.run", "housingfe.source.trueman.run"):
         try:
             module = importlib.import_module(name)
         except ModuleNotFoundError:

@@ -19,7 +19,7 @@ Cases (every one small: seconds each):
   and a 1e11 N/m bearing on a 0.05 kg node (against scipy's dense eigh);
 - a rigid rotor on two short journal bearings through the onset of oil whirl (against Lund's threshold), and the
   projected forced-response solver flagging the unstable point;
-- the gear source at a load and speed where the teeth separate: flagged (housingfe.source.dynamics.contact_check);
+- the gear source at a load and speed where the teeth separate: flagged (housingfe.source.roosmalen.dynamics.contact_check);
 - a P2 tetrahedral cube with a sliver: refused/warned by the quality check, its effect on the frequencies measured.
 
 `housingfe bench stability [--quick]` prints the table and writes stability.csv, stability.md and stability.png
@@ -648,13 +648,13 @@ def _projected_flags(bearing, mass, load, rpm) -> list:
 def contact_loss() -> CaseResult:
     """Gear set D (thesis) at 10 N m near its mesh resonance (7750 rpm, tooth frequency 3.1 kHz): the dynamic
     mesh force exceeds the mean, the teeth separate.  The steady state must be flagged by
-    housingfe.source.dynamics.contact_check ("contact loss at 10 N m, 7750 rpm"), and the nominal point
+    housingfe.source.roosmalen.dynamics.contact_check ("contact loss at 10 N m, 7750 rpm"), and the nominal point
     (2000 N m, 1500 rpm) must not be.  Reference: a contact force cannot be negative."""
     import tomllib
 
     from housingfe.scenefile import SCENE_DIR
-    from housingfe.source import dynamics as dyn
-    from housingfe.source import roosmalen
+    from housingfe.source.roosmalen import dynamics as dyn
+    from housingfe.source.roosmalen import run as roosmalen
 
     t0 = time.perf_counter()
     path = SCENE_DIR / "gearset-D.toml"

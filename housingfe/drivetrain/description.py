@@ -10,7 +10,7 @@ operating point (it sets the bearing loads and the mean mesh stiffness).
 Two reductions of it:
 
 * `to_lumped()` -> (LumpedInterior, ShaftGeometry, MeshModel): van Roosmalen's 14-DOF source model on RIGID bores
-  (housingfe.source.dynamics), what `housingfe source gearset-*` and `housingfe.source.operating.SourceModel` use;
+  (housingfe.source.roosmalen.dynamics), what `housingfe source gearset-*` and `housingfe.source.roosmalen.operating.SourceModel` use;
 * `to_coupling_spec()` -> CouplingSpec: the FE interior (Timoshenko shafts, rigid gear discs, 6x6 bearings at the
   housing's bores, the gear mesh) that housingfe.drivetrain.interior couples with the housing model.
 
@@ -39,8 +39,8 @@ import numpy as np
 
 from housingfe.errors import InputError
 from housingfe.solvers.blas import single_thread_blas
-from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair
+from housingfe.source.roosmalen import dynamics as dyn
 from housingfe.source.stiffness import (
     Corrections,
     MeshModel,
@@ -70,7 +70,7 @@ class GearSet:
     def from_scene(cls, scene: str) -> "GearSet":
         """The gear set of a source scene (a built-in name such as "gearset-A", or a path to a TOML file)."""
         from housingfe.scenefile import read_scene_dict
-        from housingfe.source import roosmalen
+        from housingfe.source.roosmalen import run as roosmalen
 
         data, path = read_scene_dict(scene)
         table = roosmalen.parse(data, str(path))
@@ -237,7 +237,7 @@ class Drivetrain:
 
     def to_lumped(self) -> tuple[dyn.LumpedInterior, dyn.ShaftGeometry, MeshModel]:
         """The lumped source model on rigid bores: (LumpedInterior, ShaftGeometry, MeshModel).  Masses and
-        inertias: gear body + its shaft between the bearings (housingfe.source.dynamics.derive_interior)."""
+        inertias: gear body + its shaft between the bearings (housingfe.source.roosmalen.dynamics.derive_interior)."""
         geometry = self.shaft_geometry()
         interior = dyn.derive_interior(self.gears.pair, geometry, self.loss_factor, self.lumped_bearings())
         model = MeshModel(self.gears.pair,
@@ -248,10 +248,10 @@ class Drivetrain:
         return interior, geometry, model
 
     def source_model(self, misalignment="none", **kwargs):
-        """housingfe.source.operating.SourceModel of the lumped reduction (kwargs: its options).  misalignment:
+        """housingfe.source.roosmalen.operating.SourceModel of the lumped reduction (kwargs: its options).  misalignment:
         "none", "lumped" (the 14-DOF model's own static tilt) or a function torque [N m] -> MeshModel.lead_gap [m/m],
         e.g. housingfe.drivetrain.misalignment.lead_gap_law(drivetrain, "rigid-bores")."""
-        from housingfe.source.operating import SourceModel
+        from housingfe.source.roosmalen.operating import SourceModel
 
         interior, geometry, model = self.to_lumped()
         return SourceModel(self.gears.pair, self.gears.corrections, interior, geometry, mesh_model=model,
@@ -260,7 +260,7 @@ class Drivetrain:
     # ------------------------------------------------------------------------- lumped <-> housing frames
     def lumped_frame(self) -> np.ndarray:
         """3x3, columns = the lumped model's x, y, z in the housing frame: x along the centre line (pinion to
-        wheel), z along the shaft axis, y = z cross x (housingfe.source.dynamics.mesh_direction)."""
+        wheel), z along the shaft axis, y = z cross x (housingfe.source.roosmalen.dynamics.mesh_direction)."""
         p, w = self.shaft("pinion"), self.shaft("wheel")
         a = np.asarray(p.axis, float) / np.linalg.norm(p.axis)
         c = np.asarray(w.centre, float) - np.asarray(p.centre, float)

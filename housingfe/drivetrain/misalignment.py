@@ -144,7 +144,7 @@ def rigid_bore_misalignment(drivetrain) -> mis.Misalignment:
 
 def mesh_misalignment(drivetrain, model: str = DEFAULT_MISALIGNMENT) -> mis.Misalignment:
     """The Misalignment of `drivetrain` at its torque by `model` (MISALIGNMENT_MODELS)."""
-    from housingfe.source import dynamics as dyn
+    from housingfe.source.roosmalen import dynamics as dyn
     from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
 
     mis.check_model(model, MISALIGNMENT_MODELS)
@@ -164,7 +164,7 @@ def mesh_misalignment(drivetrain, model: str = DEFAULT_MISALIGNMENT) -> mis.Misa
 
 def lead_gap_law(drivetrain, model: str = DEFAULT_MISALIGNMENT):
     """A function torque [N m] -> MeshModel.lead_gap [m/m] of `drivetrain` at that torque by `model` (cached per
-    torque), for housingfe.source.operating.SourceModel(misalignment=...)."""
+    torque), for housingfe.source.roosmalen.operating.SourceModel(misalignment=...)."""
     mis.check_model(model, MISALIGNMENT_MODELS)
     cache: dict = {}
 
@@ -187,7 +187,7 @@ def misalignment_rows(gear_sets=("A",), bearings: str = "ball", torques=(2000.0,
     mesh stiffness (N/m) and the quasi-static excitation k_m (d - mean d), d = (F - F_e)/S(t), per tooth harmonic
     n = 1..harmonics (N, one-sided; `housingfe source-spectrum`'s quantity, face-width engagement)."""
     from housingfe.drivetrain.description import test_gearbox
-    from housingfe.source import roosmalen as rs
+    from housingfe.source.roosmalen import run as rs
     from housingfe.source.stiffness import contact_loss_fraction
 
     for m in models:

@@ -10,7 +10,7 @@ bearings as 6x6 matrices at star connections to the bores, the gear mesh), its c
 basis_factor x the highest line, and a Ritz reduction (housingfe.response.reduced) on the two unit loads the routes
 need: a torque of 1 N m about the wheel axis at the wheel centre, and a unit compressive pair along the gear-mesh
 normal (the loads the gear-mesh element carries).  Per speed and torque: the source's operating point
-(housingfe.source.operating), then each route's L_v per tooth harmonic, then each radiator's L_sigma and L_W.
+(housingfe.source.roosmalen.operating), then each route's L_v per tooth harmonic, then each radiator's L_sigma and L_W.
 
 Routes (`ROUTES`, a registry: `@register_route(name)`):
 
@@ -258,14 +258,14 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
                          first_order: bool = False, harmonics: int | None = None) -> tuple[Lines, float]:
     """The source's lines (`source_lines`, the rigid-bore source's L_omega kept for the tf_omega route) with the
     mesh excitation from the harmonic balance of the time-varying mesh solved on the coupled gearbox instead of the
-    rigid-bore lumped interior (housingfe.source.dynamics.mesh_harmonic_balance
+    rigid-bore lumped interior (housingfe.source.roosmalen.dynamics.mesh_harmonic_balance
     with the coupled model's mesh receptance, `mesh_receptance`): S(t) and F_e(t) of `source` at each torque, the
     coupled model's mean mesh stiffness k_ref, its static state (the transmitted normal force F: b_0 = F / k_ref,
     g(0) = 1 / k_ref).  mesh_excitation is W_n - k_ref d_n (what the mesh_force route applies); L_omega_flexible is
     the wheel's level on the coupled model (what the mesh_force route's L_omega_coupled then is, too).  model: the
     GearboxModel at the torque (one torque per model: another torque changes the bearings, `with_drivetrain`).  first_order: the mean-stiffness solve (quasi-static transmission
     error on the mean system).  harmonics: H of the balance (default: the source's).  Returns (Lines, seconds)."""
-    from housingfe.source.dynamics import mesh_harmonic_balance
+    from housingfe.source.roosmalen.dynamics import mesh_harmonic_balance
     from housingfe.source.stiffness import normal_force_from_torque
 
     t0 = time.perf_counter()
@@ -410,7 +410,7 @@ def _energy_sum(values_db: np.ndarray, groups: np.ndarray, n_groups: int) -> np.
 def runup(model: GearboxModel, source, speeds_rpm, torques_nm, *, routes=("tf_omega", "mesh_force"),
           lines: Lines | None = None) -> RunupResult:
     """L_v, L_W and L_WA per tooth harmonic and in total at every speed (rev/min) and torque (N m) for every route
-    (ROUTES) and radiator of the model.  source: housingfe.source.operating.SourceModel (or `lines` computed
+    (ROUTES) and radiator of the model.  source: housingfe.source.roosmalen.operating.SourceModel (or `lines` computed
     before, e.g. to reuse them across gear-set models)."""
     unknown = [r for r in routes if r not in ROUTES]
     if unknown:

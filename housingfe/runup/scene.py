@@ -25,8 +25,8 @@ from housingfe.errors import InputError
 from housingfe.scene import RadiationPlate
 from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table, read_scene_dict
 from housingfe.solvers.blas import single_thread
-from housingfe.source.dynamics import DEFAULT_ENGAGEMENT
-from housingfe.source.operating import SPEED_RANGE_RPM
+from housingfe.source.roosmalen.dynamics import DEFAULT_ENGAGEMENT
+from housingfe.source.roosmalen.operating import SPEED_RANGE_RPM
 
 
 def _gearboxes() -> dict:
@@ -104,7 +104,7 @@ class RunupSpec(_Strict):
     harmonics: PositiveInt = 30
     spectrum_speeds_rpm: list[PositiveFloat] = [500.0, 1000.0, 1500.0]
     surface: str = "outer"
-    # the source's engagement shock (housingfe.source.dynamics.ENGAGEMENT_MODELS): "face-width" distributes
+    # the source's engagement shock (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS): "face-width" distributes
     # Eq. 2.62 over the face-width slices; "thesis-2d" is the thesis' two-dimensional shock (the replica)
     engagement: Literal["face-width", "thesis-2d"] = DEFAULT_ENGAGEMENT
     # the receptance around the mesh in the source's harmonic balance (housingfe.runup.chain.SOURCE_RECEPTANCES):

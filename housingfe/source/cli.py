@@ -2,9 +2,9 @@
 
 The scene is a built-in name (housingfe/scenes/<name>.toml) or a path to a TOML file with
 [scene] kind = "source" and a [source] table whose `model` picks the implementation:
-  "roosmalen" -> housingfe.source.roosmalen.run_scene   (van Roosmalen 1994, Ch. 2)
-  "fukuma"    -> housingfe.source.fukuma_run.run_scene     (Fukuma et al. 1973)
-  "trueman"   -> housingfe.source.trueman_run.run_scene    (Trueman 1974)
+  "roosmalen" -> housingfe.source.roosmalen.run.run_scene   (van Roosmalen 1994, Ch. 2)
+  "fukuma"    -> housingfe.source.fukuma.run.run_scene     (Fukuma et al. 1973)
+  "trueman"   -> housingfe.source.trueman.run.run_scene    (Trueman 1974)
 each called as run_scene(scene: dict, scene_path: str, out_dir: pathlib.Path) with out_dir an already
 created temporary folder that replaces the result folder (default results/<scene name>) on success.
 """
@@ -18,9 +18,9 @@ from housingfe.errors import InputError
 from housingfe.scenefile import read_scene_dict, scene_name_problem
 
 MODELS = {
-    "roosmalen": "housingfe.source.roosmalen",
-    "fukuma": "housingfe.source.fukuma_run",
-    "trueman": "housingfe.source.trueman_run",
+    "roosmalen": "housingfe.source.roosmalen.run",
+    "fukuma": "housingfe.source.fukuma.run",
+    "trueman": "housingfe.source.trueman.run",
 }
 
 

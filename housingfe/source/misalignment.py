@@ -16,7 +16,7 @@ opens a gap: lead_gap = -cos(beta_b) gamma.  Constant parts (translations, rotat
 the mean approach.
 
 Where e_w points: in the MeshModel the contact line of helix 0 runs s = s0 + w tan(beta_b), i.e. the contact
-normal is n = cos(beta_b) l - sin(beta_b) e_w.  In the lumped model (housingfe.source.dynamics.mesh_direction,
+normal is n = cos(beta_b) l - sin(beta_b) e_w.  In the lumped model (housingfe.source.roosmalen.dynamics.mesh_direction,
 n = (sin a cos bb, cos a cos bb, -sin bb)) that is e_w = +z; in the FE reduction of housingfe.drivetrain (n with
 +sin(beta_b) along the shaft axis a) e_w = -a.  MeshModel's torque_configuration fixes the pinion torque at w = 0.
 
@@ -79,7 +79,7 @@ def from_tilts(model: str, torque: float, theta_pinion, theta_wheel, face_axis, 
 
 def lumped_misalignment(pair, mats, preload: np.ndarray, torque: float, total_width: float) -> Misalignment:
     """The "lumped" misalignment: static mean state q = (K0 + k_m h h^T)^-1 f0 of the 14-DOF model
-    (housingfe.source.dynamics: `mats` = assemble(...), `preload` = preload_force(mats, torque)).  Its gear tilts
+    (housingfe.source.roosmalen.dynamics: `mats` = assemble(...), `preload` = preload_force(mats, torque)).  Its gear tilts
     theta_x, theta_y (DOFs 3, 4 and 9, 10, ordinary right-handed rotations of the lumped frame; theta_z does not
     tilt) give gamma; e_w = +z of the lumped frame, n = the pinion's part of h."""
     K = mats.K0 + mats.mean_mesh_stiffness * np.outer(mats.h, mats.h)

@@ -16,7 +16,9 @@ ball - configuration with mean and standard deviation over the measured speed ra
 frequency 320-600 Hz) and over all lines, CSV + PNG, next to the thesis' 7.3 dB (s.d. 4.5) for ball minus
 self-aligning.  The thesis' FEM had no self-aligning bearing model: it used the ball bearing matrices with the
 moment terms zeroed; that comparison is the configuration `ball_zero_moment`, next to our spherical roller
-model `self_aligning` (whose radial stiffness is several times the ball bearing's).
+model `self_aligning` (whose radial stiffness is several times the ball bearing's).  `ball_zero_tilt_stiffness`
+zeroes only the tilt block and keeps the loaded ball bearings' force-tilt couplings: the two differ by what the
+couplings (the axial offset of a bearing's load centre) do, which in the test gearbox is all of it.
 """
 from __future__ import annotations
 
@@ -38,6 +40,11 @@ POSITIONS = ("pinion_front", "pinion_back", "wheel_front", "wheel_back")
 # the thesis' FEM stand-in for self-aligning bearings (Sec. 5.8): the ball bearing matrices with their moment
 # rows and columns zeroed ("the stiffness matrix of the ball bearings was used with zero moment stiffness")
 THESIS_SELF_ALIGNING = "ball_zero_moment"
+# the same with only the tilt block k_theta,theta zeroed: the force-tilt couplings k_(x,y,z),theta of the loaded ball
+# bearings (the axial offset of their load centre, 14-17 mm here) kept.  In the test gearbox the couplings make
+# the whole ball - ball_zero_moment difference, the tilt stiffness ~0 dB (benchmarks/experiments/bearing_ranking,
+# section 3)
+ZERO_TILT_STIFFNESS = "ball_zero_tilt_stiffness"
 # a sensitivity of the moment terms: the ball matrices with Appendix C's rotational values (3.4-5.2e6 N m/rad) on
 # every bearing.  They are NOT one bearing's moment stiffness: Appendix C's theta values are the lumped shaft's
 # tilt on its two bearings, k_theta = k_r L^2 / 4 with one span L = 0.16-0.17 m for all four
@@ -63,7 +70,7 @@ def gear_forces(gear_set: str, torque: float, point, pinion_centre, wheel_centre
     common tangent, tilted out of it by the base helix angle (0 for a double helical set, whose two halves
     cancel axially)."""
     from housingfe.scenefile import read_scene_dict
-    from housingfe.source import roosmalen
+    from housingfe.source.roosmalen import run as roosmalen
     from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
 
     data, path = read_scene_dict(GEAR_SCENES[gear_set])
@@ -119,6 +126,9 @@ def configuration_spec(base, config: str, torque: float = TORQUE_NM):
     configs = configurations()
     if config == THESIS_SELF_ALIGNING:
         return _ball_with_moment_stiffness(base, torque, {"pinion": (0.0, 0.0), "wheel": (0.0, 0.0)})
+    if config == ZERO_TILT_STIFFNESS:
+        return _ball_with_moment_stiffness(base, torque, {"pinion": (0.0, 0.0), "wheel": (0.0, 0.0)},
+                                           keep_couplings=True)
     if config == APPENDIX_C_MOMENTS:
         from housingfe.verification.published import thesis
 
@@ -161,15 +171,19 @@ def configuration_spec(base, config: str, torque: float = TORQUE_NM):
     return spec, loads, forces
 
 
-def _ball_with_moment_stiffness(base, torque: float, moments: dict):
+def _ball_with_moment_stiffness(base, torque: float, moments: dict, keep_couplings: bool = False):
     """The ball configuration with the moment rows and columns of every bearing replaced by the diagonal
-    (k_theta_x, k_theta_y) of `moments` {"pinion"|"wheel": (N m/rad, N m/rad)}."""
+    (k_theta_x, k_theta_y) of `moments` {"pinion"|"wheel": (N m/rad, N m/rad)}; keep_couplings: only the tilt
+    block (rows and columns 3-4 among themselves) replaced, the force-tilt couplings kept."""
     spec, loads, forces = configuration_spec(base, "ball", torque)
     bearings = []
     for b in spec.bearings:
         k = np.array(b.stiffness_matrix)
-        k[3:5, :] = 0.0
-        k[:, 3:5] = 0.0
+        if keep_couplings:
+            k[3:5, 3:5] = 0.0
+        else:
+            k[3:5, :] = 0.0
+            k[:, 3:5] = 0.0
         k[3, 3], k[4, 4] = moments[b.name.split("_")[0]]
         bearings.append(b.model_copy(update={"stiffness_matrix": k.tolist()}))
     return spec.model_copy(update={"bearings": bearings}), loads, forces
@@ -216,7 +230,7 @@ def run_study(scene_name: str = "test-gearbox-interior", configs=None, out_dir=N
     if scene.coupling is None or scene.analysis.harmonic is None or not scene.analysis.harmonic.angular_velocity_node:
         raise InputError(f"{scene_name}: bearing-variants needs a scene with [coupling], [analysis.harmonic] and "
                          "analysis.harmonic.angular_velocity_node")
-    configs = list(configs or [*configurations(), THESIS_SELF_ALIGNING, APPENDIX_C_MOMENTS])
+    configs = list(configs or [*configurations(), THESIS_SELF_ALIGNING, ZERO_TILT_STIFFNESS, APPENDIX_C_MOMENTS])
     from housingfe.progress import Progress
 
     comm = MPI.COMM_WORLD
@@ -345,8 +359,10 @@ def register_cli(subparsers) -> None:
                               help="TF_omega of the test gearbox with each bearing configuration (Sec. 5.8/5.9)")
     p.add_argument("--scene", default="test-gearbox-interior", help="housing scene with an interior")
     p.add_argument("--configs", nargs="+", default=None,
-                   help="configurations (default: all of housingfe.bearings.configurations and ball_zero_moment, the "
-                        "thesis' FEM stand-in for self-aligning bearings; 'ball' is the reference)")
+                   help="configurations (default: all of housingfe.bearings.configurations, ball_zero_moment (the "
+                        "thesis' FEM stand-in for self-aligning bearings: moment rows and columns zeroed), "
+                        "ball_zero_tilt_stiffness (only the tilt block zeroed) and ball_appendix_c_moments; 'ball' is "
+                        "the reference)")
     p.add_argument("--torque", type=float, default=TORQUE_NM, help="pinion torque [N m]")
     p.add_argument("--out", default=None, help="result folder")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value")

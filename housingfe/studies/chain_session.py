@@ -159,7 +159,7 @@ class ChainSession:
         return model
 
     def source(self, drivetrain):
-        """The lumped source (housingfe.source.operating.SourceModel) of a drivetrain with the scene's options,
+        """The lumped source (housingfe.source.roosmalen.operating.SourceModel) of a drivetrain with the scene's options,
         one per gear set and lumped reduction (the FE bearings play no part in it)."""
         key = source_key(drivetrain)
         if key not in self._sources:

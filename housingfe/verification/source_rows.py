@@ -2,12 +2,12 @@
 
 - van Roosmalen (1994) Appendix F: gear geometry, contact ratios, loads of the single and double helical test
   gears (housingfe.source.gears), Sec. 5.2 tooth deflection, Sec. 5.3 L_omega of gear set A, Sec. 5.7 effect
-  of the profile corrections (housingfe.source.roosmalen); published values from housingfe/data/roosmalen1994.toml;
-- issue 28: the quasi-static excitation's envelope over the tooth harmonics (housingfe.source.studies);
-- Trueman (1974) Table 6.1 and Sec. 6.9 critical speeds (housingfe.source.trueman); published values from
-  housingfe.source.trueman_data;
+  of the profile corrections (housingfe.source.roosmalen.run); published values from housingfe/data/roosmalen1994.toml;
+- issue 28: the quasi-static excitation's envelope over the tooth harmonics (housingfe.source.roosmalen.studies);
+- Trueman (1974) Table 6.1 and Sec. 6.9 critical speeds (housingfe.source.trueman.response); published values from
+  housingfe.source.trueman.data;
 - Fukuma et al. (1973) Table 1 shaft stiffness from the equivalent radius and the Sec. 4.2 tilt resonance
-  (housingfe.source.fukuma); published values from the fukuma-series-a/-b scenes, which carry Table 1.
+  (housingfe.source.fukuma.model); published values from the fukuma-series-a/-b scenes, which carry Table 1.
 
 `published_rows()` returns them in the `housingfe.verification.published.row` format (about 40 s on one core).
 """
@@ -82,8 +82,8 @@ def appendix_f_rows() -> list[dict]:
 
 def _gear_set(name: str):
     """(pair, corrections, interior, mesh model, table) of a built-in roosmalen source scene."""
-    from housingfe.source import roosmalen as rs
     from housingfe.source.cli import load_scene
+    from housingfe.source.roosmalen import run as rs
 
     scene, path = load_scene(name)
     table = rs.parse(scene, str(path))
@@ -93,8 +93,8 @@ def _gear_set(name: str):
 
 def roosmalen_source_rows() -> list[dict]:
     """Sec. 5.2 tooth deflection, Sec. 5.3 L_omega of gear set A at 2000 N m, Sec. 5.7 profile corrections."""
-    from housingfe.source import dynamics as dyn
-    from housingfe.source import roosmalen as rs
+    from housingfe.source.roosmalen import dynamics as dyn
+    from housingfe.source.roosmalen import run as rs
     from housingfe.source.stiffness import stiffness_curve
 
     out = []
@@ -145,33 +145,52 @@ def roosmalen_source_rows() -> list[dict]:
 def excitation_rows() -> list[dict]:
     """Issue 28 check "quasi-static excitation: the harmonics' envelope decays at least as 1/n with no flat range
     for every set": for every gear set and both engagement models, the smallest octave drop of the upper envelope
-    of k_m (d - mean d) over the harmonics 1-15 (housingfe.source.studies.envelope_decay; 1/n gives 6.0 dB)."""
-    from housingfe.source.studies import FLAT_OCTAVE_DB, SPECTRUM_SCENES, envelope_decay, excitation_spectrum
+    of k_m (d - mean d) over the harmonics 1-15 (housingfe.source.roosmalen.studies.envelope_decay; 1/n gives 6.0 dB).
+    The default engagement's (face-width) rows are the checks (check_id 28.excitation.envelope.<set>)."""
+    from housingfe.source.roosmalen.studies import SPECTRUM_SCENES, excitation_spectrum
 
     rows = excitation_spectrum(SPECTRUM_SCENES, harmonics=15)
     out = []
     for scene in dict.fromkeys(r["scene"] for r in rows):
         for engagement in ("face-width", "thesis-2d"):
             sel = [r for r in rows if r["scene"] == scene and r["engagement"] == engagement]
-            check = envelope_decay([r["excitation_N"] for r in sel])
-            lo, hi = check["worst_octave"]
-            out.append(row(scene, f"quasi-static excitation, engagement {engagement}: smallest drop of the harmonics' "
-                           "envelope per octave, n = 1-15", check["min_octave_drop_dB"], 20 * math.log10(2), "dB",
-                           "1/n envelope of a step excitation (derived; ../shared/notes/run-up-physics.md §5.2); "
-                           "check of issue 28",
-                           note=f"passed: {'yes' if check['passed'] else 'no'}; goal: every octave >= "
-                                f"{FLAT_OCTAVE_DB:g} dB (no flat range) and n E(n) <= F_1 (max n E(n)/F_1 = "
-                                f"{check['max_n_envelope_ratio']:.2f}); smallest drop at n = {lo}-{hi}; "
-                                f"F_1 = {sel[0]['excitation_N']:.0f} N at {sel[0]['torque_Nm']:g} N m "
-                                "(`housingfe source-spectrum`)"))
+            out.append(envelope_row(scene, engagement, [r["excitation_N"] for r in sel], sel[0]["torque_Nm"]))
     return out
+
+
+def envelope_row(scene: str, engagement: str, amplitudes, torque_nm: float) -> dict:
+    """The envelope check of one spectrum a_1..a_N (N, one-sided amplitudes of the tooth harmonics 1..N) as a
+    validate row; for the default engagement (face-width) a check row of issue 28.  Envelope and flat range as
+    housingfe.source.roosmalen.studies.envelope_decay defines them: E(n) = max over m >= n of a_m (the running maximum from
+    the highest harmonic down); it decays at least as 1/n when n E(n) <= a_1 for every n; a flat range is an octave
+    n -> 2n over which E falls by less than FLAT_OCTAVE_DB = 3 dB (half of 1/n's 6.0 dB)."""
+    from housingfe.source.roosmalen.studies import FLAT_OCTAVE_DB, envelope_decay
+    from housingfe.verification.checks import tag
+
+    check = envelope_decay(amplitudes)
+    lo, hi = check["worst_octave"]
+    r = row(scene, f"quasi-static excitation, engagement {engagement}: smallest drop of the harmonics' "
+                   f"envelope per octave, n = 1-{len(amplitudes)}", check["min_octave_drop_dB"], 20 * math.log10(2),
+            "dB", "1/n envelope of a step excitation (derived; ../shared/notes/run-up-physics.md §5.2); check of "
+                  "issue 28",
+            note=f"passed: {'yes' if check['passed'] else 'no'}; goal: every octave >= "
+                 f"{FLAT_OCTAVE_DB:g} dB (no flat range) and n E(n) <= F_1 (max n E(n)/F_1 = "
+                 f"{check['max_n_envelope_ratio']:.2f}); smallest drop at n = {lo}-{hi}; "
+                 f"F_1 = {amplitudes[0]:.0f} N at {torque_nm:g} N m (`housingfe source-spectrum`)")
+    if engagement == "face-width":      # the check of issue 28 is on the default engagement
+        tag(r, f"28.excitation.envelope.{scene.removeprefix('gearset-')}",
+            tolerance=f"envelope E(n) = max over m >= n of a_m: n E(n) <= a_1 and every octave n -> 2n drops >= "
+                      f"{FLAT_OCTAVE_DB:g} dB (no flat range)", passed=check["passed"],
+            why=f"smallest octave drop {check['min_octave_drop_dB']:.1f} dB at n = {lo}-{hi}; max n E(n) / a_1 = "
+                f"{check['max_n_envelope_ratio']:.2f}")
+    return r
 
 
 def trueman_rows() -> list[dict]:
     """Table 6.1 critical speeds of the 10-box drives (drawroll rpm; the configurations the model cannot
     represent as rows without a value) and the 4-box rig of Sec. 6.9."""
-    from housingfe.source import trueman as tr
-    from housingfe.source import trueman_data as data
+    from housingfe.source.trueman import data
+    from housingfe.source.trueman import response as tr
 
     out = []
     for name, published in data.TABLE_6_1_RPM.items():
@@ -202,9 +221,9 @@ def fukuma_rows() -> list[dict]:
     against the printed K_s; Sec. 4.2: the phi_V tilt natural frequency of series A near 3 f_z at 650 rpm."""
     import scipy.linalg as sl
 
-    from housingfe.source import fukuma as fk
     from housingfe.source.cli import load_scene
-    from housingfe.source.fukuma_run import build_pair, parse_scene
+    from housingfe.source.fukuma import model as fk
+    from housingfe.source.fukuma.run import build_pair, parse_scene
 
     out = []
     for series in ("a", "b"):

@@ -40,14 +40,15 @@ from housingfe.scenefile import builtin_scenes
 from housingfe.verification.published import THESIS, row, thesis, thesis_source
 
 RESULTS = Path("results")
-OWN_FILES = ("validate.csv", "validate.md")     # what --out holds (besides housingfe.outputs.MARKER)
+OWN_FILES = ("validate.csv", "validate.md", "checks.csv", "checks.md")     # what --out holds (besides housingfe.outputs.MARKER)
 PACKAGE = Path(__file__).resolve().parent.parent   # the housingfe package (this file is in verification/)
 STAMP = ".validate-key"
 # the bearing-variant study (thesis Sec. 5.8, Fig. 5.18) and the configurations it needs
 VARIANT_SCENE = "test-gearbox-interior"
 VARIANT_CONFIGS = ("ball", "self_aligning", "ball_zero_moment")
 # Ch. 5 run-ups (housingfe.runup): the built-in scene and the overrides of each validated variant
-RUNUP_SCENES = (("test-gearbox-runup", ()), ("test-gearbox-runup-double-helical", ()),
+DEFAULT_RUNUP = "test-gearbox-runup"          # the default chain of issue 28's checks
+RUNUP_SCENES = ((DEFAULT_RUNUP, ()), ("test-gearbox-runup-double-helical", ()),
                 ("test-gearbox-runup-double-helical", ("drivetrain.bearings=fluid_film",)))
 
 
@@ -75,14 +76,31 @@ class ComputationFailed(Exception):
     """A subprocess of validate failed; the message is one line."""
 
 
+# `housingfe validate --only NAME`: a subset computed alone, by the only_rows(results, quick, failures) of a row
+# provider (found by name like the providers themselves)
+ONLY = {"runup-checks": "housingfe.verification.runup_checks_rows"}
+
+
 def main(out_dir: str | Path = "results/validate", json_path: str | Path | None = None,
-         scenes: list[str] | None = None, quick: bool = False, results_dir: str | Path | None = None) -> list[dict]:
-    """Collect the rows, print them, write validate.csv and validate.md to out_dir (and the JSON list of
-    rows to json_path if given).  scenes: names or paths (only their rows); default every built-in housing
-    scene with a reference and a modal analysis plus the other modules' rows; quick: the CI subset.
-    results_dir: where FE results are cached (default results/).  Raises SolverError (one line) after
-    writing the table when a computation failed."""
+         scenes: list[str] | None = None, quick: bool = False, results_dir: str | Path | None = None,
+         only: str | None = None, bands: str | Path | None = None) -> list[dict]:
+    """Collect the rows, print them, write validate.csv and validate.md to out_dir, and the check rows of issue 28
+    (housingfe.verification.checks) to checks.csv and checks.md (and the JSON list of rows to json_path if
+    given).  scenes: names or paths (only their rows); default every built-in housing scene with a reference and a
+    modal analysis plus the other modules' rows; quick: the CI subset; only="runup-checks": the check rows of
+    issue 28 alone (runup_checks_rows.only_rows).  results_dir: where FE results are cached (default results/).  bands: a JSON
+    file {check_id: [low, high]} of the model's uncertainty bands, attached to the check rows (checks.attach_bands;
+    without it every band is "—").  Raises SolverError (one line) after writing the table when a computation
+    failed."""
     from housingfe.progress import Progress
+
+    if only is not None and only not in ONLY:
+        raise InputError(f"validate: --only: {only!r} is not one of {', '.join(ONLY)}")
+    if only is not None and scenes:
+        raise InputError("validate: --only and scene names: give one or the other")
+    from housingfe.verification.checks import attach_bands, read_bands
+
+    band_table = read_bands(bands) if bands is not None else {}
 
     t0 = time.perf_counter()
     results = Path(results_dir) if results_dir is not None else RESULTS
@@ -92,6 +110,20 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     # checked and locked before minutes of computation; validate.csv and validate.md alone are an older
     # validate's output (written before result folders carried a marker)
     reserve_output(out_dir, own_files=OWN_FILES)
+    if only is not None:
+        failures: list[str] = []
+        rows = importlib.import_module(ONLY[only]).only_rows(results, quick, failures)
+        attach_bands(rows, band_table)
+        write_outputs(rows, Path(out_dir), json_path)
+        from housingfe.verification.checks import checks_markdown
+
+        print(checks_markdown(rows), end="")
+        print(f"{len(rows)} check rows in {time.perf_counter() - t0:.0f} s; written to {out_dir}/checks.md, checks.csv, "
+              "validate.csv, validate.md" + (f" and {json_path}" if json_path else ""))
+        if failures:
+            raise SolverError(f"validate: {len(failures)} computation(s) failed, their rows are missing: "
+                              + "; ".join(failures))
+        return rows
     names = scenes or default_scenes(quick)
     rows: list[dict] = []
     failures: list[str] = []
@@ -130,6 +162,7 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
                 progress.update(note=name)
         rows += provider_rows(failures, progress, results=results, quick=quick)
     progress.close()
+    attach_bands(rows, band_table)
     write_outputs(rows, Path(out_dir), json_path)
     print(format_rows(rows))
     print(f"{len(rows)} rows in {time.perf_counter() - t0:.0f} s; written to {out_dir}/validate.csv, validate.md "
@@ -366,10 +399,10 @@ def bearing_variant_rows(results: Path | None = None) -> list[dict]:
     return out
 
 
-def runup_rows(name: str, overrides=(), results: Path | None = None) -> list[dict]:
-    """Ch. 5 checks of a run-up scene (housingfe.runup.checks: L_WA maximum, resonant speeds, speed and torque
-    laws, L_omega in the tooth band) as validate rows; runup.json reused when its key matches, else computed
-    (about a minute)."""
+def runup_folder(name: str, overrides=(), results: Path | None = None, quick: bool = False) -> tuple[str, Path] | None:
+    """(label, folder) of a run-up scene's cached result <results>/<label>/ (runup.json, runup.csv,
+    runup_harmonics.csv), computed first when its key does not match (about a minute); with quick a stale result is
+    not computed: None, and a note on the console."""
     from housingfe.runup.scene import load_runup_scene
 
     results = RESULTS if results is None else results
@@ -380,8 +413,24 @@ def runup_rows(name: str, overrides=(), results: Path | None = None) -> list[dic
     extra = {"overrides": list(overrides), "housing": housing.model_dump(mode="json")}
     reason = stale_reason(folder, scene, "runup.json", extra)
     if reason:
+        if quick:
+            print(f"validate: {label} rows left out with --quick (no valid cached {folder}/: {reason}; "
+                  "`housingfe validate` computes it)", flush=True)
+            return None
         compute({"kind": "run", "scene": str(path), "overrides": list(overrides)}, scene, folder, results,
                 f"housingfe run {name}" + "".join(f" --set {o}" for o in overrides), extra, reason)
+    return label, folder
+
+
+def runup_rows(name: str, overrides=(), results: Path | None = None, quick: bool = False) -> list[dict]:
+    """Ch. 5 checks of a run-up scene (housingfe.runup.checks: L_WA maximum, resonant speeds, speed and torque
+    laws, L_omega in the tooth band) as validate rows; runup.json reused when its key matches, else computed
+    (about a minute; not with quick: no rows).  The default scene's rows that are checks of issue 28 carry their
+    check_id (tag_default_runup)."""
+    found = runup_folder(name, overrides, results, quick)
+    if found is None:
+        return []
+    label, folder = found
     with open(folder / "runup.json") as fh:
         data = json.load(fh)
     src = thesis_source("test_gearbox", "Ch. 5")
@@ -394,8 +443,47 @@ def runup_rows(name: str, overrides=(), results: Path | None = None) -> list[dic
                                      is not None else "", c["note"]) if x)
         unit = "rpm" if c["check"] in ("resonant_speeds", "L_omega_resonance") else "dB(A)" if c["check"] in (
             "LwA_max", "speed_law", "torque_law") else "dB"
-        out.append(row(label, c["quantity"], ours, published, unit, src, note))
+        r = row(label, c["quantity"], ours, published, unit, src, note)
+        if name == DEFAULT_RUNUP and not overrides:
+            tag_default_runup(r, c, data["checks"])
+        out.append(r)
     return out
+
+
+def tag_default_runup(r: dict, c: dict, run_checks: list[dict] = ()) -> dict:
+    """Give a row of the default run-up (test-gearbox-runup) its issue-28 check_id where it is one: the L_WA
+    maximum per route, the speed law per route, L_omega on the flexible housing at 500/1000/1500 rpm and where its
+    resonance lies.  c: the run's check (runup.json "checks"); run_checks: all of them (the L_WA maximum's row says
+    how far the route's excitation, L_omega in the tooth band, is from the measured one)."""
+    from housingfe.verification.checks import tag
+
+    route = c["quantity"].split(":", 1)[0]
+    common = {"measured": c["measured"], "thesis_calculated": c["thesis_calculated"], "passed": c["passed"]}
+    if c["check"] == "LwA_max":
+        # the route's excitation: tf_omega multiplies the rigid-bore source's L_omega, mesh_force drives the coupled
+        # model with the source on the flexible housing
+        kind = "L_omega" if route == "tf_omega" else "L_omega_flexible"
+        gaps = [x["ours"] - x["measured"] for x in run_checks if x["check"] == kind
+                and isinstance(x["ours"], (int, float)) and isinstance(x["measured"], (int, float))]
+        which = "rigid-bore source" if kind == "L_omega" else "flexible housing"
+        why = (f"the route's excitation, L_omega in the tooth band ({which}), is {np.mean(gaps):+.1f} dB from the "
+               f"measured (mean over the measured speeds 500/1000/1500 rpm the run has: {len(gaps)})") if gaps else ""
+        tag(r, f"28.default.max_lwa.{route}", tolerance="3 dB", why=why, **common)
+    elif c["check"] == "speed_law":
+        tag(r, f"28.speed_law.{route}", tolerance="2 dB", why=c["note"].split("; total")[0], **common)
+    elif c["check"] == "L_omega_flexible":
+        speed = c["quantity"].rsplit(" at ", 1)[1].split()[0]
+        rigid = next((x["ours"] for x in run_checks if x["check"] == "L_omega"
+                      and x["quantity"].endswith(f" at {speed} rpm")), None)
+        why = c["note"]
+        if isinstance(rigid, (int, float)) and isinstance(c["ours"], (int, float)):
+            why = (f"the rigid-bore source gives {rigid:.1f} dB here: the flexible housing moves it by "
+                   f"{c['ours'] - rigid:+.1f} dB; {why}")
+        tag(r, f"28.l_omega.flexible.{speed}rpm", tolerance="6 dB", why=why, **common)
+    elif c["check"] == "L_omega_resonance":
+        tag(r, "28.l_omega.resonance", tolerance="moved from the rigid-bore source's towards 1500 rpm",
+            why=c["note"], **common)
+    return r
 
 
 def joint_rows(modal: dict[str, dict]) -> list[dict]:
@@ -532,11 +620,16 @@ def write_outputs(rows: list[dict], out_dir: Path, json_path) -> None:
         for r in rows:
             lines.append("| " + " | ".join(c.replace("|", "/") for c in _cells(r)) + " |")
         (tmp / "validate.md").write_text("\n".join(lines) + "\n")
+        from housingfe.verification.checks import write_checks
+
+        write_checks(rows, tmp)
     if json_path:
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
         keys = ("scene", "quantity", "ours", "published", "unit", "source", "note")
+        check_keys = ("check_id", "measured", "thesis_calculated", "tolerance", "passed", "why", "band")
         with open(json_path, "w") as fh:
-            fh.write(dumps_json([{k: _jsonable(r.get(k, "")) for k in keys} for r in rows], indent=1))
+            fh.write(dumps_json([{k: _jsonable(r.get(k, "")) for k in keys + (check_keys if r.get("check_id") else ())}
+                                 for r in rows], indent=1))
 
 
 def _csv(v):

@@ -10,7 +10,7 @@ from housingfe.drivetrain.interior import CouplingSpec
 from housingfe.drivetrain.shafts import STEEL, RigidDisc
 from housingfe.errors import InputError
 from housingfe.scenefile import read_scene_dict
-from housingfe.source import roosmalen
+from housingfe.source.roosmalen import run as roosmalen
 
 
 def _scene_source(name):
@@ -126,7 +126,7 @@ def test_lumped_mesh_loads_map_onto_the_fe_mesh_loads(gear_set):
     node: force along the contact normal and its moment about the gear centre, all six components.  (Single helical
     only: for the double helical set the lumped normal keeps the axial component and cos(beta_b) of one helix,
     the FE reduction takes beta_b = 0 as the halves cancel; docs/drivetrain.md.)"""
-    from housingfe.source.dynamics import mesh_direction
+    from housingfe.source.roosmalen.dynamics import mesh_direction
 
     d = test_gearbox(gear_set)
     h = mesh_direction(d.gears.pair)

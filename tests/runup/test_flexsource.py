@@ -22,7 +22,7 @@ from housingfe.runup.chain import (
     runup,
     source_lines,
 )
-from housingfe.source.dynamics import _fourier_coefficients, mesh_harmonic_balance
+from housingfe.source.roosmalen.dynamics import _fourier_coefficients, mesh_harmonic_balance
 from housingfe.source.stiffness import normal_force_from_torque
 from tests.runup.conftest import F_LINES, SPEEDS
 

@@ -69,7 +69,7 @@ def test_unknown_builtin_scene_exits_2(capsys):
 
 def test_builtin_gearsets_are_valid_source_scenes():
     from housingfe.source.cli import load_scene
-    from housingfe.source.roosmalen import build, parse
+    from housingfe.source.roosmalen.run import build, parse
 
     for name in ("gearset-A", "gearset-B", "gearset-C", "gearset-D", "gearset-uncorrected", "gearset-double-helical"):
         scene, path = load_scene(name)
@@ -83,7 +83,7 @@ def test_builtin_gearsets_are_valid_source_scenes():
 def test_engagement_key_selects_the_shock_model(tmp_path):
     """source.engagement: "face-width" (default) or "thesis-2d"; anything else is named as the bad key."""
     from housingfe.scenefile import read_scene_dict
-    from housingfe.source import roosmalen
+    from housingfe.source.roosmalen import run as roosmalen
 
     data, path = read_scene_dict(str(_small_scene(tmp_path)))
     assert roosmalen.parse(data, str(path)).engagement == "face-width"

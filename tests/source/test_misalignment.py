@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import housingfe
-from housingfe.source import dynamics as dyn
-from housingfe.source import roosmalen as rs
 from housingfe.source.gears import GearPair
 from housingfe.source.misalignment import from_tilts, lumped_misalignment
-from housingfe.source.operating import SourceModel
+from housingfe.source.roosmalen import dynamics as dyn
+from housingfe.source.roosmalen import run as rs
+from housingfe.source.roosmalen.operating import SourceModel
 from housingfe.source.stiffness import (
     MeshModel,
     contact_loss_fraction,

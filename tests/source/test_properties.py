@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from housingfe.errors import InputError
-from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair
+from housingfe.source.roosmalen import dynamics as dyn
 from housingfe.source.stiffness import MeshModel, normal_force_from_torque, stiffness_curve
 
 SETTINGS = settings(max_examples=10, derandomize=True, deadline=None)

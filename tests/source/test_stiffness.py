@@ -225,3 +225,46 @@ def test_face_load_share_follows_where_the_torques_enter():
     for phi in share.values():
         assert np.argmax(phi) == 0 and phi[:4].mean() > 1.02 > 0.98 > phi[4:].mean()
     assert share[2][0] / share[2][-1] < share[1][0] / share[1][-1]
+
+
+def test_correction_d_is_read_as_appendix_f_and_its_triangle_edge_is_a_contact_line():
+    """Set D (App. F, Fig. F.1; Sec. 2.7 table): pinion 30 um over 5.2 mm, wheel 37 um over 6.0 mm along the line
+    of action from Q to P, triangle widths 25 / 30 mm.  The thesis: line P-R "is parallel to the lines of contact",
+    so on every contact line inside the triangle the relief is one value (the engagement runs out linearly from Q,
+    in time, not across the line), the wheel's contact starts at its corner Q with the full 37 um, and P-R itself is
+    unrelieved.  The published W tan(beta_b) = 5.98 / 4.98 mm against L = 6.0 / 5.2 mm bounds the residual slope
+    along a line by C |1 - W tan(beta_b) / L|: 0.14 um (wheel), 1.3 um (pinion).  A triangle mirrored across the
+    face (corner at the wrong face) varies by the full amount along a line and fails."""
+    from housingfe.scenefile import read_scene_dict
+    from housingfe.source.roosmalen import run as rs
+    from housingfe.source.stiffness import flank_gaps
+
+    data, path = read_scene_dict("gearset-D")
+    pair, corr, _, _, model = rs.build(rs.parse(data, str(path)), str(path))
+    assert corr.triangular
+    assert np.allclose(corr.tip_relief, (30e-6, 37e-6))
+    assert np.allclose(corr.tip_relief_length, (5.2e-3, 6.0e-3))
+    assert np.allclose(corr.triangle_width, (25e-3, 30e-3))
+    tb = math.tan(pair.base_helix_angle)
+    A, _ = pair.path_of_contact
+    b = pair.contact_width
+    for g in (0, 1):
+        bound = corr.tip_relief[g] * abs(1 - corr.triangle_width[g] * tb / corr.tip_relief_length[g])
+        only = Corrections(tip_relief=tuple(corr.tip_relief[i] if i == g else 0.0 for i in (0, 1)),
+                           tip_relief_length=corr.tip_relief_length, triangular=True,
+                           triangle_width=corr.triangle_width)
+        spreads, relieved = [], 0
+        for u in np.linspace(0.0, pair.transverse_base_pitch, 13, endpoint=False):
+            pts = MeshModel(pair, corrections=only, n_slices=64).contact_points(float(u))
+            gap = flank_gaps(pair, only, pts["s"], pts["w_local"], pts["w"], pts["helix"])
+            for k in np.unique(pts["pair"]):
+                inside = (pts["pair"] == k) & (gap > 0)
+                if inside.sum() >= 2:
+                    relieved += 1
+                    spreads.append(np.ptp(gap[inside]))
+        assert relieved >= 3
+        assert max(spreads) <= bound + 1e-9 * corr.tip_relief[g], (g, max(spreads) * 1e6, bound * 1e6)
+    # the wheel's first contact point (s = A) is its corner Q at the face w = b, with the full relief
+    q = flank_gaps(pair, Corrections(tip_relief=(0.0, 37e-6), tip_relief_length=(0.0, 6.0e-3), triangular=True,
+                                     triangle_width=(0.0, 30e-3)), A, b, b, 0)
+    assert q == pytest.approx(37e-6, rel=1e-12)

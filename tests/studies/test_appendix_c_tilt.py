@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from housingfe.source.dynamics import APPENDIX_C_BEARINGS
+from housingfe.source.roosmalen.dynamics import APPENDIX_C_BEARINGS
 from housingfe.verification.bearing_rows import printed_matrices
 
 

@@ -46,3 +46,21 @@ def test_builtin_scene_carries_the_computed_loads_and_mesh():
     mesh = scene.coupling.gear_meshes[0]
     assert mesh.stiffness == pytest.approx(forces.stiffness, rel=1e-4)
     assert np.allclose(mesh.direction, forces.direction, atol=1e-6)
+
+
+def test_zero_tilt_stiffness_keeps_the_couplings_zero_moment_drops_them():
+    """ball_zero_moment (the thesis' stand-in) zeroes the moment rows and columns, ball_zero_tilt_stiffness only the
+    tilt block; the locating ball bearings have force-tilt couplings of ~1e7 N/rad, the load centre's axial offset
+    |k_x,theta| / k_xx of 1-2 cm (the thesis' printed Sec. 4.6 matrix: 11 mm), which the second keeps."""
+    base = load_scene("test-gearbox-interior").coupling
+    ball = {b.name: np.array(b.stiffness_matrix) for b in bv.configuration_spec(base, "ball")[0].bearings}
+    zero = {b.name: np.array(b.stiffness_matrix) for b in bv.configuration_spec(base, bv.THESIS_SELF_ALIGNING)[0].bearings}
+    tilt = {b.name: np.array(b.stiffness_matrix) for b in bv.configuration_spec(base, bv.ZERO_TILT_STIFFNESS)[0].bearings}
+    for name, k in ball.items():
+        assert np.all(zero[name][3:5] == 0) and np.all(zero[name][:, 3:5] == 0)
+        assert np.all(tilt[name][3:5, 3:5] == 0)
+        assert np.array_equal(tilt[name][:3], k[:3]) and np.array_equal(tilt[name][:, :3], k[:, :3])
+    for name in ("pinion_front", "wheel_front"):                     # the locating (axially loaded) bearings
+        k = ball[name]
+        offset = max(abs(k[0, 4]) / k[0, 0], abs(k[1, 3]) / k[1, 1])
+        assert 0.008 < offset < 0.03, (name, offset)

@@ -176,7 +176,8 @@ def test_row_providers_are_the_rows_modules_and_no_other_module_has_rows():
     import housingfe.verification as package
 
     assert validate.ROW_PROVIDERS == ("housingfe.verification.bearing_rows", "housingfe.verification.radiation_rows",
-                                      "housingfe.verification.source_rows", "housingfe.verification.study_rows")
+                                      "housingfe.verification.runup_checks_rows", "housingfe.verification.source_rows",
+                                      "housingfe.verification.study_rows")
     for m in pkgutil.iter_modules(package.__path__):
         name = f"housingfe.verification.{m.name}"
         assert hasattr(importlib.import_module(name), "published_rows") == (name in validate.ROW_PROVIDERS), name
@@ -214,7 +215,7 @@ def test_radiation_rows_carry_appendix_e_and_reproduce_it():
 
 @pytest.mark.slow
 def test_source_rows_carry_appendix_f_trueman_and_fukuma():
-    from housingfe.source import trueman_data
+    from housingfe.source.trueman import data as trueman_data
     from housingfe.verification import source_rows as validation
 
     rows = validation.published_rows()

@@ -43,7 +43,7 @@ def lumped_like(dt, other_spec, ball_spec):
     """The drivetrain whose lumped source (rigid bores) has Appendix C's bearing diagonal scaled per shaft by the
     FE bearings' stiffness ratio other / ball: radial (x, y) and the shaft tilt (two bearings' radial stiffness x
     span^2, so the same ratio) by the mean radial ratio, axial (z) by the axial ratio."""
-    from housingfe.source.dynamics import APPENDIX_C_BEARINGS
+    from housingfe.source.roosmalen.dynamics import APPENDIX_C_BEARINGS
 
     a, b = common.diagonals(other_spec), common.diagonals(ball_spec)
     out = {}

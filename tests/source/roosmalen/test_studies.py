@@ -10,10 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from housingfe.source.studies import envelope_decay
+from housingfe.source.roosmalen.studies import envelope_decay
 
 HOUSINGFE = [sys.executable, "-m", "housingfe"]
-ENV = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[2]), "OPENBLAS_NUM_THREADS": "1"}
+ENV = {**os.environ, "PYTHONPATH": str(Path(__file__).parents[3]), "OPENBLAS_NUM_THREADS": "1"}
 
 
 def test_envelope_of_a_step_spectrum_decays_6_dB_per_octave():
@@ -40,7 +40,7 @@ def test_a_plateau_fails_the_envelope_check():
 
 def test_source_spectrum_command_writes_table_and_plot(tmp_path):
     out = tmp_path / "spec"
-    scene = Path(__file__).parents[2] / "housingfe/scenes/gearset-A.toml"
+    scene = Path(__file__).parents[3] / "housingfe/scenes/gearset-A.toml"
     text = scene.read_text().replace("stiffness_positions = 32", "stiffness_positions = 8").replace(
         "slices = 24", "slices = 6")
     path = tmp_path / "small-A.toml"

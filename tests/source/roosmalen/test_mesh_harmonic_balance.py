@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 import scipy.linalg as sla
 
-from housingfe.source import dynamics as dyn
-from tests.source.test_dynamics import GEOMETRY, K_MEAN, PAIR
+from housingfe.source.roosmalen import dynamics as dyn
+from tests.source.roosmalen.test_dynamics import GEOMETRY, K_MEAN, PAIR
 
 H = 12
 

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 import housingfe
-from housingfe.source import dynamics as dyn
+from housingfe.source.roosmalen import dynamics as dyn
 
 SCENES = Path(housingfe.__file__).parent / "scenes"
 

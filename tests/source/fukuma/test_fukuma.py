@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from housingfe.errors import InputError
-from housingfe.source import fukuma as fk
-from housingfe.source import fukuma_run
+from housingfe.source.fukuma import model as fk
+from housingfe.source.fukuma import run as fukuma_run
 
 KP, KS, L = 2.39e7, 9.5e7, 0.220
 
@@ -127,7 +127,7 @@ def test_bearing_loads_balance_the_gear_load():
 
 
 def _load(name):
-    path = Path(fk.__file__).parents[1] / "scenes" / f"{name}.toml"
+    path = Path(fk.__file__).parents[2] / "scenes" / f"{name}.toml"
     return tomllib.loads(path.read_text()), str(path)
 
 
@@ -175,7 +175,7 @@ def test_tilt_natural_frequency_near_three_times_contact_frequency_series_a():
     position is not printed (Fig. 5 missing), so every position of the half span is accepted within 10 %."""
     import scipy.linalg as sl
 
-    from housingfe.source.fukuma_run import build_pair, parse_scene
+    from housingfe.source.fukuma.run import build_pair, parse_scene
 
     scene, path = _load("fukuma-series-a")
     pair, _ = build_pair(parse_scene(scene, path))

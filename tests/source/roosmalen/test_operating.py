@@ -1,4 +1,4 @@
-"""The source stage (housingfe.source.operating): SourceModel.operating_point gives what `housingfe source` computes,
+"""The source stage (housingfe.source.roosmalen.operating): SourceModel.operating_point gives what `housingfe source` computes,
 its mesh force and transmission error obey F = S(t) d(t) + F_e(t), its bearing loads balance the lumped reactions,
 and bad operating points are input errors."""
 import math
@@ -9,9 +9,9 @@ import pytest
 from housingfe.errors import InputError
 from housingfe.levels import OMEGA0, level
 from housingfe.scenefile import read_scene_dict
-from housingfe.source import dynamics as dyn
-from housingfe.source import roosmalen
-from housingfe.source.operating import SourceModel
+from housingfe.source.roosmalen import dynamics as dyn
+from housingfe.source.roosmalen import run as roosmalen
+from housingfe.source.roosmalen.operating import SourceModel
 
 
 @pytest.fixture(scope="module")

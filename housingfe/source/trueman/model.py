@@ -26,7 +26,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from housingfe.errors import InputError
-from housingfe.source import trueman_data as data
+from housingfe.source.trueman import data
 
 MESH_POSITIONS = 6          # drawroll-pair branches per drawbox
 

@@ -271,7 +271,7 @@ def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffn
     n_helices).  A slice's share of the load is thus its stiffness times its deflection compatibility, and a
     helical tooth enters over eps_beta mesh periods instead of at once.
 
-    Limits (tests/source/test_dynamics.py): spur gears (eps_beta = 0) with origin = A give exactly
+    Limits (tests/source/roosmalen/test_dynamics.py): spur gears (eps_beta = 0) with origin = A give exactly
     `engagement_force`; for a uniform load and constant S the harmonics are those of the transverse-section
     shock (Eq. 2.62 with eps_alpha) times the slices' array factor, |sinc(n eps_beta)| for many slices."""
     S = np.asarray(stiffness, dtype=float)

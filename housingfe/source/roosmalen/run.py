@@ -24,8 +24,8 @@ from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt
 
 from housingfe.errors import InputError
 from housingfe.outputs import format_table, write_csv, write_json
-from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair, tooth_profile
+from housingfe.source.roosmalen import dynamics as dyn
 from housingfe.source.stiffness import (
     Corrections,
     MeshModel,
@@ -155,7 +155,7 @@ def build(table: SourceTable, scene_path: str = "scene"):
 
 class OperatingPoint:
     """Stiffness curve, matrices, shock force and preload for one pinion torque [N m].  engagement: the shock
-    model (housingfe.source.dynamics.ENGAGEMENT_MODELS): "face-width" (default) distributes Eq. 2.62 over the
+    model (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS): "face-width" (default) distributes Eq. 2.62 over the
     face-width slices with the load share of `face_load_share`, "thesis-2d" is the thesis' Eq. 2.62.
     lead_gap [m/m]: the misalignment under load (MeshModel.lead_gap, housingfe.source.misalignment), in the
     stiffness curve and the load share (0: aligned gears, exactly as before)."""
@@ -288,7 +288,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     write_json(out_dir / "bearing_spectra.json", {
         "description": "complex one-sided amplitudes [re, im] of loads the shafts exert on the housing at "
                        "the bearings; load(t) = Re(sum A exp(i 2 pi f t)); components Fx Fy Fz [N] Mx My Mz [N m]; "
-                       "z [m] along the shaft from the gear centre plane (see housingfe.source.dynamics.BearingSpectra)",
+                       "z [m] along the shaft from the gear centre plane (see housingfe.source.roosmalen.dynamics.BearingSpectra)",
         "components": ["Fx", "Fy", "Fz", "Mx", "My", "Mz"],
         "operating_points": [{"speed_rpm": b.speed_rpm, "torque_Nm": b.torque_Nm, "frequency_hz": b.frequency,
                               "bearings": [{"name": n, "z_m": float(z), "re": ld.real, "im": ld.imag}

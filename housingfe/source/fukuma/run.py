@@ -125,7 +125,7 @@ def parse_scene(scene: dict, scene_path: str) -> FukumaScene:
 
 def build_pair(sc: FukumaScene):
     """FukumaPair of a scene: pressure angle and radii from the shared spur-gear geometry."""
-    from housingfe.source import fukuma as fk
+    from housingfe.source.fukuma import model as fk
     from housingfe.source.gears import GearPair
 
     g = sc.gear
@@ -151,7 +151,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
     """Run a Fukuma scene: influence coefficients, equivalent inertia and radial / axial conversion ratios
     over the gear position (CSV + PNG), bearing force and moment spectra at the listed gear positions, the
     Table 1 shaft-stiffness check.  Writes into the existing folder `out_dir`."""
-    from housingfe.source import fukuma as fk
+    from housingfe.source.fukuma import model as fk
 
     sc = parse_scene(scene, scene_path)
     out_dir = Path(out_dir)
@@ -209,7 +209,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
 
 
 def _bearing_outputs(sc: FukumaScene, pair, out_dir: Path) -> list:
-    from housingfe.source import fukuma as fk
+    from housingfe.source.fukuma import model as fk
 
     rows, out = [], []
     for pos in sc.loads.gear_positions_m:
@@ -257,9 +257,9 @@ def bench_rows(quick: bool) -> list[dict]:
     Table 1's K_s and K_s computed from its equivalent radius (E = 206 GPa assumed)."""
     import tomllib
 
-    from housingfe.source import fukuma as fk
+    from housingfe.source.fukuma import model as fk
 
-    path = Path(__file__).parents[1] / "scenes" / "fukuma-series-a.toml"
+    path = Path(__file__).parents[2] / "scenes" / "fukuma-series-a.toml"
     scene = tomllib.loads(path.read_text())
     sc = parse_scene(scene, str(path))
     pair, _ = build_pair(sc)

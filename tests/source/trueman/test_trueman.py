@@ -10,9 +10,9 @@ import pytest
 import scipy.sparse as sp
 
 from housingfe.errors import InputError
-from housingfe.source import trueman as tr
-from housingfe.source import trueman_data as data
-from housingfe.source import trueman_run
+from housingfe.source.trueman import data
+from housingfe.source.trueman import response as tr
+from housingfe.source.trueman import run as trueman_run
 
 INCH = data.INCH
 
@@ -163,7 +163,7 @@ def test_fe_drawshaft_matches_exact_distributed_shaft():
     for length, dia in reversed(d["drawshaft_sections"]):
         k = tr.shaft_end_stiffness(k, w, length, dia, d["shear_modulus"], d["density"])
     # FE: condense a chain gear(0) ... drawroll
-    from housingfe.source.trueman_model import _Assembler
+    from housingfe.source.trueman.model import _Assembler
     asm = _Assembler()
     start = gear = asm.node()
     for length, dia in d["drawshaft_sections"]:
@@ -225,7 +225,7 @@ def _load_scene(name):
     import tomllib
     from pathlib import Path
 
-    path = Path(tr.__file__).parents[1] / "scenes" / f"{name}.toml"
+    path = Path(tr.__file__).parents[2] / "scenes" / f"{name}.toml"
     return tomllib.loads(path.read_text()), str(path)
 
 

@@ -10,13 +10,12 @@
   excitation spectrum (issue 28): the quasi-static engagement shock F_e and excitation k_m (d - mean d) per
       tooth harmonic of the built-in gear sets, both engagement models (`housingfe source-spectrum`).
 
-Run: `python -m housingfe.source.studies [out_dir]` (default results/source-studies); writes CSV + PNG.
+Run: `python -m housingfe.source.roosmalen.studies [out_dir]` (default results/source-studies); writes CSV + PNG.
 """
 from __future__ import annotations
 
 import argparse
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -56,7 +55,7 @@ def main(out_dir: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from housingfe.source.roosmalen import correction_study
+    from housingfe.source.roosmalen.run import correction_study
 
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -118,9 +117,9 @@ def excitation_spectrum(scenes=SPECTRUM_SCENES, harmonics: int = 15, torque_nm: 
     and excitation_N: one-sided amplitude of k_m (d - mean d) with d = (F - F_e) / S(t) the quasi-static mesh
     compression (what mesh stiffness variation and shock together impose on a structure that holds the mean
     stiffness k_m: the load of the run-up's mesh_force route at low speed), N."""
-    from housingfe.source import dynamics as dyn
-    from housingfe.source import roosmalen as rs
     from housingfe.source.cli import load_scene
+    from housingfe.source.roosmalen import dynamics as dyn
+    from housingfe.source.roosmalen import run as rs
 
     rows = []
     for name in scenes:
@@ -265,4 +264,9 @@ def register_cli(subparsers) -> None:
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]) if len(sys.argv) > 1 else Path("results/source-studies"))
+    # argparse, so that `--help` prints help instead of becoming the name of the output folder
+    parser = argparse.ArgumentParser(prog="python -m housingfe.source.roosmalen.studies",
+                                     description="Overlap-ratio study (Fig. 2.9) and correction study (Fig. 2.18): "
+                                                 "CSV + PNG into OUT_DIR.")
+    parser.add_argument("out_dir", nargs="?", default="results/source-studies", type=Path)
+    main(parser.parse_args().out_dir)

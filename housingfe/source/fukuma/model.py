@@ -26,7 +26,7 @@ positions of Fig. 5 (figure missing; only A1 = mid-span, zl = 110 mm, is stated)
 
 Public API: `ShaftBearing`, `GearBody`, `FukumaPair`, `influence_coefficients`, `equivalent_inertia`,
 `harmonic_response`, `conversion_ratios`, `bearing_load_spectra`; the scene runner (`run_scene`,
-`bench_rows`) is housingfe.source.fukuma_run.
+`bench_rows`) is housingfe.source.fukuma.run.
 """
 from __future__ import annotations
 
@@ -342,7 +342,7 @@ def bearing_load_spectra(pair: FukumaPair, z: float, rpm: float, te_harmonics_m,
     with harmonic amplitudes `te_harmonics_m` [m] at 1, 2, ... times the mesh frequency (disturbing force
     F = K e, eq. 12) at shaft speed `rpm` and gear position z [-].
 
-    Returns the housing chain's structure `housingfe.source.dynamics.BearingSpectra` (issue 7):
+    Returns the housing chain's structure `housingfe.source.roosmalen.dynamics.BearingSpectra` (issue 7):
     frequency [Hz], names, z [m] (bearing positions along the shaft from the gear centre plane: -z l and
     (1 - z) l), loads (4, 6, n_freq) complex one-sided amplitudes of [F_x, F_y, F_z, M_x, M_y, M_z] that
     each SHAFT exerts on the housing at the bearing, load(t) = Re(A exp(i 2 pi f t)); x = horizontal H,
@@ -354,7 +354,7 @@ def bearing_load_spectra(pair: FukumaPair, z: float, rpm: float, te_harmonics_m,
     The gear loads on the shaft are P = (gamma y - beta phi)/Lambda, M = (alpha phi - beta y)/Lambda
     (eq. 2); bearing forces K_p y_bearing follow from the blended influence functions, bearing moments are
     lambda times the clamped-end moments."""
-    from housingfe.source.dynamics import BearingSpectra
+    from housingfe.source.roosmalen.dynamics import BearingSpectra
 
     te = np.atleast_1d(np.asarray(te_harmonics_m, dtype=complex))
     omega0 = mesh_frequency(pair, rpm)

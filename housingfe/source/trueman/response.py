@@ -1,6 +1,6 @@
 """Trueman (1974): branched multi-mesh torsional drive excited by transmission-error (TE) harmonics.
 
-Model (thesis Sec. 5.2-5.4, Appendices A-I; data Appendix B, see `trueman_data`): torsion only, rigid
+Model (thesis Sec. 5.2-5.4, Appendices A-I; data Appendix B, see `housingfe.source.trueman.data`): torsion only, rigid
 bearings, viscous damping, teeth always in contact, only the once-per-drawroll-revolution TE harmonic.
 All rotations are drawroll-referred; speeds are DRAWROLL r.p.m.; omega = 2 pi rpm / 60.
 
@@ -10,13 +10,13 @@ What differs from the thesis's program (on purpose):
   equivalent equal-and-opposite torque pair +-(k_m + j omega c_m) theta_E on a and b; all meshes are solved
   together and the mesh torque is T = (k_m + j omega c_m)(theta_a - theta_b - theta_E).  The thesis
   propagates "theta = T_D / K4" from the source box by box, which is not the physical gear displacement
-  (shown on a two-inertia case in tests/source/test_trueman.py).
+  (shown on a two-inertia case in tests/source/trueman/test_trueman.py).
 - A machine's random TE set is drawn ONCE and kept over the whole speed sweep (the thesis re-draws at every
   speed card); the generator is numpy's PCG64 with an explicit seed.
 
 Public API: `critical_speeds`, `mesh_transfer`, `mesh_torques`, `random_te`, `mesh_load_envelopes`,
 `mesh_torque_from_receptances`, `shaft_end_stiffness`; the scene runner (`run_scene`, `bench_rows`) is
-housingfe.source.trueman_run.
+housingfe.source.trueman.run.
 """
 from __future__ import annotations
 
@@ -28,8 +28,8 @@ import scipy.optimize as so
 import scipy.sparse.linalg as sla
 
 from housingfe.errors import InputError, SolverError
-from housingfe.source import trueman_data as data
-from housingfe.source.trueman_model import DriveConfig, DriveModel, build_drive, vs_drive_ratios
+from housingfe.source.trueman import data
+from housingfe.source.trueman.model import DriveConfig, DriveModel, build_drive, vs_drive_ratios
 
 __all__ = [
     "DriveConfig",

@@ -1,12 +1,12 @@
 """The source as a stage: `SourceModel.operating_point(speed_rpm, torque_nm) -> Excitation`.
 
-A SourceModel is van Roosmalen's lumped source model (housingfe.source.dynamics: 14 DOFs on rigid bores, the
+A SourceModel is van Roosmalen's lumped source model (housingfe.source.roosmalen.dynamics: 14 DOFs on rigid bores, the
 time-varying mesh stiffness S(t) of housingfe.source.stiffness and the engagement shock F_e(t), steady state by
 harmonic balance), built from a gear pair with its corrections and the lumped reduction of a drivetrain
 (housingfe.drivetrain.description.Drivetrain.to_lumped, or a gearset-* scene).  It computes exactly what
-`housingfe source gearset-*` computes (housingfe.source.roosmalen.run_scene), per operating point, and hands the
+`housingfe source gearset-*` computes (housingfe.source.roosmalen.run.run_scene), per operating point, and hands the
 housing side what it needs: per harmonic n of the tooth frequency the complex dynamic mesh force and transmission
-error, the bearing forces and moments (housingfe.source.dynamics.BearingSpectra) and L_omega of the wheel.
+error, the bearing forces and moments (housingfe.source.roosmalen.dynamics.BearingSpectra) and L_omega of the wheel.
 
 Amplitude convention (as everywhere in housingfe.source): one-sided complex amplitudes A_n of n f_tooth,
 x(t) = x_mean + Re(sum_n A_n exp(i 2 pi n f_tooth t)).
@@ -22,10 +22,10 @@ import numpy as np
 
 from housingfe.errors import InputError
 from housingfe.levels import OMEGA0, level
-from housingfe.source import dynamics as dyn
 from housingfe.source.gears import GearPair
 from housingfe.source.misalignment import check_model as check_misalignment
 from housingfe.source.misalignment import lumped_misalignment
+from housingfe.source.roosmalen import dynamics as dyn
 from housingfe.source.stiffness import Corrections, MeshModel, ShaftBending
 
 # the run-up range of the thesis' measurements (Sec. 5.3) and of the gearset-* scenes
@@ -107,7 +107,7 @@ class SourceModel:
         """The model of a roosmalen source scene (built-in name such as "gearset-A", or a TOML path), with the
         scene's harmonics, stiffness positions and speed range."""
         from housingfe.scenefile import read_scene_dict
-        from housingfe.source import roosmalen
+        from housingfe.source.roosmalen import run as roosmalen
 
         data, path = read_scene_dict(str(scene))
         table = roosmalen.parse(data, str(path))
@@ -118,7 +118,7 @@ class SourceModel:
 
     def _point(self, torque: float):
         """Stiffness curve, matrices, shock and preload at a torque (cached: they do not depend on speed)."""
-        from housingfe.source.roosmalen import OperatingPoint
+        from housingfe.source.roosmalen.run import OperatingPoint
 
         if torque not in self._points:
             self._points[torque] = OperatingPoint(self.pair, self.corrections, self.interior, self.mesh_model,

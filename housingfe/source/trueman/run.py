@@ -39,10 +39,10 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from housingfe.outputs import format_table, write_csv, write_json
 from housingfe.scenefile import SceneInfo, parse_table
-from housingfe.source import trueman_data as data
+from housingfe.source.trueman import data
 
 if TYPE_CHECKING:
-    from housingfe.source.trueman_model import DriveConfig
+    from housingfe.source.trueman.model import DriveConfig
 
 
 class _Strict(BaseModel):
@@ -128,7 +128,7 @@ def parse_scene(scene: dict, scene_path: str) -> TruemanScene:
 
 def drive_config(sc: TruemanScene, conf) -> DriveConfig:
     """DriveConfig of one scene configuration (machine table as defaults)."""
-    from housingfe.source.trueman_model import DriveConfig
+    from housingfe.source.trueman.model import DriveConfig
 
     m = sc.machine
     return DriveConfig(
@@ -152,7 +152,7 @@ def drive_config(sc: TruemanScene, conf) -> DriveConfig:
 
 # --------------------------------------------------------------------------------------------- outputs
 def _critical_outputs(sc: TruemanScene, out_dir: Path) -> list:
-    from housingfe.source.trueman import critical_speeds
+    from housingfe.source.trueman.response import critical_speeds
 
     result, rows = {}, []
     for conf in sc.configurations:
@@ -185,8 +185,8 @@ def helical_mesh_geometry() -> dict:
 
 
 def _forced_outputs(sc: TruemanScene, out_dir: Path) -> dict:
-    from housingfe.source.trueman import mesh_transfer, random_te, rpm_to_omega
-    from housingfe.source.trueman_model import MESH_POSITIONS, build_drive
+    from housingfe.source.trueman.model import MESH_POSITIONS, build_drive
+    from housingfe.source.trueman.response import mesh_transfer, random_te, rpm_to_omega
 
     f = sc.forced
     conf = next(c for c in sc.configurations if c.name == f.configuration)
@@ -246,8 +246,8 @@ def _forced_outputs(sc: TruemanScene, out_dir: Path) -> dict:
 def _thesis_emulation(cfg, f, te, labels, out_dir: Path) -> dict:
     """Per-mesh loads at `histogram_rpm` from the consistent solution and from an emulation of the thesis's
     superposition (induced terms scaled by K_B / K_4), to show where its published magnitudes come from."""
-    from housingfe.source.trueman import mesh_transfer, rpm_to_omega, thesis_style_transfer
-    from housingfe.source.trueman_model import build_drive
+    from housingfe.source.trueman.model import build_drive
+    from housingfe.source.trueman.response import mesh_transfer, rpm_to_omega, thesis_style_transfer
 
     model = build_drive(cfg, f.histogram_rpm)
     omega = float(rpm_to_omega(f.histogram_rpm))
@@ -335,7 +335,7 @@ def bench_rows(quick: bool) -> list[dict]:
       solved per speed with one sparse LU);
     - 100 Monte-Carlo machines over the same sweep (the per-speed transfer matrix is reused, so machines
       are a 60 x 60 matrix product each)."""
-    from housingfe.source.trueman import (
+    from housingfe.source.trueman.response import (
         DriveConfig,
         build_drive,
         critical_speeds,

@@ -1,0 +1,249 @@
+"""The checks of issue 28 as rows of `housingfe validate`: one row per check, with a stable `check_id`.
+
+A check row is an ordinary validate row (housingfe.verification.published.row: scene, quantity, ours, published,
+unit, source, note) with these fields added (`tag`):
+
+* check_id — stable name, "28.<group>.<what>[.<variant>][.<route>]", e.g. "28.default.max_lwa.mesh_force"; the
+  groups, in the issue's order: replica, default, excitation, speed_law, l_omega, variants (CHECK_GROUPS);
+* measured, thesis_calculated — the published numbers beside ours (either may be None);
+* tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
+* passed — "yes", "no" or "" (a report row: nothing to pass);
+* why — what made the result, where it is known (the line, the modes, the term, ...);
+* band — the hook for the model's own uncertainty (issue 28 item 5): None until someone attaches one
+  (`attach_bands`), rendered "—".  A band is (low, high) of ours in the check's unit; the table then says whether
+  the measured value lies inside it.
+
+Rows of other providers that already are an issue-28 check (the study rows, the default run-up's rows, the
+quasi-static excitation rows) are tagged where they are made, not repeated here; the rows no provider had are made
+by housingfe.verification.runup_checks_rows.  `checks_markdown` / `write_checks` give the checks alone
+(validate's checks.csv / checks.md; `housingfe validate --only runup-checks`).
+
+The pure pass/fail logic of the checks lives here too (tested on synthetic inputs with known answers in
+tests/verification/test_checks.py): the measured peak windows, the harmonic that carries the L_WA at a speed,
+whether the tooth-frequency 1/3-octave band is the largest, a ranking's quietest and loudest.
+"""
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+
+CHECK_GROUPS = ("replica", "default", "excitation", "speed_law", "l_omega", "variants")
+CHECK_COLUMNS = ("check_id", "quantity", "ours", "measured", "thesis_calculated", "tolerance", "passed", "band", "why",
+                 "unit", "scene", "source")
+NO_BAND = "—"
+
+# issue 28, "Default chain": the measured L_WA peaks (windows, rev/min), how close ours must be, and the band of the
+# coupled modes the measured peaks sit on (the tooth frequency meeting 180 / 340-380 / 520-540 Hz modes, Sec. 5.4)
+PEAK_WINDOWS_RPM = ((450.0, 500.0), (850.0, 950.0), (1300.0, 1350.0))
+PEAK_TOLERANCE_RPM = 100.0
+PEAK_MODE_BAND_HZ = (150.0, 600.0)
+PEAKS_NEEDED = 2
+HIGHEST_MAKING_HARMONIC = 2            # the maximum and every peak made by the tooth frequency or its 2nd harmonic
+TOOTH_BAND_SPEED_MIN_RPM = 400.0
+TOOTH_BAND_SHARE = 0.8                 # the tooth band the largest at >= 80 % of the speeds >= 400 rpm
+MAX_LWA_TOLERANCE_DB = 3.0
+REPLICA_MAX_TOLERANCE_DB = 1.5
+
+
+# ------------------------------------------------------------------------------------------- the row format
+def tag(row: dict, check_id: str, *, measured=None, thesis_calculated=None, tolerance: str = "", passed=None,
+        why: str = "") -> dict:
+    """Make a validate row a check row (module docstring); passed: True/False, "yes"/"no", or None/"" (report)."""
+    if not check_id.startswith("28.") or check_id.split(".")[1] not in CHECK_GROUPS:
+        raise ValueError(f"check_id {check_id!r}: must be 28.<group>.<...> with group in {CHECK_GROUPS}")
+    if isinstance(passed, (bool, np.bool_)):
+        passed = "yes" if passed else "no"
+    row.update(check_id=check_id, measured=measured, thesis_calculated=thesis_calculated, tolerance=tolerance,
+               passed=passed or "", why=why)
+    row.setdefault("band", None)
+    return row
+
+
+def check_row(check_id: str, scene: str, quantity: str, ours, unit: str, source: str, *, measured=None,
+              thesis_calculated=None, tolerance: str = "", passed=None, why: str = "") -> dict:
+    """A new check row: `published` is the measured value, or the thesis' calculated one where nothing was
+    measured; the note repeats goal, pass and why for validate.md."""
+    from housingfe.verification.published import row
+
+    published = measured if measured is not None else thesis_calculated
+    p = "yes" if passed is True else "no" if passed is False else (passed or "")
+    note = "; ".join(x for x in (f"goal: {tolerance}" if tolerance else "", f"passed: {p}" if p else "", why) if x)
+    return tag(row(scene, quantity, ours, published, unit, source, note), check_id, measured=measured,
+               thesis_calculated=thesis_calculated, tolerance=tolerance, passed=passed, why=why)
+
+
+def is_check(row: dict) -> bool:
+    return bool(row.get("check_id"))
+
+
+def check_rows(rows) -> list[dict]:
+    """The check rows of `rows`, in the issue's order of groups (stable within a group)."""
+    found = [r for r in rows if is_check(r)]
+    return sorted(found, key=lambda r: CHECK_GROUPS.index(r["check_id"].split(".")[1]))
+
+
+def attach_bands(rows, bands) -> int:
+    """The uncertainty hook: bands {check_id: (low, high)} (ours' band in the check's unit, e.g. from a Monte-Carlo
+    run) set on the rows with that check_id; returns how many rows got one.  Rows without a band show "—"."""
+    n = 0
+    for r in rows:
+        if is_check(r) and r["check_id"] in bands:
+            lo, hi = bands[r["check_id"]]
+            r["band"] = (float(lo), float(hi))
+            n += 1
+    return n
+
+
+def read_bands(path) -> dict[str, tuple[float, float]]:
+    """Bands from a JSON file {check_id: [low, high]} (`housingfe validate --bands FILE`); InputError naming the file
+    and key for anything else."""
+    import json
+
+    from housingfe.errors import InputError
+
+    try:
+        data = json.loads(Path(path).read_text())
+    except (OSError, ValueError) as exc:
+        raise InputError(f"{path}: cannot read a JSON object of bands: {exc}") from None
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: must be a JSON object {{check_id: [low, high]}}")
+    out = {}
+    for key, value in data.items():
+        ok = (isinstance(value, list) and len(value) == 2
+              and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value))
+        if not ok or value[0] > value[1]:
+            raise InputError(f"{path}: {key}: must be [low, high] with finite numbers, low <= high, not {value!r}")
+        out[key] = (float(value[0]), float(value[1]))
+    return out
+
+
+def band_text(row: dict) -> str:
+    """"—" without a band; else "low … high" and whether the measured value is inside it."""
+    band = row.get("band")
+    if band is None:
+        return NO_BAND
+    lo, hi = band
+    m = row.get("measured")
+    where = ""
+    if isinstance(m, (int, float)) and not isinstance(m, bool):
+        where = ": measured inside" if lo <= m <= hi else ": measured outside"
+    return f"{lo:.4g} … {hi:.4g}{where}"
+
+
+def _cell(v) -> str:
+    if v is None:
+        return ""
+    if isinstance(v, float):
+        return "nan" if math.isnan(v) else f"{v:.4g}"
+    return str(v)
+
+
+def _cells(r: dict) -> list[str]:
+    return [r["check_id"], r["quantity"], _cell(r["ours"]), _cell(r.get("measured")),
+            _cell(r.get("thesis_calculated")), r.get("tolerance", ""), r.get("passed", "") or "report", band_text(r),
+            r.get("why", ""), r["unit"], r["scene"], r["source"]]
+
+
+def checks_markdown(rows) -> str:
+    """The check rows of `rows` as a Markdown table (the columns of CHECK_COLUMNS) and a count line."""
+    found = check_rows(rows)
+    lines = ["| " + " | ".join(CHECK_COLUMNS) + " |", "|" + "---|" * len(CHECK_COLUMNS)]
+    lines += ["| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in _cells(r)) + " |" for r in found]
+    passed = sum(r.get("passed") == "yes" for r in found)
+    failed = sum(r.get("passed") == "no" for r in found)
+    lines += ["", f"{len(found)} checks: {passed} passed, {failed} failed, {len(found) - passed - failed} reported"]
+    return "\n".join(lines) + "\n"
+
+
+def write_checks(rows, folder: Path) -> None:
+    """checks.csv and checks.md (the check rows of `rows`) into folder."""
+    found = check_rows(rows)
+    with open(Path(folder) / "checks.csv", "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(CHECK_COLUMNS)
+        for r in found:
+            cells = _cells(r)
+            cells[7] = "" if r.get("band") is None else cells[7]
+            writer.writerow(cells)
+    (Path(folder) / "checks.md").write_text(checks_markdown(rows))
+
+
+# ------------------------------------------------------------------------------------------ pass/fail logic
+def window_distance(speed: float, window) -> float:
+    """Distance (rev/min) of a speed from a window (lo, hi); 0 inside."""
+    lo, hi = window
+    return max(lo - speed, speed - hi, 0.0)
+
+
+def peak_windows(peaks, windows=PEAK_WINDOWS_RPM, tolerance=PEAK_TOLERANCE_RPM, mode_band=PEAK_MODE_BAND_HZ,
+                 needed=PEAKS_NEEDED) -> dict:
+    """The "L_WA peaks within 100 rpm of at least two of the measured windows, each traced to coupled modes between
+    150 and 600 Hz" check.  peaks: [(speed rpm, dominant mode Hz or None)] — the dominant mode is the one with the
+    largest share of the peak's <v^2>.  Per window the nearest peak that qualifies (within `tolerance` and its mode
+    inside mode_band) or, if none, the nearest peak at all; passed when `needed` windows have a qualifying peak."""
+    per_window = []
+    for w in windows:
+        qualifying = [(window_distance(s, w), s, f) for s, f in peaks if window_distance(s, w) <= tolerance
+                      and f is not None and mode_band[0] <= f <= mode_band[1]]
+        near = [(window_distance(s, w), s, f) for s, f in peaks]
+        best = min(qualifying or near, default=None)
+        per_window.append({"window": tuple(w), "matched": bool(qualifying),
+                           "peak_rpm": None if best is None else best[1], "distance_rpm": None if best is None else
+                           best[0], "mode_hz": None if best is None else best[2]})
+    hits = sum(p["matched"] for p in per_window)
+    return {"windows": per_window, "hits": hits, "passed": hits >= needed}
+
+
+def carrying_harmonic(harmonics, lwa_db) -> tuple[int, float]:
+    """(harmonic, its share of the total power) of the line with the largest L_WA at one speed."""
+    lw = np.asarray(lwa_db, float)
+    power = 10.0 ** (lw / 10.0)
+    i = int(np.nanargmax(lw))
+    return int(np.asarray(harmonics)[i]), float(power[i] / np.nansum(power))
+
+
+def third_octave_index(frequency_hz) -> np.ndarray:
+    """The base-10 one-third-octave band number of each frequency (IEC 61260-1: band b has the exact centre
+    1000 * 10^((b - 30) / 10) Hz, its edges at +-1/20 decade): round(10 lg f)."""
+    return np.rint(10.0 * np.log10(np.asarray(frequency_hz, float))).astype(int)
+
+
+def tooth_band_largest(frequency_hz, harmonic, level_db) -> bool:
+    """At one speed: is the 1/3-octave band of the tooth frequency (harmonic 1) the largest band of this quantity's
+    spectrum?  Lines energy-summed per band (at high harmonics two lines can share a band); ties count as largest."""
+    band = third_octave_index(frequency_hz)
+    power = 10.0 ** (np.asarray(level_db, float) / 10.0)
+    h = np.asarray(harmonic)
+    if not np.any(h == 1):
+        raise ValueError("tooth_band_largest: no tooth-frequency line")
+    tooth = band[h == 1][0]
+    sums = {b: float(np.nansum(power[band == b])) for b in np.unique(band)}
+    return sums[tooth] >= max(sums.values()) * (1.0 - 1e-12)
+
+
+def tooth_band_share(speeds, frequency_hz, harmonic, level_db, speed_min=TOOTH_BAND_SPEED_MIN_RPM
+                     ) -> tuple[float, int, list[float]]:
+    """(share of the speeds >= speed_min at which the tooth band is the largest, number of such speeds, the speeds
+    where it is not); all arguments per line (one row per speed and harmonic)."""
+    s = np.asarray(speeds, float)
+    f, h, lv = (np.asarray(x) for x in (frequency_hz, harmonic, level_db))
+    keep = np.unique(s[s >= speed_min])
+    if not keep.size:
+        return float("nan"), 0, []
+    missed = [float(v) for v in keep if not tooth_band_largest(f[s == v], h[s == v], lv[s == v])]
+    return 1.0 - len(missed) / keep.size, int(keep.size), missed
+
+
+def ranking_ends(ours: str, measured: str) -> dict:
+    """Quietest-first rankings "a < b < c": do the quietest and the loudest agree, and the whole order?"""
+    o, m = [x.strip() for x in ours.split("<")], [x.strip() for x in measured.split("<")]
+    return {"quietest": o[0] == m[0], "loudest": o[-1] == m[-1], "order": o == m,
+            "passed": o[0] == m[0] and o[-1] == m[-1]}
+
+
+def within(ours: float, target: float, tolerance: float) -> bool:
+    """|ours - target| <= tolerance (False for NaN)."""
+    return bool(abs(float(ours) - float(target)) <= tolerance)

@@ -1,0 +1,203 @@
+"""Rows for `housingfe validate`: the checks of issue 28 that no other provider makes (housingfe.verification.checks).
+
+From the default run-up's cached result (<results>/test-gearbox-runup/: runup.json, runup.csv,
+runup_harmonics.csv; the computation `housingfe validate` runs anyway for its run-up rows), per route:
+
+* 28.default.max_lwa_harmonic.<route> — the line carrying the most L_WA at the speed of the L_WA maximum: the
+  tooth frequency or its 2nd harmonic (n <= 2);
+* 28.default.peaks.<route> — L_WA peaks (prominence 2 dB, housingfe.runup.checks.peaks) within 100 rpm of at least
+  two of 450-500 / 850-950 / 1300-1350 rpm, each traced to a coupled mode between 150 and 600 Hz (the mode with
+  the largest share of the peak's <v^2>, runup.json peak_contributions);
+* 28.default.no_high_harmonic_peak.<route> — no L_WA peak made (its line with the most L_WA) by the 3rd harmonic
+  or higher;
+* 28.default.tooth_band.<L_omega|L_v|L_W>.<route> — the tooth-frequency 1/3-octave band the largest band of the
+  spectrum at >= 80 % of the speeds >= 400 rpm (L_omega: the source's on tf_omega, the wheel's on the flexible
+  housing on mesh_force when the run has it);
+
+and from the design-variant study's cached result (<results>/study-validate/, housingfe.verification.study_rows):
+
+* 28.replica.max_lwa — the thesis replica (engagement thesis-2d, the rigid-bore source's L_omega times TF_omega,
+  sigma = 1, gear set A, ball bearings, 2000 N m): max L_WA within 1.5 dB of the thesis' calculated 89.4 dB(A).
+
+Nothing is computed here that validate does not compute anyway: with both caches valid these rows take well under
+a second; with quick and a stale cache they are left out (a note on the console).  `only_rows` collects every check
+row of issue 28 (these and the ones tagged by the other providers) for `housingfe validate --only runup-checks`.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from housingfe.errors import SolverError
+from housingfe.verification import checks as ck
+
+SOURCE = "van Roosmalen 1994, Ch. 5 (Secs. 5.4-5.6, Figs. 5.6, 5.7, 5.10) [test_gearbox]; issue 28"
+TOOTH_BAND_QUANTITIES = {"L_omega": "L_omega", "L_v": "Lv_dB", "L_W": "Lw_dB"}
+
+
+def published_rows(results: Path | None = None, quick: bool = False) -> list[dict]:
+    """The rows of the module docstring from the cached default run-up and study results (computed first when stale,
+    not with quick)."""
+    from housingfe.verification import study_rows, validate
+
+    out = []
+    found = validate.runup_folder(validate.DEFAULT_RUNUP, (), results, quick)
+    if found is not None:
+        out += default_chain_rows(*found)
+    folder = study_rows.study_folder(results, quick)
+    if folder is not None:
+        out += replica_rows(folder)
+    return out
+
+
+def only_rows(results: Path, quick: bool = False, failures: list[str] | None = None) -> list[dict]:
+    """The check rows of issue 28 alone (`housingfe validate --only runup-checks`): the default run-up's tagged rows,
+    the design-variant study's (study_rows), the quasi-static excitation's (source_rows.excitation_rows) and the
+    checks no other provider makes (runup_checks_rows), each from the same cached computation the full validate
+    uses.  A failed computation is appended to failures (its rows are missing)."""
+    from housingfe.verification import source_rows, study_rows, validate
+    from housingfe.verification.checks import check_rows
+
+    failures = [] if failures is None else failures
+    rows: list[dict] = []
+    # in the order of the full validate (its run-up rows, then the providers by name), so both give one table
+    for what, make in ((validate.DEFAULT_RUNUP, lambda: validate.runup_rows(validate.DEFAULT_RUNUP, (), results, quick)),
+                       ("runup_checks_rows", lambda: published_rows(results, quick)),
+                       ("quasi-static excitation", source_rows.excitation_rows),
+                       ("study rows", lambda: study_rows.published_rows(results, quick))):
+        try:
+            rows += make()
+        except validate.ComputationFailed as exc:
+            failures.append(str(exc))
+        except SolverError as exc:
+            failures.append(f"{what}: {exc}")
+    return check_rows(rows)
+
+
+def _read_csv(path: Path) -> list[dict]:
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _num(x: str) -> float:
+    return float(x) if x not in ("", None) else float("nan")
+
+
+def default_chain_rows(label: str, folder: Path) -> list[dict]:
+    """The default chain's rows (module docstring) from a run-up result folder."""
+    data = json.loads((folder / "runup.json").read_text())
+    rad = data["scene_settings"]["radiation"]["models"][0]
+    totals = [r for r in _read_csv(folder / "runup.csv") if r["radiation"] == rad]
+    harm = [r for r in _read_csv(folder / "runup_harmonics.csv") if r["radiation"] == rad]
+    top = max(_num(r["torque_nm"]) for r in totals)
+    out = []
+    for route in dict.fromkeys(r["route"] for r in totals):
+        tot = [r for r in totals if r["route"] == route and _num(r["torque_nm"]) == top]
+        lines = [r for r in harm if r["route"] == route and _num(r["torque_nm"]) == top]
+        where = f"{route}, {top:g} N m, sigma {rad}"
+        out.append(max_harmonic_row(label, route, where, tot, lines))
+        contributions = [c for c in data["peak_contributions"] if c["route"] == route and c["torque_nm"] == top]
+        out += peak_rows(label, route, where, contributions)
+        out += tooth_band_rows(label, route, where, lines)
+    return out
+
+
+def max_harmonic_row(label: str, route: str, where: str, totals: list[dict], lines: list[dict]) -> dict:
+    """28.default.max_lwa_harmonic: which line carries the L_WA at the speed of the maximum."""
+    speeds = np.array([_num(r["speed_rpm"]) for r in totals])
+    lwa = np.array([_num(r["LwA_dB"]) for r in totals])
+    s = float(speeds[int(np.nanargmax(lwa))])
+    at = [r for r in lines if _num(r["speed_rpm"]) == s]
+    n, share = ck.carrying_harmonic([int(r["harmonic"]) for r in at], [_num(r["LwA_dB"]) for r in at])
+    f = next(_num(r["frequency_hz"]) for r in at if int(r["harmonic"]) == n)
+    return ck.check_row(f"28.default.max_lwa_harmonic.{route}", label,
+                        f"{where}: harmonic carrying the L_WA maximum ({s:g} rpm, {lwa.max():.1f} dB(A))", n, "-",
+                        SOURCE, measured="1 or 2", tolerance=f"n <= {ck.HIGHEST_MAKING_HARMONIC}",
+                        passed=n <= ck.HIGHEST_MAKING_HARMONIC,
+                        why=f"harmonic {n} at {f:.0f} Hz carries {share:.0%} of the L_WA; measured: the tooth "
+                            "frequency and its 2nd harmonic only (Fig. 5.6)")
+
+
+def _dominant_mode(contribution: dict) -> float | None:
+    modes = contribution.get("modes") or []
+    return max(modes, key=lambda m: m["share"])["frequency_hz"] if modes else None
+
+
+def peak_rows(label: str, route: str, where: str, contributions: list[dict]) -> list[dict]:
+    """28.default.peaks (the measured windows, traced to 150-600 Hz modes) and 28.default.no_high_harmonic_peak."""
+    peaks = [(c["speed_rpm"], _dominant_mode(c)) for c in contributions]
+    result = ck.peak_windows(peaks)
+    listed = ", ".join(f"{c['speed_rpm']:g} (n = {c['harmonic']}, mode {_dominant_mode(c) or 0:.0f} Hz)"
+                       for c in contributions) or "none"
+    per_window = "; ".join(
+        f"{w['window'][0]:g}-{w['window'][1]:g}: " + ("no peak" if w["peak_rpm"] is None else
+                                                     f"{w['peak_rpm']:g} rpm ({w['distance_rpm']:g} rpm off, mode "
+                                                     f"{w['mode_hz'] or 0:.0f} Hz) {'yes' if w['matched'] else 'no'}")
+        for w in result["windows"])
+    lo, hi = ck.PEAK_MODE_BAND_HZ
+    windows = " / ".join(f"{a:g}-{b:g}" for a, b in ck.PEAK_WINDOWS_RPM)
+    rows = [ck.check_row(f"28.default.peaks.{route}", label,
+                         f"{where}: L_WA peaks (rpm; line, dominant mode) near the measured ones, on {lo:g}-{hi:g} Hz "
+                         "modes", listed, "rpm", SOURCE, measured=windows,
+                         tolerance=f"{ck.PEAKS_NEEDED} of 3 windows: a peak within {ck.PEAK_TOLERANCE_RPM:g} rpm whose "
+                                   f"dominant mode is {lo:g}-{hi:g} Hz",
+                         passed=result["passed"], why=f"{result['hits']} of 3 matched; {per_window}")]
+    high = [c for c in contributions if c["harmonic"] > ck.HIGHEST_MAKING_HARMONIC]
+    rows.append(ck.check_row(
+        f"28.default.no_high_harmonic_peak.{route}", label,
+        f"{where}: L_WA peaks made by the 3rd harmonic or higher", len(high), "-", SOURCE, measured=0,
+        tolerance="none", passed=not high,
+        why=("; ".join(f"{c['speed_rpm']:g} rpm: n = {c['harmonic']} at {c['line_hz']:.0f} Hz "
+                       f"({c['line_share_of_LwA']:.0%} of the L_WA)" for c in high)
+             or f"{len(contributions)} peaks, all made by n <= {ck.HIGHEST_MAKING_HARMONIC}")))
+    return rows
+
+
+def tooth_band_rows(label: str, route: str, where: str, lines: list[dict]) -> list[dict]:
+    """28.default.tooth_band.<quantity>: the share of the speeds >= 400 rpm at which the tooth band is largest."""
+    rows = []
+    speeds = [_num(r["speed_rpm"]) for r in lines]
+    freq = [_num(r["frequency_hz"]) for r in lines]
+    harmonic = [int(r["harmonic"]) for r in lines]
+    for name, column in TOOTH_BAND_QUANTITIES.items():
+        what = name
+        if name == "L_omega":
+            flexible = [_num(r["L_omega_coupled_dB"]) for r in lines]
+            if route == "mesh_force" and np.all(np.isfinite(flexible)):
+                values, what = flexible, "L_omega of the wheel on the flexible housing"
+            else:
+                values, what = [_num(r["L_omega_dB"]) for r in lines], "L_omega of the source (rigid bores)"
+        else:
+            values = [_num(r[column]) for r in lines]
+        share, count, missed = ck.tooth_band_share(speeds, freq, harmonic, values)
+        rows.append(ck.check_row(
+            f"28.default.tooth_band.{name}.{route}", label,
+            f"{where}: share of the speeds >= {ck.TOOTH_BAND_SPEED_MIN_RPM:g} rpm at which the tooth band is the "
+            f"largest 1/3-octave band of {name}", round(share, 2), "-", SOURCE, measured="tooth band dominant",
+            tolerance=f">= {ck.TOOTH_BAND_SHARE:g}", passed=share >= ck.TOOTH_BAND_SHARE,
+            why=f"{what}; {count} speeds; not the largest at "
+                + (", ".join(f"{s:g}" for s in missed) + " rpm" if missed else "none")))
+    return rows
+
+
+def replica_rows(folder: Path) -> list[dict]:
+    """28.replica.max_lwa from the study's thesis-2d profile-corrections run (set A, tf_omega)."""
+    from housingfe.verification.study_rows import JOBS, REPLICA_GOAL_DB
+
+    sub = next(s for f, o, s in JOBS if f == "profile-corrections" and any("thesis-2d" in x for x in o))
+    data = json.loads((folder / sub / "study.json").read_text())
+    r = next((r for r in data["rows"] if r["variant"] == "A" and r["route"] == "tf_omega"), None)
+    if r is None:
+        return []
+    ok = ck.within(r["LwA_max_dBA"], r["thesis_calc_max_dBA"], REPLICA_GOAL_DB)
+    return [ck.check_row("28.replica.max_lwa", f"study profile-corrections ({data['engagement']})",
+                         f"thesis replica (engagement {data['engagement']}, rigid-bore L_omega x TF_omega, sigma "
+                         f"{data['radiation']}, set A, ball, 2000 N m): max L_WA dB(A) ({r['at_rpm']:g} rpm)",
+                         r["LwA_max_dBA"], "dB(A)", data["source"], measured=r["measured_max_dBA"],
+                         thesis_calculated=r["thesis_calc_max_dBA"], tolerance=f"{REPLICA_GOAL_DB:g} dB of the "
+                         "thesis' calculation", passed=ok,
+                         why=f"the thesis' own chain gave {r['thesis_calc_max_dBA']} dB(A) against "
+                             f"{r['measured_max_dBA']} measured")]

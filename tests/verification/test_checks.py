@@ -1,0 +1,269 @@
+"""The checks of issue 28 as validate rows (housingfe.verification.checks, runup_checks_rows, the tags of study_rows,
+source_rows and validate.runup_rows): each check's pass/fail logic on synthetic inputs whose answer is known by
+hand, and the rows reaching validate's row collection from a cached run-up result."""
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from housingfe.verification import checks as ck
+from housingfe.verification import runup_checks_rows, source_rows, study_rows, validate
+
+
+# ------------------------------------------------------------------------------------------- peaks and modes
+def test_peak_windows_match_within_100_rpm_on_150_600_hz_modes():
+    # 470 rpm lies inside 450-500; 1040 rpm is 90 rpm above 850-950; 1460 rpm is 110 rpm above 1300-1350
+    result = ck.peak_windows([(470.0, 340.0), (1040.0, 520.0), (1460.0, 560.0)])
+    assert [w["matched"] for w in result["windows"]] == [True, True, False]
+    assert [w["distance_rpm"] for w in result["windows"]] == [0.0, 90.0, 110.0]
+    assert result["hits"] == 2 and result["passed"]
+
+
+def test_a_peak_on_a_high_mode_does_not_count():
+    # the right speeds, but made by a 2.7 kHz mode (the mesh_force peaks of the thesis-2d chain): not traced to
+    # 150-600 Hz, so only one window is matched
+    result = ck.peak_windows([(470.0, 2725.0), (900.0, 2632.0), (1320.0, 180.0)])
+    assert [w["matched"] for w in result["windows"]] == [False, False, True]
+    assert not result["passed"]
+    assert not ck.peak_windows([])["passed"]
+
+
+def test_the_harmonic_carrying_a_speed():
+    n, share = ck.carrying_harmonic([1, 2, 3], [80.0, 86.0, 83.0])
+    p = 10 ** np.array([8.0, 8.6, 8.3])
+    assert n == 2 and share == pytest.approx(p[1] / p.sum())
+
+
+def test_third_octave_band_numbers():
+    # base-10 bands: band 30 is centred on 1000 Hz with edges 10^(+-1/20) x 1000 = 891 / 1122 Hz
+    assert list(ck.third_octave_index([1000.0, 200.0, 1100.0, 1130.0, 880.0, 900.0])) == [30, 23, 30, 31, 29, 30]
+
+
+def test_tooth_band_largest_sums_lines_sharing_a_band():
+    f = [200.0, 400.0, 1800.0, 2000.0]           # 1800 and 2000 Hz both lie in band 33 (1778-2239 Hz)
+    assert ck.tooth_band_largest(f, [1, 2, 9, 10], [88.0, 85.0, 80.0, 80.0])
+    assert not ck.tooth_band_largest(f, [1, 2, 9, 10], [88.0, 89.0, 80.0, 80.0])   # the 2nd harmonic louder
+    # each high line alone is 2 dB under the tooth line, their band is 1 dB over it
+    assert not ck.tooth_band_largest(f, [1, 2, 9, 10], [88.0, 85.0, 86.0, 86.0])
+
+
+def test_tooth_band_share_counts_speeds_from_400_rpm():
+    speeds, freq, harm, level = [], [], [], []
+    for s, second in ((300.0, 99.0), (400.0, 80.0), (500.0, 80.0), (600.0, 80.0), (700.0, 99.0)):
+        f1 = 0.4 * s
+        speeds += [s, s]
+        freq += [f1, 2 * f1]
+        harm += [1, 2]
+        level += [90.0, second]
+    share, count, missed = ck.tooth_band_share(speeds, freq, harm, level)
+    assert (share, count, missed) == (0.75, 4, [700.0])          # 300 rpm is not counted
+    assert share < ck.TOOTH_BAND_SHARE
+
+
+def test_ranking_ends():
+    measured = "self_aligning < angular_contact < tapered_roller < ball"
+    assert ck.ranking_ends(measured, measured) == {"quietest": True, "loudest": True, "order": True, "passed": True}
+    swapped = ck.ranking_ends("self_aligning < tapered_roller < angular_contact < ball", measured)
+    assert swapped["passed"] and not swapped["order"]
+    assert not ck.ranking_ends("ball < angular_contact < tapered_roller < self_aligning", measured)["passed"]
+
+
+# ------------------------------------------------------------------------------------ quasi-static excitation
+def test_an_envelope_falling_as_1_over_n_passes_and_a_plateau_fails():
+    n = np.arange(1, 16)
+    assert source_rows.envelope_row("gearset-A", "face-width", list(1000.0 / n), 2000.0)["passed"] == "yes"
+    assert source_rows.envelope_row("gearset-A", "face-width", list(1000.0 / n ** 2), 2000.0)["passed"] == "yes"
+    plateau = 1000.0 / n
+    plateau[5:12] = 50.0                          # flat from n = 6 to 12: the thesis-2d shock's plateau
+    r = source_rows.envelope_row("gearset-A", "face-width", list(plateau), 2000.0)
+    assert r["check_id"] == "28.excitation.envelope.A" and r["passed"] == "no"
+    assert r["ours"] < 3.0                        # an octave (6 -> 12) with less than 3 dB drop
+    # a harmonic above the tooth line's 1/n: n E(n) > a_1
+    above = 1000.0 / n
+    above[2] = 400.0
+    assert source_rows.envelope_row("gearset-B", "face-width", list(above), 2000.0)["passed"] == "no"
+    # the replica's engagement is reported, not a check of issue 28
+    assert "check_id" not in source_rows.envelope_row("gearset-A", "thesis-2d", list(plateau), 2000.0)
+
+
+# ------------------------------------------------------------------------------------------ the row format
+def test_check_ids_and_the_band_hook():
+    with pytest.raises(ValueError):
+        ck.tag({}, "default.max_lwa")
+    r = ck.check_row("28.default.max_lwa.mesh_force", "s", "q", 99.0, "dB(A)", "src", measured=100.5,
+                     tolerance="3 dB", passed=True)
+    assert r["published"] == 100.5 and r["difference"] == pytest.approx(-1.5) and r["passed"] == "yes"
+    assert ck.band_text(r) == ck.NO_BAND
+    assert "| — |" in ck.checks_markdown([r])
+    assert ck.attach_bands([r], {"28.default.max_lwa.mesh_force": (97.0, 101.0)}) == 1
+    assert ck.band_text(r) == "97 … 101: measured inside"
+    ck.attach_bands([r], {"28.default.max_lwa.mesh_force": (90.0, 95.0)})
+    assert ck.band_text(r).endswith("measured outside")
+    rows = [ck.check_row("28.variants.x", "s", "q", 1.0, "dB", "src"), {"quantity": "not a check"},
+            ck.check_row("28.replica.y", "s", "q", 1.0, "dB", "src")]
+    assert [r["check_id"] for r in ck.check_rows(rows)] == ["28.replica.y", "28.variants.x"]
+
+
+def _study(family, rows=(), rankings=(), torque_law=()):
+    return {"family": family, "engagement": "face-width", "source": "src", "reference": "ball", "rows": list(rows),
+            "rankings": list(rankings), "torque_law": list(torque_law)}
+
+
+def test_study_rows_carry_their_check_ids():
+    ranking = {"route": "mesh_force", "measure": "mean difference 800-1500 rpm",
+               "ours": "angular_contact < tapered_roller < self_aligning < ball",
+               "measured": "self_aligning < angular_contact < tapered_roller < ball",
+               "matches": False, "quietest": False, "loudest": True}
+    mean = {"route": "mesh_force", "variant": "self_aligning", "mean_diff_dB": 1.2, "sd_diff_dB": 2.0,
+            "measured_mean_dB": -5.1, "measured_sd_dB": 6.0, "thesis_calc_mean_dB": None, "thesis_calc_sd_dB": None,
+            "LwA_max_dBA": 80.0, "at_rpm": 1400.0, "measured_max_dBA": 92.3, "thesis_calc_max_dBA": None}
+    rows = {r.get("check_id"): r for r in study_rows.study_rows(_study("bearings", [mean], [ranking]))}
+    rank = rows["28.variants.ranking.bearings.mean.mesh_force"]
+    assert rank["passed"] == "no" and "loudest yes" in rank["why"]           # the quietest is wrong
+    m = rows["28.variants.mean.bearings.self_aligning.mesh_force"]
+    assert (m["ours"], m["measured"], m["passed"]) == (1.2, -5.1, "no")     # 6.3 dB off
+    assert "outside the measured s.d." in m["why"]                           # 6.3 > 6.0
+    helical = study_rows.study_rows(_study("double-helical", torque_law=[{
+        "route": "tf_omega", "bearings": "fluid_film", "step_mean_dB": 4.0, "measured_step_dBA": 2.7, "step_sd_dB": 1.0,
+        "step_at_1500rpm_dB": 4.2, "torques_nm": [500, 1000, 1500, 2000], "slope_dB_per_doubling": 5.9}]))
+    assert helical[0]["check_id"] == "28.variants.torque_law.fluid_film.tf_omega" and helical[0]["passed"] == "yes"
+
+
+# --------------------------------------------------------------------- the default chain from a run-up folder
+ROUTE = "mesh_force"
+
+
+def _write_runup(folder, checks=()):
+    """A run-up result with known answers: speeds 400-1500 rpm; the tooth line at 90 dB everywhere, the 2nd
+    harmonic at 80 dB except at 900 rpm (95 dB: it carries the maximum there, L_WA 100 dB(A)); an 8th harmonic at
+    92 dB at 1300 rpm (a peak made by n = 8, above the tooth band at that speed)."""
+    speeds = np.arange(400.0, 1501.0, 100.0)
+    harm, tot = [], []
+    for s in speeds:
+        f1 = 0.4 * s
+        lines = {1: 90.0, 2: 95.0 if s == 900 else 80.0, 8: 92.0 if s == 1300 else 40.0}
+        for n, lv in lines.items():
+            harm.append({"route": ROUTE, "radiation": "erp", "torque_nm": 2000, "speed_rpm": s, "harmonic": n,
+                         "frequency_hz": n * f1, "L_omega_dB": 100.0 if n == 1 else 60.0, "TF_omega_dB": "",
+                         "L_omega_coupled_dB": 100.0 if n == 1 else 60.0, "Lv_dB": lv, "L_sigma_dB": 0,
+                         "Lw_dB": lv, "LwA_dB": lv + (5.0 if s == 900 and n == 2 else 0.0)})
+        lwa = 10 * math.log10(sum(10 ** (r["LwA_dB"] / 10) for r in harm if r["speed_rpm"] == s))
+        tot.append({"route": ROUTE, "radiation": "erp", "torque_nm": 2000, "speed_rpm": s, "LwA_dB": lwa})
+    for name, rows in (("runup_harmonics.csv", harm), ("runup.csv", tot)):
+        with open(folder / name, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+    peak = {"route": ROUTE, "torque_nm": 2000.0, "line_share_of_LwA": 0.9}
+    contributions = [{**peak, "speed_rpm": 900.0, "harmonic": 2, "line_hz": 720.0,
+                      "modes": [{"frequency_hz": 700.0, "share": 0.2, "interior_share": 0.5},
+                                {"frequency_hz": 360.0, "share": 0.7, "interior_share": 0.5}]},
+                     {**peak, "speed_rpm": 1300.0, "harmonic": 8, "line_hz": 4160.0,
+                      "modes": [{"frequency_hz": 4100.0, "share": 0.9, "interior_share": 0.5}]}]
+    (folder / "runup.json").write_text(json.dumps({"scene_settings": {"radiation": {"models": ["erp"]}},
+                                                   "peak_contributions": contributions, "checks": list(checks)}))
+
+
+def test_default_chain_rows_on_known_answers(tmp_path):
+    _write_runup(tmp_path)
+    rows = {r["check_id"]: r for r in runup_checks_rows.default_chain_rows("test-gearbox-runup", tmp_path)}
+    top = rows[f"28.default.max_lwa_harmonic.{ROUTE}"]
+    assert (top["ours"], top["passed"]) == (2, "yes") and "(900 rpm" in top["quantity"]
+    peaks = rows[f"28.default.peaks.{ROUTE}"]
+    # 900 rpm (inside 850-950, dominant mode 360 Hz) matches; 1300 rpm is made by a 4.1 kHz mode: 1 of 3
+    assert peaks["passed"] == "no" and peaks["why"].startswith("1 of 3 matched")
+    high = rows[f"28.default.no_high_harmonic_peak.{ROUTE}"]
+    assert (high["ours"], high["passed"]) == (1, "no") and "1300 rpm: n = 8" in high["why"]
+    # the tooth band is the largest of L_v at every speed but 900 and 1300 rpm: 10 of 12 = 0.83
+    lv = rows[f"28.default.tooth_band.L_v.{ROUTE}"]
+    assert lv["ours"] == pytest.approx(0.83) and lv["passed"] == "yes" and "900, 1300 rpm" in lv["why"]
+    assert rows[f"28.default.tooth_band.L_omega.{ROUTE}"]["ours"] == 1.0
+    assert "flexible housing" in rows[f"28.default.tooth_band.L_omega.{ROUTE}"]["why"]
+
+
+def test_rows_reach_validate_from_a_cached_default_runup(tmp_path):
+    """validate's row collection (runup_rows, as `housingfe validate` and `--only runup-checks` call it) gives the
+    default run-up's check rows their check_id, read from a cached result whose key is current (stamped as
+    validate stamps it, here with no code files: the key then depends on the scene alone)."""
+    from housingfe.runup.scene import load_runup_scene
+    from housingfe.scene import load_housing_scene
+
+    checks = [{"check": "LwA_max", "quantity": "mesh_force: max L_WA dB(A) (900 rpm, 2000 N m, sigma erp)",
+               "ours": 100.2, "measured": 100.5, "thesis_calculated": 89.4, "goal": "within 3 dB of measured",
+               "passed": "yes", "note": ""},
+              {"check": "speed_law", "quantity": "mesh_force: speed law", "ours": 5.5, "measured": 6.0,
+               "thesis_calculated": None, "goal": "within 2 dB of 6, term named", "passed": "yes",
+               "note": "made by transfer (+5.88), held back by A_weighting (-0.36); total: ..."},
+              {"check": "L_omega", "quantity": "source (rigid bores): L_omega tooth band dB at 500 rpm", "ours": 88.2,
+               "measured": 109.9, "thesis_calculated": None, "goal": "report", "passed": "", "note": ""},
+              {"check": "L_omega_flexible", "quantity": "flexible housing: L_omega tooth band dB at 500 rpm",
+               "ours": 84.6, "measured": 109.9, "thesis_calculated": None, "goal": "within 6 dB of measured",
+               "passed": "no", "note": "how"}]
+    folder = tmp_path / validate.DEFAULT_RUNUP
+    folder.mkdir()
+    _write_runup(folder, checks)
+    scene, _ = load_runup_scene(validate.DEFAULT_RUNUP, [])
+    housing, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
+    validate.write_stamp(folder, scene, [], {"overrides": [], "housing": housing.model_dump(mode="json")})
+    rows = validate.runup_rows(validate.DEFAULT_RUNUP, (), tmp_path, quick=True)
+    rows += runup_checks_rows.published_rows(tmp_path, quick=True)      # the study is not cached: left out
+    ids = [r["check_id"] for r in ck.check_rows(rows)]
+    assert ids[:2] == [f"28.default.max_lwa.{ROUTE}", f"28.default.max_lwa_harmonic.{ROUTE}"]
+    assert f"28.speed_law.{ROUTE}" in ids and f"28.default.tooth_band.L_W.{ROUTE}" in ids
+    speed = next(r for r in rows if r.get("check_id") == f"28.speed_law.{ROUTE}")
+    assert speed["why"] == "made by transfer (+5.88), held back by A_weighting (-0.36)"
+    flexible = next(r for r in rows if r.get("check_id") == "28.l_omega.flexible.500rpm")
+    assert flexible["passed"] == "no" and "moves it by -3.6 dB" in flexible["why"]
+    top = next(r for r in rows if r.get("check_id") == f"28.default.max_lwa.{ROUTE}")
+    assert "is -25.3 dB from the measured (mean over" in top["why"]   # mesh_force: the flexible L_omega
+    assert not any(r["quantity"].startswith("source (rigid") and r.get("check_id") for r in rows)
+    validate.write_outputs(rows, tmp_path / "out", None)
+    table = (tmp_path / "out" / "checks.md").read_text()
+    assert f"| 28.default.peaks.{ROUTE} |" in table and table.rstrip().endswith("0 reported")
+
+
+def test_only_with_scene_names_is_bad_input_one_line(tmp_path):
+    """`housingfe validate --only runup-checks box-free`: one error line, exit 2, nothing written."""
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-m", "housingfe", "validate", "--only", "runup-checks", "box-free",
+                           "--out", str(tmp_path / "v"), "--results", str(tmp_path / "r")],
+                          capture_output=True, text=True)
+    assert proc.returncode == 2
+    assert proc.stderr.strip().splitlines() == [
+        "housingfe: error: validate: --only and scene names: give one or the other"]
+    assert not (tmp_path / "v").exists()
+
+
+def test_bands_reach_the_json_and_checks_csv(tmp_path):
+    r = ck.check_row("28.replica.max_lwa", "s", "q", 88.6, "dB(A)", "src", measured=100.5, thesis_calculated=89.4,
+                     tolerance="1.5 dB", passed=True)
+    ck.attach_bands([r], {"28.replica.max_lwa": (86.0, 91.0)})
+    validate.write_outputs([r, {"scene": "x", "quantity": "y", "ours": 1.0, "published": 1.0, "unit": "-",
+                                "source": "z"}], tmp_path / "out", tmp_path / "rows.json")
+    stored = json.loads((tmp_path / "rows.json").read_text())
+    assert stored[0]["band"] == [86.0, 91.0] and stored[0]["check_id"] == "28.replica.max_lwa"
+    assert "check_id" not in stored[1]
+    with open(tmp_path / "out" / "checks.csv") as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert row["band"] == "86 … 91: measured outside" and row["passed"] == "yes"
+
+
+def test_a_bad_bands_file_is_one_error_line(tmp_path):
+    import subprocess
+    import sys
+
+    good = tmp_path / "good.json"
+    good.write_text(json.dumps({"28.replica.max_lwa": [86, 91.5]}))
+    assert ck.read_bands(good) == {"28.replica.max_lwa": (86.0, 91.5)}
+    bad = tmp_path / "bands.json"
+    bad.write_text(json.dumps({"28.replica.max_lwa": [91.0, 86.0]}))
+    proc = subprocess.run([sys.executable, "-m", "housingfe", "validate", "--only", "runup-checks", "--bands", str(bad),
+                           "--out", str(tmp_path / "v"), "--results", str(tmp_path / "r")], capture_output=True, text=True)
+    assert proc.returncode == 2 and not (tmp_path / "v").exists()
+    assert proc.stderr.strip().splitlines() == [
+        f"housingfe: error: {bad}: 28.replica.max_lwa: must be [low, high] with finite numbers, low <= high, not "
+        "[91.0, 86.0]"]
