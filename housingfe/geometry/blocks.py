@@ -239,10 +239,11 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int,
     return {"cells": cell_groups, "facets": facet_groups, "mesher": "transfinite hexahedra (reproducible)"}
 
 
-def mesh_tetrahedra(size: float) -> str:
+def mesh_tetrahedra(size: float, hxt_fallback: bool = True) -> str:
     """Mesh the current gmsh model with linear tetrahedra of `size` (m) the project's way: every option set,
-    Delaunay on one thread (reproducible), slivers refined away, HXT only where that fails.  Returns the
-    mesher's description for the reports.  Any OCC solid can be meshed so (block models, imported CAD)."""
+    Delaunay on one thread (reproducible), slivers refined away, HXT only where that fails (hxt_fallback;
+    False keeps Delaunay's best mesh, slivers and all, for the caller's quality rule).  Returns the mesher's
+    description for the reports.  Any OCC solid can be meshed so (block models, imported CAD)."""
     import gmsh
 
     _set_mesh_options("tet")
@@ -250,7 +251,10 @@ def mesh_tetrahedra(size: float) -> str:
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
     gmsh.model.mesh.generate(3)
-    if _refine_slivers(size) < DELAUNAY_MIN_QUALITY:
+    worst = _refine_slivers(size)
+    if worst < DELAUNAY_MIN_QUALITY and not hxt_fallback:
+        return f"gmsh Delaunay (reproducible; slivers left, worst {worst:.3f})"
+    if worst < DELAUNAY_MIN_QUALITY:
         _hxt_fallback(size)
         return "gmsh HXT (Delaunay left slivers; HXT is not reproducible run to run)"
     return "gmsh Delaunay (reproducible)"
