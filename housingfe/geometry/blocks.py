@@ -517,6 +517,7 @@ def _set_mesh_options(element: str) -> None:
     gmsh.option.setNumber("Mesh.Algorithm", 6)
     gmsh.option.setNumber("Mesh.Algorithm3D", TET_ALGORITHM)
     gmsh.option.setNumber("Mesh.Optimize", 1)
+    gmsh.option.setNumber("Mesh.Smoothing", 1)      # gmsh's default; the CAD face analysis turns it off
     gmsh.option.setNumber("Mesh.OptimizeThreshold", 0.3)
     gmsh.option.setNumber("General.NumThreads", 1)   # parallel meshing is not reproducible
     for dim in (1, 2, 3):

@@ -390,6 +390,10 @@ def analyse_faces(volumes: list[int], size: float) -> dict:
     # small holes keep their small triangles to themselves: 85 000 instead of 208 000 triangles (4.5 instead of
     # 6.7 s) on a 5 MB STEP with 1250 holes; mesh_tetrahedra sets it back for the volume mesh
     gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    # no Laplacian smoothing of the triangles: the same 1-D mesh and triangle count, 2.4x less time (17.1 -> 7.2 s
+    # on the loaded host, 5 MB STEP, 83 000 triangles); the analysis needs the faces' extents (on the curves, so
+    # unchanged) and ray origins, not well-shaped triangles
+    gmsh.option.setNumber("Mesh.Smoothing", 0)
     gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
