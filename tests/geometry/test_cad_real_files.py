@@ -72,7 +72,7 @@ def _free_modes(tmp_path: Path, size: float) -> tuple[dict, str]:
 
 
 def test_free_modes_of_the_nist_part_run_with_its_slivers_reported(tmp_path):
-    """The real part meshes and runs (about 25 s at 20 mm and 65 s at 15 mm on the loaded 2-core host): the
+    """The real part meshes and runs (both sizes 100-245 s on the loaded 2-core host): the
     slivers gmsh leaves at its sub-millimetre chamfers are counted, warned about and fill a tiny share of the
     volume; the mass is density x OpenCASCADE's volume; the rigid modes' mass is that to the faceting of the
     small holes by straight-edged tetrahedra; the first three elastic frequencies (1.1-2.4 kHz) agree between
