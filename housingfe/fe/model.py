@@ -169,8 +169,10 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
 
 
 def check_element_quality(quality: dict, size: float, wall: float | None, element: str) -> str:
-    """Refuse a mesh whose worst element is below MIN_ELEMENT_QUALITY (InputError naming mesh.size) and return a
-    warning (printed on stderr, kept in quality["warning"]) when it is below WARN_ELEMENT_QUALITY, else "".
+    """Refuse a mesh whose elements below MIN_ELEMENT_QUALITY fill more than MAX_SLIVER_VOLUME_FRACTION of its
+    volume (or whose quality dict does not say: InputError naming mesh.size); return a warning (printed on
+    stderr, kept in quality["warning"]) for fewer such slivers or a worst element below WARN_ELEMENT_QUALITY,
+    else "".
     quality: element_quality's dict; size: the element size (m); wall: the thinnest wall (m) or None."""
     q = quality["min"]
     flat = (f": the elements are flat, {size / wall:.0f} times wider ({size:g} m) than the thinnest wall ({wall:g} m)"
