@@ -13,6 +13,10 @@ from housingfe.geometry.blocks import build_gmsh_model, tet_quality
 # the registry's lookup, with the built-in kinds registered (specs imports their modules)
 from housingfe.geometry.specs import GEOMETRY_KINDS, block_model_for
 
+# Elements below this quality count as slivers in element_quality's low_count / low_volume_fraction (the
+# FE model's refusal threshold, housingfe.fe.model.MIN_ELEMENT_QUALITY).
+LOW_QUALITY = 0.05
+
 
 @dataclass
 class HousingMesh:
@@ -133,7 +137,8 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
 def element_quality(mesh) -> dict:
     """Min/max element quality over the mesh (all ranks): for tetrahedra 6*sqrt(2)*V / l_rms^3 (1 for the
     regular tetrahedron), for hexahedra the minimum scaled Jacobian over the eight corners (1 for a cube,
-    <= 0 for an inverted element)."""
+    <= 0 for an inverted element); low_count: the elements below LOW_QUALITY, low_volume_fraction: their
+    share of the mesh's volume (tetrahedra; hexahedra: their share of the cells), elements: the cell count."""
     x = mesh.geometry.x
     dofs = mesh.geometry.dofmap.array.reshape(mesh.topology.index_map(3).size_local
                                               + mesh.topology.index_map(3).num_ghosts, -1)
@@ -142,13 +147,22 @@ def element_quality(mesh) -> dict:
     if xc.shape[1] == 4 or (xc.shape[1] == 10):
         q = tet_quality(xc[:, :4])
         measure = "tet 6*sqrt(2)*V/l_rms^3"
+        v = xc[:, :4]
+        volume = np.abs(np.einsum("ij,ij->i", v[:, 1] - v[:, 0], np.cross(v[:, 2] - v[:, 0], v[:, 3] - v[:, 0]))) / 6
     else:
         q = _hex_scaled_jacobian(xc[:, :8])
         measure = "hex min scaled Jacobian"
+        volume = np.ones(len(q))
     comm = mesh.comm
     qmin = comm.allreduce(float(q.min()) if len(q) else np.inf, op=_mpi_min())
     qmax = comm.allreduce(float(q.max()) if len(q) else -np.inf, op=_mpi_max())
-    return {"min": qmin, "max": qmax, "measure": measure}
+    low = q < LOW_QUALITY
+    low_count = comm.allreduce(int(low.sum()))
+    low_volume = comm.allreduce(float(volume[low].sum()))
+    total_volume = comm.allreduce(float(volume.sum()))
+    return {"min": qmin, "max": qmax, "measure": measure, "low_quality": LOW_QUALITY, "low_count": low_count,
+            "low_volume_fraction": low_volume / total_volume if total_volume > 0 else 0.0,
+            "elements": comm.allreduce(len(q))}
 
 
 def _mpi_min():
