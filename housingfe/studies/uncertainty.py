@@ -383,16 +383,33 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
     if "bearings" in families:
         measured = measured_bearing_means()
         order_measured = sorted(measured, key=measured.get)
-        curves = {b: _curves(base, values, "B", b) for b in BEARING_FAMILY}
+        curves, failed = {}, {}
+        for b in BEARING_FAMILY:
+            try:
+                curves[b] = _curves(base, values, "B", b)
+            except InputError as exc:          # e.g. a bearing of the sample that cannot carry its load
+                failed[b] = str(exc)
+        out["failed"] = "; ".join(f"{b}: {why}" for b, why in failed.items())
+        nan = float("nan")
         for route in base.session.spec.routes:
-            s_ref, l_ref = curves["ball"][route, rad]
             means = {}
+            l_ref = curves["ball"][route, rad][1] if "ball" in curves else None
             for b in BEARING_FAMILY:
-                s, lwa = curves[b][route, rad]
-                means[b] = 0.0 if b == "ball" else difference_stats(s, lwa, l_ref)[0]
+                if b not in curves:
+                    means[b] = nan
+                    out[f"{route}/max_lwa_B_{b}_dBA"] = nan
+                else:
+                    s, lwa = curves[b][route, rad]
+                    means[b] = 0.0 if b == "ball" else (difference_stats(s, lwa, l_ref)[0] if l_ref is not None
+                                                        else nan)
+                    out[f"{route}/max_lwa_B_{b}_dBA"] = float(np.max(lwa))
                 if b != "ball":
                     out[f"{route}/variant_mean_{b}_dB"] = means[b]
-                out[f"{route}/max_lwa_B_{b}_dBA"] = float(np.max(lwa))
+            if failed:
+                out[f"{route}/quietest"] = "failed"
+                out[f"{route}/measured_ranking_holds"] = nan
+                out[f"{route}/self_aligning_quieter_than_ball"] = nan
+                continue
             ours = sorted(means, key=means.get)
             out[f"{route}/quietest"] = ours[0]
             out[f"{route}/measured_ranking_holds"] = float(ours == order_measured)
@@ -454,13 +471,14 @@ class UncertaintyResult:
 
     def fraction(self, quantity: str, route: str | None = None) -> float:
         """Share of the samples in which a yes/no quantity (1/0) holds."""
-        return float(np.mean(self.values(quantity, route)))
+        v = self.values(quantity, route)
+        return float(np.mean(v[np.isfinite(v)])) if np.any(np.isfinite(v)) else float("nan")
 
     def quietest_fractions(self, route: str | None = None) -> dict[str, float]:
         """{configuration: share of samples in which it is the quietest} (bearings family)."""
         key = self._key("quietest", route)
-        got = [m[key] for m in self.metrics]
-        return {b: got.count(b) / len(got) for b in BEARING_FAMILY}
+        got = [m[key] for m in self.metrics if m[key] != "failed"]
+        return {b: (got.count(b) / len(got) if got else float("nan")) for b in BEARING_FAMILY}
 
     @property
     def quantities(self) -> list[str]:
@@ -482,7 +500,7 @@ class UncertaintyResult:
             yes_no = name in ("measured_ranking_holds", "self_aligning_quieter_than_ball")
             p5, p50, p95 = self.band(key)
             rows.append({"route": route, "quantity": name, "p5": p5, "median": p50, "p95": p95,
-                         "fraction": float(np.mean(v)) if yes_no else None,
+                         "fraction": self.fraction(key) if yes_no else None,
                          "samples": int(np.sum(np.isfinite(v)))})
         if "bearings" in self.families:
             for route in self.routes:
@@ -581,7 +599,11 @@ def summary_text(result: UncertaintyResult) -> str:
     cost = (f"cost: {t['per_sample_s']:.1f} s per sample (CPU {t['per_sample_cpu_s']:.1f} s) ({'set A + 4 bearing configurations of set B' if result.families else 'set A'}), "
             f"{t['basis_per_process_s']:.1f} s for the one modal basis per process ({t['processes']} process(es)); "
             f"wall time {t['wall_s']:.1f} s")
-    return "\n".join([head, format_table(["route", "quantity", "p5", "median", "p95", "fraction"], rows), cost])
+    failed = [m["failed"] for m in result.metrics if m.get("failed")]
+    notes = [f"{len(failed)} sample(s) with a configuration that could not run (NaN, left out of the bands): "
+             + " | ".join(failed[:3])] if failed else []
+    return "\n".join([head, format_table(["route", "quantity", "p5", "median", "p95", "fraction"], rows), cost,
+                      *notes])
 
 
 def _f(x) -> str:
@@ -597,6 +619,8 @@ def write(folder: Path, result: UncertaintyResult) -> None:
 
     names = list(PARAMETERS)
     keys = [k for k in result.metrics[0] if not k.endswith("lwa_curve_dBA") and k not in ("pid", "setup_s")]
+    keys += sorted({k for m in result.metrics for k in m} - set(keys) - {"pid", "setup_s"}
+                   - {k for k in result.metrics[0] if k.endswith("lwa_curve_dBA")})
     write_csv(folder / "samples.csv", ["sample", *names, *keys],
               ([i, *(s[n] for n in names), *(m[k] for k in keys)]
                for i, (s, m) in enumerate(zip(result.samples, result.metrics))))
