@@ -243,7 +243,6 @@ def perturbed_drivetrain(base: _Base, values: dict, gear_set: str, bearings: str
     from dataclasses import replace
 
     from housingfe.runup.scene import drivetrain_of
-    from housingfe.source.dynamics import APPENDIX_C_BEARINGS
 
     spec = base.session.scene.drivetrain.model_copy(update={"gear_set": gear_set, "bearings": bearings})
     dt = drivetrain_of(spec, float(torque)).with_bores(base.surfaces)
@@ -260,7 +259,7 @@ def perturbed_drivetrain(base: _Base, values: dict, gear_set: str, bearings: str
         changes["lumped_bearing_spans"] = {"pinion": (span, span), "wheel": (span, span)}
     if values["appendix_c_bearing_scale"] != 1.0:
         changes["lumped_bearing_stiffness"] = {k: tuple(x * values["appendix_c_bearing_scale"] for x in v)
-                                               for k, v in APPENDIX_C_BEARINGS.items()}
+                                               for k, v in dt.lumped_bearings().items()}
     if values["source_loss_factor"] != dt.loss_factor:
         changes["loss_factor"] = values["source_loss_factor"]
     return replace(dt, **changes) if changes else dt
