@@ -438,6 +438,21 @@ class UncertaintyResult:
     workers: int
     timings: dict = field(default_factory=dict)
 
+    @classmethod
+    def load(cls, folder) -> "UncertaintyResult":
+        """The result of an earlier `housingfe uncertainty` run from its folder (uncertainty.json): the bands
+        without re-running the samples."""
+        path = Path(folder) / "uncertainty.json"
+        if not path.is_file():
+            raise InputError(f"{path}: no uncertainty result there (run `housingfe uncertainty --out {folder}`)")
+        d = json.loads(path.read_text())
+        metrics = [{k: (float("nan") if v is None and "/" in k and not k.endswith("quietest") else v)
+                    for k, v in m.items()} for m in d["metrics"]]
+        routes = tuple(dict.fromkeys(k.split("/", 1)[0] for k in metrics[0] if "/" in k))
+        return cls(d["scene"], d["seed"], d["samples"], metrics, routes, np.asarray(d["speeds_rpm"], float),
+                   tuple(d["families"]), {k: tuple(v) for k, v in d["ranges"].items()}, d["engine"], d["workers"],
+                   d["timings_s"])
+
     @property
     def default_route(self) -> str:
         return "mesh_force" if "mesh_force" in self.routes else self.routes[0]
@@ -664,15 +679,19 @@ def plot(path: Path, result: UncertaintyResult) -> None:
         width = 0.8 / len(result.routes)
         for j, route in enumerate(result.routes):
             data = [result.values(f"variant_mean_{b}_dB", route) for b in others]
-            ax.boxplot(data, positions=np.arange(len(others)) + j * width, widths=width * 0.8,
-                       whis=(5, 95), showfliers=False, manage_ticks=False)
-            ax.text(len(others) - 0.6, -1 - 2 * j, route, fontsize=7)
+            data = [d[np.isfinite(d)] for d in data]
+            box = ax.boxplot(data, positions=np.arange(len(others)) + j * width, widths=width * 0.8,
+                             whis=(5, 95), showfliers=False, manage_ticks=False, patch_artist=True)
+            for patch in box["boxes"]:
+                patch.set_facecolor(f"C{j}")
+                patch.set_alpha(0.5)
+            ax.plot([], [], "s", color=f"C{j}", alpha=0.5, label=f"ours, {route}")
         ax.plot(np.arange(len(others)) + width * (len(result.routes) - 1) / 2, [measured[b] for b in others],
                 "k<", ms=8, label="measured (Sec. 5.8)")
         ax.axhline(0.0, color="k", lw=0.6)
         ax.set_xticks(np.arange(len(others)) + width * (len(result.routes) - 1) / 2, others)
         ax.set_ylabel("L_WA - L_WA(ball), mean 800-1500 rpm, gear set B [dB]")
-        ax.set_title("boxes: 5/25/50/75/95 % per route (" + ", ".join(result.routes) + ")", fontsize=10)
+        ax.set_title("boxes: 25-75 %, median; whiskers 5-95 %", fontsize=10)
         ax.legend(fontsize=8)
     else:
         ax.axis("off")

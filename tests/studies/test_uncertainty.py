@@ -61,7 +61,7 @@ def serial():
 
 
 @pytest.mark.slow
-def test_one_and_two_workers_agree(serial):
+def test_one_and_two_workers_agree(serial, tmp_path):
     pooled = unc.run_uncertainty("test-gearbox-runup", 3, seed=7, workers=2, overrides=COARSE, families=())
     assert pooled.engine == "mpi4py.futures"
     assert pooled.samples == serial.samples
@@ -70,6 +70,13 @@ def test_one_and_two_workers_agree(serial):
         np.testing.assert_allclose(pooled.values(key), serial.values(key), rtol=0, atol=1e-9, err_msg=key)
     # the samples differ from each other: the ranges act
     assert np.ptp(serial.values("max_lwa_dBA")) > 0.1
+    # the written result reads back with the same bands (the API the validate column uses)
+    unc.write(tmp_path, serial)
+    assert {p.name for p in tmp_path.iterdir()} >= {"samples.csv", "summary.csv", "summary.txt", "uncertainty.png",
+                                                      "uncertainty.json"}
+    loaded = unc.UncertaintyResult.load(tmp_path)
+    for key in serial.quantities:
+        np.testing.assert_array_equal(loaded.band(key), serial.band(key))
 
 
 @pytest.mark.slow
