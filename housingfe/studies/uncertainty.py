@@ -420,7 +420,13 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
     return out
 
 
+def evaluate_batch(batch, worker: bool = True) -> list[dict]:
+    """evaluate_sample for each (scene, overrides, values, families) of `batch`, in order (one pool task)."""
+    return [evaluate_sample(*a, worker=worker) for a in batch]
+
+
 # ------------------------------------------------------------------------------------------------ the run
+SAMPLES_PER_PROCESS = 6
 @dataclass
 class UncertaintyResult:
     """Samples (parameter values) and their metrics, in sample order; routes; the default route of `band`;
@@ -553,12 +559,14 @@ def check_request(n_samples, seed, workers, families, engine) -> None:
 
 def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 0, workers: int = 1, *,
                     ranges: dict | None = None, overrides=(), families: tuple = FAMILIES, engine: str = "mpi",
-                    progress=None) -> UncertaintyResult:
+                    samples_per_process: int = SAMPLES_PER_PROCESS, progress=None) -> UncertaintyResult:
     """Run `n_samples` seeded Latin-hypercube samples of the estimated inputs (PARAMETERS, `ranges` overriding:
     {name: (low, high)}, radiation: (models...)) through the run-up scene's chain (--set `overrides`) on `workers`
     processes (engine "mpi": mpi4py.futures; "processes": concurrent.futures) and return the UncertaintyResult.
     families: ("bearings",) adds gear set B's bearing configurations (4 re-analyses more per sample); () = set A
-    only (the cheap mode).  Bad input -> InputError before any model is built."""
+    only (the cheap mode).  A process runs at most samples_per_process samples (then a new one builds the basis
+    again: memory, see the code); workers == 1 with no more samples than that runs in this process.  Bad input
+    -> InputError before any model is built."""
     from housingfe.runup.scene import load_runup_scene
 
     families = tuple(families)
@@ -573,22 +581,29 @@ def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 
     say = progress or (lambda text: None)
     t0 = time.perf_counter()
     args = [(scene, tuple(overrides), s, families) for s in samples]
-    if workers == 1:
+    if workers == 1 and n_samples <= samples_per_process:
         metrics = []
         for i, a in enumerate(args):
             metrics.append(evaluate_sample(*a))
             say(f"sample {i + 1}/{n_samples}: {metrics[-1]['seconds']:.1f} s")
         used = "serial"
     else:
+        # batches of samples_per_process samples, at most `workers` batches per pool: the pool's processes end
+        # after them (each re-analysis leaves ~0.1 GB in the process, not held by Python objects, so a process
+        # must not run for ever: 14 samples of the bearings family took 10 GB and the kernel killed it)
         used = "mpi4py.futures" if engine == "mpi" else "concurrent.futures"
-        with _executor(engine, workers) as ex:
-            futures = [ex.submit(evaluate_sample, *a, worker=True) for a in args]
-            metrics = []
-            for i, fut in enumerate(futures):        # in sample order: the answer does not depend on the pool
-                metrics.append(fut.result())
-                say(f"sample {i + 1}/{n_samples}: {metrics[-1]['seconds']:.1f} s (process {metrics[-1]['pid']})")
+        batches = [args[i:i + samples_per_process] for i in range(0, len(args), samples_per_process)]
+        metrics = []
+        for first in range(0, len(batches), workers):
+            group = batches[first:first + workers]
+            with _executor(engine, len(group)) as ex:
+                futures = [ex.submit(evaluate_batch, batch, worker=True) for batch in group]
+                for fut in futures:                 # in sample order: the answer does not depend on the pool
+                    for m in fut.result():
+                        metrics.append(m)
+                        say(f"sample {len(metrics)}/{n_samples}: {m['seconds']:.1f} s (process {m['pid']})")
     wall = time.perf_counter() - t0
-    setups = [m["setup_s"] for m in metrics if m["setup_s"] > 0]
+    setups = [m["setup_s"] for m in metrics if m["setup_s"] > 0]     # one per process that built a basis
     timings = {"wall_s": wall, "per_sample_s": float(np.mean([m["seconds"] for m in metrics])),
                "per_sample_cpu_s": float(np.mean([m["cpu_s"] for m in metrics])),
                "basis_per_process_s": float(np.mean(setups)) if setups else 0.0, "processes": len(setups)}
@@ -702,7 +717,8 @@ def plot(path: Path, result: UncertaintyResult) -> None:
 
 
 def run_command(scene: str, n_samples: int, seed: int, workers: int, out_dir: str | None, ranges_items=(),
-                overrides=(), families=FAMILIES, engine: str = "mpi") -> Path:
+                overrides=(), families=FAMILIES, engine: str = "mpi",
+                samples_per_process: int = SAMPLES_PER_PROCESS) -> Path:
     """`housingfe uncertainty`: check the request, reserve the result folder, run, write atomically, print."""
     from mpi4py import MPI
 
@@ -711,6 +727,8 @@ def run_command(scene: str, n_samples: int, seed: int, workers: int, out_dir: st
 
     families = tuple(families)
     check_request(n_samples, seed, workers, families, engine)
+    if samples_per_process < 1:
+        raise InputError(f"uncertainty: --samples-per-process: {samples_per_process}: must be >= 1")
     ranges = parse_ranges(ranges_items)
     scene_obj, path = load_runup_scene(scene, list(overrides))
     draw_samples(scene_obj, 1, seed, ranges)                 # a bad radiation choice stops here
@@ -718,7 +736,8 @@ def run_command(scene: str, n_samples: int, seed: int, workers: int, out_dir: st
     comm = MPI.COMM_WORLD
     outputs.reserve_output(out, comm, inputs=[path])
     result = run_uncertainty(scene, n_samples, seed, workers, ranges=ranges, overrides=overrides,
-                             families=families, engine=engine, progress=lambda t: print(t, flush=True))
+                             families=families, engine=engine, samples_per_process=samples_per_process,
+                             progress=lambda t: print(t, flush=True))
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
             write(tmp, result)
@@ -738,6 +757,9 @@ def register_cli(subparsers) -> None:
     p.add_argument("--workers", type=int, default=1, help="processes (default 1; > 1: mpi4py.futures)")
     p.add_argument("--engine", default="mpi", help="pool for --workers > 1: mpi (mpi4py.futures, default) or "
                                                    "processes (concurrent.futures)")
+    p.add_argument("--samples-per-process", type=int, default=SAMPLES_PER_PROCESS,
+                   help=f"samples a process runs before a new one takes over (default {SAMPLES_PER_PROCESS}; each "
+                        "re-analysis leaves memory behind in its process, docs/uncertainty.md)")
     p.add_argument("--out", default=None, help="result folder (default results/uncertainty-<scene>)")
     p.add_argument("--range", action="append", metavar="NAME=LOW:HIGH",
                    help="override a parameter's range (NAME=VALUE: fixed; radiation=erp[,foller]); names: "
@@ -753,5 +775,5 @@ def _cmd(args: argparse.Namespace) -> int:
     fams = args.family or list(FAMILIES)
     fams = () if fams == ["none"] else tuple(fams)
     run_command(args.scene, args.samples, args.seed, args.workers, args.out, args.range or (), args.set or (),
-                fams, args.engine)
+                fams, args.engine, args.samples_per_process)
     return 0

@@ -62,10 +62,12 @@ def serial():
 
 @pytest.mark.slow
 def test_one_and_two_workers_agree(serial, tmp_path):
-    pooled = unc.run_uncertainty("test-gearbox-runup", 3, seed=7, workers=2, overrides=COARSE, families=())
+    # two samples per process: the three samples run in two spawned processes, each with its own basis
+    pooled = unc.run_uncertainty("test-gearbox-runup", 3, seed=7, workers=2, overrides=COARSE, families=(),
+                                 samples_per_process=2)
     assert pooled.engine == "mpi4py.futures"
     assert pooled.samples == serial.samples
-    assert len({m["pid"] for m in pooled.metrics}) >= 1
+    assert len({m["pid"] for m in pooled.metrics}) == 2 and pooled.timings["processes"] == 2
     for key in serial.quantities:
         np.testing.assert_allclose(pooled.values(key), serial.values(key), rtol=0, atol=1e-9, err_msg=key)
     # the samples differ from each other: the ranges act
@@ -104,6 +106,7 @@ def test_zero_width_ranges_give_the_deterministic_run(serial, tmp_path):
     (["--samples", "-3"], "uncertainty: --samples: -3: must be a whole number >= 1"),
     (["--range", "bearing_magic=1:2"], "--range bearing_magic: unknown parameter"),
     (["--family", "gears"], "--family gears: unknown"),
+    (["--samples-per-process", "0"], "--samples-per-process: 0: must be >= 1"),
     (["--range", "radiation=numerical"], "--range radiation: numerical: not a radiation model of the scene"),
 ])
 def test_bad_input_is_one_line_and_no_folder(tmp_path, args, message):
