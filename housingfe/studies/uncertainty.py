@@ -500,6 +500,28 @@ class UncertaintyResult:
         got = [m[key] for m in self.metrics if m[key] != "failed"]
         return {b: (got.count(b) / len(got) if got else float("nan")) for b in BEARING_FAMILY}
 
+    def driver(self, quantity: str, route: str | None = None) -> dict:
+        """{"driver": the input whose Spearman rank correlation with the quantity is largest in size,
+        "driver_rho": that correlation} over the samples (numeric inputs; "" with fewer than 5 finite samples or
+        no spread).  With n samples, |rho| below about 2/sqrt(n) is noise."""
+        from scipy.stats import spearmanr
+
+        v = self.values(quantity, route)
+        keep = np.isfinite(v)
+        best = ("", float("nan"))
+        if keep.sum() >= 5 and np.ptp(v[keep]) > 0:
+            for name in PARAMETERS:
+                x = np.array([s[name] for s in self.samples], dtype=object)[keep]
+                if name == "radiation":
+                    x = np.array([str(a) == str(x[0]) for a in x], float)
+                x = x.astype(float)
+                if np.ptp(x) == 0:
+                    continue
+                rho = float(spearmanr(x, v[keep])[0])
+                if np.isfinite(rho) and (not best[0] or abs(rho) > abs(best[1])):
+                    best = (name, rho)
+        return {"driver": best[0], "driver_rho": best[1]}
+
     @property
     def quantities(self) -> list[str]:
         """The numeric quantities "route/name" of the run (band / values)."""
@@ -521,12 +543,13 @@ class UncertaintyResult:
             p5, p50, p95 = self.band(key)
             rows.append({"route": route, "quantity": name, "p5": p5, "median": p50, "p95": p95,
                          "fraction": self.fraction(key) if yes_no else None,
-                         "samples": int(np.sum(np.isfinite(v)))})
+                         "samples": int(np.sum(np.isfinite(v))), **self.driver(key)})
         if "bearings" in self.families:
             for route in self.routes:
                 for b, share in self.quietest_fractions(route).items():
                     rows.append({"route": route, "quantity": f"quietest_{b}", "p5": None, "median": None,
-                                 "p95": None, "fraction": share, "samples": len(self.metrics)})
+                                 "p95": None, "fraction": share, "samples": len(self.metrics), "driver": "",
+                                 "driver_rho": None})
         return rows
 
 
@@ -619,9 +642,9 @@ def summary_text(result: UncertaintyResult) -> str:
     rows = []
     for r in result.summary_rows():
         if r["fraction"] is not None:
-            rows.append([r["route"], r["quantity"], "", "", "", f"{r['fraction']:.2f}"])
+            rows.append([r["route"], r["quantity"], "", "", "", f"{r['fraction']:.2f}", _driver(r)])
         else:
-            rows.append([r["route"], r["quantity"], _f(r["p5"]), _f(r["median"]), _f(r["p95"]), ""])
+            rows.append([r["route"], r["quantity"], _f(r["p5"]), _f(r["median"]), _f(r["p95"]), "", _driver(r)])
     t = result.timings
     head = (f"uncertainty {result.scene}: {len(result.samples)} Latin-hypercube samples, seed {result.seed}, "
             f"{result.workers} worker(s) ({result.engine}); families: {', '.join(result.families) or 'set A only'}")
@@ -631,15 +654,21 @@ def summary_text(result: UncertaintyResult) -> str:
     failed = [m["failed"] for m in result.metrics if m.get("failed")]
     notes = [f"{len(failed)} sample(s) with a configuration that could not run (NaN, left out of the bands): "
              + " | ".join(failed[:3])] if failed else []
-    return "\n".join([head, format_table(["route", "quantity", "p5", "median", "p95", "fraction"], rows), cost,
+    table = format_table(["route", "quantity", "p5", "median", "p95", "fraction", "driver (Spearman rho)"], rows)
+    return "\n".join([head, table, cost, f"driver: the input of largest |rank correlation|; with "
+                      f"{len(result.samples)} samples |rho| < {2 / math.sqrt(max(len(result.samples), 1)):.2f} is noise",
                       *notes])
+
+
+def _driver(row) -> str:
+    return f"{row['driver']} ({row['driver_rho']:+.2f})" if row.get("driver") else ""
 
 
 def _f(x) -> str:
     return "nan" if x is None or not np.isfinite(x) else f"{x:.2f}"
 
 
-SUMMARY_COLUMNS = ("route", "quantity", "p5", "median", "p95", "fraction", "samples")
+SUMMARY_COLUMNS = ("route", "quantity", "p5", "median", "p95", "fraction", "samples", "driver", "driver_rho")
 
 
 def write(folder: Path, result: UncertaintyResult) -> None:
