@@ -426,7 +426,16 @@ def evaluate_batch(batch, worker: bool = True) -> list[dict]:
 
 
 # ------------------------------------------------------------------------------------------------ the run
-SAMPLES_PER_PROCESS = 6
+# re-analyses (configurations x samples) one process runs before a fresh one takes over: each leaves ~0.12 GB
+# behind on the scene's 4 kHz mesh (in build_interior, not held by Python objects), so 30 keep a process near 4 GB
+CONFIGURATIONS_PER_PROCESS = 30
+
+
+def default_samples_per_process(families) -> int:
+    """Samples per process: CONFIGURATIONS_PER_PROCESS over the configurations of a sample (set A, + 4 with the
+    bearings family): 6 with the bearings family, 30 for set A alone."""
+    per_sample = 1 + (len(BEARING_FAMILY) if "bearings" in families else 0)
+    return max(1, CONFIGURATIONS_PER_PROCESS // per_sample)
 @dataclass
 class UncertaintyResult:
     """Samples (parameter values) and their metrics, in sample order; routes; the default route of `band`;
@@ -582,18 +591,20 @@ def check_request(n_samples, seed, workers, families, engine) -> None:
 
 def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 0, workers: int = 1, *,
                     ranges: dict | None = None, overrides=(), families: tuple = FAMILIES, engine: str = "mpi",
-                    samples_per_process: int = SAMPLES_PER_PROCESS, progress=None) -> UncertaintyResult:
+                    samples_per_process: int | None = None, progress=None) -> UncertaintyResult:
     """Run `n_samples` seeded Latin-hypercube samples of the estimated inputs (PARAMETERS, `ranges` overriding:
     {name: (low, high)}, radiation: (models...)) through the run-up scene's chain (--set `overrides`) on `workers`
     processes (engine "mpi": mpi4py.futures; "processes": concurrent.futures) and return the UncertaintyResult.
     families: ("bearings",) adds gear set B's bearing configurations (4 re-analyses more per sample); () = set A
-    only (the cheap mode).  A process runs at most samples_per_process samples (then a new one builds the basis
-    again: memory, see the code); workers == 1 with no more samples than that runs in this process.  Bad input
+    only (the cheap mode).  A process runs at most samples_per_process samples (default
+    `default_samples_per_process`; then a new one builds the basis again: memory, see the code); workers == 1 with
+    no more samples than that runs in this process.  Bad input
     -> InputError before any model is built."""
     from housingfe.runup.scene import load_runup_scene
 
     families = tuple(families)
     check_request(n_samples, seed, workers, families, engine)
+    samples_per_process = samples_per_process or default_samples_per_process(families)
     scene_obj, path = load_runup_scene(scene, list(overrides))
     if families and not np.any((scene_obj.runup.speeds >= MEAN_RANGE_RPM[0])
                                 & (scene_obj.runup.speeds <= MEAN_RANGE_RPM[1])):
@@ -747,7 +758,7 @@ def plot(path: Path, result: UncertaintyResult) -> None:
 
 def run_command(scene: str, n_samples: int, seed: int, workers: int, out_dir: str | None, ranges_items=(),
                 overrides=(), families=FAMILIES, engine: str = "mpi",
-                samples_per_process: int = SAMPLES_PER_PROCESS) -> Path:
+                samples_per_process: int | None = None) -> Path:
     """`housingfe uncertainty`: check the request, reserve the result folder, run, write atomically, print."""
     from mpi4py import MPI
 
@@ -756,7 +767,7 @@ def run_command(scene: str, n_samples: int, seed: int, workers: int, out_dir: st
 
     families = tuple(families)
     check_request(n_samples, seed, workers, families, engine)
-    if samples_per_process < 1:
+    if samples_per_process is not None and samples_per_process < 1:
         raise InputError(f"uncertainty: --samples-per-process: {samples_per_process}: must be >= 1")
     ranges = parse_ranges(ranges_items)
     scene_obj, path = load_runup_scene(scene, list(overrides))
@@ -786,9 +797,9 @@ def register_cli(subparsers) -> None:
     p.add_argument("--workers", type=int, default=1, help="processes (default 1; > 1: mpi4py.futures)")
     p.add_argument("--engine", default="mpi", help="pool for --workers > 1: mpi (mpi4py.futures, default) or "
                                                    "processes (concurrent.futures)")
-    p.add_argument("--samples-per-process", type=int, default=SAMPLES_PER_PROCESS,
-                   help=f"samples a process runs before a new one takes over (default {SAMPLES_PER_PROCESS}; each "
-                        "re-analysis leaves memory behind in its process, docs/uncertainty.md)")
+    p.add_argument("--samples-per-process", type=int, default=None,
+                   help="samples a process runs before a new one takes over (default 6 with the bearings family, 30 "
+                        "for set A alone; each re-analysis leaves memory behind in its process, docs/uncertainty.md)")
     p.add_argument("--out", default=None, help="result folder (default results/uncertainty-<scene>)")
     p.add_argument("--range", action="append", metavar="NAME=LOW:HIGH",
                    help="override a parameter's range (NAME=VALUE: fixed; radiation=erp[,foller]); names: "
