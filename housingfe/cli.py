@@ -26,6 +26,7 @@ _EXTENSIONS = (
     "housingfe.studies.reduce",
     "housingfe.studies.design_variants",
     "housingfe.studies.runup_causes",
+    "housingfe.studies.uncertainty",
 )
 
 

@@ -30,7 +30,9 @@ Estimation rules (stated before any result was computed, not tuned to any publis
 """
 from __future__ import annotations
 
+import contextvars
 import math
+from contextlib import contextmanager
 from typing import TYPE_CHECKING
 
 from housingfe.errors import InputError
@@ -72,6 +74,36 @@ _TAPERED = {
 
 _SPHERICAL_CONTACT_ANGLE_DEG = 9.0
 
+# the estimated internals in effect (`estimated_internals`); None: the rules of the module docstring
+_INTERNALS: contextvars.ContextVar = contextvars.ContextVar("bearing_internals", default=None)
+INTERNAL_KEYS = ("clearance_position", "groove_inner", "groove_outer", "spherical_contact_angle_deg",
+                 "tapered_e_scale")
+
+
+@contextmanager
+def estimated_internals(**values):
+    """Within the block, `lookup` builds bearings with other values of the ESTIMATED internals (uncertainty studies,
+    housingfe.studies.uncertainty); published data (d, D, B, the 7xxx B contact angle, the printed ball sets) stay.
+
+    clearance_position: where in the ISO 5753-1 Group N diametral clearance range [0 = lowest, 1 = highest] the
+    radial clearance (half the diametral) sits (the rule: 0.5, mid-range; bearings adjusted to 0 stay at 0);
+    groove_inner, groove_outer: groove curvature ratios f_i, f_o (rule 0.52, 0.53); spherical_contact_angle_deg
+    (rule 9 deg); tapered_e_scale: factor on the recalled calculation factor e of the tapered rollers (rule 1).
+    Unknown keys -> InputError."""
+    unknown = sorted(set(values) - set(INTERNAL_KEYS))
+    if unknown:
+        raise InputError(f"estimated_internals: {', '.join(unknown)} unknown (known: {', '.join(INTERNAL_KEYS)})")
+    token = _INTERNALS.set(dict(values))
+    try:
+        yield
+    finally:
+        _INTERNALS.reset(token)
+
+
+def _internal(key: str, rule: float) -> float:
+    values = _INTERNALS.get()
+    return rule if values is None else float(values.get(key, rule))
+
 
 def normalise(designation: str) -> str:
     """'SKF 7316 B' -> '7316B' (upper case, no spaces, no 'SKF' prefix)."""
@@ -103,7 +135,9 @@ def lookup(designation: str) -> RollingBearing:
     pitch = (d + outer) / 2.0
     est = {"pitch_diameter": "(d + D) / 2", "youngs_modulus": "bearing steel 208 GPa", "poisson_ratio": "0.3"}
     name = f"SKF {key}"
-    radial_clearance = 0.0 if clearance is None else 0.25 * (clearance[0] + clearance[1]) * _UM
+    position = _internal("clearance_position", 0.5)
+    radial_clearance = 0.0 if clearance is None else \
+        0.5 * (clearance[0] + position * (clearance[1] - clearance[0])) * _UM
     if clearance is not None:
         est["radial_clearance"] = f"half of the mid-range ISO 5753-1 Group N diametral clearance {clearance} um"
     else:
@@ -122,7 +156,8 @@ def lookup(designation: str) -> RollingBearing:
         return RollingBearing(designation=name, kind=kind, bore=d, outer_diameter=outer, width=width,
                               n_elements=z, element_diameter=dw, pitch_diameter=pitch,
                               contact_angle=math.radians(alpha_deg), radial_clearance=radial_clearance,
-                              groove_inner=0.52, groove_outer=0.53, estimated=est)
+                              groove_inner=_internal("groove_inner", 0.52),
+                              groove_outer=_internal("groove_outer", 0.53), estimated=est)
     if kind == "cylindrical_roller":
         dw = 0.26 * (outer - d)
         z = round(0.80 * math.pi * pitch / dw)
@@ -137,7 +172,8 @@ def lookup(designation: str) -> RollingBearing:
                contact_angle=f"{_SPHERICAL_CONTACT_ANGLE_DEG} deg (e = 1.5 tan(alpha) ~ 0.24)")
     return RollingBearing(designation=name, kind=kind, bore=d, outer_diameter=outer, width=width, n_elements=z,
                           element_diameter=dw, pitch_diameter=pitch,
-                          contact_angle=math.radians(_SPHERICAL_CONTACT_ANGLE_DEG),
+                          contact_angle=math.radians(_internal("spherical_contact_angle_deg",
+                                                               _SPHERICAL_CONTACT_ANGLE_DEG)),
                           radial_clearance=radial_clearance, roller_length=0.4 * width, rows=2, estimated=est)
 
 
@@ -149,7 +185,7 @@ def _tapered(key: str, d: float, outer: float, width: float) -> RollingBearing:
     pitch = (d + outer) / 2.0
     dw = 0.22 * (outer - d)
     z = round(0.80 * math.pi * pitch / dw)
-    alpha = math.atan(data["e"] / 1.5)
+    alpha = math.atan(data["e"] * _internal("tapered_e_scale", 1.0) / 1.5)
     est = {"pitch_diameter": "(d + D) / 2", "youngs_modulus": "bearing steel 208 GPa", "poisson_ratio": "0.3",
            "element_diameter": "0.22 (D - d) (mean roller diameter)", "roller_length": "0.6 B",
            "n_elements": "round(0.80 pi d_m / D_w)",

@@ -1,0 +1,819 @@
+"""`housingfe uncertainty`: the spread of the run-up's answers over stated ranges of the inputs that are estimates
+(issue 28, item 5).
+
+A seeded Latin hypercube (scipy.stats.qmc.LatinHypercube) over the parameters of `PARAMETERS` — the bearings'
+estimated internals, the assumed quill shafts and couplings of Appendix C's drive line, Appendix C's lumped source
+parameters, the modal damping, the radiation model and the helices' slope deviation within DIN 3962 quality 5 —
+each sample a re-analysis of the default chain (`housingfe run test-gearbox-runup`: the coupled source, the
+misalignment under load, both routes):
+
+* set A, ball bearings, at the scene's highest torque: max L_WA and its speed, the L_WA peak speeds nearest the
+  measured resonance windows, the L_WA slope 250-1500 rev/min;
+* with `families=("bearings",)` also gear set B with ball, angular contact, self-aligning and tapered roller
+  bearings: each configuration's mean L_WA difference to ball over 800-1500 rev/min, its maximum, which one is
+  quietest and whether the measured ranking holds (Sec. 5.8).
+
+No parameter changes the layout (the FE interior without its bearing matrices and mean mesh stiffness): the
+bearings' internals change their 6x6 matrices, the drive line and Appendix C's parameters only the lumped source,
+the damping the reduced system, the radiation model which of the computed curves is read, the helix deviation the
+source's lead gap.  So each process computes ONE modal basis (the scene's set A / ball model, ~30 s) and every
+sample is a Rayleigh-Ritz re-analysis per configuration on it (housingfe.runup.chain.with_drivetrain).
+
+Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
+concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A sample's answer
+does not depend on the process that computed it (each builds the same basis): 1 and 2 workers give the same
+numbers (tests/studies/test_uncertainty.py).
+
+Python API (the quantity names are those of `UncertaintyResult.quantities`, docs/uncertainty.md):
+
+    result = run_uncertainty("test-gearbox-runup", n_samples=8, seed=1, workers=1)
+    p5, p50, p95 = result.band("max_lwa_dBA")                 # default route (mesh_force if computed)
+    result.band("tf_omega/slope_dBA_per_doubling")
+    result.fraction("measured_ranking_holds")                 # share of samples (bearings family)
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from housingfe.errors import InputError
+from housingfe.studies.chain_session import MEAN_RANGE_RPM, difference_stats
+
+DEFAULT_SCENE = "test-gearbox-runup"
+BEARING_FAMILY = ("ball", "angular_contact", "self_aligning", "tapered_roller")   # gear set B, Sec. 5.8
+FAMILIES = ("bearings",)
+ENGINES = ("mpi", "processes")
+# the measured L_WA / L_v resonance windows of set A (housingfe.runup.checks.MEASURED_PEAKS_RPM)
+PEAK_WINDOWS_RPM = ((450.0, 450.0), (850.0, 950.0), (1300.0, 1350.0))
+
+
+# ------------------------------------------------------------------------------------------------ parameters
+@dataclass(frozen=True)
+class Parameter:
+    """An estimated input: its range [low, high] (distribution "uniform" or "loguniform"; "choice": one of the
+    scene's radiation models, equally likely), the value the chain uses (`nominal`, None: the scene's), unit,
+    what it acts on, and where the range comes from."""
+
+    name: str
+    distribution: str
+    low: float
+    high: float
+    nominal: float | None
+    unit: str
+    acts_on: str
+    source: str
+
+
+def helix_slope_tolerance(diameter_m: float, face_width_m: float, quality: int = 5) -> float:
+    """f_Hbeta (m): the helix slope deviation tolerance of ISO 1328-1:1995 (eq. for quality 5, 0.07 sqrt(d) +
+    0.45 sqrt(b) + 3.0 um with d, b in mm, times 2^((Q - 5) / 2)), unrounded.  DIN 3962-2 (the thesis' standard,
+    App. F: quality 5) tabulates f_Hbeta by face width in classes of the same size; the ISO formula stands in for
+    the table, which is not at hand."""
+    d, b = diameter_m * 1e3, face_width_m * 1e3
+    return (0.07 * math.sqrt(d) + 0.45 * math.sqrt(b) + 3.0) * 2.0 ** ((quality - 5) / 2.0) * 1e-6
+
+
+PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
+    Parameter("damping_ratio", "loguniform", 0.02, 0.08, None, "-", "modal damping of the coupled gearbox",
+              "estimate, x/÷2 around the thesis' 0.04 (Sec. 5.4: 'an averaged result of measured modal damping "
+              "factors of a few FRFs'); Sec. 4.5 measured 0.014 for one mode and strongly mode-dependent damping"),
+    Parameter("radiation", "choice", 0.0, 1.0, None, "-", "radiation model (sigma) read for L_W",
+              "the scene's radiation models, equally likely (test-gearbox-runup: sigma = 1 'erp', Föller's "
+              "plate model); the thesis used sigma = 1 (Ch. 5)"),
+    Parameter("clearance_position", "uniform", 0.0, 1.0, 0.5, "-",
+              "FE bearings: radial clearance within ISO 5753-1 Group N",
+              "catalogue rule: mid-range of Group N (housingfe/bearings/catalogue.py); the fitted bearings' class "
+              "is not stated: the whole Group N range"),
+    Parameter("groove_inner", "uniform", 0.51, 0.53, 0.52, "-", "FE ball bearings: inner groove curvature f_i",
+              "estimate, ±0.01 around Harris' typical 0.52 (SKF does not publish it)"),
+    Parameter("groove_outer", "uniform", 0.52, 0.54, 0.53, "-", "FE ball bearings: outer groove curvature f_o",
+              "estimate, ±0.01 around Harris' typical 0.53"),
+    Parameter("spherical_contact_angle_deg", "uniform", 7.0, 11.0, 9.0, "deg",
+              "FE self-aligning (spherical roller) bearings: contact angle",
+              "estimate, ±2 deg around 9 deg (from a typical SKF factor e = 0.24; 21316 CC / 22219 CC not checked)"),
+    Parameter("tapered_e_scale", "uniform", 0.85, 1.15, 1.0, "-",
+              "FE tapered roller bearings: factor on the calculation factor e (contact angle)",
+              "estimate, ±15 %: e of 30316 J2 / 30219 J2 recalled, not checked against the catalogue"),
+    Parameter("quill_diameter_scale", "uniform", 0.8, 1.25, 1.0, "-",
+              "source: diameters of the four torsion shafts to motor and brake (App. C shafts 1-4)",
+              "estimate, -20/+25 %: the diameters are assumed (docs/source.md; App. C's table is lost)"),
+    Parameter("quill_length_scale", "loguniform", 0.5, 2.0, 1.0, "-",
+              "source: lengths of the four torsion shafts",
+              "estimate, x/÷2: 'long, torsionally weak shafts', lengths assumed (docs/source.md)"),
+    Parameter("coupling_inertia_scale", "loguniform", 0.5, 2.0, 1.0, "-",
+              "source: the two coupling inertias (App. C DOFs 13, 14)", "estimate, x/÷2: assumed 0.02 / 0.05 kg m^2"),
+    Parameter("lumped_bearing_span_m", "uniform", 0.045, 0.075, 0.06, "m",
+              "source: bearing to gear face (Fig. 2.6) in the lumped model and its shaft bending",
+              "estimate, ±25 % around the assumed 60 mm (the FE seats are at 107.5 mm from the gear centre)"),
+    Parameter("appendix_c_bearing_scale", "loguniform", 0.7, 1.4, 1.0, "-",
+              "source: Appendix C's bearing diagonal of the lumped model",
+              "estimate, x/÷1.4: printed for one load and used for every configuration and torque; the FE "
+              "bearings' stiffness changes by about this much between configurations (docs/bearings.md)"),
+    Parameter("source_loss_factor", "loguniform", 0.05, 0.2, 0.1, "-",
+              "source: loss factor of the lumped model's modes",
+              "estimate, x/÷2: Sec. 2.5 'varied quite a lot between the resonant frequencies'; 0.1 averaged"),
+    Parameter("helix_deviation_pinion", "uniform", -1.0, 1.0, 0.0, "f_Hbeta",
+              "source: the pinion's helix slope deviation, added to the lead gap",
+              "DIN 3962 quality 5 (App. F): ±f_Hbeta (ISO 1328-1 formula, `helix_slope_tolerance`)"),
+    Parameter("helix_deviation_wheel", "uniform", -1.0, 1.0, 0.0, "f_Hbeta",
+              "source: the wheel's helix slope deviation, added to the lead gap",
+              "DIN 3962 quality 5 (App. F): ±f_Hbeta"),
+)}
+
+
+def parse_ranges(items) -> dict[str, tuple]:
+    """--range NAME=LOW:HIGH or NAME=VALUE (zero width) -> {name: (low, high)}; radiation=MODEL[,MODEL...] ->
+    {"radiation": (models...)}.  Unknown names, unparsable or reversed ranges -> InputError."""
+    out = {}
+    for item in items or ():
+        name, sep, text = str(item).partition("=")
+        name = name.strip()
+        if not sep:
+            raise InputError(f"--range {item}: give NAME=LOW:HIGH or NAME=VALUE")
+        if name not in PARAMETERS:
+            raise InputError(f"--range {name}: unknown parameter (known: {', '.join(PARAMETERS)})")
+        if name == "radiation":
+            out[name] = tuple(m.strip() for m in text.split(",") if m.strip())
+            continue
+        try:
+            parts = [float(x) for x in text.split(":")]
+        except ValueError:
+            raise InputError(f"--range {name}: {text!r} is not LOW:HIGH or a number") from None
+        if len(parts) not in (1, 2) or not all(math.isfinite(x) for x in parts):
+            raise InputError(f"--range {name}: {text!r} is not LOW:HIGH or a number")
+        lo, hi = (parts[0], parts[0]) if len(parts) == 1 else parts
+        if lo > hi:
+            raise InputError(f"--range {name}: low {lo:g} above high {hi:g}")
+        if PARAMETERS[name].distribution == "loguniform" and lo <= 0:
+            raise InputError(f"--range {name}: {lo:g}: must be > 0 (log-uniform)")
+        out[name] = (lo, hi)
+    return out
+
+
+def nominal_ranges(scene) -> dict[str, tuple]:
+    """Every range at the value the chain uses (zero width): the deterministic run as an uncertainty run."""
+    out = {}
+    for p in PARAMETERS.values():
+        if p.name == "radiation":
+            out[p.name] = (scene.radiation.models[0],)
+        elif p.name == "damping_ratio":
+            out[p.name] = (scene.runup.damping_ratio,) * 2
+        else:
+            out[p.name] = (p.nominal, p.nominal)
+    return out
+
+
+def draw_samples(scene, n_samples: int, seed: int, ranges: dict | None = None) -> list[dict]:
+    """n_samples Latin-hypercube samples {parameter: value} (scipy.stats.qmc.LatinHypercube, `seed`) over the
+    PARAMETERS' ranges with `ranges` overriding some ({name: (low, high)}; radiation: (models...))."""
+    from scipy.stats import qmc
+
+    ranges = dict(ranges or {})
+    names = list(PARAMETERS)
+    u = qmc.LatinHypercube(d=len(names), seed=int(seed)).random(int(n_samples))
+    models = list(scene.radiation.models)
+    samples = [{} for _ in range(int(n_samples))]
+    for j, name in enumerate(names):
+        p = PARAMETERS[name]
+        if name == "radiation":
+            pick = list(ranges.get(name, models))
+            bad = [m for m in pick if m not in models]
+            if bad or not pick:
+                raise InputError(f"--range radiation: {', '.join(bad) or 'nothing'}: not a radiation model of the "
+                                 f"scene (its models: {', '.join(models)})")
+            for i in range(len(samples)):
+                samples[i][name] = pick[min(int(u[i, j] * len(pick)), len(pick) - 1)]
+            continue
+        lo, hi = ranges.get(name, (p.low, p.high))
+        for i in range(len(samples)):
+            if lo == hi:
+                v = lo
+            elif p.distribution == "loguniform":
+                v = lo * (hi / lo) ** u[i, j]
+            else:
+                v = lo + (hi - lo) * u[i, j]
+            samples[i][name] = float(v)
+    return samples
+
+
+# ------------------------------------------------------------------------------------------------ one sample
+_STATE: dict = {}      # per process: (scene, overrides) -> _Base (the housing model and the basis)
+
+
+@dataclass
+class _Base:
+    session: object
+    model: object          # GearboxModel of the scene's drivetrain (set A, ball) at the highest torque
+    surfaces: dict         # bearing -> housing bore (bore matching)
+    setup_s: float
+
+
+def _base(scene_name: str, overrides: tuple, comm) -> _Base:
+    key = json.dumps([scene_name, list(overrides)])
+    if key not in _STATE:
+        from housingfe.drivetrain.bore_matching import match_bores
+        from housingfe.studies.chain_session import ChainSession
+
+        t0 = time.perf_counter()
+        session = ChainSession.from_scene(scene_name, list(overrides), comm=comm)
+        spec = session.scene.drivetrain
+        dt = session.drivetrain(spec.gear_set, spec.bearings, max(session.spec.torques_nm))
+        housing = session.housing()
+        ref = session.scene.housing
+        try:
+            surfaces = match_bores(housing, dt, ref.bores, ref.match, ref.bore_tolerance)
+        except InputError as exc:
+            raise InputError(f"{session.scene_path}: {exc}") from None
+        model = session.model(dt.with_bores(surfaces), "uncertainty base")
+        _STATE[key] = _Base(session, model, surfaces, time.perf_counter() - t0)
+    return _STATE[key]
+
+
+def perturbed_drivetrain(base: _Base, values: dict, gear_set: str, bearings: str, torque: float):
+    """The test gearbox of the scene with gear set, bearings and torque, and the sample's drive line and
+    Appendix C parameters (the FE bearings' internals act through housingfe.bearings.catalogue.estimated_internals
+    while the matrices are computed)."""
+    from dataclasses import replace
+
+    from housingfe.runup.scene import drivetrain_of
+
+    spec = base.session.scene.drivetrain.model_copy(update={"gear_set": gear_set, "bearings": bearings})
+    dt = drivetrain_of(spec, float(torque)).with_bores(base.surfaces)
+    changes = {}
+    sd, sl = values["quill_diameter_scale"], values["quill_length_scale"]
+    if (sd, sl) != (1.0, 1.0):
+        changes["quill_shafts"] = tuple(replace(q, diameter=q.diameter * sd, length=q.length * sl)
+                                        for q in dt.quill_shafts)
+    if values["coupling_inertia_scale"] != 1.0:
+        changes["couplings"] = tuple(replace(c, inertia=c.inertia * values["coupling_inertia_scale"])
+                                     for c in dt.couplings)
+    span = values["lumped_bearing_span_m"]
+    if span != 0.06:
+        changes["lumped_bearing_spans"] = {"pinion": (span, span), "wheel": (span, span)}
+    if values["appendix_c_bearing_scale"] != 1.0:
+        changes["lumped_bearing_stiffness"] = {k: tuple(x * values["appendix_c_bearing_scale"] for x in v)
+                                               for k, v in dt.lumped_bearings().items()}
+    if values["source_loss_factor"] != dt.loss_factor:
+        changes["loss_factor"] = values["source_loss_factor"]
+    return replace(dt, **changes) if changes else dt
+
+
+def helix_lead_gap(drivetrain, values: dict) -> float:
+    """The lead gap (m/m, MeshModel.lead_gap) of the sample's helix slope deviations: f_Hbeta of each gear
+    (`helix_slope_tolerance` at its pitch diameter and face width) times the sample's fraction, measured in the
+    transverse plane along the base tangent, so cos(beta_b) along the flank normal, per m of face width; the two
+    gears' deviations add (the signs are symmetric in the ranges)."""
+    pair = drivetrain.gears.pair
+    d = pair.pitch_diameter
+    b = pair.face_width
+    cb = math.cos(pair.base_helix_angle)
+    gap = 0.0
+    for i, key in enumerate(("helix_deviation_pinion", "helix_deviation_wheel")):
+        gap += values[key] * helix_slope_tolerance(float(d[i]), float(b[i])) / float(b[i])
+    return cb * gap
+
+
+def _misalignment(base: _Base, drivetrain, values: dict):
+    """The source's misalignment: the scene's model (as `housingfe run`) plus the helix deviations' lead gap."""
+    spec = base.session.spec
+    model = spec.misalignment_model
+    extra = helix_lead_gap(drivetrain, values)
+    if model == "rigid-bores":
+        from housingfe.drivetrain.misalignment import lead_gap_law
+
+        law = lead_gap_law(drivetrain, "rigid-bores")
+    elif model == "coupled":
+        from housingfe.drivetrain.misalignment import coupled_misalignment
+
+        gap = coupled_misalignment(base.session.housing(), drivetrain).lead_gap
+
+        def law(torque: float) -> float:
+            return gap
+    elif model == "lumped":
+        probe = drivetrain.source_model(misalignment="lumped", harmonics=spec.harmonics, engagement=spec.engagement)
+        law = probe.lead_gap
+    else:
+        law = None
+    if extra == 0.0:
+        return "none" if law is None else law
+    if law is None:
+        return lambda torque: extra
+    return lambda torque: law(torque) + extra
+
+
+def _curves(base: _Base, values: dict, gear_set: str, bearings: str) -> dict:
+    """{(route, radiation): (speeds rev/min, L_WA dB(A))} of one configuration in one sample."""
+    from dataclasses import replace
+
+    from housingfe.bearings.catalogue import estimated_internals
+    from housingfe.runup.chain import run_source, runup, with_drivetrain
+    from housingfe.solvers import harmonic
+
+    spec = base.session.spec
+    torque = max(spec.torques_nm)
+    internals = {k: values[k] for k in ("clearance_position", "groove_inner", "groove_outer",
+                                        "spherical_contact_angle_deg", "tapered_e_scale")}
+    with estimated_internals(**internals):
+        dt = perturbed_drivetrain(base, values, gear_set, bearings, torque)
+        start = base.model
+        if values["damping_ratio"] != spec.damping_ratio:
+            damping = harmonic.Damping(lambda f: np.zeros(np.shape(f)), modal_ratio=values["damping_ratio"])
+            start = replace(start, reduction=start.reduction.with_damping(damping))
+        model = with_drivetrain(start, dt)
+        source = dt.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
+                                 misalignment=_misalignment(base, dt, values))
+        lines, _ = run_source(model, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance)
+        res = runup(model, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
+    return {(route, rad): res.series(route, rad, torque, "LwA_dB")
+            for route in spec.routes for rad in base.session.scene.radiation.models}
+
+
+def _peak_metrics(speeds, lwa) -> dict:
+    from housingfe.runup.checks import PEAK_TOLERANCE_RPM, peaks, speed_law_slope
+
+    found = peaks(speeds, lwa)
+    out = {"max_lwa_dBA": float(np.max(lwa)), "max_lwa_speed_rpm": float(speeds[int(np.argmax(lwa))]),
+           "slope_dBA_per_doubling": float(speed_law_slope(speeds, lwa)),
+           "lwa_peaks_rpm": " ".join(f"{s:g}" for s in found)}
+    hits = 0
+    for lo, hi in PEAK_WINDOWS_RPM:
+        dist = [max(lo - s, s - hi, 0.0) for s in found]
+        key = f"peak_speed_{lo:g}" + ("" if lo == hi else f"_{hi:g}") + "_rpm"
+        out[key] = float(found[int(np.argmin(dist))]) if found else float("nan")
+        hits += bool(dist) and min(dist) <= PEAK_TOLERANCE_RPM
+    out["peaks_in_measured_windows"] = float(hits)
+    return out
+
+
+def measured_bearing_means() -> dict[str, float]:
+    """Measured mean L_W differences to ball bearings over 800-1500 rev/min (Sec. 5.8, dB; ball 0)."""
+    from housingfe.studies.design_variants import families
+
+    return {v.key: (0.0 if v.key == "ball" else v.measured_mean) for v in families()["bearings"].variants}
+
+
+def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: tuple = FAMILIES,
+                    worker: bool = False) -> dict:
+    """The metrics of one sample (see the module docstring), {"route/quantity": value}, and "seconds" (its wall
+    time, without the process's one basis) and "setup_s" (the basis, when this sample built it).  worker: the call
+    runs in a pool process (its FE on MPI.COMM_SELF)."""
+    from mpi4py import MPI
+
+    comm = MPI.COMM_SELF if worker else MPI.COMM_WORLD
+    fresh = json.dumps([scene_name, list(overrides)]) not in _STATE
+    base = _base(scene_name, tuple(overrides), comm)
+    t0, c0 = time.perf_counter(), time.process_time()
+    scene = base.session.scene
+    rad = values["radiation"]
+    out = {}
+    curves_a = _curves(base, values, scene.drivetrain.gear_set, scene.drivetrain.bearings)
+    for route in base.session.spec.routes:
+        s, lwa = curves_a[route, rad]
+        for k, v in _peak_metrics(s, lwa).items():
+            out[f"{route}/{k}"] = v
+        out[f"{route}/lwa_curve_dBA"] = [float(x) for x in lwa]
+    if "bearings" in families:
+        measured = measured_bearing_means()
+        order_measured = sorted(measured, key=measured.get)
+        curves, failed = {}, {}
+        for b in BEARING_FAMILY:
+            try:
+                curves[b] = _curves(base, values, "B", b)
+            except InputError as exc:          # e.g. a bearing of the sample that cannot carry its load
+                failed[b] = str(exc)
+        out["failed"] = "; ".join(f"{b}: {why}" for b, why in failed.items())
+        nan = float("nan")
+        for route in base.session.spec.routes:
+            means = {}
+            l_ref = curves["ball"][route, rad][1] if "ball" in curves else None
+            for b in BEARING_FAMILY:
+                if b not in curves:
+                    means[b] = nan
+                    out[f"{route}/max_lwa_B_{b}_dBA"] = nan
+                else:
+                    s, lwa = curves[b][route, rad]
+                    means[b] = 0.0 if b == "ball" else (difference_stats(s, lwa, l_ref)[0] if l_ref is not None
+                                                        else nan)
+                    out[f"{route}/max_lwa_B_{b}_dBA"] = float(np.max(lwa))
+                if b != "ball":
+                    out[f"{route}/variant_mean_{b}_dB"] = means[b]
+            if failed:
+                out[f"{route}/quietest"] = "failed"
+                out[f"{route}/measured_ranking_holds"] = nan
+                out[f"{route}/self_aligning_quieter_than_ball"] = nan
+                continue
+            ours = sorted(means, key=means.get)
+            out[f"{route}/quietest"] = ours[0]
+            out[f"{route}/measured_ranking_holds"] = float(ours == order_measured)
+            out[f"{route}/self_aligning_quieter_than_ball"] = float(means["self_aligning"] < 0.0)
+    out["seconds"] = time.perf_counter() - t0
+    out["cpu_s"] = time.process_time() - c0          # the machine is shared: CPU time is the steadier measure
+    out["setup_s"] = base.setup_s if fresh else 0.0
+    out["pid"] = os.getpid()
+    return out
+
+
+def evaluate_batch(batch, worker: bool = True) -> list[dict]:
+    """evaluate_sample for each (scene, overrides, values, families) of `batch`, in order (one pool task)."""
+    return [evaluate_sample(*a, worker=worker) for a in batch]
+
+
+# ------------------------------------------------------------------------------------------------ the run
+# re-analyses (configurations x samples) one process runs before a fresh one takes over: each leaves ~0.12 GB
+# behind on the scene's 4 kHz mesh (in build_interior, not held by Python objects), so 30 keep a process near 4 GB
+CONFIGURATIONS_PER_PROCESS = 30
+
+
+def default_samples_per_process(families) -> int:
+    """Samples per process: CONFIGURATIONS_PER_PROCESS over the configurations of a sample (set A, + 4 with the
+    bearings family): 6 with the bearings family, 30 for set A alone."""
+    per_sample = 1 + (len(BEARING_FAMILY) if "bearings" in families else 0)
+    return max(1, CONFIGURATIONS_PER_PROCESS // per_sample)
+@dataclass
+class UncertaintyResult:
+    """Samples (parameter values) and their metrics, in sample order; routes; the default route of `band`;
+    speeds of the L_WA curves; families run; timings (s) and the engine used."""
+
+    scene: str
+    seed: int
+    samples: list
+    metrics: list
+    routes: tuple
+    speeds: np.ndarray
+    families: tuple
+    ranges: dict
+    engine: str
+    workers: int
+    timings: dict = field(default_factory=dict)
+
+    @classmethod
+    def load(cls, folder) -> "UncertaintyResult":
+        """The result of an earlier `housingfe uncertainty` run from its folder (uncertainty.json): the bands
+        without re-running the samples."""
+        path = Path(folder) / "uncertainty.json"
+        if not path.is_file():
+            raise InputError(f"{path}: no uncertainty result there (run `housingfe uncertainty --out {folder}`)")
+        d = json.loads(path.read_text())
+        metrics = [{k: (float("nan") if v is None and "/" in k and not k.endswith("quietest") else v)
+                    for k, v in m.items()} for m in d["metrics"]]
+        routes = tuple(dict.fromkeys(k.split("/", 1)[0] for k in metrics[0] if "/" in k))
+        return cls(d["scene"], d["seed"], d["samples"], metrics, routes, np.asarray(d["speeds_rpm"], float),
+                   tuple(d["families"]), {k: tuple(v) for k, v in d["ranges"].items()}, d["engine"], d["workers"],
+                   d["timings_s"])
+
+    @property
+    def default_route(self) -> str:
+        return "mesh_force" if "mesh_force" in self.routes else self.routes[0]
+
+    def _key(self, quantity: str, route: str | None) -> str:
+        if "/" in quantity:
+            return quantity
+        return f"{route or self.default_route}/{quantity}"
+
+    def values(self, quantity: str, route: str | None = None) -> np.ndarray:
+        """The per-sample values of a quantity ("name" on the default route, or "route/name")."""
+        key = self._key(quantity, route)
+        if not self.metrics or key not in self.metrics[0]:
+            raise KeyError(f"{key}: not a quantity of this run (known: {', '.join(self.quantities)})")
+        return np.array([m[key] for m in self.metrics], float)
+
+    def band(self, quantity: str, route: str | None = None) -> tuple[float, float, float]:
+        """(5th percentile, median, 95th percentile) of a quantity over the samples (NaN-aware: a peak speed is
+        NaN in a sample without any L_WA peak)."""
+        v = self.values(quantity, route)
+        if np.all(np.isnan(v)):
+            return (float("nan"),) * 3
+        p5, p50, p95 = np.nanpercentile(v, [5.0, 50.0, 95.0])
+        return float(p5), float(p50), float(p95)
+
+    def inside(self, quantity: str, value: float, route: str | None = None) -> bool:
+        """Whether `value` lies inside the 5-95 % band of `quantity`."""
+        p5, _, p95 = self.band(quantity, route)
+        return bool(p5 <= value <= p95)
+
+    def fraction(self, quantity: str, route: str | None = None) -> float:
+        """Share of the samples in which a yes/no quantity (1/0) holds."""
+        v = self.values(quantity, route)
+        return float(np.mean(v[np.isfinite(v)])) if np.any(np.isfinite(v)) else float("nan")
+
+    def quietest_fractions(self, route: str | None = None) -> dict[str, float]:
+        """{configuration: share of samples in which it is the quietest} (bearings family)."""
+        key = self._key("quietest", route)
+        got = [m[key] for m in self.metrics if m[key] != "failed"]
+        return {b: (got.count(b) / len(got) if got else float("nan")) for b in BEARING_FAMILY}
+
+    def driver(self, quantity: str, route: str | None = None) -> dict:
+        """{"driver": the input whose Spearman rank correlation with the quantity is largest in size,
+        "driver_rho": that correlation} over the samples (numeric inputs; "" with fewer than 5 finite samples or
+        no spread).  With n samples, |rho| below about 2/sqrt(n) is noise."""
+        from scipy.stats import spearmanr
+
+        v = self.values(quantity, route)
+        keep = np.isfinite(v)
+        best = ("", float("nan"))
+        if keep.sum() >= 5 and np.ptp(v[keep]) > 0:
+            for name in PARAMETERS:
+                x = np.array([s[name] for s in self.samples], dtype=object)[keep]
+                if name == "radiation":
+                    x = np.array([str(a) == str(x[0]) for a in x], float)
+                x = x.astype(float)
+                if np.ptp(x) == 0:
+                    continue
+                rho = float(spearmanr(x, v[keep])[0])
+                if np.isfinite(rho) and (not best[0] or abs(rho) > abs(best[1])):
+                    best = (name, rho)
+        return {"driver": best[0], "driver_rho": best[1]}
+
+    @property
+    def quantities(self) -> list[str]:
+        """The numeric quantities "route/name" of the run (band / values)."""
+        m = self.metrics[0] if self.metrics else {}
+        return [k for k, v in m.items() if "/" in k and isinstance(v, float)]
+
+    @property
+    def cost_per_sample_s(self) -> float:
+        """Mean wall time of a sample (s) in its process, without the process's one basis."""
+        return float(np.mean([m["seconds"] for m in self.metrics]))
+
+    def summary_rows(self) -> list[dict]:
+        """One row per quantity and route: p5, median, p95, samples; fractions for the yes/no quantities."""
+        rows = []
+        for key in self.quantities:
+            route, name = key.split("/", 1)
+            v = self.values(key)
+            yes_no = name in ("measured_ranking_holds", "self_aligning_quieter_than_ball")
+            p5, p50, p95 = self.band(key)
+            rows.append({"route": route, "quantity": name, "p5": p5, "median": p50, "p95": p95,
+                         "fraction": self.fraction(key) if yes_no else None,
+                         "samples": int(np.sum(np.isfinite(v))), **self.driver(key)})
+        if "bearings" in self.families:
+            for route in self.routes:
+                for b, share in self.quietest_fractions(route).items():
+                    rows.append({"route": route, "quantity": f"quietest_{b}", "p5": None, "median": None,
+                                 "p95": None, "fraction": share, "samples": len(self.metrics), "driver": "",
+                                 "driver_rho": None})
+        return rows
+
+
+def _executor(engine: str, workers: int):
+    if engine == "mpi":
+        from mpi4py.futures import MPIPoolExecutor
+
+        # a singleton MPI process has one slot: spawning more needs oversubscription (Open MPI 4)
+        return MPIPoolExecutor(max_workers=workers, mpi_info={"map_by": ":OVERSUBSCRIBE"})
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+
+
+def check_request(n_samples, seed, workers, families, engine) -> None:
+    """InputError (one line) for a request that cannot run."""
+    if not isinstance(n_samples, (int, np.integer)) or n_samples < 1:
+        raise InputError(f"uncertainty: --samples: {n_samples}: must be a whole number >= 1")
+    if not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise InputError(f"uncertainty: --seed: {seed}: must be a whole number >= 0")
+    if not isinstance(workers, (int, np.integer)) or workers < 1:
+        raise InputError(f"uncertainty: --workers: {workers}: must be a whole number >= 1")
+    bad = [f for f in families if f not in FAMILIES]
+    if bad:
+        raise InputError(f"uncertainty: --family {', '.join(bad)}: unknown (known: {', '.join(FAMILIES)}, none)")
+    if engine not in ENGINES:
+        raise InputError(f"uncertainty: --engine {engine}: unknown (known: {', '.join(ENGINES)})")
+
+
+def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 0, workers: int = 1, *,
+                    ranges: dict | None = None, overrides=(), families: tuple = FAMILIES, engine: str = "mpi",
+                    samples_per_process: int | None = None, progress=None) -> UncertaintyResult:
+    """Run `n_samples` seeded Latin-hypercube samples of the estimated inputs (PARAMETERS, `ranges` overriding:
+    {name: (low, high)}, radiation: (models...)) through the run-up scene's chain (--set `overrides`) on `workers`
+    processes (engine "mpi": mpi4py.futures; "processes": concurrent.futures) and return the UncertaintyResult.
+    families: ("bearings",) adds gear set B's bearing configurations (4 re-analyses more per sample); () = set A
+    only (the cheap mode).  A process runs at most samples_per_process samples (default
+    `default_samples_per_process`; then a new one builds the basis again: memory, see the code); workers == 1 with
+    no more samples than that runs in this process.  Bad input
+    -> InputError before any model is built."""
+    from housingfe.runup.scene import load_runup_scene
+
+    families = tuple(families)
+    check_request(n_samples, seed, workers, families, engine)
+    samples_per_process = samples_per_process or default_samples_per_process(families)
+    scene_obj, path = load_runup_scene(scene, list(overrides))
+    if families and not np.any((scene_obj.runup.speeds >= MEAN_RANGE_RPM[0])
+                                & (scene_obj.runup.speeds <= MEAN_RANGE_RPM[1])):
+        raise InputError(f"{path}: runup speeds: none inside {MEAN_RANGE_RPM[0]:g}-{MEAN_RANGE_RPM[1]:g} rev/min "
+                         "(the bearings family's mean differences)")
+    full = {**{k: v for k, v in ((p.name, (p.low, p.high)) for p in PARAMETERS.values())}, **(ranges or {})}
+    samples = draw_samples(scene_obj, n_samples, seed, ranges)
+    say = progress or (lambda text: None)
+    t0 = time.perf_counter()
+    args = [(scene, tuple(overrides), s, families) for s in samples]
+    if workers == 1 and n_samples <= samples_per_process:
+        metrics = []
+        for i, a in enumerate(args):
+            metrics.append(evaluate_sample(*a))
+            say(f"sample {i + 1}/{n_samples}: {metrics[-1]['seconds']:.1f} s")
+        used = "serial"
+    else:
+        # batches of samples_per_process samples, at most `workers` batches per pool: the pool's processes end
+        # after them (each re-analysis leaves ~0.1 GB in the process, not held by Python objects, so a process
+        # must not run for ever: 14 samples of the bearings family took 10 GB and the kernel killed it)
+        used = "mpi4py.futures" if engine == "mpi" else "concurrent.futures"
+        batches = [args[i:i + samples_per_process] for i in range(0, len(args), samples_per_process)]
+        metrics = []
+        for first in range(0, len(batches), workers):
+            group = batches[first:first + workers]
+            with _executor(engine, len(group)) as ex:
+                futures = [ex.submit(evaluate_batch, batch, worker=True) for batch in group]
+                for fut in futures:                 # in sample order: the answer does not depend on the pool
+                    for m in fut.result():
+                        metrics.append(m)
+                        say(f"sample {len(metrics)}/{n_samples}: {m['seconds']:.1f} s (process {m['pid']})")
+    wall = time.perf_counter() - t0
+    setups = [m["setup_s"] for m in metrics if m["setup_s"] > 0]     # one per process that built a basis
+    timings = {"wall_s": wall, "per_sample_s": float(np.mean([m["seconds"] for m in metrics])),
+               "per_sample_cpu_s": float(np.mean([m["cpu_s"] for m in metrics])),
+               "basis_per_process_s": float(np.mean(setups)) if setups else 0.0, "processes": len(setups)}
+    return UncertaintyResult(scene, int(seed), samples, metrics, tuple(scene_obj.runup.routes),
+                             scene_obj.runup.speeds, families, full, used, int(workers), timings)
+
+
+# ------------------------------------------------------------------------------------------------ outputs
+def summary_text(result: UncertaintyResult) -> str:
+    """The console / summary.txt table: median and 5-95 % band per quantity and route, fractions, cost."""
+    from housingfe.outputs import format_table
+
+    rows = []
+    for r in result.summary_rows():
+        if r["fraction"] is not None:
+            rows.append([r["route"], r["quantity"], "", "", "", f"{r['fraction']:.2f}", _driver(r)])
+        else:
+            rows.append([r["route"], r["quantity"], _f(r["p5"]), _f(r["median"]), _f(r["p95"]), "", _driver(r)])
+    t = result.timings
+    head = (f"uncertainty {result.scene}: {len(result.samples)} Latin-hypercube samples, seed {result.seed}, "
+            f"{result.workers} worker(s) ({result.engine}); families: {', '.join(result.families) or 'set A only'}")
+    cost = (f"cost: {t['per_sample_s']:.1f} s per sample (CPU {t['per_sample_cpu_s']:.1f} s) ({'set A + 4 bearing configurations of set B' if result.families else 'set A'}), "
+            f"{t['basis_per_process_s']:.1f} s for the one modal basis per process ({t['processes']} process(es)); "
+            f"wall time {t['wall_s']:.1f} s")
+    failed = [m["failed"] for m in result.metrics if m.get("failed")]
+    notes = [f"{len(failed)} sample(s) with a configuration that could not run (NaN, left out of the bands): "
+             + " | ".join(failed[:3])] if failed else []
+    table = format_table(["route", "quantity", "p5", "median", "p95", "fraction", "driver (Spearman rho)"], rows)
+    return "\n".join([head, table, cost, f"driver: the input of largest |rank correlation|; with "
+                      f"{len(result.samples)} samples |rho| < {2 / math.sqrt(max(len(result.samples), 1)):.2f} is noise",
+                      *notes])
+
+
+def _driver(row) -> str:
+    return f"{row['driver']} ({row['driver_rho']:+.2f})" if row.get("driver") else ""
+
+
+def _f(x) -> str:
+    return "nan" if x is None or not np.isfinite(x) else f"{x:.2f}"
+
+
+SUMMARY_COLUMNS = ("route", "quantity", "p5", "median", "p95", "fraction", "samples", "driver", "driver_rho")
+
+
+def write(folder: Path, result: UncertaintyResult) -> None:
+    """samples.csv, summary.csv, summary.txt, uncertainty.png, uncertainty.json in `folder`."""
+    from housingfe.outputs import write_csv, write_json
+
+    names = list(PARAMETERS)
+    keys = [k for k in result.metrics[0] if not k.endswith("lwa_curve_dBA") and k not in ("pid", "setup_s")]
+    keys += sorted({k for m in result.metrics for k in m} - set(keys) - {"pid", "setup_s"}
+                   - {k for k in result.metrics[0] if k.endswith("lwa_curve_dBA")})
+    write_csv(folder / "samples.csv", ["sample", *names, *keys],
+              ([i, *(s[n] for n in names), *(m[k] for k in keys)]
+               for i, (s, m) in enumerate(zip(result.samples, result.metrics))))
+    rows = result.summary_rows()
+    write_csv(folder / "summary.csv", SUMMARY_COLUMNS, ([r[c] for c in SUMMARY_COLUMNS] for r in rows))
+    (folder / "summary.txt").write_text(summary_text(result) + "\n")
+    write_json(folder / "uncertainty.json", {
+        "scene": result.scene, "seed": result.seed, "samples": result.samples,
+        "ranges": {k: list(v) for k, v in result.ranges.items()},
+        "parameters": {p.name: {"distribution": p.distribution, "low": p.low, "high": p.high,
+                                "nominal": p.nominal, "unit": p.unit, "acts_on": p.acts_on, "source": p.source}
+                       for p in PARAMETERS.values()},
+        "families": list(result.families), "engine": result.engine, "workers": result.workers,
+        "timings_s": result.timings, "summary": rows, "speeds_rpm": result.speeds,
+        "metrics": [{k: v for k, v in m.items() if k != "pid"} for m in result.metrics]})
+    plot(folder / "uncertainty.png", result)
+
+
+def plot(path: Path, result: UncertaintyResult) -> None:
+    """L_WA over speed (set A): median and 5-95 % band per route; the bearing configurations' mean differences
+    (box per configuration, measured as markers)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, 2, figsize=(13, 5))
+    ax = axes[0]
+    for route in result.routes:
+        curves = np.array([m[f"{route}/lwa_curve_dBA"] for m in result.metrics])
+        p5, p50, p95 = np.percentile(curves, [5, 50, 95], axis=0)
+        line, = ax.plot(result.speeds, p50, label=f"{route}: median")
+        ax.fill_between(result.speeds, p5, p95, color=line.get_color(), alpha=0.25, label=f"{route}: 5-95 %")
+    ax.set_xlabel("pinion speed [rev/min]")
+    ax.set_ylabel("L_WA, set A, ball [dB(A)]")
+    ax.set_title(f"{len(result.samples)} samples, seed {result.seed}", fontsize=10)
+    ax.legend(fontsize=8)
+    ax = axes[1]
+    if "bearings" in result.families:
+        others = [b for b in BEARING_FAMILY if b != "ball"]
+        measured = measured_bearing_means()
+        width = 0.8 / len(result.routes)
+        for j, route in enumerate(result.routes):
+            data = [result.values(f"variant_mean_{b}_dB", route) for b in others]
+            data = [d[np.isfinite(d)] for d in data]
+            box = ax.boxplot(data, positions=np.arange(len(others)) + j * width, widths=width * 0.8,
+                             whis=(5, 95), showfliers=False, manage_ticks=False, patch_artist=True)
+            for patch in box["boxes"]:
+                patch.set_facecolor(f"C{j}")
+                patch.set_alpha(0.5)
+            ax.plot([], [], "s", color=f"C{j}", alpha=0.5, label=f"ours, {route}")
+        ax.plot(np.arange(len(others)) + width * (len(result.routes) - 1) / 2, [measured[b] for b in others],
+                "k<", ms=8, label="measured (Sec. 5.8)")
+        ax.axhline(0.0, color="k", lw=0.6)
+        ax.set_xticks(np.arange(len(others)) + width * (len(result.routes) - 1) / 2, others)
+        ax.set_ylabel("L_WA - L_WA(ball), mean 800-1500 rpm, gear set B [dB]")
+        ax.set_title("boxes: 25-75 %, median; whiskers 5-95 %", fontsize=10)
+        ax.legend(fontsize=8)
+    else:
+        ax.axis("off")
+    fig.suptitle(f"housingfe uncertainty {result.scene}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def run_command(scene: str, n_samples: int, seed: int, workers: int, out_dir: str | None, ranges_items=(),
+                overrides=(), families=FAMILIES, engine: str = "mpi",
+                samples_per_process: int | None = None) -> Path:
+    """`housingfe uncertainty`: check the request, reserve the result folder, run, write atomically, print."""
+    from mpi4py import MPI
+
+    from housingfe import outputs
+    from housingfe.runup.scene import load_runup_scene
+
+    families = tuple(families)
+    check_request(n_samples, seed, workers, families, engine)
+    if samples_per_process is not None and samples_per_process < 1:
+        raise InputError(f"uncertainty: --samples-per-process: {samples_per_process}: must be >= 1")
+    ranges = parse_ranges(ranges_items)
+    scene_obj, path = load_runup_scene(scene, list(overrides))
+    draw_samples(scene_obj, 1, seed, ranges)                 # a bad radiation choice stops here
+    out = Path(out_dir or f"results/uncertainty-{scene_obj.scene.name}")
+    comm = MPI.COMM_WORLD
+    outputs.reserve_output(out, comm, inputs=[path])
+    result = run_uncertainty(scene, n_samples, seed, workers, ranges=ranges, overrides=overrides,
+                             families=families, engine=engine, samples_per_process=samples_per_process,
+                             progress=lambda t: print(t, flush=True))
+    with outputs.atomic_output_dir(out, comm) as tmp:
+        if comm.rank == 0:
+            write(tmp, result)
+    print(summary_text(result))
+    print(f"results: {out}/")
+    return out
+
+
+def register_cli(subparsers) -> None:
+    """Add `housingfe uncertainty [SCENE] --samples N --seed S [--workers K] [--out DIR] [--range NAME=LO:HI]
+    [--family bearings|none] [--engine mpi|processes] [--set KEY=VALUE]`."""
+    p = subparsers.add_parser("uncertainty", help="spread of the run-up's answers over the ranges of the "
+                                                  "estimated inputs (seeded Latin hypercube; docs/uncertainty.md)")
+    p.add_argument("scene", nargs="?", default=DEFAULT_SCENE, help=f"run-up scene (default {DEFAULT_SCENE})")
+    p.add_argument("--samples", type=int, default=8, help="number of samples (default 8)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the Latin hypercube (default 0)")
+    p.add_argument("--workers", type=int, default=1, help="processes (default 1; > 1: mpi4py.futures)")
+    p.add_argument("--engine", default="mpi", help="pool for --workers > 1: mpi (mpi4py.futures, default) or "
+                                                   "processes (concurrent.futures)")
+    p.add_argument("--samples-per-process", type=int, default=None,
+                   help="samples a process runs before a new one takes over (default 6 with the bearings family, 30 "
+                        "for set A alone; each re-analysis leaves memory behind in its process, docs/uncertainty.md)")
+    p.add_argument("--out", default=None, help="result folder (default results/uncertainty-<scene>)")
+    p.add_argument("--range", action="append", metavar="NAME=LOW:HIGH",
+                   help="override a parameter's range (NAME=VALUE: fixed; radiation=erp[,foller]); names: "
+                        + ", ".join(PARAMETERS))
+    p.add_argument("--family", action="append", metavar="bearings|none",
+                   help="variant families per sample (default bearings: gear set B with the four bearing "
+                        "configurations; none: set A only, the cheap mode)")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the run-up scene")
+    p.set_defaults(func=_cmd)
+
+
+def _cmd(args: argparse.Namespace) -> int:
+    fams = args.family or list(FAMILIES)
+    fams = () if fams == ["none"] else tuple(fams)
+    run_command(args.scene, args.samples, args.seed, args.workers, args.out, args.range or (), args.set or (),
+                fams, args.engine, args.samples_per_process)
+    return 0
