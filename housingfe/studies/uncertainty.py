@@ -493,6 +493,24 @@ class UncertaintyResult:
         p5, p50, p95 = np.nanpercentile(v, [5.0, 50.0, 95.0])
         return float(p5), float(p50), float(p95)
 
+    def check_bands(self) -> dict[str, tuple[float, float]]:
+        """{check_id: (p5, p95)} for the issue-28 check rows of `housingfe validate` whose quantity this run
+        sampled (max L_WA, speed law, the bearing variants' mean differences), per route: the file
+        `housingfe validate --bands` reads (bands.json of the result folder)."""
+        out = {}
+        for route in self.routes:
+            pairs = [(f"28.default.max_lwa.{route}", "max_lwa_dBA"),
+                     (f"28.speed_law.{route}", "slope_dBA_per_doubling")]
+            pairs += [(f"28.variants.mean.bearings.{b}.{route}", f"variant_mean_{b}_dB") for b in BEARING_FAMILY[1:]]
+            for check_id, quantity in pairs:
+                try:
+                    p5, _, p95 = self.band(quantity, route)
+                except KeyError:            # a quantity of a family this run did not include
+                    continue
+                if np.isfinite(p5) and np.isfinite(p95):
+                    out[check_id] = (p5, p95)
+        return out
+
     def inside(self, quantity: str, value: float, route: str | None = None) -> bool:
         """Whether `value` lies inside the 5-95 % band of `quantity`."""
         p5, _, p95 = self.band(quantity, route)
@@ -683,7 +701,8 @@ SUMMARY_COLUMNS = ("route", "quantity", "p5", "median", "p95", "fraction", "samp
 
 
 def write(folder: Path, result: UncertaintyResult) -> None:
-    """samples.csv, summary.csv, summary.txt, uncertainty.png, uncertainty.json in `folder`."""
+    """samples.csv, summary.csv, summary.txt, uncertainty.png, uncertainty.json and bands.json (the check rows'
+    bands for `housingfe validate --bands`) in `folder`."""
     from housingfe.outputs import write_csv, write_json
 
     names = list(PARAMETERS)
@@ -705,6 +724,7 @@ def write(folder: Path, result: UncertaintyResult) -> None:
         "families": list(result.families), "engine": result.engine, "workers": result.workers,
         "timings_s": result.timings, "summary": rows, "speeds_rpm": result.speeds,
         "metrics": [{k: v for k, v in m.items() if k != "pid"} for m in result.metrics]})
+    write_json(folder / "bands.json", {k: list(v) for k, v in result.check_bands().items()})
     plot(folder / "uncertainty.png", result)
 
 

@@ -116,3 +116,20 @@ def test_bad_input_is_one_line_and_no_folder(tmp_path, args, message):
     assert proc.stderr.strip().count("\n") == 0 and "Traceback" not in proc.stderr
     assert proc.stderr.startswith("housingfe: error:") and message in proc.stderr
     assert not out.exists()
+
+
+def test_check_bands_name_the_validate_check_rows_and_hold_the_5_95_percent_band():
+    """bands.json maps each sampled quantity to the check_id of its validate row (28.default.max_lwa.<route>, ...)
+    with the 5-95 % band of the samples: 0..100 uniformly spaced gives (5, 95)."""
+    from housingfe.studies.uncertainty import UncertaintyResult
+
+    values = np.linspace(0.0, 100.0, 101)
+    metrics = [{"mesh_force/max_lwa_dBA": v, "mesh_force/slope_dBA_per_doubling": v / 10,
+                "mesh_force/variant_mean_self_aligning_dB": -v} for v in values]
+    result = UncertaintyResult("test-gearbox-runup", 1, [{}] * len(values), metrics, ("mesh_force",),
+                               np.array([500.0]), (), {}, "processes", 1)
+    bands = result.check_bands()
+    assert set(bands) == {"28.default.max_lwa.mesh_force", "28.speed_law.mesh_force",
+                          "28.variants.mean.bearings.self_aligning.mesh_force"}
+    assert bands["28.default.max_lwa.mesh_force"] == pytest.approx((5.0, 95.0))
+    assert bands["28.variants.mean.bearings.self_aligning.mesh_force"] == pytest.approx((-95.0, -5.0))
