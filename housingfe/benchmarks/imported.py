@@ -218,6 +218,7 @@ def _worker(job_path: str) -> None:
 # ------------------------------------------------------------------------------------------ driver
 CASES = [("housingfe", {"ranks": 1}), ("calculix", {}), ("housingfe", {"ranks": 2}), ("reduce", {}),
          ("inspect", {})]
+CASE_KEYS = ("housingfe1", "calculix", "housingfe2", "reduce", "inspect")     # --cases names, in CASES' order
 
 
 def label(kind: str, job: dict) -> str:
@@ -225,22 +226,42 @@ def label(kind: str, job: dict) -> str:
             "reduce": "housingfe reduce (CB, 1 rank)", "inspect": "housingfe inspect"}[kind]
 
 
-def main(out_dir: Path, quick: bool = False, resume: bool = False) -> None:
-    """Write the inputs, run the cases interleaved, print the table; imported_bench.csv/.png/.txt in out_dir."""
+def selected_cases(cases: list[str] | None) -> list[tuple[str, dict]]:
+    """The (kind, job) of the named cases (CASE_KEYS; None: all) in the bench's order; InputError for an unknown
+    name, or CalculiX without housingfe on 1 rank (its deck and reference are that run's)."""
+    from housingfe.errors import InputError
+
+    keys = list(CASE_KEYS) if cases is None else cases
+    unknown = [k for k in keys if k not in CASE_KEYS]
+    if unknown or not keys:
+        raise InputError(f"bench: --cases: unknown case {', '.join(unknown) or '(none)'} "
+                         f"(cases: {', '.join(CASE_KEYS)})")
+    if "calculix" in keys and "housingfe1" not in keys:
+        raise InputError("bench: --cases: calculix needs housingfe1 (the deck is the mesh that run solved)")
+    return [case for key, case in zip(CASE_KEYS, CASES) if key in keys]
+
+
+def main(out_dir: Path, quick: bool = False, resume: bool = False, size_mm: float | None = None,
+         cases: list[str] | None = None, rounds: int | None = None) -> None:
+    """Write the inputs, run the cases interleaved, print the table; imported_bench.csv/.png/.txt in out_dir.
+    size_mm: the element size (mm; default 13.5, --quick 60); cases: a subset of CASE_KEYS; rounds: interleaved
+    rounds (default REPEATS, --quick 1)."""
     from housingfe.benchmarks._runs import FinishedRuns
 
-    size = QUICK_SIZE if quick else SIZE
-    repeats = 1 if quick else REPEATS
+    size = size_mm / 1e3 if size_mm else QUICK_SIZE if quick else SIZE
+    repeats = rounds or (1 if quick else REPEATS)
+    order = [(k, j) for k, j in selected_cases(cases) if k != "calculix" or shutil.which("ccx")]
     work = Path(f"{out_dir}.inputs")      # beside <out>.partial: the deck a --resume re-uses
     work.mkdir(parents=True, exist_ok=True)
     inputs = write_inputs(work, size)
-    bolted = work / f"bolted-{QUICK_HOLES if quick else HOLES}.step"
-    if not bolted.exists():
-        write_bolted_housing(bolted, QUICK_HOLES if quick else HOLES)
-    inputs["bolted"] = str(bolted)
-    bolted_mb = bolted.stat().st_size / 1e6
+    bolted_mb = float("nan")
+    if any(k == "inspect" for k, _ in order):
+        bolted = work / f"bolted-{QUICK_HOLES if quick else HOLES}.step"
+        if not bolted.exists():
+            write_bolted_housing(bolted, QUICK_HOLES if quick else HOLES)
+        inputs["bolted"] = str(bolted)
+        bolted_mb = bolted.stat().st_size / 1e6
     step_mb = Path(inputs["step"]).stat().st_size / 1e6
-    order = [(k, j) for k, j in CASES if k != "calculix" or shutil.which("ccx")]
     finished = FinishedRuns("imported", out_dir, {"size": size, "repeats": repeats, "order": order},
                             repeats * len(order) + 1, resume=resume)
     runs: dict[str, list] = {label(k, j): [] for k, j in order}
@@ -361,7 +382,9 @@ def _plot(path: Path, rows: list) -> None:
         if r[8] == r[8]:
             ax.annotate(f"{r[8]:.2f} GB", (r[3], i), xytext=(4, -3), textcoords="offset points", fontsize=7)
     ax.set_xlabel("wall time per run, median (bars: min-max) (s)")
-    ax.set_title(f"imported gearbox housing (STEP), {rows[0][1]} DOFs, modes to 4 kHz; inspect: {rows[-1][1]}")
+    inspect = [r[1] for r in rows if r[0] == "housingfe inspect"]
+    ax.set_title(f"imported gearbox housing (STEP), {rows[0][1]} DOFs, modes to 4 kHz"
+                 + (f"; inspect: {inspect[0]}" if inspect else ""))
     ax.grid(alpha=0.3, axis="x")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
