@@ -36,7 +36,7 @@ def main(which: str, out_dir: str | None = None, quick: bool = False, only: list
         extra = {"resume": True}
     else:
         extra = {}
-    extra.update(_tuning(which, module.main, {"size_mm": size_mm, "cases": cases, "rounds": rounds}))
+    extra.update(_tuning(which, module, {"size_mm": size_mm, "cases": cases, "rounds": rounds}))
     if notes_only:
         if which != "all" or only or quick:
             raise InputError("bench: --notes applies to `housingfe bench all` alone (no --only, no --quick)")
@@ -53,13 +53,13 @@ def main(which: str, out_dir: str | None = None, quick: bool = False, only: list
     module.main(out, quick, **extra)
 
 
-def _tuning(which: str, main, given: dict) -> dict:
-    """The options given (not None) that the benchmark's main takes; InputError for one it does not take or a
-    non-positive number."""
+def _tuning(which: str, module, given: dict) -> dict:
+    """The options given (not None) that the benchmark's main takes; InputError, before any output place is
+    taken, for one it does not take, a non-positive number or cases its selected_cases() refuses."""
     import inspect
 
     option = {"size_mm": "--size", "cases": "--cases", "rounds": "--rounds"}
-    takes = inspect.signature(main).parameters
+    takes = inspect.signature(module.main).parameters
     out = {}
     for key, value in given.items():
         if value is None:
@@ -70,5 +70,7 @@ def _tuning(which: str, main, given: dict) -> dict:
             raise InputError(f"bench: {option[key]}: {which} does not take it (those that do: {', '.join(users)})")
         if key != "cases" and not value > 0:
             raise InputError(f"bench: {option[key]}: {value:g} must be positive")
+        if key == "cases" and hasattr(module, "selected_cases"):
+            module.selected_cases(value)
         out[key] = value
     return out

@@ -32,8 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.benchmarks._launch import mpi_environment, mpi_launcher
-from housingfe.benchmarks.modal import load_average, parse_calculix_frequencies
+from housingfe.benchmarks._calculix import run_calculix
+from housingfe.benchmarks._launch import mpi_environment, mpi_launcher, write_worker_result
+from housingfe.benchmarks.modal import load_average
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 F_MAX = 4000.0          # Hz
@@ -148,14 +149,8 @@ def write_c3d10_deck(scene_path: str, deck: Path, modes: int) -> dict:
 def run_calculix_case(deck: str, workdir: Path) -> dict:
     """ccx on a copy of the deck (2 threads); elastic frequencies (> 1 Hz) and wall time."""
     shutil.copy(deck, workdir / "housing.inp")
-    env = {**os.environ, "OMP_NUM_THREADS": "2", "CCX_NPROC_EQUATION_SOLVER": "2"}
-    t0 = time.perf_counter()
-    proc = subprocess.run(["ccx", "-i", "housing"], cwd=workdir, capture_output=True, text=True, env=env)
-    wall = time.perf_counter() - t0
-    if proc.returncode != 0 or not (workdir / "housing.dat").exists():
-        raise RuntimeError(f"ccx failed: {proc.stdout[-2000:]}")
-    freqs = parse_calculix_frequencies(workdir / "housing.dat")
-    return {"frequencies_hz": freqs[freqs > 1.0].tolist(), "wall_s": wall}
+    freqs, wall = run_calculix(workdir, "housing")
+    return {"frequencies_hz": freqs.tolist(), "wall_s": wall}
 
 
 def _subprocess(cmd: list[str], cwd: str | None = None) -> tuple[float, int, str]:
@@ -197,10 +192,6 @@ def _case(kind: str, job: dict) -> dict:
 
 
 def _worker(job_path: str) -> None:
-    import resource
-
-    from mpi4py import MPI
-
     job = json.loads(Path(job_path).read_text())
     if job["kind"] == "housingfe":
         out = run_housingfe_case(job["scene"])
@@ -208,11 +199,7 @@ def _worker(job_path: str) -> None:
         out = write_c3d10_deck(job["scene"], Path(job["deck"]), job["modes"])
     else:
         out = run_calculix_case(job["deck"], Path(job["workdir"]))
-    self_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    child_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    out["peak_memory_gb"] = MPI.COMM_WORLD.allreduce(max(self_kb, child_kb)) / 1024**2
-    if MPI.COMM_WORLD.rank == 0:
-        (Path(job["workdir"]) / "result.json").write_text(json.dumps(out))
+    write_worker_result(out, job["workdir"])
 
 
 # ------------------------------------------------------------------------------------------ driver
