@@ -4,7 +4,7 @@ CalculiX (C3D10 on the very same mesh), the Craig–Bampton export beside the mo
 The housing: the package's test gearbox (565 x 300 x 375 mm, 10 mm walls, two bores of 170 mm) written to STEP
 by its own OpenCASCADE model (housingfe.geometry.cad.write_step, metres) and read back as geometry kind "cad",
 P2 on gmsh's linear tetrahedra of mesh.size (full: 13.5 mm, 257 k DOFs; --quick: 60 mm, 28 k; --size MM: 11.5 mm
-367 k, 7.5 mm ~1 M).  --cases picks a subset of CASE_KEYS, --rounds the number of interleaved rounds.
+367 k; ~7.5 mm for 1 M, extrapolated).  --cases picks a subset of CASE_KEYS, --rounds the number of interleaved rounds.
 
 Cases, each in its own process (wall time includes start-up, import, meshing, assembly, solve; peak memory is the
 process's own, summed over ranks):
