@@ -134,7 +134,7 @@ bearings = "ball"
 
 [runup]
 speed_min_rpm = {speed_min}
-speed_max_rpm = 1500.0
+speed_max_rpm = {speed_max}
 speed_step_rpm = {speed_step}
 torques_nm = [2000.0]
 f_max_hz = {f_max}
@@ -162,7 +162,7 @@ def main(argv=None) -> int:
         (work / "housing.toml").write_text(HOUSING.format(
             bores=bore_selectors(step), f_max=f_max, size="size = 0.06\n" if args.small else ""))
         (work / "runup-scene.toml").write_text(RUNUP.format(
-            speed_min=speed_min, speed_step=speed_step, f_max=f_max, spectrum=f"{speed_min:g}.0"))
+            speed_min=speed_min, speed_max=1500.0, speed_step=speed_step, f_max=f_max, spectrum=f"{speed_min:g}.0"))
         results = run_scene(str(work / "runup-scene.toml"), out_dir=str(work / "results"))
 
         with open(results / "runup.csv") as fh:

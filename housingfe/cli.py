@@ -58,8 +58,9 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     from housingfe.benchmarks import _dispatch as bench
 
     only = [n for n in (args.only or "").split(",") if n]
+    cases = [n for n in (args.cases or "").split(",") if n]
     bench.main(args.which, out_dir=args.out, quick=args.quick, only=only or None, notes_only=args.notes,
-               resume=args.resume)
+               resume=args.resume, size_mm=args.size, cases=cases or None, rounds=args.rounds)
     return 0
 
 
@@ -153,6 +154,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="re-use the runs an interrupted bench left in <out>.partial/ (docs/progress.md)")
     p.add_argument("--notes", action="store_true",
                    help="with `all`: run nothing; put the edited docs/benchmarks-notes.md into docs/benchmarks.md")
+    p.add_argument("--size", type=float, default=None, metavar="MM",
+                   help="element size in mm (benchmarks that take one: imported)")
+    p.add_argument("--cases", default=None, metavar="NAMES",
+                   help="run only these cases, comma-separated (benchmarks that take them: imported)")
+    p.add_argument("--rounds", type=int, default=None, metavar="N",
+                   help="interleaved rounds instead of the default (benchmarks that take them: imported)")
     p.set_defaults(func=_cmd_bench)
 
     p = sub.add_parser("mesh-picture", help="PNG of a scene's mesh coloured by feature (for the docs)")

@@ -6,9 +6,9 @@ from __future__ import annotations
 import math
 import tomllib
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, ValidationError, field_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, ValidationError
 
 from housingfe.errors import InputError
 
@@ -32,18 +32,21 @@ def scene_name_problem(name) -> str | None:
     return None
 
 
+def _plain_folder_name(name: str) -> str:
+    problem = scene_name_problem(name)
+    if problem is not None:
+        raise ValueError(problem)
+    return name
+
+
+# a str field that names a result folder (scene names, update names): scene_name_problem as its validator
+FolderName = Annotated[str, AfterValidator(_plain_folder_name)]
+
+
 class SceneInfo(_Strict):
-    name: str  # names the result folder (results/<name> unless --out is given) and the reports
+    name: FolderName  # names the result folder (results/<name> unless --out is given) and the reports
     kind: Literal["housing", "source", "runup"]  # which schema the rest of the file follows
     description: str = ""  # one line, shown by `housingfe scenes`
-
-    @field_validator("name")
-    @classmethod
-    def _plain_folder_name(cls, name: str) -> str:
-        problem = scene_name_problem(name)
-        if problem is not None:
-            raise ValueError(problem)
-        return name
 
 
 def builtin_scenes() -> dict[str, str]:

@@ -522,6 +522,11 @@ COMMAND_CASES = [
     ("bench-notes-with-only", ["bench", "all", "--notes", "--only", "modal"], ["--notes"]),
     ("bench-resume-not-kept", ["bench", "frf", "--resume"], ["--resume", "frf does not keep its runs"]),
     ("bench-resume-with-notes", ["bench", "all", "--notes", "--resume"], ["--resume", "--notes"]),
+    ("bench-size-not-taken", ["bench", "frf", "--size", "10"], ["--size", "frf does not take it", "imported"]),
+    ("bench-size-negative", ["bench", "imported", "--size", "-5"], ["--size", "-5 must be positive"]),
+    ("bench-cases-unknown", ["bench", "imported", "--cases", "housingfe1,housingfe3"],
+     ["--cases", "unknown case housingfe3", "housingfe2"]),
+    ("bench-cases-calculix-alone", ["bench", "imported", "--cases", "calculix"], ["--cases", "needs housingfe1"]),
 ]
 
 

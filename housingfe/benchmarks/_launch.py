@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+from pathlib import Path
 
 
 def mpi_launcher(ranks: int) -> list[str]:
@@ -23,3 +24,18 @@ def mpi_environment(env: dict | None = None) -> dict:
         out.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
         out.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
     return out
+
+
+def write_worker_result(out: dict, workdir: Path) -> None:
+    """The end of a case's worker process: add its peak resident memory (GB, summed over the ranks, each rank's
+    own peak or its child processes' if larger) to `out` and write it to workdir/result.json on rank 0."""
+    import json
+    import resource
+
+    from mpi4py import MPI
+
+    self_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    child_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    out["peak_memory_gb"] = MPI.COMM_WORLD.allreduce(max(self_kb, child_kb)) / 1024**2
+    if MPI.COMM_WORLD.rank == 0:
+        (Path(workdir) / "result.json").write_text(json.dumps(out))

@@ -3,7 +3,8 @@ CalculiX (C3D10 on the very same mesh), the Craig–Bampton export beside the mo
 
 The housing: the package's test gearbox (565 x 300 x 375 mm, 10 mm walls, two bores of 170 mm) written to STEP
 by its own OpenCASCADE model (housingfe.geometry.cad.write_step, metres) and read back as geometry kind "cad",
-P2 on gmsh's linear tetrahedra of mesh.size (full: 13.5 mm, ~0.3 M DOFs; --quick: 60 mm, 28 k).
+P2 on gmsh's linear tetrahedra of mesh.size (full: 13.5 mm, 257 k DOFs; --quick: 60 mm, 28 k; --size MM: 11.5 mm
+367 k; ~7.5 mm for 1 M, extrapolated).  --cases picks a subset of CASE_KEYS, --rounds the number of interleaved rounds.
 
 Cases, each in its own process (wall time includes start-up, import, meshing, assembly, solve; peak memory is the
 process's own, summed over ranks):
@@ -32,8 +33,9 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.benchmarks._launch import mpi_environment, mpi_launcher
-from housingfe.benchmarks.modal import load_average, parse_calculix_frequencies
+from housingfe.benchmarks._calculix import run_calculix
+from housingfe.benchmarks._launch import mpi_environment, mpi_launcher, write_worker_result
+from housingfe.benchmarks.modal import load_average
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 F_MAX = 4000.0          # Hz
@@ -148,14 +150,8 @@ def write_c3d10_deck(scene_path: str, deck: Path, modes: int) -> dict:
 def run_calculix_case(deck: str, workdir: Path) -> dict:
     """ccx on a copy of the deck (2 threads); elastic frequencies (> 1 Hz) and wall time."""
     shutil.copy(deck, workdir / "housing.inp")
-    env = {**os.environ, "OMP_NUM_THREADS": "2", "CCX_NPROC_EQUATION_SOLVER": "2"}
-    t0 = time.perf_counter()
-    proc = subprocess.run(["ccx", "-i", "housing"], cwd=workdir, capture_output=True, text=True, env=env)
-    wall = time.perf_counter() - t0
-    if proc.returncode != 0 or not (workdir / "housing.dat").exists():
-        raise RuntimeError(f"ccx failed: {proc.stdout[-2000:]}")
-    freqs = parse_calculix_frequencies(workdir / "housing.dat")
-    return {"frequencies_hz": freqs[freqs > 1.0].tolist(), "wall_s": wall}
+    freqs, wall = run_calculix(workdir, "housing")
+    return {"frequencies_hz": freqs.tolist(), "wall_s": wall}
 
 
 def _subprocess(cmd: list[str], cwd: str | None = None) -> tuple[float, int, str]:
@@ -197,10 +193,6 @@ def _case(kind: str, job: dict) -> dict:
 
 
 def _worker(job_path: str) -> None:
-    import resource
-
-    from mpi4py import MPI
-
     job = json.loads(Path(job_path).read_text())
     if job["kind"] == "housingfe":
         out = run_housingfe_case(job["scene"])
@@ -208,16 +200,13 @@ def _worker(job_path: str) -> None:
         out = write_c3d10_deck(job["scene"], Path(job["deck"]), job["modes"])
     else:
         out = run_calculix_case(job["deck"], Path(job["workdir"]))
-    self_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    child_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    out["peak_memory_gb"] = MPI.COMM_WORLD.allreduce(max(self_kb, child_kb)) / 1024**2
-    if MPI.COMM_WORLD.rank == 0:
-        (Path(job["workdir"]) / "result.json").write_text(json.dumps(out))
+    write_worker_result(out, job["workdir"])
 
 
 # ------------------------------------------------------------------------------------------ driver
 CASES = [("housingfe", {"ranks": 1}), ("calculix", {}), ("housingfe", {"ranks": 2}), ("reduce", {}),
          ("inspect", {})]
+CASE_KEYS = ("housingfe1", "calculix", "housingfe2", "reduce", "inspect")     # --cases names, in CASES' order
 
 
 def label(kind: str, job: dict) -> str:
@@ -225,22 +214,42 @@ def label(kind: str, job: dict) -> str:
             "reduce": "housingfe reduce (CB, 1 rank)", "inspect": "housingfe inspect"}[kind]
 
 
-def main(out_dir: Path, quick: bool = False, resume: bool = False) -> None:
-    """Write the inputs, run the cases interleaved, print the table; imported_bench.csv/.png/.txt in out_dir."""
+def selected_cases(cases: list[str] | None) -> list[tuple[str, dict]]:
+    """The (kind, job) of the named cases (CASE_KEYS; None: all) in the bench's order; InputError for an unknown
+    name, or CalculiX without housingfe on 1 rank (its deck and reference are that run's)."""
+    from housingfe.errors import InputError
+
+    keys = list(CASE_KEYS) if cases is None else cases
+    unknown = [k for k in keys if k not in CASE_KEYS]
+    if unknown or not keys:
+        raise InputError(f"bench: --cases: unknown case {', '.join(unknown) or '(none)'} "
+                         f"(cases: {', '.join(CASE_KEYS)})")
+    if "calculix" in keys and "housingfe1" not in keys:
+        raise InputError("bench: --cases: calculix needs housingfe1 (the deck is the mesh that run solved)")
+    return [case for key, case in zip(CASE_KEYS, CASES) if key in keys]
+
+
+def main(out_dir: Path, quick: bool = False, resume: bool = False, size_mm: float | None = None,
+         cases: list[str] | None = None, rounds: int | None = None) -> None:
+    """Write the inputs, run the cases interleaved, print the table; imported_bench.csv/.png/.txt in out_dir.
+    size_mm: the element size (mm; default 13.5, --quick 60); cases: a subset of CASE_KEYS; rounds: interleaved
+    rounds (default REPEATS, --quick 1)."""
     from housingfe.benchmarks._runs import FinishedRuns
 
-    size = QUICK_SIZE if quick else SIZE
-    repeats = 1 if quick else REPEATS
+    size = size_mm / 1e3 if size_mm else QUICK_SIZE if quick else SIZE
+    repeats = rounds or (1 if quick else REPEATS)
+    order = [(k, j) for k, j in selected_cases(cases) if k != "calculix" or shutil.which("ccx")]
     work = Path(f"{out_dir}.inputs")      # beside <out>.partial: the deck a --resume re-uses
     work.mkdir(parents=True, exist_ok=True)
     inputs = write_inputs(work, size)
-    bolted = work / f"bolted-{QUICK_HOLES if quick else HOLES}.step"
-    if not bolted.exists():
-        write_bolted_housing(bolted, QUICK_HOLES if quick else HOLES)
-    inputs["bolted"] = str(bolted)
-    bolted_mb = bolted.stat().st_size / 1e6
+    bolted_mb = float("nan")
+    if any(k == "inspect" for k, _ in order):
+        bolted = work / f"bolted-{QUICK_HOLES if quick else HOLES}.step"
+        if not bolted.exists():
+            write_bolted_housing(bolted, QUICK_HOLES if quick else HOLES)
+        inputs["bolted"] = str(bolted)
+        bolted_mb = bolted.stat().st_size / 1e6
     step_mb = Path(inputs["step"]).stat().st_size / 1e6
-    order = [(k, j) for k, j in CASES if k != "calculix" or shutil.which("ccx")]
     finished = FinishedRuns("imported", out_dir, {"size": size, "repeats": repeats, "order": order},
                             repeats * len(order) + 1, resume=resume)
     runs: dict[str, list] = {label(k, j): [] for k, j in order}
@@ -361,7 +370,9 @@ def _plot(path: Path, rows: list) -> None:
         if r[8] == r[8]:
             ax.annotate(f"{r[8]:.2f} GB", (r[3], i), xytext=(4, -3), textcoords="offset points", fontsize=7)
     ax.set_xlabel("wall time per run, median (bars: min-max) (s)")
-    ax.set_title(f"imported gearbox housing (STEP), {rows[0][1]} DOFs, modes to 4 kHz; inspect: {rows[-1][1]}")
+    inspect = [r[1] for r in rows if r[0] == "housingfe inspect"]
+    ax.set_title(f"imported gearbox housing (STEP), {rows[0][1]} DOFs, modes to 4 kHz"
+                 + (f"; inspect: {inspect[0]}" if inspect else ""))
     ax.grid(alpha=0.3, axis="x")
     fig.tight_layout()
     fig.savefig(path, dpi=120)

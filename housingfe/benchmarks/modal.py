@@ -34,7 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.benchmarks._launch import mpi_environment, mpi_launcher
+from housingfe.benchmarks._calculix import run_calculix
+from housingfe.benchmarks._launch import mpi_environment, mpi_launcher, write_worker_result
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 F_MAX = 4000.0          # Hz, the range of the thesis' free-box study
@@ -110,15 +111,9 @@ def run_calculix_case(case: dict, workdir: Path) -> dict:
     """Export the same gmsh geometry as an Abaqus/CalculiX deck and run ccx *FREQUENCY on it."""
     deck = workdir / "box.inp"
     n_nodes, n_elements = write_calculix_deck(case, deck)
-    env = {**os.environ, "OMP_NUM_THREADS": "2", "CCX_NPROC_EQUATION_SOLVER": "2"}
-    t0 = time.perf_counter()
-    proc = subprocess.run(["ccx", "-i", "box"], cwd=workdir, capture_output=True, text=True, env=env)
-    wall = time.perf_counter() - t0
-    if proc.returncode != 0:
-        raise RuntimeError(f"ccx failed: {proc.stdout[-2000:]}")
-    freqs = parse_calculix_frequencies(workdir / "box.dat")
-    return {"dofs": 3 * n_nodes, "elements": n_elements, "frequencies_hz": freqs[freqs > 1.0].tolist(),
-            "wall_s": wall, "complete": None}
+    freqs, wall = run_calculix(workdir, "box")
+    return {"dofs": 3 * n_nodes, "elements": n_elements, "frequencies_hz": freqs.tolist(), "wall_s": wall,
+            "complete": None}
 
 
 def write_calculix_deck(case: dict, path: Path) -> tuple[int, int]:
@@ -167,22 +162,6 @@ def _volume_part_of_inp(text: str, ccx_type: str) -> tuple[str, str]:
     return nodes, "".join(elements)
 
 
-def parse_calculix_frequencies(dat: Path) -> np.ndarray:
-    """Eigenfrequencies (Hz, column CYCLES/TIME) from a ccx .dat file."""
-    freqs, reading = [], False
-    for line in dat.read_text().splitlines():
-        if "E I G E N V A L U E   O U T P U T" in line:
-            reading, freqs = True, []
-            continue
-        if reading:
-            parts = line.split()
-            if len(parts) >= 4 and parts[0].isdigit():
-                freqs.append(float(parts[3]))
-            elif freqs and not parts:
-                reading = False
-    return np.array(freqs)
-
-
 # ------------------------------------------------------------------------------------------ driver
 def _case_in_subprocess(code: str, case: dict) -> dict:
     """Run one case in a fresh interpreter; also returns its peak resident memory (GB)."""
@@ -203,21 +182,12 @@ def _case_in_subprocess(code: str, case: dict) -> dict:
 
 
 def _worker(job_path: str) -> None:
-    import resource
-
-    from mpi4py import MPI
-
     job = json.loads(Path(job_path).read_text())
     if job["code"] == "housingfe":
         out = run_housingfe_case(job["case"])
     else:
         out = run_calculix_case(job["case"], Path(job["workdir"]))
-    self_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-    child_kb = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
-    # peak resident memory summed over the ranks (each rank's own peak)
-    out["peak_memory_gb"] = MPI.COMM_WORLD.allreduce(max(self_kb, child_kb)) / 1024**2
-    if MPI.COMM_WORLD.rank == 0:
-        (Path(job["workdir"]) / "result.json").write_text(json.dumps(out))
+    write_worker_result(out, job["workdir"])
 
 
 def errors_against(reference: np.ndarray, freqs: list) -> tuple[float, float]:

@@ -28,10 +28,10 @@ from pathlib import Path
 from typing import Callable, Literal, Optional
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, model_validator
 
 from housingfe.errors import InputError, SolverError
-from housingfe.scenefile import scene_name_problem
+from housingfe.scenefile import FolderName
 
 
 class _Strict(BaseModel):
@@ -102,7 +102,7 @@ class UpdateSpec(_Strict):
     """An updating problem: parameters, targets, overrides used during the search (e.g. a coarse mesh) and
     in the confirmation (default: none, the scenes' own mesh)."""
 
-    name: str = "update"        # the default result folder is results/update-<name>: a plain folder name
+    name: FolderName = "update"     # the default result folder is results/update-<name>: a plain folder name
     parameters: list[ParameterSpec] = Field(min_length=1)
     targets: list[TargetSpec] = Field(min_length=1)
     # scene -> overrides of every evaluation (search and confirmation), before the parameters: a parameter may set a
@@ -115,14 +115,6 @@ class UpdateSpec(_Strict):
     multistart: list[dict[str, float]] = []        # further start points (parameter name -> value)
     max_evaluations: int = Field(60, ge=1)
     fd_step: PositiveFloat = 0.02   # forward-difference step, fraction of each parameter's range
-
-    @field_validator("name")
-    @classmethod
-    def _plain_folder_name(cls, name: str) -> str:
-        problem = scene_name_problem(name)
-        if problem is not None:
-            raise ValueError(problem)
-        return name
 
 
 def load_update_spec(path: str) -> UpdateSpec:

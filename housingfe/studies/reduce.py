@@ -4,8 +4,8 @@ summary.json; with --check also check.csv (the full model's modes with the maste
 model's, and the time of each).
 
 Masters (one per bore, rbe2): --master SURFACE (repeatable) or, by default, the scene's [coupling] bores, the
-bores of a "mesh" geometry ([[geometry.bores]]), or each bearing seat of a "gearbox" geometry
-(bore_<name>_front / _back)."""
+bores of a "mesh" geometry ([[geometry.bores]]), the bore selectors of a "cad" geometry (bore_<name>), or each
+bearing seat of a "gearbox" geometry (bore_<name>_front / _back)."""
 from __future__ import annotations
 
 import argparse
@@ -62,6 +62,8 @@ def scene_masters(scene, model, surfaces: list[str] | None) -> list:
     names = []
     if geometry.kind == "mesh":
         names = [b.name for b in geometry.bores]
+    elif geometry.kind == "cad":        # a bore selector's faces are the surface bore_<name>
+        names = [f"bore_{b.name}" for b in geometry.bores]
     elif geometry.kind == "gearbox":
         names = [f"bore_{b.name}_{side}" for b in geometry.bores for side in ("front", "back")]
     if not names:

@@ -178,6 +178,39 @@ def test_reduce_an_imported_mesh_at_its_bores(tmp_path, box):
     assert np.allclose(back.frequencies_with(K6s), red.frequencies_with(K6s), rtol=1e-8)
 
 
+def test_reduce_a_cad_housing_at_its_bore_selectors(tmp_path):
+    """`housingfe reduce` on a "cad" geometry takes its bore selectors as masters (bore_<name>), as with
+    --master: a 200 x 100 x 100 mm block with two 20 mm holes along y (STEP written by gmsh's OpenCASCADE); the
+    masters sit on the holes' axes, mid-length, and the reduced model equals the one with the masters named."""
+    from housingfe.geometry.cad import _native_output_captured, gmsh_session
+
+    holes = {"left": (0.05, 0.05), "right": (0.15, 0.05)}      # (x, z) of each hole's axis, m
+    with gmsh_session() as gmsh:
+        occ = gmsh.model.occ
+        gmsh.model.add("block")
+        block = occ.addBox(0, 0, 0, 0.2, 0.1, 0.1)
+        occ.cut([(3, block)], [(3, occ.addCylinder(x, -0.01, z, 0, 0.12, 0, 0.02)) for x, z in holes.values()])
+        occ.synchronize()
+        with _native_output_captured():
+            gmsh.write(str(tmp_path / "block.step"))
+    bores = "".join(f'[[geometry.bores]]\nname = "{n}"\naxis = [0, 1, 0]\ncentre = [{x}, 0.05, {z}]\n'
+                    for n, (x, z) in holes.items())
+    (tmp_path / "block.toml").write_text('[scene]\nname = "block"\nkind = "housing"\n[geometry]\nkind = "cad"\n'
+                                         f'file = "block.step"\nunits = "m"\n{bores}[mesh]\nelement = "tet"\n'
+                                         'degree = 1\nsize = 0.03\n[analysis.modal]\nf_max = 3000.0\n')
+    runs = {"default": [], "named": ["--master", "bore_left", "--master", "bore_right"]}
+    for name, extra in runs.items():
+        assert main(["reduce", str(tmp_path / "block.toml"), "--cutoff", "20000", "--out", str(tmp_path / name)]
+                    + extra) == 0
+    default, named = (np.load(tmp_path / name / "reduced.npz") for name in runs)
+    assert list(default["master_names"]) == list(default["master_surfaces"]) == ["bore_left", "bore_right"]
+    # the bounding-box centre of a hole's surface: on its axis (to the faceting of the circle), at y = 50 mm
+    assert np.allclose(default["master_xyz"], [[x, 0.05, z] for x, z in holes.values()], atol=1e-3)
+    assert len(default["fixed_interface_hz"]) > 0
+    for key in ("K", "M", "master_xyz", "fixed_interface_hz"):
+        assert np.array_equal(default[key], named[key]), key
+
+
 def mpi_case(comm) -> dict:
     _, masters, red = reduce_box(comm)
     return {"ranks": comm.size, "n_modes": red.n_modes,
