@@ -36,6 +36,7 @@ import numpy as np
 from housingfe.benchmarks._calculix import run_calculix
 from housingfe.benchmarks._launch import mpi_environment, mpi_launcher, write_worker_result
 from housingfe.benchmarks.modal import load_average
+from housingfe.errors import InputError
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 F_MAX = 4000.0          # Hz
@@ -186,7 +187,10 @@ def _case(kind: str, job: dict) -> dict:
                               capture_output=True, text=True, env=mpi_environment())
         wall = time.perf_counter() - t0
         if proc.returncode != 0:
-            raise RuntimeError(proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed")
+            last = proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed"
+            if "InputError: " in last:       # the case refused its input (e.g. the memory guard): say so in one line
+                raise InputError(f"bench imported: case {kind}: {last.split('InputError: ', 1)[1]}")
+            raise RuntimeError(last)
         out = json.loads((Path(tmp) / "result.json").read_text())
         out["process_wall_s"] = wall
         return out
