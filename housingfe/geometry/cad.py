@@ -358,13 +358,13 @@ class RayCaster:
         points, ids, cell = vtkPoints(), vtkIdList(), vtkGenericCell()
         nearest = np.full(len(origins), np.inf)
         counts = np.zeros(len(origins), dtype=int)
-        ends = origins + self.reach * directions
+        ends = (origins + self.reach * directions).tolist()
+        starts = np.ascontiguousarray(origins, dtype=float).tolist()     # plain lists: VTK's fastest argument
+        intersect, n_points = self.locator.IntersectWithLine, points.GetNumberOfPoints
         for k in range(len(origins)):
-            o = origins[k]
-            self.locator.IntersectWithLine(tuple(o), tuple(ends[k]), 1e-12, points, ids, cell)
-            m = points.GetNumberOfPoints()
-            if m:
-                d = np.linalg.norm(vtk_to_numpy(points.GetData()) - o, axis=1)
+            intersect(starts[k], ends[k], 1e-12, points, ids, cell)
+            if n_points():
+                d = np.linalg.norm(vtk_to_numpy(points.GetData()) - origins[k], axis=1)
                 if min_incidence > 0.0:
                     cells = [ids.GetId(i) for i in range(ids.GetNumberOfIds())]
                     d = d[np.abs(self.normals[cells] @ directions[k]) >= min_incidence]
