@@ -14,8 +14,11 @@ The machinery of the run-up studies (`housingfe study`, `housingfe runup-causes`
   (`with_drivetrain`: seconds; its Ritz space holds the static responses to unit pairs across every bearing and to
   the mesh load, docs/runup.md).  `fresh_basis=True` computes a basis per variant instead (to measure what the
   reuse costs in accuracy);
-* the source's lines (housingfe.runup.chain.source_lines) are computed once per source (the lumped model depends on
-  the gear set, shafts and Appendix C's bearing diagonal, not on the FE bearings) and torque.
+* each run-up's source is the scene's, as `housingfe run` computes it (`scene_lines`: the coupled model's receptance
+  at the mesh with runup.source_receptance = "coupled", the misalignment under load of runup.misalignment), so a
+  variant's source sees its own bearings; `lines` gives the rigid-bore lumped source's lines instead (computed once
+  per source and torque: the lumped model depends on the gear set, shafts and Appendix C's bearing diagonal, not on
+  the FE bearings), which `runup-causes` uses on purpose.
 
 `session.log` records per model whether its basis was built or re-used, and the times.
 """
@@ -168,7 +171,9 @@ class ChainSession:
         return self._sources[key]
 
     def lines(self, drivetrain, torque: float):
-        """The source's lines (housingfe.runup.chain.Lines) at the scene's speeds and one torque (N m)."""
+        """The rigid-bore lumped source's lines (housingfe.runup.chain.Lines) at the scene's speeds and one torque
+        (N m), without misalignment: the same for every FE bearing configuration (cached).  `runup` uses
+        `scene_lines` instead, the source of the scene's chain."""
         from housingfe.runup.chain import source_lines
 
         key = (source_key(drivetrain), float(torque))
@@ -179,12 +184,41 @@ class ChainSession:
             self.timings["source_s"] = self.timings.get("source_s", 0.0) + seconds
         return self._lines[key]
 
+    def scene_lines(self, model, torque: float):
+        """The source's lines of a coupled model at one torque (N m) as `housingfe run` computes them: the
+        scene's source receptance (runup.source_receptance: "coupled" = this model's receptance at the mesh) and
+        mesh misalignment under load (runup.misalignment).  With "rigid-bores" and no misalignment these are the
+        cached lumped lines of `lines`."""
+        from housingfe.runup.chain import run_source
+
+        spec, drivetrain = self.spec, model.drivetrain
+        misalignment = spec.misalignment_model
+        if spec.source_receptance == "rigid-bores" and misalignment == "none":
+            return self.lines(drivetrain, torque)
+        if misalignment == "coupled":          # the static tilt of this drivetrain on the flexible housing
+            from housingfe.drivetrain.misalignment import coupled_misalignment
+
+            gap = coupled_misalignment(self.housing(), drivetrain).lead_gap
+
+            def misalignment(_torque: float) -> float:
+                return gap
+        elif misalignment == "rigid-bores":
+            from housingfe.drivetrain.misalignment import lead_gap_law
+
+            misalignment = lead_gap_law(drivetrain, "rigid-bores")
+        source = drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
+                                         misalignment=misalignment)
+        lines, seconds = run_source(model, source, spec.speeds, [float(torque)], spec.f_max_hz,
+                                    spec.source_receptance)
+        self.timings["source_s"] = self.timings.get("source_s", 0.0) + seconds
+        return lines
+
     def runup(self, model, torque: float, lines=None):
         """The run-up (RunupResult) of a coupled model at one torque (N m) over the scene's speeds and routes;
-        lines: the source's (default: the model's drivetrain's, cached)."""
+        lines: the source's (default: `scene_lines`, the source as `housingfe run` computes it)."""
         from housingfe.runup.chain import runup
 
-        lines = self.lines(model.drivetrain, torque) if lines is None else lines
+        lines = self.scene_lines(model, torque) if lines is None else lines
         return runup(model, None, self.spec.speeds, [float(torque)], routes=tuple(self.spec.routes), lines=lines)
 
     @property
