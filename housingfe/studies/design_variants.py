@@ -121,8 +121,8 @@ def families() -> dict[str, Family]:
             ("measured: Figs. 5.16/5.17, mean differences of L_W over 800-1500 rev/min to ball bearings",
              "thesis calculated: no run-up; its FE gave TF_omega ball - self-aligning +7.3 dB (s.d. 4.5) over "
              "320-600 Hz with the ball bearings' moment terms zeroed (Fig. 5.18; `housingfe bearing-variants`)",
-             "the lumped source uses Appendix C's bearing diagonal for every configuration (the FE bearings do not "
-             "enter it), so the bearings change only the coupled model here")),
+             "the source is the scene's (runup.source_receptance = \"coupled\": the coupled model's receptance at "
+             "the mesh), so each configuration's FE bearings act on its source as well as on its transfer")),
         "double-helical": Family(
             "double-helical", "test-gearbox-runup-double-helical",
             "double helical set: cylindrical roller vs fluid-film bearings, 500-2000 N m", tuple(helical),
