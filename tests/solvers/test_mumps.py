@@ -8,6 +8,7 @@ import pytest
 
 from housingfe.errors import SolverError
 from housingfe.solvers import modal, mumps
+from tests.two_ranks import rerun_on_two_ranks
 
 BACKENDS = ["direct", "petsc"]
 
@@ -137,19 +138,4 @@ def test_auto_calls_mumps_directly_only_in_parallel(shifted):
 def test_the_tests_above_pass_on_two_ranks(comm):
     """The distributed path (MUMPS' solution rows moved back to PETSc's, the collective pattern check) runs in
     `make test` too: this file's other tests under `mpirun -n 2`."""
-    import os
-    import shutil
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    if comm.size > 1 or not shutil.which("mpirun"):
-        pytest.skip("runs from a one-rank session with mpirun installed")
-    root = Path(__file__).resolve().parents[2]
-    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
-           "OPENBLAS_NUM_THREADS": "1"}
-    proc = subprocess.run([shutil.which("mpirun"), "-n", "2", sys.executable, "-m", "pytest", "-q", "-p",
-                           "no:cacheprovider", "-k", "not two_ranks", str(Path(__file__))],
-                          capture_output=True, text=True, env=env, timeout=600, cwd=root)
-    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
-    assert proc.stdout.count(" passed") == 2      # one summary line per rank
+    rerun_on_two_ranks(__file__, comm, timeout=600)

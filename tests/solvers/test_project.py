@@ -6,6 +6,7 @@ import pytest
 from petsc4py import PETSc
 
 from housingfe.solvers import harmonic
+from tests.two_ranks import rerun_on_two_ranks
 
 N, VECTORS = 600, 9
 
@@ -44,19 +45,4 @@ def test_projection_equals_the_dense_product(comm):
 
 @pytest.mark.mpi
 def test_the_projection_passes_on_two_ranks(comm):
-    import os
-    import shutil
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    if comm.size > 1 or not shutil.which("mpirun"):
-        pytest.skip("runs from a one-rank session with mpirun installed")
-    root = Path(__file__).resolve().parents[2]
-    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
-           "OPENBLAS_NUM_THREADS": "1"}
-    proc = subprocess.run([shutil.which("mpirun"), "-n", "2", sys.executable, "-m", "pytest", "-q", "-p",
-                           "no:cacheprovider", "-k", "not two_ranks", str(Path(__file__))],
-                          capture_output=True, text=True, env=env, timeout=300, cwd=root)
-    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]
-    assert proc.stdout.count(" passed") == 2
+    rerun_on_two_ranks(__file__, comm, timeout=300)
