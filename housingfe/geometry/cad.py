@@ -626,6 +626,10 @@ def bore_points(spec: CadGeometry, facts: CadFacts) -> dict[str, list[tuple[floa
 SURFACE_NODES_PER_H2 = 1.3        # surface nodes per h^2 of boundary area, for the local size of a triangle
 INTERIOR_NODES_PER_H3 = 0.44
 BOUNDARY_LAYER = 0.75
+# above this many surface nodes (SURFACE_NODES_PER_H2 x area / h^2, ~5 M P2 DOFs and more) the surface is not
+# triangulated (that alone would take minutes): its nodes are counted from its area, which misses the refinement
+# around small features (an under-count) but decides the guard's question (no machine here holds such a model)
+SURFACE_MESH_MAX_NODES = 300_000
 EDGES_PER_NODE = {"surface": 4.95, "interior": 7.5}
 CELLS_PER_NODE = {"surface": 3.0, "interior": 6.56}
 _SURFACE_CACHE: dict[tuple, dict] = {}
@@ -663,27 +667,37 @@ def surface_mesh_facts(facts: CadFacts, size: float) -> dict:
 
 def estimate_mesh_entities(facts: CadFacts, size: float) -> dict:
     """Nodes, edges, faces and cells of the linear tetrahedral mesh mesh_tetrahedra makes of the solid at
-    element size `size` (m), without the volume mesh: the surface nodes are counted on gmsh's own surface
-    triangulation (surface_mesh_facts, which holds the refinement gmsh makes around features smaller than the
-    element, e.g. 8 mm bolt holes); under every surface triangle a column reaches half the local wall thickness
-    tau into the solid (the nearest ray sample of the face analysis), and holds interior nodes
-    INTERIOR_NODES_PER_H3 / h^3 beyond BOUNDARY_LAYER h, h the triangle's own size (sqrt(2.6 x its area):
-    SURFACE_NODES_PER_H2 nodes per h^2, two triangles per node).  The columns are scaled to the solid's volume
-    (the columns of a chunky block overlap: a cube's count it three times).  Edges and cells per node
-    EDGES_PER_NODE, CELLS_PER_NODE; faces by Euler's formula (nodes - edges + faces - cells = 1)."""
+    element size `size` (m), without the volume mesh (docs/cad.md "Model size").  The surface nodes are counted
+    on gmsh's own surface triangulation (surface_mesh_facts: it holds the refinement gmsh makes around features
+    smaller than the element, e.g. 8 mm bolt holes, which no count from area and volume sees).  Under every
+    surface triangle a column reaches half the local wall thickness tau (the nearest ray sample of the face
+    analysis) into the solid and holds INTERIOR_NODES_PER_H3 / h^3 interior nodes beyond BOUNDARY_LAYER h, h
+    the geometric mean of the element size and the triangle's own size (sqrt(2.6 x area): SURFACE_NODES_PER_H2
+    nodes per h^2, two triangles per node).  The columns are scaled down to the solid's volume where they
+    overlap (a cube's columns hold it three times).  Edges and cells per node EDGES_PER_NODE, CELLS_PER_NODE;
+    faces by Euler's formula (nodes - edges + faces - cells = 1).  Beyond SURFACE_MESH_MAX_NODES surface nodes
+    the surface is not triangulated: its nodes are SURFACE_NODES_PER_H2 x area / size^2 (an under-count where
+    small features refine the mesh)."""
     from scipy.spatial import cKDTree
 
-    surface = surface_mesh_facts(facts, size)
-    area = surface["areas"]
-    # the interior element size under a triangle: between the triangle's own (sqrt(2.6 x area)) and the
-    # element size, to which gmsh's interpolated size grows away from a refined surface (geometric mean)
-    h = np.sqrt(np.sqrt(2.0 * SURFACE_NODES_PER_H2 * area) * size)
-    _, nearest = cKDTree(facts.wall_points).query(surface["centroids"])
-    tau = facts.wall_samples[nearest]
+    boundary_area = float(facts.wall_areas.sum())
+    if SURFACE_NODES_PER_H2 * boundary_area / size**2 > SURFACE_MESH_MAX_NODES:
+        # from the geometry alone: the thickness samples' triangles at the element size
+        area, tau = facts.wall_areas, facts.wall_samples
+        surface_nodes = SURFACE_NODES_PER_H2 * boundary_area / size**2
+        h = np.full(len(area), size)
+    else:
+        surface = surface_mesh_facts(facts, size)
+        area, surface_nodes = surface["areas"], float(surface["nodes"])
+        # the interior element size under a triangle: between the triangle's own (sqrt(2.6 x area)) and the
+        # element size, to which gmsh's interpolated size grows away from a refined surface (geometric mean)
+        h = np.sqrt(np.sqrt(2.0 * SURFACE_NODES_PER_H2 * area) * size)
+        _, nearest = cKDTree(facts.wall_points).query(surface["centroids"])
+        tau = facts.wall_samples[nearest]
     columns = float(np.sum(area * tau / 2))
     depth = np.maximum(0.0, tau / 2 - BOUNDARY_LAYER * h)
     interior = INTERIOR_NODES_PER_H3 * float(np.sum(area * depth / h**3)) * min(1.0, facts.volume / columns)
-    nodes = {"surface": float(surface["nodes"]), "interior": interior}
+    nodes = {"surface": surface_nodes, "interior": interior}
     edges = sum(EDGES_PER_NODE[k] * n for k, n in nodes.items())
     cells = sum(CELLS_PER_NODE[k] * n for k, n in nodes.items())
     vertices = nodes["surface"] + nodes["interior"]
