@@ -243,19 +243,27 @@ def main(out_dir: Path, quick: bool = False, resume: bool = False, size_mm: floa
     size = size_mm / 1e3 if size_mm else QUICK_SIZE if quick else SIZE
     repeats = rounds or (1 if quick else REPEATS)
     order = [(k, j) for k, j in selected_cases(cases) if k != "calculix" or shutil.which("ccx")]
-    work = Path(f"{out_dir}.inputs")      # beside <out>.partial: the deck a --resume re-uses
-    work.mkdir(parents=True, exist_ok=True)
-    inputs = write_inputs(work, size)
-    bolted_mb = float("nan")
-    if any(k == "inspect" for k, _ in order):
-        bolted = work / f"bolted-{QUICK_HOLES if quick else HOLES}.step"
-        if not bolted.exists():
-            write_bolted_housing(bolted, QUICK_HOLES if quick else HOLES)
-        inputs["bolted"] = str(bolted)
-        bolted_mb = bolted.stat().st_size / 1e6
-    step_mb = Path(inputs["step"]).stat().st_size / 1e6
+    # the checkpoint first: a second bench into the same --out stops here, before it touches the inputs folder
     finished = FinishedRuns("imported", out_dir, {"size": size, "repeats": repeats, "order": order},
                             repeats * len(order) + 1, resume=resume)
+    # beside <out>.partial: the inputs, rewritten by every run, and the C3D10 deck, which a --resume re-uses once
+    # the checkpoint holds its run (the "deck" record): kept after a refusal or interruption only then
+    work = Path(f"{out_dir}.inputs")
+    try:
+        work.mkdir(parents=True, exist_ok=True)
+        inputs = write_inputs(work, size)
+        bolted_mb = float("nan")
+        if any(k == "inspect" for k, _ in order):
+            bolted = work / f"bolted-{QUICK_HOLES if quick else HOLES}.step"
+            if not bolted.exists():
+                write_bolted_housing(bolted, QUICK_HOLES if quick else HOLES)
+            inputs["bolted"] = str(bolted)
+            bolted_mb = bolted.stat().st_size / 1e6
+        step_mb = Path(inputs["step"]).stat().st_size / 1e6
+    except BaseException as exc:
+        finished.interrupted(exc)
+        _drop_inputs(work, finished)
+        raise
     runs: dict[str, list] = {label(k, j): [] for k, j in order}
     last: dict[str, dict] = {}
     deck_info = None
@@ -282,6 +290,7 @@ def main(out_dir: Path, quick: bool = False, resume: bool = False, size_mm: floa
                                f"load before {res['load_before']:.2f}")
     except BaseException as exc:
         finished.interrupted(exc)
+        _drop_inputs(work, finished)
         raise
     finished.close()
     rows, header, summary = _table(runs, last, deck_info, step_mb, size, bolted_mb)
@@ -301,6 +310,13 @@ def main(out_dir: Path, quick: bool = False, resume: bool = False, size_mm: floa
     print(summary)
     print(note)
     print(f"results: {out_dir}/")
+
+
+def _drop_inputs(work: Path, finished) -> None:
+    """After a refusal (InputError), an error or an interruption: remove the inputs folder unless the checkpoint
+    holds the deck run, whose C3D10 deck (work/housing.inp) a --resume re-uses instead of writing it again."""
+    if "deck" not in finished.done:
+        shutil.rmtree(work, ignore_errors=True)
 
 
 def _table(runs: dict, last: dict, deck_info: dict | None, step_mb: float, size: float, bolted_mb: float):

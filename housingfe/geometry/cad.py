@@ -126,6 +126,10 @@ class CadFacts:
     notes: list[str] = field(default_factory=list)
     triangles: Optional[np.ndarray] = None     # the coarse boundary triangulation (n, 3, 3), m
     owner: Optional[np.ndarray] = None         # the face tag of each triangle
+    # the wall thickness samples (m) and the boundary area each stands for (m^2, summing to the boundary's area)
+    wall_samples: Optional[np.ndarray] = None
+    wall_areas: Optional[np.ndarray] = None
+    wall_points: Optional[np.ndarray] = None   # where each sample's ray starts (m)
 
 
 @contextmanager
@@ -449,6 +453,7 @@ def analyse_faces(volumes: list[int], size: float) -> dict:
                                   tris[idx].reshape(-1, 3)[first]))
     finite = np.isfinite(thickness)
     return {"faces": faces, "outer": outer, "thickness": thickness[finite], "weights": area[sample][finite],
+            "points": centroid[sample][finite],
             "lo": lo, "hi": hi, "triangles": tris, "owner": owner}
 
 
@@ -550,6 +555,7 @@ def read_cad(path: Path, units: str, heal: str = "auto", key: str | None = "geom
         where = f"{key}.file: {path}" if key else str(path)
         raise InputError(f"{where}: no wall thickness found (no ray from the surface crosses material)")
     thin = _weighted_quantile(analysis["thickness"], analysis["weights"], THIN_WALL_QUANTILE)
+    boundary_area = sum(f.area for f in analysis["faces"])
     notes = []
     if imported["solids"] > 1:
         notes.append(f"{imported['solids']} solids fragmented into one conforming solid of {len(volumes)} volumes")
@@ -557,7 +563,10 @@ def read_cad(path: Path, units: str, heal: str = "auto", key: str | None = "geom
                     centroid=moment / volume, lo=analysis["lo"], hi=analysis["hi"], thin_wall=thin,
                     thinnest_ray=float(analysis["thickness"].min()), faces=analysis["faces"],
                     outer=analysis["outer"], import_s=t1 - t0, analysis_s=time.perf_counter() - t1, notes=notes,
-                    triangles=analysis["triangles"], owner=analysis["owner"])
+                    triangles=analysis["triangles"], owner=analysis["owner"], wall_samples=analysis["thickness"],
+                    wall_areas=analysis["weights"] * (boundary_area / analysis["weights"].sum()),
+                    wall_points=analysis["points"])
+
 
 
 _FACTS_CACHE: dict[tuple, CadFacts] = {}
@@ -609,21 +618,104 @@ def bore_points(spec: CadGeometry, facts: CadFacts) -> dict[str, list[tuple[floa
 
 
 # ------------------------------------------------------------------------------------------------ meshing
-# displacement DOFs per V / (h^2 min(h, t)) of a gmsh tetrahedral mesh, by degree: measured for P2 on three CAD
-# meshes (box-free STEP at 30 mm: 39 354 DOFs, 91; test gearbox at 37 mm: 44 619, 43; the stepped block of the
-# tests at 20 mm: 8 568, 40), 60 is within a factor 1.5 of each; P1 and P3 scaled by the nodes per cell of an
-# unstructured tet mesh (0.18 and 4.5 against 1.36)
-CAD_DOFS_PER_UNIT = {1: 8.0, 2: 60.0, 3: 200.0}
+# How gmsh's Delaunay (mesh_tetrahedra) fills a solid, measured on plates of 40 x 40 h and thickness 0.25-8 h
+# (docs/cad.md "Model size"): the surface triangulation first (the estimate makes it: it is exact), then interior
+# nodes at INTERIOR_NODES_PER_H3 per h^3 (gmsh's interior edges run ~1.5 h) farther than BOUNDARY_LAYER h from
+# the surface (a wall thinner than ~1.5 h gets no interior node: one element through it); the edges and cells
+# per node of the surface and interior nodes (P2 needs the edges, P3 the faces and cells too).
+SURFACE_NODES_PER_H2 = 1.3        # surface nodes per h^2 of boundary area, for the local size of a triangle
+INTERIOR_NODES_PER_H3 = 0.44
+BOUNDARY_LAYER = 0.75
+# above this many surface nodes (SURFACE_NODES_PER_H2 x area / h^2, ~5 M P2 DOFs and more) the surface is not
+# triangulated (that alone would take minutes): its nodes are counted from its area, which misses the refinement
+# around small features (an under-count) but decides the guard's question (no machine here holds such a model)
+SURFACE_MESH_MAX_NODES = 300_000
+EDGES_PER_NODE = {"surface": 4.95, "interior": 7.5}
+CELLS_PER_NODE = {"surface": 3.0, "interior": 6.56}
+_SURFACE_CACHE: dict[tuple, dict] = {}
+
+
+def surface_mesh_facts(facts: CadFacts, size: float) -> dict:
+    """gmsh's triangulation of the solid's boundary at element size `size` (m), made as mesh_tetrahedra makes
+    it before it fills the volume (same options; seconds where the volume mesh takes minutes): its node count,
+    and per triangle the area (m^2) and centroid (m).  Cached per processed solid and size."""
+    import gmsh
+
+    from housingfe.geometry.blocks import _set_mesh_options
+
+    key = (str(facts.brep), size)
+    if key not in _SURFACE_CACHE:
+        with gmsh_session():
+            gmsh.model.add("surface")
+            load_processed(facts.brep)
+            _set_mesh_options("tet")
+            # no Laplacian smoothing: it moves the nodes, never adds any (as in analyse_faces)
+            gmsh.option.setNumber("Mesh.Smoothing", 0)
+            gmsh.option.setNumber("Mesh.MeshSizeMin", 0.0)
+            gmsh.option.setNumber("Mesh.MeshSizeMax", size)
+            gmsh.model.mesh.setSize(gmsh.model.getEntities(0), size)
+            gmsh.model.mesh.generate(2)
+            tags, coords, _ = gmsh.model.mesh.getNodes()
+            xyz = np.zeros((int(tags.max()) + 1, 3))
+            xyz[tags.astype(int)] = coords.reshape(-1, 3)
+            _, _, conn = gmsh.model.mesh.getElements(2)
+            tris = xyz[np.concatenate([c.astype(int) for c in conn]).reshape(-1, 3)]
+        area = 0.5 * np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1)
+        _SURFACE_CACHE[key] = {"nodes": len(tags), "areas": area, "centroids": tris.mean(axis=1)}
+    return _SURFACE_CACHE[key]
+
+
+def estimate_mesh_entities(facts: CadFacts, size: float) -> dict:
+    """Nodes, edges, faces and cells of the linear tetrahedral mesh mesh_tetrahedra makes of the solid at
+    element size `size` (m), without the volume mesh (docs/cad.md "Model size").  The surface nodes are counted
+    on gmsh's own surface triangulation (surface_mesh_facts: it holds the refinement gmsh makes around features
+    smaller than the element, e.g. 8 mm bolt holes, which no count from area and volume sees).  Under every
+    surface triangle a column reaches half the local wall thickness tau (the nearest ray sample of the face
+    analysis) into the solid and holds INTERIOR_NODES_PER_H3 / h^3 interior nodes beyond BOUNDARY_LAYER h, h
+    the geometric mean of the element size and the triangle's own size (sqrt(2.6 x area): SURFACE_NODES_PER_H2
+    nodes per h^2, two triangles per node).  The columns are scaled down to the solid's volume where they
+    overlap (a cube's columns hold it three times).  Edges and cells per node EDGES_PER_NODE, CELLS_PER_NODE;
+    faces by Euler's formula (nodes - edges + faces - cells = 1).  Beyond SURFACE_MESH_MAX_NODES surface nodes
+    the surface is not triangulated: its nodes are SURFACE_NODES_PER_H2 x area / size^2 (an under-count where
+    small features refine the mesh)."""
+    from scipy.spatial import cKDTree
+
+    boundary_area = float(facts.wall_areas.sum())
+    if SURFACE_NODES_PER_H2 * boundary_area / size**2 > SURFACE_MESH_MAX_NODES:
+        # from the geometry alone: the thickness samples' triangles at the element size
+        area, tau = facts.wall_areas, facts.wall_samples
+        surface_nodes = SURFACE_NODES_PER_H2 * boundary_area / size**2
+        h = np.full(len(area), size)
+    else:
+        surface = surface_mesh_facts(facts, size)
+        area, surface_nodes = surface["areas"], float(surface["nodes"])
+        # the interior element size under a triangle: between the triangle's own (sqrt(2.6 x area)) and the
+        # element size, to which gmsh's interpolated size grows away from a refined surface (geometric mean)
+        h = np.sqrt(np.sqrt(2.0 * SURFACE_NODES_PER_H2 * area) * size)
+        _, nearest = cKDTree(facts.wall_points).query(surface["centroids"])
+        tau = facts.wall_samples[nearest]
+    columns = float(np.sum(area * tau / 2))
+    depth = np.maximum(0.0, tau / 2 - BOUNDARY_LAYER * h)
+    interior = INTERIOR_NODES_PER_H3 * float(np.sum(area * depth / h**3)) * min(1.0, facts.volume / columns)
+    nodes = {"surface": surface_nodes, "interior": interior}
+    edges = sum(EDGES_PER_NODE[k] * n for k, n in nodes.items())
+    cells = sum(CELLS_PER_NODE[k] * n for k, n in nodes.items())
+    vertices = nodes["surface"] + nodes["interior"]
+    return {"nodes": vertices, "edges": edges, "faces": 1.0 - vertices + edges + cells, "cells": cells,
+            "surface_nodes": nodes["surface"], "interior_nodes": interior}
 
 
 def estimate_cad_dofs(spec: CadGeometry, element: str, degree: int, size: float, layers: int,
                       layer_size: float | None = None) -> int:
-    """Displacement DOFs of the tetrahedral mesh of element size `size` (m), estimated from the volume V and
-    the thinnest wall t: CAD_DOFS_PER_UNIT[degree] * V / (size^2 min(size, t)) (a wall thinner than the
-    element size still gets elements through it).  Good to a factor of about 1.5 on the meshes measured."""
-    facts = cad_facts(spec)
-    t = spec.min_thickness
-    return int(round(CAD_DOFS_PER_UNIT[degree] * facts.volume / (size**2 * min(size, t))))
+    """Displacement DOFs of the tetrahedral mesh of element size `size` (m) at Lagrange degree 1-3: three per
+    node of the degree-`degree` field on the counts of estimate_mesh_entities (a node per vertex, degree - 1
+    per edge, (degree - 1)(degree - 2)/2 per face).  0.82-1.21 of the meshes measured in docs/cad.md ("Model
+    size": element sizes from a tenth of the thinnest wall to ten walls), but 0.65 where the volume mesher's
+    sliver refinement adds nodes (NIST FTC-06 at 30 mm)."""
+    counts = estimate_mesh_entities(cad_facts(spec), size)
+    p = degree
+    nodes = counts["nodes"] + (p - 1) * counts["edges"] + (p - 1) * (p - 2) / 2 * counts["faces"]
+    return int(round(3 * nodes))
 
 
 def build_cad_mesh(spec: CadGeometry, element: str, size: float, layers: int, comm, grading: float = 1.0,
