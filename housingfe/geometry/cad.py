@@ -163,6 +163,42 @@ def _native_output_captured():
             os.close(saved[1])
 
 
+# OpenCASCADE's STEP and IGES readers heal every shape they translate (the resource file
+# /usr/share/opencascade/resources/XSTEPResource/STEP, sequence FromSTEP.FixShape).  One of those fixes, crossings
+# of non-adjacent edges of one wire (FixNonAdjacentIntersectingEdgesMode), re-applies the history of the whole face
+# for each of its wires (ShapeFix_IntersectionTool::FixSelfIntersectWire calls Context()->Apply(face)): quadratic
+# in the holes of a face, 2.7 of 5.4 s on a 5 MB STEP file with 1250 bolt holes.  It is switched off; every other
+# fix runs as OCC's defaults say.  A wire that crosses itself is an invalid CAD export; heal = "always" (gmsh's
+# healShapes: it fixes self-intersecting wires too) is the remedy for such a file.
+_READER_FIX_OFF = "FixNonAdjacentIntersectingEdgesMode"
+_OCC_RESOURCES = Path("/usr/share/opencascade/resources/XSTEPResource")   # Debian's occt-misc (gmsh depends on it)
+
+
+@contextmanager
+def _reader_resources(suffix: str):
+    """For the block, OCC's resource file of the STEP or IGES reader with _READER_FIX_OFF set to 0 (a copy of the
+    installed one in the scratch folder, through CSF_STEPDefaults / CSF_IGESDefaults).  Nothing changes for a
+    BREP file, where the variable is set by the user already, or where the installed file is not found."""
+    name = {".step": "STEP", ".stp": "STEP", ".iges": "IGES", ".igs": "IGES"}.get(suffix.lower())
+    variable = f"CSF_{name}Defaults"
+    source = _OCC_RESOURCES / str(name)
+    if name is None or variable in os.environ or not source.is_file():
+        yield
+        return
+    folder = _scratch_dir() / "occ-resources"
+    if not (folder / name).is_file():
+        key = f"From{name}.FixShape.{_READER_FIX_OFF}"
+        lines = [f"{key} : 0" if line.split(":")[0].strip() == key else line
+                 for line in source.read_text().splitlines()]
+        folder.mkdir(exist_ok=True)
+        (folder / name).write_text("\n".join(lines) + "\n")
+    os.environ[variable] = str(folder)
+    try:
+        yield
+    finally:
+        del os.environ[variable]
+
+
 def import_solid(path: Path, units: str, heal: str = "auto", key: str | None = "geometry") -> dict:
     """Import a CAD file into the current (empty) gmsh model, scaled to metres, healed, checked and fragmented
     into one conforming solid.  Returns {"solids": count in the file, "volumes": volume tags, "scale": factor}.
@@ -178,7 +214,7 @@ def import_solid(path: Path, units: str, heal: str = "auto", key: str | None = "
     scale = UNIT_SCALE[units]
     gmsh.option.setNumber("Geometry.OCCScaling", scale)
     try:
-        with _native_output_captured():
+        with _native_output_captured(), _reader_resources(path.suffix):
             try:
                 occ.importShapes(str(path))
             except Exception:   # noqa: BLE001 - gmsh raises a bare Exception; OCC's own message went to the sink
