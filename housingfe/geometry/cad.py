@@ -33,6 +33,7 @@ reported as well.
 """
 from __future__ import annotations
 
+import math
 import os
 import tempfile
 import time
@@ -387,7 +388,6 @@ class RayCaster:
         farther than eps (inf if none) and the number of such crossings.  min_incidence: ignore crossings where
         |cos| of the angle between ray and triangle normal is smaller (grazing hits on the facets of a coarsely
         triangulated hole, next to which a ray parallel to the hole's axis starts)."""
-        from vtkmodules.util.numpy_support import vtk_to_numpy
         from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints
         from vtkmodules.vtkCommonDataModel import vtkGenericCell
 
@@ -396,20 +396,41 @@ class RayCaster:
         counts = np.zeros(len(origins), dtype=int)
         ends = (origins + self.reach * directions).tolist()
         starts = np.ascontiguousarray(origins, dtype=float).tolist()     # plain lists: VTK's fastest argument
-        intersect, n_points = self.locator.IntersectWithLine, points.GetNumberOfPoints
+        ways = np.ascontiguousarray(directions, dtype=float).tolist()
+        normals = self.normals.tolist()
+        intersect, n_points, get_point, get_id = (self.locator.IntersectWithLine, points.GetNumberOfPoints,
+                                                  points.GetPoint, ids.GetId)
+        sqrt = math.sqrt
+        # most rays cross 1 to 3 triangles: plain floats per crossing, not numpy arrays of three (the distance as
+        # numpy's norm sums it, (dx^2 + dy^2) + dz^2, so the same numbers to the last bit)
         for k in range(len(origins)):
             intersect(starts[k], ends[k], 1e-12, points, ids, cell)
-            if n_points():
-                d = np.linalg.norm(vtk_to_numpy(points.GetData()) - origins[k], axis=1)
+            m = n_points()
+            if not m:
+                continue
+            ox, oy, oz = starts[k]
+            dx, dy, dz = ways[k]
+            d = []
+            for i in range(m):
                 if min_incidence > 0.0:
-                    cells = [ids.GetId(i) for i in range(ids.GetNumberOfIds())]
-                    d = d[np.abs(self.normals[cells] @ directions[k]) >= min_incidence]
-                # a ray through a mesh edge or vertex hits every triangle there at one distance: count once
-                d = np.sort(d[d > eps])
-                d = d[np.concatenate([[True], np.diff(d) > eps])] if len(d) else d
-                if len(d):
-                    nearest[k] = d.min()
-                    counts[k] = len(d)
+                    nx, ny, nz = normals[get_id(i)]
+                    if abs(nx * dx + ny * dy + nz * dz) < min_incidence:
+                        continue
+                x, y, z = get_point(i)
+                x, y, z = x - ox, y - oy, z - oz
+                dist = sqrt(x * x + y * y + z * z)
+                if dist > eps:
+                    d.append(dist)
+            if not d:
+                continue
+            d.sort()
+            # a ray through a mesh edge or vertex hits every triangle there at one distance: count once
+            kept = 1
+            for a, b in zip(d, d[1:]):
+                if b - a > eps:
+                    kept += 1
+            nearest[k] = d[0]
+            counts[k] = kept
         return nearest, counts
 
 
