@@ -519,7 +519,8 @@ def _face_record(tag: int, triangles: np.ndarray, areas: np.ndarray, centroids: 
     kind = gmsh.model.getType(2, tag)
     # area and centre of mass exact from OpenCASCADE (the triangles only approximate curved edges)
     area = float(gmsh.model.occ.getMass(2, tag))
-    centre = np.asarray(gmsh.model.occ.getCenterOfMass(2, tag))
+    # a cylinder's centre is a point on its axis (below): no centre of mass (0.3 s for 1250 bolt holes)
+    centre = None if kind == "Cylinder" else np.asarray(gmsh.model.occ.getCenterOfMass(2, tag))
     normal_sum = (areas[:, None] * normals).sum(axis=0)
     mean_normal = normal_sum / max(np.linalg.norm(normal_sum), 1e-300)
     if kind == "Plane":
