@@ -381,6 +381,7 @@ class RayCaster:
         self.reach = 2.0 * float(np.linalg.norm(np.ptp(triangles.reshape(-1, 3), axis=0)))
         normal = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
         self.normals = normal / np.maximum(np.linalg.norm(normal, axis=1), 1e-300)[:, None]
+        self._normal_list = None
 
     def hits(self, origins: np.ndarray, directions: np.ndarray, eps: float,
              min_incidence: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
@@ -397,7 +398,9 @@ class RayCaster:
         ends = (origins + self.reach * directions).tolist()
         starts = np.ascontiguousarray(origins, dtype=float).tolist()     # plain lists: VTK's fastest argument
         ways = np.ascontiguousarray(directions, dtype=float).tolist()
-        normals = self.normals.tolist()
+        if min_incidence > 0.0 and self._normal_list is None:
+            self._normal_list = self.normals.tolist()     # once: 0.1 s for 83 000 triangles
+        normals = self._normal_list
         intersect, n_points, get_point, get_id = (self.locator.IntersectWithLine, points.GetNumberOfPoints,
                                                   points.GetPoint, ids.GetId)
         sqrt = math.sqrt
@@ -529,7 +532,8 @@ def _face_record(tag: int, triangles: np.ndarray, areas: np.ndarray, centroids: 
         (u0, v0), (u1, v1) = gmsh.model.getParametrizationBounds(2, tag)
         vm = 0.5 * (v0 + v1)
         us = [u0 + (u1 - u0) * s for s in (0.1, 0.5, 0.9)]
-        a, b, c = (np.array(gmsh.model.getValue(2, tag, [u, vm])) for u in us)
+        # the three points in one call (the API's overhead per call is most of the cost)
+        a, b, c = np.array(gmsh.model.getValue(2, tag, [us[0], vm, us[1], vm, us[2], vm])).reshape(3, 3)
         axis = np.cross(b - a, c - a)
         axis /= np.linalg.norm(axis)
         centre, radius = _circumcircle(a, b, c)
