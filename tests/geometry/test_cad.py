@@ -100,6 +100,29 @@ def test_a_part_reads_back_with_its_exact_volume_bores_and_thinnest_wall_in_m_mm
     assert 0.020 <= facts.thin_wall <= 0.030
 
 
+def test_a_plate_with_many_holes_reads_with_its_exact_volume_through_the_faster_step_reader(tmp_path):
+    """The STEP reader runs without OCC's quadratic fix of self-crossing wires (cad._reader_resources): a face
+    with many hole wires must still read as one solid of the plate's volume, and the environment is restored."""
+    import os
+
+    rows, cols, r, (a, b, t) = 8, 16, 0.003, (0.2, 0.1, 0.01)
+
+    def plate(occ, s):
+        holes = [occ.addCylinder(0.01 + 0.0117 * i, 0.01 + 0.0114 * j, -0.001, 0, 0, t + 0.002, r)
+                 for i in range(cols) for j in range(rows)]
+        occ.cut([(3, occ.addBox(0, 0, 0, a, b, t))], [(3, h) for h in holes])
+
+    path = _write(tmp_path / "plate.step", plate)
+    before = {k: v for k, v in os.environ.items() if k.startswith("CSF_")}
+    with gmsh_session() as gmsh:
+        imported = import_solid(path, "m", key=None)
+        volume = sum(gmsh.model.occ.getMass(3, v) for v in imported["volumes"])
+        faces = len(gmsh.model.getEntities(2))
+    assert imported["solids"] == 1 and faces == 6 + rows * cols
+    assert volume == pytest.approx(a * b * t - rows * cols * math.pi * r**2 * t, rel=1e-9)
+    assert {k: v for k, v in os.environ.items() if k.startswith("CSF_")} == before
+
+
 @pytest.mark.parametrize("scene", ["nafems-fv12", "box-free", "box-halves", "test-gearbox"])
 def test_every_built_in_housing_written_to_step_reads_back_with_its_mass(scene, tmp_path):
     """Issue 29 item 7: same mass (1e-6) after STEP out and in; plate, box, box halves, gearbox with bores."""
