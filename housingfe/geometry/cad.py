@@ -163,23 +163,24 @@ def _native_output_captured():
             os.close(saved[1])
 
 
-# OpenCASCADE's STEP and IGES readers heal every shape they translate (the resource file
+# OpenCASCADE's STEP reader heals every shape it translates (the resource file
 # /usr/share/opencascade/resources/XSTEPResource/STEP, sequence FromSTEP.FixShape).  One of those fixes, crossings
 # of non-adjacent edges of one wire (FixNonAdjacentIntersectingEdgesMode), re-applies the history of the whole face
 # for each of its wires (ShapeFix_IntersectionTool::FixSelfIntersectWire calls Context()->Apply(face)): quadratic
 # in the holes of a face, 2.7 of 5.4 s on a 5 MB STEP file with 1250 bolt holes.  It is switched off; every other
 # fix runs as OCC's defaults say.  A wire that crosses itself is an invalid CAD export; heal = "always" (gmsh's
-# healShapes: it fixes self-intersecting wires too) is the remedy for such a file.
+# healShapes: it fixes self-intersecting wires too) is the remedy for such a file.  The IGES reader (its own
+# resource file, the same fix) is left as it is: gmsh 4.8 writes no IGES to test it with.
 _READER_FIX_OFF = "FixNonAdjacentIntersectingEdgesMode"
 _OCC_RESOURCES = Path("/usr/share/opencascade/resources/XSTEPResource")   # Debian's occt-misc (gmsh depends on it)
 
 
 @contextmanager
 def _reader_resources(suffix: str):
-    """For the block, OCC's resource file of the STEP or IGES reader with _READER_FIX_OFF set to 0 (a copy of the
-    installed one in the scratch folder, through CSF_STEPDefaults / CSF_IGESDefaults).  Nothing changes for a
-    BREP file, where the variable is set by the user already, or where the installed file is not found."""
-    name = {".step": "STEP", ".stp": "STEP", ".iges": "IGES", ".igs": "IGES"}.get(suffix.lower())
+    """For the block, OCC's resource file of the STEP reader with _READER_FIX_OFF set to 0 (a copy of the
+    installed one in the scratch folder, through CSF_STEPDefaults).  Nothing changes for an IGES or BREP file,
+    where the variable is set by the user already, or where the installed file is not found."""
+    name = {".step": "STEP", ".stp": "STEP"}.get(suffix.lower())
     variable = f"CSF_{name}Defaults"
     source = _OCC_RESOURCES / str(name)
     if name is None or variable in os.environ or not source.is_file():
