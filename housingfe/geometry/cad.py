@@ -462,17 +462,25 @@ class RayCaster:
                 np.zeros(0),)
         return best
 
+    RAYS_PER_WALK = 4096     # the candidate pairs of a walk's steps stay within tens of MB
+
+    def _chunked(self, origins, directions, eps, min_incidence, mode):
+        n = len(origins)
+        return np.concatenate([self._walk(origins[k:k + self.RAYS_PER_WALK], directions[k:k + self.RAYS_PER_WALK],
+                                          eps, min_incidence, mode)
+                               for k in range(0, n, self.RAYS_PER_WALK)]) if n else np.zeros(0)
+
     def nearest(self, origins: np.ndarray, directions: np.ndarray, eps: float,
                 min_incidence: float = 0.0) -> np.ndarray:
         """For every ray (origin, unit direction, m): the distance to the nearest crossing of the surface
         farther than eps (inf if none).  min_incidence: ignore crossings where |cos| of the angle between ray
         and triangle normal is smaller (grazing hits on the facets of a coarsely triangulated hole, next to
         which a ray parallel to the hole's axis starts)."""
-        return self._walk(origins, directions, eps, min_incidence, "nearest")
+        return self._chunked(origins, directions, eps, min_incidence, "nearest")
 
     def escapes(self, origins: np.ndarray, directions: np.ndarray, eps: float) -> np.ndarray:
         """For every ray: True where it crosses the surface nowhere farther than eps."""
-        return np.isinf(self._walk(origins, directions, eps, 0.0, "any"))
+        return np.isinf(self._chunked(origins, directions, eps, 0.0, "any"))
 
     def crossings(self, origins: np.ndarray, directions: np.ndarray, eps: float) -> np.ndarray:
         """For every ray: the number of crossings of the surface farther than eps (a ray through a mesh edge
