@@ -153,7 +153,8 @@ def candidates_picture(facts, bores: list[dict], flats: list[dict], path: Path, 
         role[np.isin(owner, bore["tags"])] = 2
     surface.cell_data["role"] = role
     pyvista.OFF_SCREEN = True
-    plotter = pyvista.Plotter(shape=(1, 2), off_screen=True, window_size=(1400, 600))
+    # 1000 x 430 px: the software renderer (Mesa llvmpipe) takes ~0.3 s less than for 1400 x 600, labels legible
+    plotter = pyvista.Plotter(shape=(1, 2), off_screen=True, window_size=(1000, 430))
     centre = 0.5 * (facts.lo + facts.hi)
     points = [b["centre"] for b in bores] + [f["point"] for f in flats]
     names = [f"B{i}" for i in range(1, len(bores) + 1)] + [f"F{i}" for i in range(1, len(flats) + 1)]

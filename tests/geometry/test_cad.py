@@ -100,6 +100,65 @@ def test_a_part_reads_back_with_its_exact_volume_bores_and_thinnest_wall_in_m_mm
     assert 0.020 <= facts.thin_wall <= 0.030
 
 
+def test_a_plate_with_many_holes_reads_with_its_exact_volume_through_the_faster_step_reader(tmp_path):
+    """The STEP reader runs without OCC's quadratic fix of self-crossing wires (cad._reader_resources): a face
+    with many hole wires must still read as one solid of the plate's volume, and the environment is restored."""
+    import os
+
+    rows, cols, r, (a, b, t) = 8, 16, 0.003, (0.2, 0.1, 0.01)
+
+    def plate(occ, s):
+        holes = [occ.addCylinder(0.01 + 0.0117 * i, 0.01 + 0.0114 * j, -0.001, 0, 0, t + 0.002, r)
+                 for i in range(cols) for j in range(rows)]
+        occ.cut([(3, occ.addBox(0, 0, 0, a, b, t))], [(3, h) for h in holes])
+
+    path = _write(tmp_path / "plate.step", plate)
+    before = {k: v for k, v in os.environ.items() if k.startswith("CSF_")}
+    with gmsh_session() as gmsh:
+        imported = import_solid(path, "m", key=None)
+        volume = sum(gmsh.model.occ.getMass(3, v) for v in imported["volumes"])
+        faces = len(gmsh.model.getEntities(2))
+    assert imported["solids"] == 1 and faces == 6 + rows * cols
+    assert volume == pytest.approx(a * b * t - rows * cols * math.pi * r**2 * t, rel=1e-9)
+    assert {k: v for k, v in os.environ.items() if k.startswith("CSF_")} == before
+
+
+def _box_triangles(lo, hi) -> np.ndarray:
+    """The 12 triangles (12, 3, 3) of an axis-parallel box's surface."""
+    corner = np.array([[(lo, hi)[(k >> a) & 1][a] for a in range(3)] for k in range(8)])
+    quads = [(0, 2, 6, 4), (1, 3, 7, 5), (0, 1, 5, 4), (2, 3, 7, 6), (0, 1, 3, 2), (4, 5, 7, 6)]
+    return np.array([corner[[q[0], q[1], q[2]]] for q in quads] + [corner[[q[0], q[2], q[3]]] for q in quads])
+
+
+def test_the_ray_caster_finds_a_slabs_thickness_and_counts_crossings_as_a_line_meets_a_box():
+    """housingfe.geometry.cad.RayCaster against closed forms: a 200 x 100 x 7 mm slab (its thickness along
+    the inward normal, from points all over it, also through edges and vertices of its triangulation), the
+    crossings of a line through two boxes, the escape of outward rays."""
+    from housingfe.geometry.cad import RayCaster
+
+    slab = _box_triangles((0.0, 0.0, 0.0), (0.2, 0.1, 0.007))
+    caster = RayCaster(slab)
+    rng = np.random.default_rng(1)
+    xy = np.column_stack([rng.uniform(0.0, 0.2, 50), rng.uniform(0.0, 0.1, 50)])
+    xy = np.vstack([xy, [[0.1, 0.05], [0.0, 0.0], [0.2, 0.1], [0.1, 0.0]]])   # a diagonal, vertices, an edge
+    top = np.column_stack([xy, np.full(len(xy), 0.007)])
+    down = np.broadcast_to([0.0, 0.0, -1.0], top.shape)
+    assert caster.nearest(top, down, 1e-9) == pytest.approx(0.007, abs=1e-15)
+    # along x from the slab's end face: its length; a ray at 45 degrees through the top: 7 mm * sqrt 2
+    assert caster.nearest([[0.0, 0.05, 0.0035]], [[1.0, 0.0, 0.0]], 1e-9)[0] == pytest.approx(0.2, abs=1e-15)
+    tilted = np.array([[np.sqrt(0.5), 0.0, -np.sqrt(0.5)]])
+    assert caster.nearest([[0.05, 0.05, 0.007]], tilted, 1e-9)[0] == pytest.approx(0.007 * np.sqrt(2), rel=1e-12)
+    # grazing crossings (|cos| < min_incidence) are skipped: nothing left for a ray at 80 degrees to the normal
+    grazing = np.array([[np.sin(np.radians(80)), 0.0, -np.cos(np.radians(80))]])
+    assert np.isinf(caster.nearest([[0.01, 0.05, 0.007]], grazing, 1e-9, min_incidence=0.3)[0])
+    assert caster.escapes(top, -down, 1e-9).all() and not caster.escapes(top, down, 1e-9).any()
+    # two boxes on a line: four crossings from outside, three from inside the first, one through an edge
+    boxes = RayCaster(np.vstack([_box_triangles((0, 0, 0), (1, 1, 1)), _box_triangles((2, 0, 0), (3, 1, 1))]))
+    line = np.array([[1.0, 0.0, 0.0]] * 3)
+    starts = np.array([[-1.0, 0.3, 0.6], [0.5, 0.5, 0.5], [-1.0, 0.5, 0.5]])   # the last along a diagonal
+    assert boxes.crossings(starts, line, 1e-9).tolist() == [4, 3, 4]
+
+
 @pytest.mark.parametrize("scene", ["nafems-fv12", "box-free", "box-halves", "test-gearbox"])
 def test_every_built_in_housing_written_to_step_reads_back_with_its_mass(scene, tmp_path):
     """Issue 29 item 7: same mass (1e-6) after STEP out and in; plate, box, box halves, gearbox with bores."""
