@@ -623,12 +623,9 @@ def evaluate_batch(batch, worker: bool = True) -> list[dict]:
 
 
 # ------------------------------------------------------------------------------------------------ the run
-def default_samples_per_process(n_samples: int, workers: int) -> int:
-    """Samples per process: all of a worker's share (ceil(n_samples / workers)), so each process builds its bases
-    once.  (A cap of 30 re-analyses per process guarded against ~0.1 GB left behind per re-analysis; since
-    housingfe.drivetrain.coupling.release_petsc_garbage the resident memory stays flat: 1293.7 MB after each of 40
-    set-A samples in one process on the scene's mesh, docs/uncertainty.md.)"""
-    return max(1, -(-int(n_samples) // max(1, int(workers))))
+# No cap on the samples per process: a cap of 30 re-analyses per process guarded against ~0.1 GB left behind per
+# re-analysis; since housingfe.drivetrain.coupling.release_petsc_garbage the resident memory stays flat (1293.7 MB
+# after each of 40 set-A samples in one process on the scene's mesh, docs/uncertainty.md).
 
 
 @dataclass
@@ -847,16 +844,17 @@ def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 
     """Run `n_samples` seeded Latin-hypercube samples of the estimated inputs (PARAMETERS, `ranges` overriding:
     {name: (low, high)}, radiation: (models...)) through the run-up scene's chain (--set `overrides`) on `workers`
     processes (engine "mpi": mpi4py.futures; "processes": concurrent.futures) and return the UncertaintyResult.
-    families: ("bearings",) adds gear set B's bearing configurations (4 re-analyses more per sample); () = set A
-    only (the cheap mode).  A process runs at most samples_per_process samples (default
-    `default_samples_per_process`; then a new one builds the basis again: memory, see the code); workers == 1 with
-    no more samples than that runs in this process.  Bad input
+    families: any of FAMILIES — "bearings" (gear set B with four bearing configurations), "profile-corrections"
+    (sets B, C, D, uncorrected, and all five sets with the replica's engagement thesis-2d), "double-helical" (its
+    own basis; two bearings at four torques); () = set A only (the cheap mode).  Each sample keeps the issue-28
+    check rows of its runs (metrics "checks").  workers > 1: one pool, one task per sample, each process building
+    its bases once; samples_per_process: instead batches of that many samples per process (a fresh process, and
+    bases, per batch); workers == 1 (without a smaller samples_per_process) runs in this process.  Bad input
     -> InputError before any model is built."""
     from housingfe.runup.scene import load_runup_scene
 
     families = tuple(families)
     check_request(n_samples, seed, workers, families, engine)
-    samples_per_process = samples_per_process or default_samples_per_process(n_samples, workers)
     scene_obj, path = load_runup_scene(scene, list(overrides))
     if families and not np.any((scene_obj.runup.speeds >= MEAN_RANGE_RPM[0])
                                 & (scene_obj.runup.speeds <= MEAN_RANGE_RPM[1])):
@@ -867,15 +865,26 @@ def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 
     say = progress or (lambda text: None)
     t0 = time.perf_counter()
     args = [(scene, tuple(overrides), s, families) for s in samples]
-    if workers == 1 and n_samples <= samples_per_process:
+    if workers == 1 and (samples_per_process is None or n_samples <= samples_per_process):
         metrics = []
         for i, a in enumerate(args):
             metrics.append(evaluate_sample(*a))
             say(f"sample {i + 1}/{n_samples}: {metrics[-1]['seconds']:.1f} s")
         used = "serial"
+    elif samples_per_process is None:
+        # one pool of `workers` processes, one task per sample: a process keeps its bases (_STATE) from task to
+        # task, and its resident memory stays flat (release_petsc_garbage; docs/uncertainty.md)
+        used = "mpi4py.futures" if engine == "mpi" else "concurrent.futures"
+        metrics = []
+        with _executor(engine, min(workers, n_samples)) as ex:
+            futures = [ex.submit(evaluate_batch, [a], worker=True) for a in args]
+            for fut in futures:                     # in sample order: the answer does not depend on the pool
+                metrics += fut.result()
+                m = metrics[-1]
+                say(f"sample {len(metrics)}/{n_samples}: {m['seconds']:.1f} s (process {m['pid']})")
     else:
-        # batches of samples_per_process samples (default: one batch per worker), at most `workers` batches per
-        # pool; a pool's processes end after their batches
+        # batches of samples_per_process samples, at most `workers` batches per pool: the pool's processes end
+        # after them and new ones build their bases again
         used = "mpi4py.futures" if engine == "mpi" else "concurrent.futures"
         batches = [args[i:i + samples_per_process] for i in range(0, len(args), samples_per_process)]
         metrics = []
