@@ -542,6 +542,7 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
             route: res.series(route, rad, torque, "LwA_dB") for route in base.session.spec.routes}
     checks = default_chain_checks(base, model_a, results_a[None], rad)
     del model_a, results_a
+    out["seconds_set_a"] = time.perf_counter() - t0        # with set A's thesis-2d source (profile-corrections)
     for route in base.session.spec.routes:
         s, lwa = runs.curves[(scene.scene.name, scene.drivetrain.gear_set, scene.drivetrain.bearings, torque,
                               None)][route]
@@ -583,9 +584,13 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
             out[f"{route}/measured_ranking_holds"] = float(ours == order_measured)
             out[f"{route}/self_aligning_quieter_than_ball"] = float(means["self_aligning"] < 0.0)
         checks.update(_family_checks("bearings", base, runs))
+    if "bearings" in families:
+        out["seconds_bearings"] = time.perf_counter() - t0 - out["seconds_set_a"]
     if "profile-corrections" in families:
+        t1 = time.perf_counter()
         checks.update(_family_checks("profile-corrections", base, runs))
         checks.update(_family_checks("profile-corrections", base, runs, REPLICA_ENGAGEMENT))
+        out["seconds_profile-corrections"] = time.perf_counter() - t1
     if "double-helical" in families:
         from housingfe.studies.design_variants import family_of
 
@@ -596,7 +601,9 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
         if fresh:                       # its basis is setup, not the sample's cost
             setup += dh.setup_s
             t0 += time.perf_counter() - t1
+        t2 = time.perf_counter()
         checks.update(_family_checks("double-helical", dh, runs))
+        out["seconds_double-helical"] = time.perf_counter() - t2
     if runs.failed and not out.get("failed"):
         out["failed"] = "; ".join(f"{k[1]}/{k[2]}@{k[3]:g}: {why}" for k, why in runs.failed.items())
     out["checks"] = checks
@@ -923,6 +930,11 @@ def summary_text(result: UncertaintyResult) -> str:
     cost = (f"cost: {t['per_sample_s']:.1f} s per sample (CPU {t['per_sample_cpu_s']:.1f} s) ({what}), "
             f"{t['basis_per_process_s']:.1f} s for the modal bases per process ({t['processes']} process(es)); "
             f"wall time {t['wall_s']:.1f} s")
+    parts = [(k.removeprefix("seconds_"), [m[k] for m in result.metrics if k in m])
+             for k in ("seconds_set_a", *(f"seconds_{f}" for f in FAMILIES))]
+    parts = [f"{name} {np.mean(v):.1f} s" for name, v in parts if v]
+    if parts:
+        cost += "; per sample by family: " + ", ".join(parts)
     rss = [m.get("rss_mb") for m in result.metrics if isinstance(m.get("rss_mb"), float)]
     if rss:
         cost += f"; resident memory {min(rss):.0f}-{max(rss):.0f} MB after a sample"
