@@ -11,13 +11,20 @@ misalignment under load, both routes):
   measured resonance windows, the L_WA slope 250-1500 rev/min;
 * with `families=("bearings",)` also gear set B with ball, angular contact, self-aligning and tapered roller
   bearings: each configuration's mean L_WA difference to ball over 800-1500 rev/min, its maximum, which one is
-  quietest and whether the measured ranking holds (Sec. 5.8).
+  quietest and whether the measured ranking holds (Sec. 5.8);
+* "profile-corrections": gear sets B, C, D and uncorrected, and all five sets with the thesis replica's engagement
+  thesis-2d; "double-helical": the double helical gearbox's scene (its own basis) with roller and fluid-film
+  bearings at 500-2000 N m;
+* and in every sample the issue-28 check rows of its runs ("checks"), made by the functions that make
+  `housingfe validate`'s rows (default_chain_checks, study_checks): bands.json gives each check's 5-95 % band and
+  in how many samples it passed (UncertaintyResult.check_bands).
 
 No parameter changes the layout (the FE interior without its bearing matrices and mean mesh stiffness): the
 bearings' internals change their 6x6 matrices, the drive line and Appendix C's parameters only the lumped source,
 the damping the reduced system, the radiation model which of the computed curves is read, the helix deviation the
-source's lead gap.  So each process computes ONE modal basis (the scene's set A / ball model, ~30 s) and every
-sample is a Rayleigh-Ritz re-analysis per configuration on it (housingfe.runup.chain.with_drivetrain).
+source's lead gap.  So each process computes ONE modal basis per layout (the scene's set A / ball model, ~30 s;
+with the double-helical family that gearbox's too) and every configuration of every sample is a Rayleigh-Ritz
+re-analysis on it (housingfe.runup.chain.with_drivetrain).
 
 Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
 concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A sample's answer
