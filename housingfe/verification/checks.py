@@ -163,17 +163,18 @@ def read_bands(path) -> dict:
 
 
 def band_text(row: dict) -> str:
-    """"—" without an uncertainty statement; else "low … high" and whether the measured value is inside it, in how
-    many samples the check passed ("passes in k/n samples") and the band's note, where given."""
+    """"—" without an uncertainty statement; else "low … high" and whether the measured value (and the thesis'
+    calculated one, where the row has one) is inside it, in how many samples the check passed ("passes in k/n samples") and the band's note, where given."""
     band, passes, note = row.get("band"), row.get("band_passes"), row.get("band_note")
     parts = []
     if band is not None:
         lo, hi = band
-        m = row.get("measured")
-        where = ""
-        if isinstance(m, (int, float)) and not isinstance(m, bool):
-            where = ": measured inside" if lo <= m <= hi else ": measured outside"
-        parts.append(f"{lo:.4g} … {hi:.4g}{where}")
+        where = []
+        for name in ("measured", "thesis_calculated"):      # the replica's goal is the thesis' calculation
+            v = row.get(name)
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
+                where.append(f"{name.replace('_', ' ')} {'inside' if lo <= v <= hi else 'outside'}")
+        parts.append(f"{lo:.4g} … {hi:.4g}" + (": " + ", ".join(where) if where else ""))
     if passes is not None:
         parts.append(f"passes in {passes[0]}/{passes[1]} samples")
     if note:

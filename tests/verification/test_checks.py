@@ -251,7 +251,7 @@ def test_bands_reach_the_json_and_checks_csv(tmp_path):
     assert "check_id" not in stored[1]
     with open(tmp_path / "out" / "checks.csv") as fh:
         (row,) = list(csv.DictReader(fh))
-    assert row["band"] == "86 … 91: measured outside" and row["passed"] == "yes"
+    assert row["band"] == "86 … 91: measured outside, thesis calculated inside" and row["passed"] == "yes"
 
 
 def test_a_bad_bands_file_is_one_error_line(tmp_path):
