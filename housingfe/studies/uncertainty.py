@@ -11,13 +11,20 @@ misalignment under load, both routes):
   measured resonance windows, the L_WA slope 250-1500 rev/min;
 * with `families=("bearings",)` also gear set B with ball, angular contact, self-aligning and tapered roller
   bearings: each configuration's mean L_WA difference to ball over 800-1500 rev/min, its maximum, which one is
-  quietest and whether the measured ranking holds (Sec. 5.8).
+  quietest and whether the measured ranking holds (Sec. 5.8);
+* "profile-corrections": gear sets B, C, D and uncorrected, and all five sets with the thesis replica's engagement
+  thesis-2d; "double-helical": the double helical gearbox's scene (its own basis) with roller and fluid-film
+  bearings at 500-2000 N m;
+* and in every sample the issue-28 check rows of its runs ("checks"), made by the functions that make
+  `housingfe validate`'s rows (default_chain_checks, study_checks): bands.json gives each check's 5-95 % band and
+  in how many samples it passed (UncertaintyResult.check_bands).
 
 No parameter changes the layout (the FE interior without its bearing matrices and mean mesh stiffness): the
 bearings' internals change their 6x6 matrices, the drive line and Appendix C's parameters only the lumped source,
 the damping the reduced system, the radiation model which of the computed curves is read, the helix deviation the
-source's lead gap.  So each process computes ONE modal basis (the scene's set A / ball model, ~30 s) and every
-sample is a Rayleigh-Ritz re-analysis per configuration on it (housingfe.runup.chain.with_drivetrain).
+source's lead gap.  So each process computes ONE modal basis per layout (the scene's set A / ball model, ~30 s;
+with the double-helical family that gearbox's too) and every configuration of every sample is a Rayleigh-Ritz
+re-analysis on it (housingfe.runup.chain.with_drivetrain).
 
 Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
 concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A sample's answer
@@ -48,7 +55,14 @@ from housingfe.studies.chain_session import MEAN_RANGE_RPM, difference_stats
 
 DEFAULT_SCENE = "test-gearbox-runup"
 BEARING_FAMILY = ("ball", "angular_contact", "self_aligning", "tapered_roller")   # gear set B, Sec. 5.8
-FAMILIES = ("bearings",)
+# the design-variant families a sample can add (housingfe.studies.design_variants); the default stays bearings
+FAMILIES = ("bearings", "profile-corrections", "double-helical")
+DEFAULT_FAMILIES = ("bearings",)
+REPLICA_ENGAGEMENT = "thesis-2d"         # the thesis replica's engagement shock (the replica checks of issue 28)
+# the quasi-static excitation checks (28.excitation.envelope.<set>) are computed on the aligned gear pairs alone:
+# none of PARAMETERS acts on them (the helix deviations act on the run's lead gap, the rest on the dynamics)
+EXCITATION_NOTE = ("no sampled input acts on this (the quasi-static excitation of the aligned gear pair; the helix "
+                   "deviations act on the run-up's lead gap, every other input on the dynamics or the radiation)")
 ENGINES = ("mpi", "processes")
 # the measured L_WA / L_v resonance windows of set A (housingfe.runup.checks.MEASURED_PEAKS_RPM)
 PEAK_WINDOWS_RPM = ((450.0, 450.0), (850.0, 950.0), (1300.0, 1350.0))
@@ -205,6 +219,7 @@ def draw_samples(scene, n_samples: int, seed: int, ranges: dict | None = None) -
 
 # ------------------------------------------------------------------------------------------------ one sample
 _STATE: dict = {}      # per process: (scene, overrides) -> _Base (the housing model and the basis)
+_POOL: list = []       # per process: the one ModelPool its sessions share (the housing model where it is the same)
 
 
 @dataclass
@@ -219,10 +234,12 @@ def _base(scene_name: str, overrides: tuple, comm) -> _Base:
     key = json.dumps([scene_name, list(overrides)])
     if key not in _STATE:
         from housingfe.drivetrain.bore_matching import match_bores
-        from housingfe.studies.chain_session import ChainSession
+        from housingfe.studies.chain_session import ChainSession, ModelPool
 
+        if not _POOL:
+            _POOL.append(ModelPool())
         t0 = time.perf_counter()
-        session = ChainSession.from_scene(scene_name, list(overrides), comm=comm)
+        session = ChainSession.from_scene(scene_name, list(overrides), comm=comm, pool=_POOL[0])
         spec = session.scene.drivetrain
         dt = session.drivetrain(spec.gear_set, spec.bearings, max(session.spec.torques_nm))
         housing = session.housing()
@@ -308,8 +325,11 @@ def _misalignment(base: _Base, drivetrain, values: dict):
     return lambda torque: law(torque) + extra
 
 
-def _curves(base: _Base, values: dict, gear_set: str, bearings: str) -> dict:
-    """{(route, radiation): (speeds rev/min, L_WA dB(A))} of one configuration in one sample."""
+def _runs(base: _Base, values: dict, gear_set: str, bearings: str, torque: float | None = None,
+          engagements: tuple = (None,)) -> tuple:
+    """(coupled model, {engagement: RunupResult}) of one configuration in one sample: one Rayleigh-Ritz
+    re-analysis on the process's basis, then per engagement shock (None: the scene's) the coupled source and the
+    run-up at `torque` (N m; default the scene's highest)."""
     from dataclasses import replace
 
     from housingfe.bearings.catalogue import estimated_internals
@@ -317,7 +337,7 @@ def _curves(base: _Base, values: dict, gear_set: str, bearings: str) -> dict:
     from housingfe.solvers import harmonic
 
     spec = base.session.spec
-    torque = max(spec.torques_nm)
+    torque = max(spec.torques_nm) if torque is None else float(torque)
     internals = {k: values[k] for k in ("clearance_position", "groove_inner", "groove_outer",
                                         "spherical_contact_angle_deg", "tapered_e_scale")}
     with estimated_internals(**internals):
@@ -327,12 +347,28 @@ def _curves(base: _Base, values: dict, gear_set: str, bearings: str) -> dict:
             damping = harmonic.Damping(lambda f: np.zeros(np.shape(f)), modal_ratio=values["damping_ratio"])
             start = replace(start, reduction=start.reduction.with_damping(damping))
         model = with_drivetrain(start, dt)
-        source = dt.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
-                                 misalignment=_misalignment(base, dt, values))
-        lines, _ = run_source(model, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance)
-        res = runup(model, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
+        misalignment = _misalignment(base, dt, values)
+        results = {}
+        for engagement in engagements:
+            source = dt.source_model(harmonics=spec.harmonics, engagement=engagement or spec.engagement,
+                                     misalignment=misalignment)
+            lines, _ = run_source(model, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance)
+            results[engagement] = runup(model, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
+    return model, results
+
+
+def _series(base: _Base, res, torque: float | None = None) -> dict:
+    """{(route, radiation): (speeds rev/min, L_WA dB(A))} of a run-up result."""
+    spec = base.session.spec
+    torque = max(spec.torques_nm) if torque is None else float(torque)
     return {(route, rad): res.series(route, rad, torque, "LwA_dB")
             for route in spec.routes for rad in base.session.scene.radiation.models}
+
+
+def _curves(base: _Base, values: dict, gear_set: str, bearings: str) -> dict:
+    """{(route, radiation): (speeds rev/min, L_WA dB(A))} of one configuration in one sample."""
+    _, results = _runs(base, values, gear_set, bearings)
+    return _series(base, results[None])
 
 
 def _peak_metrics(speeds, lwa) -> dict:
@@ -359,46 +395,187 @@ def measured_bearing_means() -> dict[str, float]:
     return {v.key: (0.0 if v.key == "ball" else v.measured_mean) for v in families()["bearings"].variants}
 
 
-def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: tuple = FAMILIES,
+def check_values(rows) -> dict:
+    """{check_id: {"ours": number or text, "passed": "yes"/"no"/""}} of the issue-28 check rows among `rows`
+    (housingfe.verification.checks): what a sample keeps of each check row."""
+    from housingfe.verification.checks import is_check
+
+    out = {}
+    for r in rows:
+        if is_check(r):
+            ours = r["ours"]
+            if isinstance(ours, (bool, np.bool_)):
+                ours = str(ours)
+            elif isinstance(ours, (int, float, np.integer, np.floating)):
+                ours = float(ours)
+            out[r["check_id"]] = {"ours": ours, "passed": r.get("passed", "")}
+    return out
+
+
+def _scene_read_with(scene, radiation: str):
+    """The run-up scene with `radiation` as its first radiation model (the one its checks read)."""
+    models = [radiation] + [m for m in scene.radiation.models if m != radiation]
+    return scene.model_copy(update={"radiation": scene.radiation.model_copy(update={"models": models})})
+
+
+def default_chain_checks(base: _Base, model, res, radiation: str) -> dict:
+    """The checks of the default run-up on one sample's run of set A (check_values): the very functions that make
+    `housingfe validate`'s rows from `housingfe run`'s result — housingfe.runup.checks.evaluate (max L_WA, speed
+    law, L_omega on the flexible housing at 500/1000/1500 rpm and its resonance; tagged by
+    validate.run_check_rows) and runup_checks_rows.chain_rows (the harmonic of the maximum, the peaks in the
+    measured windows, no peak by n >= 3, the tooth-band shares of L_omega, L_v, L_W) — read for the sample's
+    radiation model."""
+    from housingfe.runup import checks as run_checks
+    from housingfe.verification import runup_checks_rows, validate
+
+    scene = _scene_read_with(base.session.scene, radiation)
+    torque = max(base.session.spec.torques_nm)
+    found, contributions = run_checks.evaluate(scene, {torque: (model, res)}, model)
+    rows = validate.run_check_rows("sample", found)
+    rows += runup_checks_rows.chain_rows("sample", radiation, res.totals, res.harmonic_rows(), contributions)
+    return check_values(rows)
+
+
+def study_data(family: str, engagement: str, radiation: str, routes: tuple, curves: dict) -> dict:
+    """A design-variant family's comparison (study.json's content: rows, rankings, torque law) from one sample's
+    curves {variant key: {route: (speeds rev/min, L_WA dB(A))}}, made by housingfe.studies.design_variants'
+    own compare / rankings / torque_law."""
+    from housingfe.studies.design_variants import (
+        StudyResult,
+        VariantRun,
+        compare,
+        family_of,
+        rankings,
+        torque_law,
+    )
+
+    fam = family_of(family)
+    runs = {v.key: VariantRun(v, curves[v.key], "re-analysed", 0.0, 0.0) for v in fam.variants}
+    result = StudyResult(fam, engagement, radiation, tuple(routes), runs)
+    result.rows = compare(result)
+    result.rankings = rankings(result)
+    if fam.name == "double-helical":
+        result.torque_law = torque_law(result)
+    return {"family": fam.name, "engagement": engagement, "radiation": radiation, "reference": fam.reference,
+            "source": fam.source, "rows": result.rows, "rankings": result.rankings, "torque_law": result.torque_law}
+
+
+def study_checks(data: dict) -> dict:
+    """The check rows of a study's data (check_values of housingfe.verification.study_rows.study_rows and, for the
+    thesis replica's profile corrections, runup_checks_rows.replica_rows_of)."""
+    from housingfe.verification import runup_checks_rows, study_rows
+
+    rows = study_rows.study_rows(data)
+    if data["family"] == "profile-corrections" and data["engagement"] == REPLICA_ENGAGEMENT:
+        rows += runup_checks_rows.replica_rows_of(data)
+    return check_values(rows)
+
+
+class _SampleRuns:
+    """One sample's configurations, each run once however many families need it: {(scene, gear set, bearings,
+    torque, engagement): {route: (speeds, L_WA)}} for the sample's radiation model; the engagements of one
+    configuration share its re-analysis."""
+
+    def __init__(self, values: dict):
+        self.values = values
+        self.curves: dict = {}
+        self.failed: dict = {}
+
+    def get(self, base: _Base, gear_set: str, bearings: str, torque: float | None = None,
+            engagements: tuple = (None,)) -> dict | None:
+        """{engagement: {route: (speeds, L_WA)}}, None when the configuration cannot run (InputError, e.g. a
+        bearing of the sample that cannot carry its load; the reason in `failed`)."""
+        scene = base.session.scene.scene.name
+        torque = max(base.session.spec.torques_nm) if torque is None else float(torque)
+        key = (scene, gear_set, bearings, torque)
+        if key in self.failed:
+            return None
+        missing = tuple(e for e in engagements if key + (e,) not in self.curves)
+        if missing:
+            try:
+                _, results = _runs(base, self.values, gear_set, bearings, torque, missing)
+            except InputError as exc:
+                self.failed[key] = str(exc)
+                return None
+            rad = self.values["radiation"]
+            if rad not in base.session.scene.radiation.models:      # another scene's radiation models
+                rad = base.session.scene.radiation.models[0]
+            for e, res in results.items():
+                self.curves[key + (e,)] = {route: res.series(route, rad, torque, "LwA_dB")
+                                           for route in base.session.spec.routes}
+        return {e: self.curves[key + (e,)] for e in engagements}
+
+
+def _family_checks(family: str, base: _Base, runs: _SampleRuns, engagement: str | None = None) -> dict:
+    """The check values of one design-variant family in one sample (every variant a configuration of `runs`);
+    {} when a variant could not run."""
+    from housingfe.studies.design_variants import family_of
+
+    fam = family_of(family)
+    curves = {}
+    for v in fam.variants:
+        got = runs.get(base, v.gear_set, v.bearings, v.torque, (engagement,))
+        if got is None:
+            return {}
+        curves[v.key] = got[engagement]
+    spec = base.session.spec
+    return study_checks(study_data(family, engagement or spec.engagement, runs.values["radiation"],
+                                   tuple(spec.routes), curves))
+
+
+def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: tuple = DEFAULT_FAMILIES,
                     worker: bool = False) -> dict:
-    """The metrics of one sample (see the module docstring), {"route/quantity": value}, and "seconds" (its wall
-    time, without the process's one basis) and "setup_s" (the basis, when this sample built it).  worker: the call
-    runs in a pool process (its FE on MPI.COMM_SELF)."""
+    """The metrics of one sample (see the module docstring), {"route/quantity": value}, "checks" (the issue-28
+    check rows of this sample's runs, check_values: {check_id: {"ours", "passed"}}), "seconds" (its wall time,
+    without the process's bases), "setup_s" (the bases, when this sample built them) and "rss_mb" (the process's
+    resident memory after the sample).  worker: the call runs in a pool process (its FE on MPI.COMM_SELF)."""
     from mpi4py import MPI
 
     comm = MPI.COMM_SELF if worker else MPI.COMM_WORLD
+    setup = 0.0
     fresh = json.dumps([scene_name, list(overrides)]) not in _STATE
     base = _base(scene_name, tuple(overrides), comm)
+    setup += base.setup_s if fresh else 0.0
     t0, c0 = time.perf_counter(), time.process_time()
     scene = base.session.scene
     rad = values["radiation"]
     out = {}
-    curves_a = _curves(base, values, scene.drivetrain.gear_set, scene.drivetrain.bearings)
+    runs = _SampleRuns(values)
+    engagements = (None, REPLICA_ENGAGEMENT) if "profile-corrections" in families else (None,)
+    model_a, results_a = _runs(base, values, scene.drivetrain.gear_set, scene.drivetrain.bearings, None, engagements)
+    torque = max(base.session.spec.torques_nm)
+    for e, res in results_a.items():       # set A, ball, top torque: the default chain and the families' set A
+        runs.curves[(scene.scene.name, scene.drivetrain.gear_set, scene.drivetrain.bearings, torque, e)] = {
+            route: res.series(route, rad, torque, "LwA_dB") for route in base.session.spec.routes}
+    checks = default_chain_checks(base, model_a, results_a[None], rad)
+    del model_a, results_a
+    out["seconds_set_a"] = time.perf_counter() - t0        # with set A's thesis-2d source (profile-corrections)
     for route in base.session.spec.routes:
-        s, lwa = curves_a[route, rad]
+        s, lwa = runs.curves[(scene.scene.name, scene.drivetrain.gear_set, scene.drivetrain.bearings, torque,
+                              None)][route]
         for k, v in _peak_metrics(s, lwa).items():
             out[f"{route}/{k}"] = v
         out[f"{route}/lwa_curve_dBA"] = [float(x) for x in lwa]
     if "bearings" in families:
         measured = measured_bearing_means()
         order_measured = sorted(measured, key=measured.get)
-        curves, failed = {}, {}
+        curves = {}
         for b in BEARING_FAMILY:
-            try:
-                curves[b] = _curves(base, values, "B", b)
-            except InputError as exc:          # e.g. a bearing of the sample that cannot carry its load
-                failed[b] = str(exc)
+            got = runs.get(base, "B", b)
+            if got is not None:
+                curves[b] = got[None]
+        failed = {k[2]: why for k, why in runs.failed.items() if k[1] == "B"}
         out["failed"] = "; ".join(f"{b}: {why}" for b, why in failed.items())
         nan = float("nan")
         for route in base.session.spec.routes:
             means = {}
-            l_ref = curves["ball"][route, rad][1] if "ball" in curves else None
+            l_ref = curves["ball"][route][1] if "ball" in curves else None
             for b in BEARING_FAMILY:
                 if b not in curves:
                     means[b] = nan
                     out[f"{route}/max_lwa_B_{b}_dBA"] = nan
                 else:
-                    s, lwa = curves[b][route, rad]
+                    s, lwa = curves[b][route]
                     means[b] = 0.0 if b == "ball" else (difference_stats(s, lwa, l_ref)[0] if l_ref is not None
                                                         else nan)
                     out[f"{route}/max_lwa_B_{b}_dBA"] = float(np.max(lwa))
@@ -413,11 +590,45 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
             out[f"{route}/quietest"] = ours[0]
             out[f"{route}/measured_ranking_holds"] = float(ours == order_measured)
             out[f"{route}/self_aligning_quieter_than_ball"] = float(means["self_aligning"] < 0.0)
+        checks.update(_family_checks("bearings", base, runs))
+    if "bearings" in families:
+        out["seconds_bearings"] = time.perf_counter() - t0 - out["seconds_set_a"]
+    if "profile-corrections" in families:
+        t1 = time.perf_counter()
+        checks.update(_family_checks("profile-corrections", base, runs))
+        checks.update(_family_checks("profile-corrections", base, runs, REPLICA_ENGAGEMENT))
+        out["seconds_profile-corrections"] = time.perf_counter() - t1
+    if "double-helical" in families:
+        from housingfe.studies.design_variants import family_of
+
+        dh_scene = family_of("double-helical").scene
+        fresh = json.dumps([dh_scene, list(overrides)]) not in _STATE
+        t1 = time.perf_counter()
+        dh = _base(dh_scene, tuple(overrides), comm)
+        if fresh:                       # its basis is setup, not the sample's cost
+            setup += dh.setup_s
+            t0 += time.perf_counter() - t1
+        t2 = time.perf_counter()
+        checks.update(_family_checks("double-helical", dh, runs))
+        out["seconds_double-helical"] = time.perf_counter() - t2
+    if runs.failed and not out.get("failed"):
+        out["failed"] = "; ".join(f"{k[1]}/{k[2]}@{k[3]:g}: {why}" for k, why in runs.failed.items())
+    out["checks"] = checks
     out["seconds"] = time.perf_counter() - t0
     out["cpu_s"] = time.process_time() - c0          # the machine is shared: CPU time is the steadier measure
-    out["setup_s"] = base.setup_s if fresh else 0.0
+    out["setup_s"] = setup
+    out["rss_mb"] = _rss_mb()
     out["pid"] = os.getpid()
     return out
+
+
+def _rss_mb() -> float:
+    """Resident memory of this process (MB), from /proc (NaN where there is none)."""
+    try:
+        with open("/proc/self/statm") as fh:
+            return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 1e6
+    except (OSError, ValueError, IndexError):
+        return float("nan")
 
 
 def evaluate_batch(batch, worker: bool = True) -> list[dict]:
@@ -426,16 +637,11 @@ def evaluate_batch(batch, worker: bool = True) -> list[dict]:
 
 
 # ------------------------------------------------------------------------------------------------ the run
-# re-analyses (configurations x samples) one process runs before a fresh one takes over: each leaves ~0.12 GB
-# behind on the scene's 4 kHz mesh (in build_interior, not held by Python objects), so 30 keep a process near 4 GB
-CONFIGURATIONS_PER_PROCESS = 30
+# No cap on the samples per process: a cap of 30 re-analyses per process guarded against ~0.1 GB left behind per
+# re-analysis; since housingfe.drivetrain.coupling.release_petsc_garbage the resident memory stays flat (1293.7 MB
+# after each of 40 set-A samples in one process on the scene's mesh, docs/uncertainty.md).
 
 
-def default_samples_per_process(families) -> int:
-    """Samples per process: CONFIGURATIONS_PER_PROCESS over the configurations of a sample (set A, + 4 with the
-    bearings family): 6 with the bearings family, 30 for set A alone."""
-    per_sample = 1 + (len(BEARING_FAMILY) if "bearings" in families else 0)
-    return max(1, CONFIGURATIONS_PER_PROCESS // per_sample)
 @dataclass
 class UncertaintyResult:
     """Samples (parameter values) and their metrics, in sample order; routes; the default route of `band`;
@@ -493,22 +699,61 @@ class UncertaintyResult:
         p5, p50, p95 = np.nanpercentile(v, [5.0, 50.0, 95.0])
         return float(p5), float(p50), float(p95)
 
-    def check_bands(self) -> dict[str, tuple[float, float]]:
-        """{check_id: (p5, p95)} for the issue-28 check rows of `housingfe validate` whose quantity this run
-        sampled (max L_WA, speed law, the bearing variants' mean differences), per route: the file
-        `housingfe validate --bands` reads (bands.json of the result folder)."""
+    def check_ids(self) -> list[str]:
+        """The check_ids of the issue-28 check rows the samples computed (metrics' "checks"), in first-seen order."""
+        return list(dict.fromkeys(c for m in self.metrics for c in (m.get("checks") or {})))
+
+    def check_passes(self, check_id: str) -> tuple[int, int]:
+        """(k, n): the check passed in k of the n samples that computed and judged it (passed "yes" / "no")."""
+        got = [(m.get("checks") or {}).get(check_id) for m in self.metrics]
+        judged = [g["passed"] for g in got if g and g.get("passed") in ("yes", "no")]
+        return sum(p == "yes" for p in judged), len(judged)
+
+    def check_values(self, check_id: str) -> np.ndarray:
+        """The per-sample numeric `ours` of a check (NaN where a sample did not compute it or it is not a number)."""
+        out = []
+        for m in self.metrics:
+            g = (m.get("checks") or {}).get(check_id)
+            v = g.get("ours") if g else None
+            out.append(float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else float("nan"))
+        return np.array(out, float)
+
+    def check_bands(self) -> dict[str, dict]:
+        """{check_id: {"band": [p5, p95] or None, "passes": k or None, "samples": n, "note": text}} for every
+        issue-28 check row of `housingfe validate` this run computed per sample: the 5-95 % band of the check's
+        own number (`ours`) where it is one, and in how many of the n samples that judged it the check passed; the
+        excitation envelope checks with the note that no sampled input acts on them.  A run written before the
+        samples carried their check rows (no "checks" in its metrics) gives the bands of its quantities under the
+        check_ids of their rows (max L_WA, speed law, the bearing means).  The content of bands.json
+        (housingfe.verification.checks.BANDS_FORMAT), read by `housingfe validate --bands`."""
+        from housingfe.source.roosmalen.studies import SPECTRUM_SCENES
+
+        n_all = len(self.metrics)
         out = {}
-        for route in self.routes:
-            pairs = [(f"28.default.max_lwa.{route}", "max_lwa_dBA"),
-                     (f"28.speed_law.{route}", "slope_dBA_per_doubling")]
-            pairs += [(f"28.variants.mean.bearings.{b}.{route}", f"variant_mean_{b}_dB") for b in BEARING_FAMILY[1:]]
-            for check_id, quantity in pairs:
-                try:
-                    p5, _, p95 = self.band(quantity, route)
-                except KeyError:            # a quantity of a family this run did not include
-                    continue
-                if np.isfinite(p5) and np.isfinite(p95):
-                    out[check_id] = (p5, p95)
+        for check_id in self.check_ids():
+            v = self.check_values(check_id)
+            v = v[np.isfinite(v)]
+            band = [float(x) for x in np.percentile(v, [5.0, 95.0])] if v.size else None
+            k, n = self.check_passes(check_id)
+            have = sum(check_id in (m.get("checks") or {}) for m in self.metrics)
+            note = "" if have == n_all else f"computed in {have} of {n_all} samples"
+            out[check_id] = {"band": band, "passes": k if n else None, "samples": n, "note": note}
+        if not out:
+            for route in self.routes:
+                pairs = [(f"28.default.max_lwa.{route}", "max_lwa_dBA"),
+                         (f"28.speed_law.{route}", "slope_dBA_per_doubling")]
+                pairs += [(f"28.variants.mean.bearings.{b}.{route}", f"variant_mean_{b}_dB")
+                          for b in BEARING_FAMILY[1:]]
+                for check_id, quantity in pairs:
+                    try:
+                        p5, _, p95 = self.band(quantity, route)
+                    except KeyError:            # a quantity of a family this run did not include
+                        continue
+                    if np.isfinite(p5) and np.isfinite(p95):
+                        out[check_id] = {"band": [p5, p95], "passes": None, "samples": n_all, "note": ""}
+        for scene in SPECTRUM_SCENES:
+            out[f"28.excitation.envelope.{scene.removeprefix('gearset-')}"] = {
+                "band": None, "passes": None, "samples": n_all, "note": EXCITATION_NOTE}
         return out
 
     def inside(self, quantity: str, value: float, route: str | None = None) -> bool:
@@ -602,27 +847,28 @@ def check_request(n_samples, seed, workers, families, engine) -> None:
         raise InputError(f"uncertainty: --workers: {workers}: must be a whole number >= 1")
     bad = [f for f in families if f not in FAMILIES]
     if bad:
-        raise InputError(f"uncertainty: --family {', '.join(bad)}: unknown (known: {', '.join(FAMILIES)}, none)")
+        raise InputError(f"uncertainty: --family {', '.join(bad)}: unknown (known: {', '.join(FAMILIES)}, all, none)")
     if engine not in ENGINES:
         raise InputError(f"uncertainty: --engine {engine}: unknown (known: {', '.join(ENGINES)})")
 
 
 def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 0, workers: int = 1, *,
-                    ranges: dict | None = None, overrides=(), families: tuple = FAMILIES, engine: str = "mpi",
+                    ranges: dict | None = None, overrides=(), families: tuple = DEFAULT_FAMILIES, engine: str = "mpi",
                     samples_per_process: int | None = None, progress=None) -> UncertaintyResult:
     """Run `n_samples` seeded Latin-hypercube samples of the estimated inputs (PARAMETERS, `ranges` overriding:
     {name: (low, high)}, radiation: (models...)) through the run-up scene's chain (--set `overrides`) on `workers`
     processes (engine "mpi": mpi4py.futures; "processes": concurrent.futures) and return the UncertaintyResult.
-    families: ("bearings",) adds gear set B's bearing configurations (4 re-analyses more per sample); () = set A
-    only (the cheap mode).  A process runs at most samples_per_process samples (default
-    `default_samples_per_process`; then a new one builds the basis again: memory, see the code); workers == 1 with
-    no more samples than that runs in this process.  Bad input
+    families: any of FAMILIES — "bearings" (gear set B with four bearing configurations), "profile-corrections"
+    (sets B, C, D, uncorrected, and all five sets with the replica's engagement thesis-2d), "double-helical" (its
+    own basis; two bearings at four torques); () = set A only (the cheap mode).  Each sample keeps the issue-28
+    check rows of its runs (metrics "checks").  workers > 1: one pool, one task per sample, each process building
+    its bases once; samples_per_process: instead batches of that many samples per process (a fresh process, and
+    bases, per batch); workers == 1 (without a smaller samples_per_process) runs in this process.  Bad input
     -> InputError before any model is built."""
     from housingfe.runup.scene import load_runup_scene
 
     families = tuple(families)
     check_request(n_samples, seed, workers, families, engine)
-    samples_per_process = samples_per_process or default_samples_per_process(families)
     scene_obj, path = load_runup_scene(scene, list(overrides))
     if families and not np.any((scene_obj.runup.speeds >= MEAN_RANGE_RPM[0])
                                 & (scene_obj.runup.speeds <= MEAN_RANGE_RPM[1])):
@@ -633,16 +879,26 @@ def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 
     say = progress or (lambda text: None)
     t0 = time.perf_counter()
     args = [(scene, tuple(overrides), s, families) for s in samples]
-    if workers == 1 and n_samples <= samples_per_process:
+    if workers == 1 and (samples_per_process is None or n_samples <= samples_per_process):
         metrics = []
         for i, a in enumerate(args):
             metrics.append(evaluate_sample(*a))
             say(f"sample {i + 1}/{n_samples}: {metrics[-1]['seconds']:.1f} s")
         used = "serial"
+    elif samples_per_process is None:
+        # one pool of `workers` processes, one task per sample: a process keeps its bases (_STATE) from task to
+        # task, and its resident memory stays flat (release_petsc_garbage; docs/uncertainty.md)
+        used = "mpi4py.futures" if engine == "mpi" else "concurrent.futures"
+        metrics = []
+        with _executor(engine, min(workers, n_samples)) as ex:
+            futures = [ex.submit(evaluate_batch, [a], worker=True) for a in args]
+            for fut in futures:                     # in sample order: the answer does not depend on the pool
+                metrics += fut.result()
+                m = metrics[-1]
+                say(f"sample {len(metrics)}/{n_samples}: {m['seconds']:.1f} s (process {m['pid']})")
     else:
         # batches of samples_per_process samples, at most `workers` batches per pool: the pool's processes end
-        # after them (each re-analysis leaves ~0.1 GB in the process, not held by Python objects, so a process
-        # must not run for ever: 14 samples of the bearings family took 10 GB and the kernel killed it)
+        # after them and new ones build their bases again
         used = "mpi4py.futures" if engine == "mpi" else "concurrent.futures"
         batches = [args[i:i + samples_per_process] for i in range(0, len(args), samples_per_process)]
         metrics = []
@@ -677,9 +933,21 @@ def summary_text(result: UncertaintyResult) -> str:
     t = result.timings
     head = (f"uncertainty {result.scene}: {len(result.samples)} Latin-hypercube samples, seed {result.seed}, "
             f"{result.workers} worker(s) ({result.engine}); families: {', '.join(result.families) or 'set A only'}")
-    cost = (f"cost: {t['per_sample_s']:.1f} s per sample (CPU {t['per_sample_cpu_s']:.1f} s) ({'set A + 4 bearing configurations of set B' if result.families else 'set A'}), "
-            f"{t['basis_per_process_s']:.1f} s for the one modal basis per process ({t['processes']} process(es)); "
+    what = "set A" + (f" + families {', '.join(result.families)}" if result.families else "")
+    cost = (f"cost: {t['per_sample_s']:.1f} s per sample (CPU {t['per_sample_cpu_s']:.1f} s) ({what}), "
+            f"{t['basis_per_process_s']:.1f} s for the modal bases per process ({t['processes']} process(es)); "
             f"wall time {t['wall_s']:.1f} s")
+    parts = [(k.removeprefix("seconds_"), [m[k] for m in result.metrics if k in m])
+             for k in ("seconds_set_a", *(f"seconds_{f}" for f in FAMILIES))]
+    parts = [f"{name} {np.mean(v):.1f} s" for name, v in parts if v]
+    if parts:
+        cost += "; per sample by family: " + ", ".join(parts)
+    rss = [m.get("rss_mb") for m in result.metrics if isinstance(m.get("rss_mb"), float)]
+    if rss:
+        cost += f"; resident memory {min(rss):.0f}-{max(rss):.0f} MB after a sample"
+    ids = result.check_ids()
+    if ids:
+        cost += f"\nissue-28 check rows computed per sample: {len(ids)} (bands.json, sample_checks.csv)"
     failed = [m["failed"] for m in result.metrics if m.get("failed")]
     notes = [f"{len(failed)} sample(s) with a configuration that could not run (NaN, left out of the bands): "
              + " | ".join(failed[:3])] if failed else []
@@ -701,17 +969,22 @@ SUMMARY_COLUMNS = ("route", "quantity", "p5", "median", "p95", "fraction", "samp
 
 
 def write(folder: Path, result: UncertaintyResult) -> None:
-    """samples.csv, summary.csv, summary.txt, uncertainty.png, uncertainty.json and bands.json (the check rows'
-    bands for `housingfe validate --bands`) in `folder`."""
+    """samples.csv, sample_checks.csv (each sample's issue-28 check rows: ours, passed), summary.csv, summary.txt,
+    uncertainty.png, uncertainty.json and bands.json (the check rows' bands and pass counts for `housingfe validate
+    --bands`) in `folder`."""
     from housingfe.outputs import write_csv, write_json
 
     names = list(PARAMETERS)
-    keys = [k for k in result.metrics[0] if not k.endswith("lwa_curve_dBA") and k not in ("pid", "setup_s")]
-    keys += sorted({k for m in result.metrics for k in m} - set(keys) - {"pid", "setup_s"}
+    skip = {"pid", "setup_s", "checks"}
+    keys = [k for k in result.metrics[0] if not k.endswith("lwa_curve_dBA") and k not in skip]
+    keys += sorted({k for m in result.metrics for k in m} - set(keys) - skip
                    - {k for k in result.metrics[0] if k.endswith("lwa_curve_dBA")})
     write_csv(folder / "samples.csv", ["sample", *names, *keys],
-              ([i, *(s[n] for n in names), *(m[k] for k in keys)]
+              ([i, *(s[n] for n in names), *(m.get(k, "") for k in keys)]
                for i, (s, m) in enumerate(zip(result.samples, result.metrics))))
+    write_csv(folder / "sample_checks.csv", ["sample", "check_id", "ours", "passed"],
+              ([i, c, v["ours"], v["passed"]] for i, m in enumerate(result.metrics)
+               for c, v in (m.get("checks") or {}).items()))
     rows = result.summary_rows()
     write_csv(folder / "summary.csv", SUMMARY_COLUMNS, ([r[c] for c in SUMMARY_COLUMNS] for r in rows))
     (folder / "summary.txt").write_text(summary_text(result) + "\n")
@@ -724,7 +997,11 @@ def write(folder: Path, result: UncertaintyResult) -> None:
         "families": list(result.families), "engine": result.engine, "workers": result.workers,
         "timings_s": result.timings, "summary": rows, "speeds_rpm": result.speeds,
         "metrics": [{k: v for k, v in m.items() if k != "pid"} for m in result.metrics]})
-    write_json(folder / "bands.json", {k: list(v) for k, v in result.check_bands().items()})
+    from housingfe.verification.checks import BANDS_FORMAT
+
+    write_json(folder / "bands.json", {"format": BANDS_FORMAT, "scene": result.scene, "seed": result.seed,
+                                       "samples": len(result.samples), "families": list(result.families),
+                                       "checks": result.check_bands()})
     plot(folder / "uncertainty.png", result)
 
 
@@ -777,7 +1054,7 @@ def plot(path: Path, result: UncertaintyResult) -> None:
 
 
 def run_command(scene: str, n_samples: int, seed: int, workers: int, out_dir: str | None, ranges_items=(),
-                overrides=(), families=FAMILIES, engine: str = "mpi",
+                overrides=(), families=DEFAULT_FAMILIES, engine: str = "mpi",
                 samples_per_process: int | None = None) -> Path:
     """`housingfe uncertainty`: check the request, reserve the result folder, run, write atomically, print."""
     from mpi4py import MPI
@@ -818,22 +1095,24 @@ def register_cli(subparsers) -> None:
     p.add_argument("--engine", default="mpi", help="pool for --workers > 1: mpi (mpi4py.futures, default) or "
                                                    "processes (concurrent.futures)")
     p.add_argument("--samples-per-process", type=int, default=None,
-                   help="samples a process runs before a new one takes over (default 6 with the bearings family, 30 "
-                        "for set A alone; each re-analysis leaves memory behind in its process, docs/uncertainty.md)")
+                   help="samples a process runs before a new one takes over and builds its bases again (default: "
+                        "a worker's whole share)")
     p.add_argument("--out", default=None, help="result folder (default results/uncertainty-<scene>)")
     p.add_argument("--range", action="append", metavar="NAME=LOW:HIGH",
                    help="override a parameter's range (NAME=VALUE: fixed; radiation=erp[,foller]); names: "
                         + ", ".join(PARAMETERS))
-    p.add_argument("--family", action="append", metavar="bearings|none",
-                   help="variant families per sample (default bearings: gear set B with the four bearing "
-                        "configurations; none: set A only, the cheap mode)")
+    p.add_argument("--family", action="append", metavar="FAMILY",
+                   help="variant families per sample, repeatable: bearings (default: gear set B with the four "
+                        "bearing configurations), profile-corrections (sets B, C, D, uncorrected, and the thesis "
+                        "replica's engagement thesis-2d for all five sets), double-helical (its own basis; roller "
+                        "and fluid-film bearings at 500-2000 N m), all; none: set A only, the cheap mode")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a value of the run-up scene")
     p.set_defaults(func=_cmd)
 
 
 def _cmd(args: argparse.Namespace) -> int:
-    fams = args.family or list(FAMILIES)
-    fams = () if fams == ["none"] else tuple(fams)
+    fams = args.family or list(DEFAULT_FAMILIES)
+    fams = () if fams == ["none"] else FAMILIES if "all" in fams else tuple(dict.fromkeys(fams))
     run_command(args.scene, args.samples, args.seed, args.workers, args.out, args.range or (), args.set or (),
                 fams, args.engine, args.samples_per_process)
     return 0

@@ -9,9 +9,11 @@ unit, source, note) with these fields added (`tag`):
 * tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
 * passed — "yes", "no" or "" (a report row: nothing to pass);
 * why — what made the result, where it is known (the line, the modes, the term, ...);
-* band — the hook for the model's own uncertainty (issue 28 item 5): None until someone attaches one
-  (`attach_bands`), rendered "—".  A band is (low, high) of ours in the check's unit; the table then says whether
-  the measured value lies inside it.
+* band — the model's own uncertainty (issue 28 item 5): None until someone attaches one (`attach_bands`, from the
+  bands.json of `housingfe uncertainty`), rendered "—".  A band is (low, high) of ours in the check's unit (the
+  5-95 % band over the Monte-Carlo samples); the table then says whether the measured value lies inside it.
+  Beside it band_passes (k, n): the check passed in k of the n samples (the statement for a yes/no check), and
+  band_note (e.g. "no sampled input acts on this").
 
 Rows of other providers that already are an issue-28 check (the study rows, the default run-up's rows, the
 quasi-static excitation rows) are tagged where they are made, not repeated here; the rows no provider had are made
@@ -85,21 +87,45 @@ def check_rows(rows) -> list[dict]:
     return sorted(found, key=lambda r: CHECK_GROUPS.index(r["check_id"].split(".")[1]))
 
 
+BANDS_FORMAT = "housingfe-bands-2"
+
+
 def attach_bands(rows, bands) -> int:
-    """The uncertainty hook: bands {check_id: (low, high)} (ours' band in the check's unit, e.g. from a Monte-Carlo
-    run) set on the rows with that check_id; returns how many rows got one.  Rows without a band show "—"."""
+    """The uncertainty hook: bands {check_id: entry} set on the rows with that check_id; returns how many rows got
+    one.  An entry is (low, high) — ours' band in the check's unit (the old bands.json) — or a dict (the format of
+    `housingfe uncertainty`'s bands.json, BANDS_FORMAT): {"band": [low, high] or None, "passes": k, "samples": n,
+    "note": text}: ours' 5-95 % band over the samples where the check's value is a number, in how many of the n
+    samples that computed the check it passed, and a note (e.g. that no sampled input acts on the check).  Rows
+    without an entry show "—"."""
     n = 0
     for r in rows:
-        if is_check(r) and r["check_id"] in bands:
-            lo, hi = bands[r["check_id"]]
+        if not (is_check(r) and r["check_id"] in bands):
+            continue
+        entry = bands[r["check_id"]]
+        if isinstance(entry, dict):
+            band = entry.get("band")
+            r["band"] = None if band is None else (float(band[0]), float(band[1]))
+            r["band_passes"] = (None if entry.get("passes") is None
+                                else (int(entry["passes"]), int(entry["samples"])))
+            r["band_note"] = entry.get("note") or ""
+        else:
+            lo, hi = entry
             r["band"] = (float(lo), float(hi))
-            n += 1
+        n += 1
     return n
 
 
-def read_bands(path) -> dict[str, tuple[float, float]]:
-    """Bands from a JSON file {check_id: [low, high]} (`housingfe validate --bands FILE`); InputError naming the file
-    and key for anything else."""
+def _finite_pair(value) -> bool:
+    return (isinstance(value, list) and len(value) == 2
+            and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value)
+            and value[0] <= value[1])
+
+
+def read_bands(path) -> dict:
+    """Bands from a JSON file (`housingfe validate --bands FILE`): either {check_id: [low, high]} (the first format,
+    still read) or {"format": BANDS_FORMAT, "checks": {check_id: {"band": [low, high] or null, "passes": k or null,
+    "samples": n, "note": text}}} (`housingfe uncertainty`'s bands.json); InputError naming the file and key for
+    anything else."""
     import json
 
     from housingfe.errors import InputError
@@ -110,27 +136,50 @@ def read_bands(path) -> dict[str, tuple[float, float]]:
         raise InputError(f"{path}: cannot read a JSON object of bands: {exc}") from None
     if not isinstance(data, dict):
         raise InputError(f"{path}: must be a JSON object {{check_id: [low, high]}}")
+    if "format" in data:
+        if data["format"] != BANDS_FORMAT or not isinstance(data.get("checks"), dict):
+            raise InputError(f"{path}: format: {data['format']!r}: expected {BANDS_FORMAT!r} with a \"checks\" object")
+        out = {}
+        for key, entry in data["checks"].items():
+            if not isinstance(entry, dict):
+                raise InputError(f"{path}: checks.{key}: must be an object {{band, passes, samples, note}}")
+            band, passes, n = entry.get("band"), entry.get("passes"), entry.get("samples")
+            if band is not None and not _finite_pair(band):
+                raise InputError(f"{path}: checks.{key}.band: must be [low, high] with finite numbers, low <= high, "
+                                 f"or null, not {band!r}")
+            if passes is not None and not (isinstance(passes, int) and isinstance(n, int) and 0 <= passes <= n):
+                raise InputError(f"{path}: checks.{key}.passes: must be a whole number 0..samples ({n!r}), not "
+                                 f"{passes!r}")
+            if not isinstance(entry.get("note", ""), str):
+                raise InputError(f"{path}: checks.{key}.note: must be text")
+            out[key] = {"band": band, "passes": passes, "samples": n, "note": entry.get("note", "")}
+        return out
     out = {}
     for key, value in data.items():
-        ok = (isinstance(value, list) and len(value) == 2
-              and all(isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in value))
-        if not ok or value[0] > value[1]:
+        if not _finite_pair(value):
             raise InputError(f"{path}: {key}: must be [low, high] with finite numbers, low <= high, not {value!r}")
         out[key] = (float(value[0]), float(value[1]))
     return out
 
 
 def band_text(row: dict) -> str:
-    """"—" without a band; else "low … high" and whether the measured value is inside it."""
-    band = row.get("band")
-    if band is None:
-        return NO_BAND
-    lo, hi = band
-    m = row.get("measured")
-    where = ""
-    if isinstance(m, (int, float)) and not isinstance(m, bool):
-        where = ": measured inside" if lo <= m <= hi else ": measured outside"
-    return f"{lo:.4g} … {hi:.4g}{where}"
+    """"—" without an uncertainty statement; else "low … high" and whether the measured value (and the thesis'
+    calculated one, where the row has one) is inside it, in how many samples the check passed ("passes in k/n samples") and the band's note, where given."""
+    band, passes, note = row.get("band"), row.get("band_passes"), row.get("band_note")
+    parts = []
+    if band is not None:
+        lo, hi = band
+        where = []
+        for name in ("measured", "thesis_calculated"):      # the replica's goal is the thesis' calculation
+            v = row.get(name)
+            if isinstance(v, (int, float)) and not isinstance(v, bool):
+                where.append(f"{name.replace('_', ' ')} {'inside' if lo <= v <= hi else 'outside'}")
+        parts.append(f"{lo:.4g} … {hi:.4g}" + (": " + ", ".join(where) if where else ""))
+    if passes is not None:
+        parts.append(f"passes in {passes[0]}/{passes[1]} samples")
+    if note:
+        parts.append(note)
+    return "; ".join(parts) if parts else NO_BAND
 
 
 def _cell(v) -> str:
@@ -166,7 +215,7 @@ def write_checks(rows, folder: Path) -> None:
         writer.writerow(CHECK_COLUMNS)
         for r in found:
             cells = _cells(r)
-            cells[7] = "" if r.get("band") is None else cells[7]
+            cells[7] = "" if cells[7] == NO_BAND else cells[7]
             writer.writerow(cells)
     (Path(folder) / "checks.md").write_text(checks_markdown(rows))
 

@@ -90,8 +90,18 @@ def default_chain_rows(label: str, folder: Path) -> list[dict]:
     """The default chain's rows (module docstring) from a run-up result folder."""
     data = json.loads((folder / "runup.json").read_text())
     rad = data["scene_settings"]["radiation"]["models"][0]
-    totals = [r for r in _read_csv(folder / "runup.csv") if r["radiation"] == rad]
-    harm = [r for r in _read_csv(folder / "runup_harmonics.csv") if r["radiation"] == rad]
+    return chain_rows(label, rad, _read_csv(folder / "runup.csv"), _read_csv(folder / "runup_harmonics.csv"),
+                      data["peak_contributions"])
+
+
+def chain_rows(label: str, rad: str, totals: list[dict], harm: list[dict], peak_contributions: list[dict]
+               ) -> list[dict]:
+    """The default chain's rows of one run-up: totals (runup.csv rows, or RunupResult.totals), harm
+    (runup_harmonics.csv rows, or RunupResult.harmonic_rows()) and the peak contributions (runup.json, or
+    housingfe.runup.checks.evaluate), read for the radiation model `rad` at the highest torque.  The Monte-Carlo
+    of `housingfe uncertainty` calls this on each sample's run, so its bands are of the very same quantities."""
+    totals = [r for r in totals if r["radiation"] == rad]
+    harm = [r for r in harm if r["radiation"] == rad]
     top = max(_num(r["torque_nm"]) for r in totals)
     out = []
     for route in dict.fromkeys(r["route"] for r in totals):
@@ -99,7 +109,7 @@ def default_chain_rows(label: str, folder: Path) -> list[dict]:
         lines = [r for r in harm if r["route"] == route and _num(r["torque_nm"]) == top]
         where = f"{route}, {top:g} N m, sigma {rad}"
         out.append(max_harmonic_row(label, route, where, tot, lines))
-        contributions = [c for c in data["peak_contributions"] if c["route"] == route and c["torque_nm"] == top]
+        contributions = [c for c in peak_contributions if c["route"] == route and c["torque_nm"] == top]
         out += peak_rows(label, route, where, contributions)
         out += tooth_band_rows(label, route, where, lines)
     return out
@@ -185,10 +195,16 @@ def tooth_band_rows(label: str, route: str, where: str, lines: list[dict]) -> li
 
 def replica_rows(folder: Path) -> list[dict]:
     """28.replica.max_lwa from the study's thesis-2d profile-corrections run (set A, tf_omega)."""
-    from housingfe.verification.study_rows import JOBS, REPLICA_GOAL_DB
+    from housingfe.verification.study_rows import JOBS
 
     sub = next(s for f, o, s in JOBS if f == "profile-corrections" and any("thesis-2d" in x for x in o))
-    data = json.loads((folder / sub / "study.json").read_text())
+    return replica_rows_of(json.loads((folder / sub / "study.json").read_text()))
+
+
+def replica_rows_of(data: dict) -> list[dict]:
+    """28.replica.max_lwa from a thesis-2d profile-corrections study's data (study.json's content)."""
+    from housingfe.verification.study_rows import REPLICA_GOAL_DB
+
     r = next((r for r in data["rows"] if r["variant"] == "A" and r["route"] == "tf_omega"), None)
     if r is None:
         return []

@@ -433,9 +433,16 @@ def runup_rows(name: str, overrides=(), results: Path | None = None, quick: bool
     label, folder = found
     with open(folder / "runup.json") as fh:
         data = json.load(fh)
+    return run_check_rows(label, data["checks"], tagged=name == DEFAULT_RUNUP and not overrides)
+
+
+def run_check_rows(label: str, run_checks: list[dict], tagged: bool = True) -> list[dict]:
+    """Validate rows of a run-up's checks (runup.json "checks", or housingfe.runup.checks.evaluate); tagged: the
+    default run-up's, whose rows that are checks of issue 28 carry their check_id (tag_default_runup).  The
+    Monte-Carlo of `housingfe uncertainty` calls this on each sample's run."""
     src = thesis_source("test_gearbox", "Ch. 5")
     out = []
-    for c in data["checks"]:
+    for c in run_checks:
         ours, published = c["ours"], c["measured"]
         note = "; ".join(x for x in (f"goal: {c['goal']}" if c["goal"] else "",
                                      f"passed: {c['passed']}" if c["passed"] else "",
@@ -444,8 +451,8 @@ def runup_rows(name: str, overrides=(), results: Path | None = None, quick: bool
         unit = "rpm" if c["check"] in ("resonant_speeds", "L_omega_resonance") else "dB(A)" if c["check"] in (
             "LwA_max", "speed_law", "torque_law") else "dB"
         r = row(label, c["quantity"], ours, published, unit, src, note)
-        if name == DEFAULT_RUNUP and not overrides:
-            tag_default_runup(r, c, data["checks"])
+        if tagged:
+            tag_default_runup(r, c, run_checks)
         out.append(r)
     return out
 
@@ -626,7 +633,8 @@ def write_outputs(rows: list[dict], out_dir: Path, json_path) -> None:
     if json_path:
         Path(json_path).parent.mkdir(parents=True, exist_ok=True)
         keys = ("scene", "quantity", "ours", "published", "unit", "source", "note")
-        check_keys = ("check_id", "measured", "thesis_calculated", "tolerance", "passed", "why", "band")
+        check_keys = ("check_id", "measured", "thesis_calculated", "tolerance", "passed", "why", "band",
+                      "band_passes", "band_note")
         with open(json_path, "w") as fh:
             fh.write(dumps_json([{k: _jsonable(r.get(k, "")) for k in keys + (check_keys if r.get("check_id") else ())}
                                  for r in rows], indent=1))

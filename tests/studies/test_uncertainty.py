@@ -118,18 +118,115 @@ def test_bad_input_is_one_line_and_no_folder(tmp_path, args, message):
     assert not out.exists()
 
 
-def test_check_bands_name_the_validate_check_rows_and_hold_the_5_95_percent_band():
-    """bands.json maps each sampled quantity to the check_id of its validate row (28.default.max_lwa.<route>, ...)
-    with the 5-95 % band of the samples: 0..100 uniformly spaced gives (5, 95)."""
-    from housingfe.studies.uncertainty import UncertaintyResult
-
+def test_an_old_run_still_gives_the_bands_of_its_quantities():
+    """A result written before the samples carried their check rows (no "checks" in the metrics): bands.json maps
+    each sampled quantity to the check_id of its validate row (28.default.max_lwa.<route>, ...) with the 5-95 % band
+    of the samples: 0..100 uniformly spaced gives (5, 95)."""
     values = np.linspace(0.0, 100.0, 101)
     metrics = [{"mesh_force/max_lwa_dBA": v, "mesh_force/slope_dBA_per_doubling": v / 10,
                 "mesh_force/variant_mean_self_aligning_dB": -v} for v in values]
-    result = UncertaintyResult("test-gearbox-runup", 1, [{}] * len(values), metrics, ("mesh_force",),
-                               np.array([500.0]), (), {}, "processes", 1)
+    result = unc.UncertaintyResult("test-gearbox-runup", 1, [{}] * len(values), metrics, ("mesh_force",),
+                                   np.array([500.0]), (), {}, "processes", 1)
     bands = result.check_bands()
-    assert set(bands) == {"28.default.max_lwa.mesh_force", "28.speed_law.mesh_force",
-                          "28.variants.mean.bearings.self_aligning.mesh_force"}
-    assert bands["28.default.max_lwa.mesh_force"] == pytest.approx((5.0, 95.0))
-    assert bands["28.variants.mean.bearings.self_aligning.mesh_force"] == pytest.approx((-95.0, -5.0))
+    sampled = {k for k, v in bands.items() if v["band"] is not None}
+    assert sampled == {"28.default.max_lwa.mesh_force", "28.speed_law.mesh_force",
+                       "28.variants.mean.bearings.self_aligning.mesh_force"}
+    assert bands["28.default.max_lwa.mesh_force"]["band"] == pytest.approx([5.0, 95.0])
+    assert bands["28.variants.mean.bearings.self_aligning.mesh_force"]["band"] == pytest.approx([-95.0, -5.0])
+    # the excitation checks: no sampled input acts on them, said as such
+    assert bands["28.excitation.envelope.A"]["note"].startswith("no sampled input acts on this")
+
+
+def test_check_bands_from_the_samples_check_rows():
+    """Each sample keeps its check rows ({check_id: {ours, passed}}): a numeric check gets the 5-95 % band of its
+    values and the count of samples it passed in; a yes/no check (ours a ranking text) the count alone, k of the
+    samples that judged it; a check missing in some samples says in how many it was computed."""
+    n = 21
+    metrics = []
+    for i in range(n):
+        checks = {"28.default.max_lwa.mesh_force": {"ours": 60.0 + i, "passed": "yes" if 60.0 + i >= 77.5 else "no"},
+                  "28.variants.ranking.bearings.mean.tf_omega": {"ours": "a < b", "passed": "yes" if i % 7 == 0
+                                                                 else "no"}}
+        if i < 20:
+            checks["28.l_omega.resonance"] = {"ours": 1400.0, "passed": "yes"}
+        metrics.append({"checks": checks})
+    result = unc.UncertaintyResult("test-gearbox-runup", 1, [{}] * n, metrics, ("mesh_force",), np.array([500.0]),
+                                   (), {}, "processes", 1)
+    bands = result.check_bands()
+    top = bands["28.default.max_lwa.mesh_force"]
+    assert top["band"] == pytest.approx([61.0, 79.0])            # 60..80 in steps of 1: 5 % = 61, 95 % = 79
+    assert (top["passes"], top["samples"]) == (3, 21)            # 78, 79, 80
+    ranking = bands["28.variants.ranking.bearings.mean.tf_omega"]
+    assert ranking["band"] is None and (ranking["passes"], ranking["samples"]) == (3, 21)   # i = 0, 7, 14
+    assert bands["28.l_omega.resonance"]["note"] == "computed in 20 of 21 samples"
+
+
+@pytest.mark.slow
+def test_every_sample_carries_the_default_chain_checks(serial, tmp_path):
+    """Set A alone (--family none): each sample holds every check row of the default run-up, made by the row
+    functions of `housingfe validate`; its max L_WA row is the sample's max L_WA; the written bands.json counts a
+    check's passes from the per-sample rows (sample_checks.csv) and fills the band column of validate's rows."""
+    from housingfe.verification import checks as ck
+
+    expected = {"28.l_omega.flexible.500rpm", "28.l_omega.flexible.1000rpm", "28.l_omega.flexible.1500rpm",
+                "28.l_omega.resonance"}
+    for route in ("tf_omega", "mesh_force"):
+        expected |= {f"28.default.{w}.{route}" for w in ("max_lwa", "max_lwa_harmonic", "peaks",
+                                                         "no_high_harmonic_peak", "tooth_band.L_omega",
+                                                         "tooth_band.L_v", "tooth_band.L_W")}
+        expected.add(f"28.speed_law.{route}")
+    for m in serial.metrics:
+        assert set(m["checks"]) == expected
+        for route in ("tf_omega", "mesh_force"):
+            assert m["checks"][f"28.default.max_lwa.{route}"]["ours"] == pytest.approx(m[f"{route}/max_lwa_dBA"],
+                                                                                       abs=0.051)
+    unc.write(tmp_path, serial)
+    with open(tmp_path / "sample_checks.csv") as fh:
+        per_sample = list(csv.DictReader(fh))
+    bands = ck.read_bands(tmp_path / "bands.json")
+    for check_id in expected:
+        mine = [r for r in per_sample if r["check_id"] == check_id]
+        assert len(mine) == 3
+        assert bands[check_id]["passes"] == sum(r["passed"] == "yes" for r in mine), check_id
+    rows = [ck.check_row(c, "s", "q", 1.0, "-", "src") for c in sorted(expected)]
+    assert ck.attach_bands(rows, bands) == len(expected)
+    assert all(ck.band_text(r) != ck.NO_BAND and "samples" in ck.band_text(r) for r in rows)
+
+
+# the 59 check rows of issue 28 in `housingfe validate --only runup-checks` (docs/runup.md)
+ALL_CHECK_IDS = (
+    ["28.replica.max_lwa"] + [f"28.replica.correction.{v}" for v in ("B", "C", "D", "uncorrected")]
+    + [f"28.default.{w}.{r}" for r in ("tf_omega", "mesh_force")
+       for w in ("max_lwa", "max_lwa_harmonic", "peaks", "no_high_harmonic_peak", "tooth_band.L_omega",
+                 "tooth_band.L_v", "tooth_band.L_W")]
+    + [f"28.excitation.envelope.{s}" for s in ("A", "B", "C", "D", "uncorrected", "double-helical")]
+    + [f"28.speed_law.{r}" for r in ("tf_omega", "mesh_force")]
+    + [f"28.l_omega.flexible.{s}rpm" for s in (500, 1000, 1500)] + ["28.l_omega.resonance"]
+    + [f"28.variants.{w}.{r}" for r in ("tf_omega", "mesh_force")
+       for w in ("mean.profile-corrections.B", "mean.profile-corrections.C", "mean.profile-corrections.D",
+                 "correction_d", "mean.bearings.angular_contact", "mean.bearings.self_aligning",
+                 "mean.bearings.tapered_roller", "ranking.bearings.mean", "ranking.bearings.max",
+                 "mean.double-helical.fluid_film_at_2000", "ranking.rollers_vs_fluid_films.mean",
+                 "ranking.rollers_vs_fluid_films.max", "torque_law.cylindrical_roller", "torque_law.fluid_film")])
+
+
+@pytest.mark.slow
+def test_all_families_give_every_check_row_a_band(tmp_path):
+    """`housingfe uncertainty --family all` (one sample, coarse): bands.json holds an uncertainty statement for
+    every one of the 59 check rows, so `validate --bands` leaves no "—"."""
+    from housingfe.verification import checks as ck
+
+    assert len(ALL_CHECK_IDS) == len(set(ALL_CHECK_IDS)) == 59
+    out = tmp_path / "u"
+    proc = housingfe("uncertainty", "--samples", "1", "--seed", "2", "--family", "all", "--out", str(out),
+                     *[x for s in COARSE for x in ("--set", s)])
+    assert proc.returncode == 0, proc.stderr
+    bands = ck.read_bands(out / "bands.json")
+    assert set(bands) == set(ALL_CHECK_IDS)
+    rows = [ck.check_row(c, "s", "q", 1.0, "-", "src", measured=0.0) for c in ALL_CHECK_IDS]
+    assert ck.attach_bands(rows, bands) == 59
+    texts = {r["check_id"]: ck.band_text(r) for r in rows}
+    assert ck.NO_BAND not in texts.values()
+    assert texts["28.variants.ranking.rollers_vs_fluid_films.mean.tf_omega"] in (
+        "passes in 0/1 samples", "passes in 1/1 samples")
+    assert texts["28.excitation.envelope.A"].startswith("no sampled input acts on this")

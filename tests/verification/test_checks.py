@@ -4,10 +4,12 @@ hand, and the rows reaching validate's row collection from a cached run-up resul
 import csv
 import json
 import math
+import re
 
 import numpy as np
 import pytest
 
+from housingfe.errors import InputError
 from housingfe.verification import checks as ck
 from housingfe.verification import runup_checks_rows, source_rows, study_rows, validate
 
@@ -249,7 +251,7 @@ def test_bands_reach_the_json_and_checks_csv(tmp_path):
     assert "check_id" not in stored[1]
     with open(tmp_path / "out" / "checks.csv") as fh:
         (row,) = list(csv.DictReader(fh))
-    assert row["band"] == "86 … 91: measured outside" and row["passed"] == "yes"
+    assert row["band"] == "86 … 91: measured outside, thesis calculated inside" and row["passed"] == "yes"
 
 
 def test_a_bad_bands_file_is_one_error_line(tmp_path):
@@ -267,3 +269,32 @@ def test_a_bad_bands_file_is_one_error_line(tmp_path):
     assert proc.stderr.strip().splitlines() == [
         f"housingfe: error: {bad}: 28.replica.max_lwa: must be [low, high] with finite numbers, low <= high, not "
         "[91.0, 86.0]"]
+
+
+def test_bands_of_the_uncertainty_run_carry_band_pass_count_and_note(tmp_path):
+    """bands.json of `housingfe uncertainty` (format 2): a numeric check gets its band and pass count, a yes/no
+    check its pass count alone, an excitation check the note that no sampled input acts on it; the first format
+    still reads (test above)."""
+    path = tmp_path / "bands.json"
+    path.write_text(json.dumps({"format": ck.BANDS_FORMAT, "samples": 24, "checks": {
+        "28.default.max_lwa.mesh_force": {"band": [68.3, 83.5], "passes": 0, "samples": 24, "note": ""},
+        "28.variants.ranking.bearings.mean.tf_omega": {"band": None, "passes": 3, "samples": 24, "note": ""},
+        "28.excitation.envelope.A": {"band": None, "passes": None, "samples": 24, "note": "no sampled input acts"}}}))
+    bands = ck.read_bands(path)
+    rows = [ck.check_row("28.default.max_lwa.mesh_force", "s", "q", 75.2, "dB(A)", "src", measured=100.5,
+                         passed=False),
+            ck.check_row("28.variants.ranking.bearings.mean.tf_omega", "s", "q", "a < b", "-", "src",
+                         measured="b < a", passed=False),
+            ck.check_row("28.excitation.envelope.A", "s", "q", 2.3, "dB", "src", passed=False)]
+    assert ck.attach_bands(rows, bands) == 3
+    assert [ck.band_text(r) for r in rows] == ["68.3 … 83.5: measured outside; passes in 0/24 samples",
+                                               "passes in 3/24 samples", "no sampled input acts"]
+    for entry, message in (({"band": [2, 1]}, "checks.x.band: must be [low, high]"),
+                           ({"band": None, "passes": 5, "samples": 4}, "checks.x.passes: must be a whole number"),
+                           ([1, 2], "checks.x: must be an object")):
+        path.write_text(json.dumps({"format": ck.BANDS_FORMAT, "checks": {"x": entry}}))
+        with pytest.raises(InputError, match=re.escape(message)):
+            ck.read_bands(path)
+    path.write_text(json.dumps({"format": "something-else", "checks": {}}))
+    with pytest.raises(InputError, match="format"):
+        ck.read_bands(path)
