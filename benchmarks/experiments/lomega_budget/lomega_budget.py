@@ -107,16 +107,23 @@ def main(lumped_only: bool):
     # ---- what else the two rim accelerometers could see (Sec. 5.3: r = 136 mm, circumferential, summed / 2)
     print("\n## Rigid bores, per unit TE at the tooth frequency: wheel motions at the accelerometer radius r = "
           f"{R_ACC} m")
+    print(f"wheel base radius r_b2 = {mats.h[W] / math.cos(src.pair.base_helix_angle):.4f} m; "
+          "share of the TE the wheel takes = h_w |theta_w| / |e| (h_w = r_b2 cos beta_b)")
     print("| rpm | r |Omega_z|, m/s per um | in-plane translation |v_xy|, m/s per um | rim axial from tilt r |Omega_xy|, "
-          "m/s per um | translation / rotation, dB | tilt / rotation, dB |")
-    print("|---|---|---|---|---|---|")
+          "m/s per um | translation / rotation, dB | tilt / rotation, dB | wheel's share of the TE |")
+    print("|---|---|---|---|---|---|---|")
     for rpm in MEASURED:
         w = 2 * math.pi * ftooth[rpm]
         q = np.linalg.solve(mats.K0 + km * np.outer(mats.h, mats.h) - w**2 * mats.M + 1j * w * mats.D,
                             mats.h) * km * 1e-6 * w
         rot, trans, tilt = R_ACC * abs(q[W]), np.linalg.norm(q[6:8]), R_ACC * np.linalg.norm(q[9:11])
         print(f"| {rpm} | {rot:.3e} | {trans:.3e} | {tilt:.3e} | {20 * math.log10(trans / rot):+.1f} | "
-              f"{20 * math.log10(tilt / rot):+.1f} |")
+              f"{20 * math.log10(tilt / rot):+.1f} | {mats.h[W] * abs(q[W]) / w / 1e-6:.2f} |")
+
+    print("measured wheel angle at the tooth frequency as a displacement along the line of action, h_w |theta_w| "
+          "(model-free: what the wheel would take if it took the whole TE): " + ", ".join(
+              f"{rpm} rpm {mats.h[W] * amplitude_for_level(MEASURED[rpm]) / (2 * math.pi * ftooth[rpm]) * 1e6:.2f} um"
+              for rpm in MEASURED))
 
     # ---- 3. modes and their share in the wheel's angular velocity
     fr, phi = lumped_modes(mats)
