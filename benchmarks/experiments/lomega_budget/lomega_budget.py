@@ -41,6 +41,17 @@ def level_of_amplitude(a: float) -> float:
     return 20 * math.log10(a / (math.sqrt(2.0) * levels.OMEGA0))
 
 
+def print_extrema(fgrid, R, label: str) -> None:
+    """Print the local maxima and minima of a receptance R [rad/s per m of TE] over fgrid [Hz] as L_omega per um."""
+    inner = range(1, len(fgrid) - 1)
+    peaks = [i for i in inner if R[i] > R[i - 1] and R[i] >= R[i + 1]]
+    dips = [i for i in inner if R[i] < R[i - 1] and R[i] <= R[i + 1]]
+    print(f"R_TE peaks ({label}): " + ", ".join(
+        f"{fgrid[i]:.0f} Hz: L_omega {level_of_amplitude(R[i] * 1e-6):.1f} dB per um" for i in peaks))
+    print(f"R_TE minima ({label}): " + ", ".join(
+        f"{fgrid[i]:.0f} Hz: {level_of_amplitude(R[i] * 1e-6):.1f} dB per um" for i in dips))
+
+
 def lumped_te_receptance(mats, f_hz):
     """|Omega_wheel / e| [(rad/s)/m] of the rigid-bore model holding k_m, loaded by k_m e along h."""
     km, h = mats.mean_mesh_stiffness, mats.h
@@ -156,12 +167,8 @@ def main(lumped_only: bool):
     # receptance over frequency: its peaks in 100-900 Hz
     fgrid = np.arange(50.0, 1200.0, 1.0)
     Rg = lumped_te_receptance(mats, fgrid)
-    pk = [i for i in range(1, len(fgrid) - 1) if Rg[i] > Rg[i - 1] and Rg[i] >= Rg[i + 1]]
-    print("\nR_TE peaks (rigid bores): " + ", ".join(
-        f"{fgrid[i]:.0f} Hz: L_omega {level_of_amplitude(Rg[i] * 1e-6):.1f} dB per um" for i in pk))
-    dips = [i for i in range(1, len(fgrid) - 1) if Rg[i] < Rg[i - 1] and Rg[i] <= Rg[i + 1]]
-    print("R_TE minima (rigid bores): " + ", ".join(
-        f"{fgrid[i]:.0f} Hz: {level_of_amplitude(Rg[i] * 1e-6):.1f} dB per um" for i in dips))
+    print()
+    print_extrema(fgrid, Rg, "rigid bores")
 
     # ---- 4. L_omega over speed: resonance placement
     print("\n## Tooth-band L_omega over speed, rigid bores, full harmonic balance (10 rpm steps)")
@@ -225,12 +232,7 @@ def main(lumped_only: bool):
         print(f"| {rpm} | {rot:.3e} | {np.linalg.norm(u):.3e} | {tilt:.3e} | "
               f"{20 * math.log10(np.linalg.norm(u) / rot):+.1f} | {20 * math.log10(tilt / rot):+.1f} |")
     Rc = coupled_R(fgrid)
-    pk = [i for i in range(1, len(fgrid) - 1) if Rc[i] > Rc[i - 1] and Rc[i] >= Rc[i + 1]]
-    print("R_TE peaks (coupled): " + ", ".join(
-        f"{fgrid[i]:.0f} Hz: {level_of_amplitude(Rc[i] * 1e-6):.1f} dB per um" for i in pk))
-    dips = [i for i in range(1, len(fgrid) - 1) if Rc[i] < Rc[i - 1] and Rc[i] <= Rc[i + 1]]
-    print("R_TE minima (coupled): " + ", ".join(
-        f"{fgrid[i]:.0f} Hz: {level_of_amplitude(Rc[i] * 1e-6):.1f} dB per um" for i in dips))
+    print_extrema(fgrid, Rc, "coupled")
     band = (fgrid >= 150) & (fgrid <= 650)
     i = int(np.flatnonzero(band)[np.argmax(Rc[band])])
     print(f"coupled R_TE maximum in 150-650 Hz: {fgrid[i]:.0f} Hz ({fgrid[i] / src.pair.tooth_frequency(1.0):.0f} rpm), "
