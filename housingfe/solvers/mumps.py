@@ -24,6 +24,11 @@ from petsc4py import PETSc
 from housingfe.errors import SolverError
 
 MUMPS_LIBRARY = "libdmumps-5.5.so"
+# INFOG(1) of a workspace that the analysis' estimate left too small (MUMPS 5.5 users' guide, "Error
+# diagnostics": -8 integer array IS, -9 real array S, -11/-12 S for the solve or the elimination, -14/-15 integer
+# workspace); each is cured by a larger ICNTL(14).  Up to WORKSPACE_RETRIES doublings of it (20 % -> 1280 %).
+_WORKSPACE_SHORT = (-8, -9, -11, -12, -14, -15)
+WORKSPACE_RETRIES = 6
 MUMPS_VERSION_PREFIX = "5.5."
 
 # DMUMPS_STRUC_C of MUMPS 5.5 (dmumps_c.h, MUMPS_INT = int: Debian's 32-bit-index build)
@@ -180,25 +185,26 @@ def available() -> bool:
     return _load() is not None
 
 
-def ldlt(A: PETSc.Mat, backend: str = "auto", count_only: bool = False):
+def ldlt(A: PETSc.Mat, backend: str = "auto", count_only: bool = False, workspace_percent: int | None = None):
     """An LDL^T of A, analysed, not factorised: a DirectLDLT for backend "direct", and for "auto" on more than
     one rank when it is available; else a PetscLDLT.  On one rank PETSc's interface solves in place and the
     direct one only adds its conversion of the entries (S2R box, 40 k DOFs, 3 alternating fresh runs: 0.2-0.4 s
     slower).  count_only: its factorisations only give the inertia (MUMPS discards the factors as it
     goes, ICNTL(31) = 1, a choice of the analysis): 309 k DOFs on 2 ranks, 6.2 instead of 9.2 s and 2.9 instead
-    of 3.6 GB per rank."""
+    of 3.6 GB per rank.  workspace_percent: MUMPS' ICNTL(14) for the first factorisation (default MUMPS' 20);
+    where the workspace proves short it is doubled and the factorisation repeated (WORKSPACE_RETRIES times)."""
     if backend not in ("auto", "direct", "petsc"):
         raise ValueError(f"unknown MUMPS back-end {backend!r}: choose from auto, direct, petsc")
     if backend == "direct" or (backend == "auto" and A.getComm().getSize() > 1 and available()):
-        return DirectLDLT(A, count_only)
-    return PetscLDLT(A, count_only)
+        return DirectLDLT(A, count_only, workspace_percent)
+    return PetscLDLT(A, count_only, workspace_percent)
 
 
 class DirectLDLT:
     """MUMPS LDL^T (SYM = 2) of a symmetric PETSc AIJ matrix A through cffi: distributed input (the upper
     triangle of each rank's rows), distributed right-hand sides and solutions on more than one rank."""
 
-    def __init__(self, A: PETSc.Mat, count_only: bool = False):
+    def __init__(self, A: PETSc.Mat, count_only: bool = False, workspace_percent: int | None = None):
         binding = _load()
         if binding is None:
             raise SolverError(f"MUMPS through cffi is not available ({MUMPS_LIBRARY})")
@@ -221,6 +227,8 @@ class DirectLDLT:
                      (24, 1),                             # null-pivot detection: a singular A is reported
                      (31, 1 if count_only else 0)):
             self._icntl(i, v)
+        if workspace_percent is not None:
+            self._icntl(14, int(workspace_percent))       # the first factorisation's; it doubles where short
         bs = A.getBlockSize()
         if bs > 1:
             self._icntl(15, -bs)                          # the graph of nodes, as PETSc sets it
@@ -245,7 +253,16 @@ class DirectLDLT:
             if self.comm.allreduce(changed, op=MPI.LOR):     # every rank stops, none waits in MUMPS
                 raise SolverError("MUMPS LDL^T: the matrix changed its sparsity pattern since the analysis")
             self._take_values(blocks)
-        self._call(_JOB_FACTORISE)
+        # MUMPS sizes its workspace from the analysis plus ICNTL(14) per cent; delayed pivots of an indefinite
+        # matrix can need more (INFOG(1) = -9 and kin, seen on 2 ranks of a shifted K - sigma M): the users'
+        # guide's remedy is a larger ICNTL(14) and the factorisation again.  INFOG is global: all ranks retry.
+        for attempt in range(WORKSPACE_RETRIES + 1):
+            self.id.job = _JOB_FACTORISE
+            self._lib.dmumps_c(self.id)
+            if self.id.infog[0] not in _WORKSPACE_SHORT or attempt == WORKSPACE_RETRIES:
+                break
+            self._icntl(14, 2 * max(int(self.id.icntl[13]), 20))
+        self._check(_JOB_FACTORISE)
         self._to_petsc = None
         self._solution_rows = int(self.id.info[22])     # INFO(23)
 
@@ -308,6 +325,9 @@ class DirectLDLT:
     def _call(self, job: int) -> None:
         self.id.job = job
         self._lib.dmumps_c(self.id)
+        self._check(job)
+
+    def _check(self, job: int) -> None:
         if self.id.infog[0] < 0:
             raise SolverError(f"MUMPS failed (job {job}): INFOG(1) = {self.id.infog[0]}, "
                               f"INFOG(2) = {self.id.infog[1]} (see the MUMPS users' guide, error diagnostics)")
@@ -347,17 +367,36 @@ class _RowExchange:
 class PetscLDLT:
     """The same interface on PETSc's KSP/PCCholesky with MUMPS (one rank, and the fall-back of DirectLDLT)."""
 
-    def __init__(self, A: PETSc.Mat, count_only: bool = False):
+    def __init__(self, A: PETSc.Mat, count_only: bool = False, workspace_percent: int | None = None):
+        self.count_only = count_only
+        self.rows = A.getSize()[0]
+        self._new_factor(A, workspace_percent)
+
+    def _new_factor(self, A: PETSc.Mat, workspace_percent: int | None) -> None:
         self.ksp = mumps_cholesky(A, "ldlt_", inertia=True)
         self.ksp.getPC().setFactorSetUpSolverType()
         self.factor = self.ksp.getPC().getFactorMatrix()
         # on this factor, not in the options database: other solvers under the prefix keep their factors
-        self.factor.setMumpsIcntl(31, 1 if count_only else 0)
-        self.rows = A.getSize()[0]
+        self.factor.setMumpsIcntl(31, 1 if self.count_only else 0)
+        if workspace_percent is not None:
+            self.factor.setMumpsIcntl(14, workspace_percent)
 
     def factorise(self, A: PETSc.Mat) -> None:
         self.ksp.setOperators(A)
         self.ksp.setUp()
+        for _ in range(WORKSPACE_RETRIES):
+            if int(self.factor.getMumpsInfog(1)) not in _WORKSPACE_SHORT:
+                break
+            # PETSc records the failure on the factor without raising, and never factorises a factor whose
+            # MUMPS call failed again: a new one (analysis included) with twice the workspace
+            percent = 2 * max(int(self.factor.getMumpsIcntl(14)), 20)
+            self.ksp.destroy()
+            self._new_factor(A, percent)
+            self.ksp.setUp()
+        status = int(self.factor.getMumpsInfog(1))
+        if status < 0:      # a failed factor would report the inertia of its partial elimination
+            raise SolverError(f"MUMPS failed (PETSc's interface): INFOG(1) = {status}, INFOG(2) = "
+                              f"{int(self.factor.getMumpsInfog(2))} (see the MUMPS users' guide, error diagnostics)")
 
     def inertia(self) -> tuple[int, int]:
         negative, null, _ = self.factor.getInertia()

@@ -63,6 +63,42 @@ def test_block_solves_satisfy_the_equations(shifted, backend):
         factor.destroy()
 
 
+@pytest.fixture(scope="module")
+def saddle_point():
+    """[[0, B], [B^T, 0]] of order 3000, B = I + a sparse random part (nonsingular): exactly 1500 negative and
+    1500 positive eigenvalues (Sylvester), and a zero diagonal, so MUMPS' analysis (which plans for diagonal
+    pivots) underestimates the workspace that the delayed 2 x 2 pivots need: INFOG(1) = -9 at the default
+    ICNTL(14) = 20 % through cffi, and through PETSc at 0 %."""
+    import scipy.sparse as sp
+    from petsc4py import PETSc
+
+    n = 1500
+    B = sp.random(n, n, density=4 / n, random_state=1, format="csr") + sp.eye(n)
+    A = sp.bmat([[None, B], [B.T, None]], format="csr")
+    A.sort_indices()
+    M = PETSc.Mat().createAIJ(size=A.shape, csr=(A.indptr, A.indices, A.data), comm=PETSc.COMM_SELF)
+    M.assemble()
+    yield M
+    M.destroy()
+
+
+@pytest.mark.parametrize("backend, first", [("direct", None), ("direct", 0), ("petsc", 0)])
+def test_a_workspace_too_small_for_the_delayed_pivots_is_grown_and_the_inertia_is_exact(saddle_point, backend,
+                                                                                          first):
+    """Seen on 2 ranks of a shifted K - sigma M in CI: MUMPS stopped with INFOG(1) = -9 (its real workspace
+    short by 341 342 entries).  Both back-ends now double ICNTL(14) and factorise again; the inertia is the exact
+    (1500, 0) and the factor solves; before, the direct one raised, and PETSc's kept the failed factor, whose
+    inertia is that of a partial elimination (730 here)."""
+    factor = mumps.ldlt(saddle_point, backend, workspace_percent=first)
+    try:
+        factor.factorise(saddle_point)
+        assert factor.inertia() == (1500, 0)
+        B = np.random.default_rng(5).standard_normal((3000, 2))
+        assert _residual(saddle_point, B, factor.solve_block(B)) < 1e-8
+    finally:
+        factor.destroy()
+
+
 def test_both_backends_count_the_same_eigenvalues(coarse_box_model):
     """The inertia of K - sigma M by either back-end equals the number of eigenvalues below sigma found by the
     eigensolver (count_eigenvalues_below's own check on one rank is against dense eigenvalues)."""
