@@ -102,16 +102,23 @@ def coupled_gear_tilts(housing_model, drivetrain, forces=None) -> tuple[np.ndarr
         holds.append(cp.spring(node, None, k6))
     system = cp.couple(housing_model, p.connections, p.elements + holds, p.shafts, [])
     f = system.load(node_loads=loads)
-    ksp = PETSc.KSP().create(system.K.getComm())
-    ksp.setOperators(system.K)
-    ksp.setType("preonly")
-    pc = ksp.getPC()
-    pc.setType("lu")
-    pc.setFactorSolverType("mumps")
+    from housingfe.solvers.mumps import SingularMatrix, set_up_factor, set_workspace
+
+    def make_ksp(workspace_percent):
+        ksp = PETSc.KSP().create(system.K.getComm())
+        ksp.setOperators(system.K)
+        ksp.setType("preonly")
+        pc = ksp.getPC()
+        pc.setType("lu")
+        pc.setFactorSolverType("mumps")
+        set_workspace(ksp, workspace_percent)
+        return ksp
+
     u = system.K.createVecRight()
     try:
+        ksp = set_up_factor(make_ksp, what="misalignment")   # a failed factor raises instead of solving garbage
         ksp.solve(f, u)
-    except PETSc.Error:
+    except (SingularMatrix, PETSc.Error):
         raise InputError("misalignment: the coupled gearbox is singular (a free housing? the coupled model needs "
                          "the housing's supports)") from None
     if ksp.getConvergedReason() < 0 or not np.isfinite(u.norm()):

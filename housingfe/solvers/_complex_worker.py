@@ -91,13 +91,16 @@ def _upper_triangle(indptr, indices, datas):
 
 
 
-def _factor_solver(A, symmetric: bool, block_size: int):
+def _factor_solver(A, symmetric: bool, block_size: int, workspace_percent: int | None = None):
     """preonly + MUMPS (LDL^T when symmetric, LU otherwise) on A; user options under the prefix direct_ win.
     A symmetric matrix of one kind of unknown in node blocks (FE displacements, block_size 3) gets its ordering on
     the compressed node graph (ICNTL(15)) and no row/column scaling (ICNTL(8) = 0: the rows share one unit; a line
     whose backward error then exceeds BACKWARD_ERROR_TOL is refactorised with MUMPS' scaling): 0.79 -> 0.70 s per
-    factorisation at 39 k DOFs, backward errors ~1e-16 either way."""
+    factorisation at 39 k DOFs, backward errors ~1e-16 either way.  workspace_percent: MUMPS' ICNTL(14) (None:
+    its default or the options'); set up by housingfe.solvers.mumps.set_up_factor, which grows it where short."""
     from petsc4py import PETSc
+
+    from housingfe.solvers.mumps import set_workspace
 
     n = A.getSize()[0]
     opts = PETSc.Options()
@@ -114,6 +117,7 @@ def _factor_solver(A, symmetric: bool, block_size: int):
     pc.setFactorSolverType("mumps")
     ksp.setOptionsPrefix("direct_")   # -direct_mat_mumps_icntl_* through PETSC_OPTIONS reach the worker
     ksp.setFromOptions()
+    set_workspace(ksp, workspace_percent)
     return ksp
 
 
@@ -153,6 +157,8 @@ def run(job_path: str | None, out, first: int = 0, step: int = 1) -> int:
     solutions to the binary stream `out`."""
     import scipy.sparse  # noqa: F401  (imported while the parent writes the job)
     from petsc4py import PETSc
+
+    from housingfe.solvers.mumps import SingularMatrix, set_up_factor
 
     if not np.issubdtype(PETSc.ScalarType, np.complexfloating):
         print("the complex PETSc build was not selected (PETSC_DIR/SLEPC_DIR)", file=sys.stderr)
@@ -219,7 +225,9 @@ def run(job_path: str | None, out, first: int = 0, step: int = 1) -> int:
         try:
             while True:
                 ksp.setOperators(A)   # marks the operator changed: setUp redoes the numerical factorisation only
-                ksp.setUp()
+                # a failed factor raises (a short workspace is grown on a new factor, kept for later lines)
+                ksp = set_up_factor(lambda percent: _factor_solver(A, symmetric, block_size, percent), ksp,
+                                    what=f"direct solver, line {k}")
                 factorisations += 1
                 ksp.getPC().getFactorMatrix().matSolve(rhs, sol_mat)
                 sol = sol_mat.getDenseArray().T.copy()
@@ -231,7 +239,7 @@ def run(job_path: str | None, out, first: int = 0, step: int = 1) -> int:
                 ksp.destroy()
                 PETSc.Options()["direct_mat_mumps_icntl_8"] = 77
                 ksp = _factor_solver(A, symmetric, block_size)
-        except PETSc.Error:
+        except (SingularMatrix, PETSc.Error):
             print(f"SINGULAR {k}", file=sys.stderr)
             return SINGULAR_EXIT
         t_factor = time.perf_counter() - t0

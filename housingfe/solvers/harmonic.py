@@ -549,10 +549,11 @@ def _direct_block(K, M, loads, frequencies, damping: Damping, reduce, C: PETSc.M
         A = nest.convert("aij", PETSc.Mat())   # petsc4py converts in place unless given an output
         A.setOption(PETSc.Mat.Option.SYMMETRIC, symmetric)
         t1 = time.perf_counter()
-        ksp = _factor(A, "direct_", lu=not symmetric)
+        from housingfe.solvers.mumps import SingularMatrix
+
         try:
-            ksp.setUp()
-        except PETSc.Error as exc:
+            ksp = _factor(A, "direct_", lu=not symmetric)
+        except SingularMatrix as exc:
             raise SolverError(f"direct solver: singular system at {f_hz:.6g} Hz (undamped resonance?)") from exc
         t_factor += time.perf_counter() - t1
         for j, load in enumerate(loads):
@@ -599,13 +600,20 @@ def _shifted(K, M, shift: float) -> PETSc.Mat:
     return A
 
 
-def _factor(A: PETSc.Mat, prefix: str, lu: bool = False) -> PETSc.KSP:
-    from housingfe.solvers.mumps import mumps_cholesky
+def _factor(A: PETSc.Mat, prefix: str, lu: bool = False, workspace_percent: int | None = None) -> PETSc.KSP:
+    """A set-up MUMPS factorisation of A (LDL^T, LU with `lu`) through housingfe.solvers.mumps.set_up_factor: a
+    workspace too small is grown, any other failure raises SolverError (SingularMatrix when singular).
+    workspace_percent: ICNTL(14) of the first attempt (default MUMPS' 20)."""
+    from housingfe.solvers.mumps import mumps_cholesky, set_up_factor, set_workspace
 
-    ksp = mumps_cholesky(A, prefix)
-    if lu:   # non-symmetric bearing stiffness or fluid-film damping
-        ksp.getPC().setType("lu")
-    return ksp
+    def make_ksp(percent):
+        ksp = mumps_cholesky(A, prefix)
+        if lu:   # non-symmetric bearing stiffness or fluid-film damping
+            ksp.getPC().setType("lu")
+        set_workspace(ksp, workspace_percent if percent is None else percent)
+        return ksp
+
+    return set_up_factor(make_ksp, what="direct solver" if prefix == "direct_" else "MUMPS")
 
 
 def _is_symmetric(A: PETSc.Mat) -> bool:

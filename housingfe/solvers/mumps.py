@@ -370,33 +370,23 @@ class PetscLDLT:
     def __init__(self, A: PETSc.Mat, count_only: bool = False, workspace_percent: int | None = None):
         self.count_only = count_only
         self.rows = A.getSize()[0]
-        self._new_factor(A, workspace_percent)
-
-    def _new_factor(self, A: PETSc.Mat, workspace_percent: int | None) -> None:
-        self.ksp = mumps_cholesky(A, "ldlt_", inertia=True)
-        self.ksp.getPC().setFactorSetUpSolverType()
+        self.ksp = self._new_factor(A, workspace_percent)
         self.factor = self.ksp.getPC().getFactorMatrix()
+
+    def _new_factor(self, A: PETSc.Mat, workspace_percent: int | None) -> PETSc.KSP:
+        ksp = mumps_cholesky(A, "ldlt_", inertia=True)
+        ksp.getPC().setFactorSetUpSolverType()
         # on this factor, not in the options database: other solvers under the prefix keep their factors
-        self.factor.setMumpsIcntl(31, 1 if self.count_only else 0)
-        if workspace_percent is not None:
-            self.factor.setMumpsIcntl(14, workspace_percent)
+        ksp.getPC().getFactorMatrix().setMumpsIcntl(31, 1 if self.count_only else 0)
+        set_workspace(ksp, workspace_percent)
+        return ksp
 
     def factorise(self, A: PETSc.Mat) -> None:
+        """Numerical factorisation of A (the pattern of the analysis)."""
         self.ksp.setOperators(A)
-        self.ksp.setUp()
-        for _ in range(WORKSPACE_RETRIES):
-            if int(self.factor.getMumpsInfog(1)) not in _WORKSPACE_SHORT:
-                break
-            # PETSc records the failure on the factor without raising, and never factorises a factor whose
-            # MUMPS call failed again: a new one (analysis included) with twice the workspace
-            percent = 2 * max(int(self.factor.getMumpsIcntl(14)), 20)
-            self.ksp.destroy()
-            self._new_factor(A, percent)
-            self.ksp.setUp()
-        status = int(self.factor.getMumpsInfog(1))
-        if status < 0:      # a failed factor would report the inertia of its partial elimination
-            raise SolverError(f"MUMPS failed (PETSc's interface): INFOG(1) = {status}, INFOG(2) = "
-                              f"{int(self.factor.getMumpsInfog(2))} (see the MUMPS users' guide, error diagnostics)")
+        # a failed factor would report the inertia of its partial elimination: set_up_factor raises instead
+        self.ksp = set_up_factor(lambda percent: self._new_factor(A, percent), self.ksp, what="MUMPS LDL^T")
+        self.factor = self.ksp.getPC().getFactorMatrix()
 
     def inertia(self) -> tuple[int, int]:
         negative, null, _ = self.factor.getInertia()
@@ -435,3 +425,80 @@ def mumps_cholesky(A: PETSc.Mat, prefix: str, inertia: bool = False) -> PETSc.KS
         opts[f"{prefix}mat_mumps_icntl_24"] = 1   # null-pivot detection: MatGetInertia requires it
     ksp.setFromOptions()
     return ksp
+
+
+# INFOG(1) = -10: MUMPS found the matrix numerically singular
+_SINGULAR = -10
+
+
+class SingularMatrix(SolverError):
+    """MUMPS found the matrix numerically singular (INFOG(1) = -10): callers may say why (a resonance, no
+    supports)."""
+
+
+def set_workspace(ksp: PETSc.KSP, workspace_percent: int | None) -> None:
+    """ICNTL(14) (per cent of extra workspace over the analysis' estimate) on the MUMPS factor of ksp's PC; None
+    leaves MUMPS' default (20) or the options database's value."""
+    if workspace_percent is not None:
+        pc = ksp.getPC()
+        pc.setFactorSetUpSolverType()
+        pc.getFactorMatrix().setMumpsIcntl(14, int(workspace_percent))
+
+
+def factor_status(ksp: PETSc.KSP) -> tuple[int, int] | None:
+    """(INFOG(1), INFOG(2)) of the MUMPS factor of ksp's PC after its set-up, or None when the PC is no MUMPS
+    factorisation (user options chose another) or has none yet."""
+    pc = ksp.getPC()
+    if pc.getType() not in ("lu", "cholesky") or pc.getFactorSolverType() != "mumps":
+        return None
+    try:
+        factor = pc.getFactorMatrix()
+        return int(factor.getMumpsInfog(1)), int(factor.getMumpsInfog(2))
+    except PETSc.Error:
+        return None
+
+
+def set_up_factor(make_ksp, ksp: PETSc.KSP | None = None, what: str = "MUMPS") -> PETSc.KSP:
+    """The KSP of a MUMPS factorisation through PETSc, set up and checked: the one way the package factorises with
+    MUMPS through PETSc.  make_ksp(workspace_percent) builds the KSP with its operators (workspace_percent: None,
+    or ICNTL(14) to set with set_workspace); `ksp`: one already built (its operators changed: set-up refactorises
+    it), else make_ksp(None) is called.
+
+    Through PETSc 3.18 a failed MUMPS factorisation does not raise (unless the KSP errors if not converged): the
+    factor keeps INFOG(1) < 0 and a solve then diverges or returns garbage.  Here a workspace too small
+    (INFOG(1) in _WORKSPACE_SHORT, e.g. -9 from the delayed pivots of an indefinite matrix) gets a new KSP with
+    twice the ICNTL(14) (PETSc never refactorises a factor whose MUMPS call failed), up to WORKSPACE_RETRIES times;
+    any other failure raises SolverError ("singular matrix" for INFOG(1) = -10).  Collective; INFOG is global, so
+    every rank takes the same branch.  The returned KSP may differ from `ksp` (which is then destroyed)."""
+    ksp = make_ksp(None) if ksp is None else ksp
+    for attempt in range(WORKSPACE_RETRIES + 1):
+        try:
+            ksp.setUp()
+            raised = None
+        except PETSc.Error as exc:     # a KSP that errors if not converged raises on a failed factorisation
+            raised = exc
+        status = factor_status(ksp)
+        if status is None:
+            if raised is not None:
+                ksp.destroy()
+                raise SolverError(f"{what}: the factorisation failed ({raised})") from raised
+            return ksp
+        info1, info2 = status
+        if info1 >= 0:
+            if raised is None:
+                return ksp
+            ksp.destroy()
+            raise SolverError(f"{what}: the set-up failed ({raised})") from raised
+        if info1 not in _WORKSPACE_SHORT or attempt == WORKSPACE_RETRIES:
+            break
+        percent = 2 * max(int(ksp.getPC().getFactorMatrix().getMumpsIcntl(14)), 20)
+        ksp.destroy()
+        ksp = make_ksp(percent)
+    ksp.destroy()
+    if info1 == _SINGULAR:
+        raise SingularMatrix(f"{what}: singular matrix (MUMPS INFOG(1) = {info1}, INFOG(2) = {info2})")
+    if info1 in _WORKSPACE_SHORT:
+        raise SolverError(f"{what}: MUMPS' workspace still too small after {WORKSPACE_RETRIES} doublings of "
+                          f"ICNTL(14): INFOG(1) = {info1}, INFOG(2) = {info2}")
+    raise SolverError(f"{what}: MUMPS failed: INFOG(1) = {info1}, INFOG(2) = {info2} (see the MUMPS users' "
+                      "guide, error diagnostics)")
