@@ -241,6 +241,8 @@ def solve(job: dict) -> dict:
         raise ValueError(f"unknown truncation {truncation!r}")
     L = 1j * omega_rho * ufl.inner(v_n, q) * ds(VIBRATING)
 
+    from housingfe.solvers.mumps import check_solved
+
     t1 = time.perf_counter()
     problem = LinearProblem(a, L, petsc_options={"ksp_type": "preonly", "pc_type": "lu",
                                                  "pc_factor_mat_solver_type": "mumps"})
@@ -256,6 +258,7 @@ def solve(job: dict) -> dict:
         k.value = 2 * np.pi * f / c
         omega_rho.value = 2 * np.pi * f * rho
         problem.solve()
+        check_solved(problem.solver, f"radiation FEM at {f:.6g} Hz")   # a failed MUMPS factor returns garbage
         power = fem.assemble_scalar(power_form).real
         rows.append({"frequency_hz": f, "power_w": power, "sigma": power / (rho * c * area * mean_square),
                      "area_m2": area, "mean_square_velocity": mean_square,

@@ -429,6 +429,25 @@ def _krylov_schur(K, M, shift: float, nev: int, ncv, tol: float, purify: bool, s
     pc.setType("cholesky")
     pc.setFactorSolverType("mumps")
     eps.setFromOptions()
+    try:                              # factorises K - shift M, checked (and its workspace grown) before the solve
+        eps.setUp()
+    except PETSc.Error:               # SLEPc's KSP raises on a failed factor: set_up_factor reads why
+        pass
+    operators = ksp.getOperators()
+
+    def regrown_ksp(workspace_percent):
+        new = PETSc.KSP().create(K.getComm())
+        new.setOptionsPrefix(ksp.getOptionsPrefix())
+        new.setOperators(*operators)
+        new.setType("preonly")
+        new.getPC().setType("cholesky")
+        new.getPC().setFactorSolverType("mumps")
+        new.setFromOptions()
+        mumps.set_workspace(new, workspace_percent)
+        st.setKSP(new)
+        return new
+
+    mumps.set_up_factor(regrown_ksp, st.getKSP(), what="modal solve (SLEPc's shift-and-invert)")
     eps.solve()
     pairs = []
     for i in range(eps.getConverged()):

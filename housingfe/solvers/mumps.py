@@ -438,8 +438,14 @@ class SingularMatrix(SolverError):
 
 def set_workspace(ksp: PETSc.KSP, workspace_percent: int | None) -> None:
     """ICNTL(14) (per cent of extra workspace over the analysis' estimate) on the MUMPS factor of ksp's PC; None
-    leaves MUMPS' default (20) or the options database's value."""
+    leaves MUMPS' default (20) or the options database's value.  PETSc applies -<prefix>mat_mumps_icntl_14 at the
+    analysis, over the factor's own ICNTL(14): a smaller value there is raised to workspace_percent (it proved
+    short)."""
     if workspace_percent is not None:
+        key = f"{ksp.getOptionsPrefix() or ''}mat_mumps_icntl_14"
+        options = PETSc.Options()
+        if options.hasName(key) and options.getInt(key) < workspace_percent:
+            options[key] = int(workspace_percent)
         pc = ksp.getPC()
         pc.setFactorSetUpSolverType()
         pc.getFactorMatrix().setMumpsIcntl(14, int(workspace_percent))
@@ -495,10 +501,26 @@ def set_up_factor(make_ksp, ksp: PETSc.KSP | None = None, what: str = "MUMPS") -
         ksp.destroy()
         ksp = make_ksp(percent)
     ksp.destroy()
+    raise _failure(what, info1, info2)
+
+
+def _failure(what: str, info1: int, info2: int) -> SolverError:
     if info1 == _SINGULAR:
-        raise SingularMatrix(f"{what}: singular matrix (MUMPS INFOG(1) = {info1}, INFOG(2) = {info2})")
+        return SingularMatrix(f"{what}: singular matrix (MUMPS INFOG(1) = {info1}, INFOG(2) = {info2})")
     if info1 in _WORKSPACE_SHORT:
-        raise SolverError(f"{what}: MUMPS' workspace still too small after {WORKSPACE_RETRIES} doublings of "
-                          f"ICNTL(14): INFOG(1) = {info1}, INFOG(2) = {info2}")
-    raise SolverError(f"{what}: MUMPS failed: INFOG(1) = {info1}, INFOG(2) = {info2} (see the MUMPS users' "
-                      "guide, error diagnostics)")
+        return SolverError(f"{what}: MUMPS' workspace too small (after up to {WORKSPACE_RETRIES} doublings of "
+                           f"ICNTL(14)): INFOG(1) = {info1}, INFOG(2) = {info2}")
+    return SolverError(f"{what}: MUMPS failed: INFOG(1) = {info1}, INFOG(2) = {info2} (see the MUMPS users' "
+                       "guide, error diagnostics)")
+
+
+def check_solved(ksp: PETSc.KSP, what: str = "MUMPS") -> None:
+    """After ksp.solve on a MUMPS factor that set_up_factor did not set up (dolfinx's LinearProblem sets up its
+    own in its solve): SolverError when the factorisation failed (PETSc 3.18 does not raise then; the solution is
+    garbage) or the solve diverged."""
+    status = factor_status(ksp)
+    if status is not None and status[0] < 0:
+        raise _failure(what, *status)
+    reason = ksp.getConvergedReason()
+    if reason < 0:
+        raise SolverError(f"{what}: the direct solve failed (PETSc KSP converged reason {reason})")
