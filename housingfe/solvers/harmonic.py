@@ -609,7 +609,10 @@ def _factor(A: PETSc.Mat, prefix: str, lu: bool = False, workspace_percent: int 
     def make_ksp(percent):
         ksp = mumps_cholesky(A, prefix)
         if lu:   # non-symmetric bearing stiffness or fluid-film damping
+            # a new PC type forgets the solver type: without this it was PETSc's own LU, not MUMPS
             ksp.getPC().setType("lu")
+            ksp.getPC().setFactorSolverType("mumps")
+            ksp.setFromOptions()
         set_workspace(ksp, workspace_percent if percent is None else percent)
         return ksp
 

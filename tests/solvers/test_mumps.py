@@ -175,3 +175,89 @@ def test_the_tests_above_pass_on_two_ranks(comm):
     """The distributed path (MUMPS' solution rows moved back to PETSc's, the collective pattern check) runs in
     `make test` too: this file's other tests under `mpirun -n 2`."""
     rerun_on_two_ranks(__file__, comm, timeout=600)
+
+
+def _singular(n: int = 40):
+    """diag(1, ..., 1, 0): MUMPS reports INFOG(1) = -10 (null-pivot detection is off by default)."""
+    from petsc4py import PETSc
+
+    S = PETSc.Mat().createAIJ(size=(n, n), nnz=1, comm=PETSc.COMM_SELF)
+    for i in range(n):
+        S.setValue(i, i, 0.0 if i == n - 1 else 1.0)
+    S.assemble()
+    return S
+
+
+def test_set_up_factor_grows_a_short_workspace_and_raises_on_a_singular_matrix(saddle_point):
+    """The one way the package factorises with MUMPS through PETSc: at ICNTL(14) = 0 the saddle point's factor
+    fails with INFOG(1) = -9 (which PETSc 3.18 does not raise); the helper builds a new factor with 40 % and it
+    solves to round-off; a singular matrix raises SingularMatrix (a SolverError) instead of leaving a failed
+    factor whose solve is garbage."""
+    asked = []
+
+    def make_ksp(percent):
+        asked.append(percent)
+        ksp = mumps.mumps_cholesky(saddle_point, "test_grow_")
+        mumps.set_workspace(ksp, 0 if percent is None else percent)
+        return ksp
+
+    ksp = mumps.set_up_factor(make_ksp)
+    try:
+        assert asked == [None, 40]
+        assert mumps.factor_status(ksp)[0] == 0
+        b, x = saddle_point.createVecs()
+        b.getArray()[:] = np.random.default_rng(7).standard_normal(3000)
+        ksp.solve(b, x)
+        assert _residual(saddle_point, b.getArray()[:, None], x.getArray()[:, None]) < 1e-8
+    finally:
+        ksp.destroy()
+    S = _singular()
+    with pytest.raises(mumps.SingularMatrix, match=r"singular matrix \(MUMPS INFOG\(1\) = -10"):
+        mumps.set_up_factor(lambda percent: mumps.mumps_cholesky(S, "test_singular_"))
+    S.destroy()
+
+
+def test_the_harmonic_solvers_factor_is_checked_and_grown(saddle_point):
+    """harmonic._factor (the residual vectors' K - shift M and the 2x2 real block system per line, symmetric
+    indefinite): a short workspace is grown (LDL^T and LU) and solves to round-off; a singular system raises."""
+    from housingfe.solvers import harmonic
+
+    for lu in (False, True):
+        ksp = harmonic._factor(saddle_point, "test_harmonic_", lu=lu, workspace_percent=0)
+        try:
+            assert ksp.getPC().getFactorMatrix().getMumpsIcntl(14) == 40
+            b, x = saddle_point.createVecs()
+            b.getArray()[:] = np.random.default_rng(8).standard_normal(3000)
+            ksp.solve(b, x)
+            assert _residual(saddle_point, b.getArray()[:, None], x.getArray()[:, None]) < 1e-8
+        finally:
+            ksp.destroy()
+    S = _singular()
+    with pytest.raises(SolverError, match="singular"):
+        harmonic._factor(S, "direct_")
+    S.destroy()
+
+
+def test_slepc_shift_invert_regrows_a_short_workspace(saddle_point):
+    """The modal "slepc" method's shift-and-invert factor of K - 0 M with K the saddle point (M = I): with
+    -st_mat_mumps_icntl_14 0 it fails with INFOG(1) = -9 (SLEPc then raised PETSc's error); now a new factor with
+    more workspace is made and the eigenvalues nearest 0 are +-(the smallest singular values of B), exactly."""
+    import scipy.sparse as sp
+    from petsc4py import PETSc
+
+    identity = sp.eye(3000, format="csr")
+    M = PETSc.Mat().createAIJ(size=(3000, 3000), csr=(identity.indptr, identity.indices, identity.data),
+                              comm=PETSc.COMM_SELF)
+    M.assemble()
+    ia, ja, va = saddle_point.getValuesCSR()
+    B = sp.csr_matrix((va, ja, ia), shape=(3000, 3000))[:1500, 1500:].toarray()
+    sv = np.sort(np.linalg.svd(B, compute_uv=False))[:2]
+    options = PETSc.Options()
+    options["st_mat_mumps_icntl_14"] = 0
+    try:
+        pairs = modal._krylov_schur(saddle_point, M, 0.0, 4, None, 1e-10, False, np.inf,
+                                    structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    finally:
+        options.delValue("st_mat_mumps_icntl_14")
+        M.destroy()
+    np.testing.assert_allclose([p[0] for p in pairs], [-sv[1], -sv[0], sv[0], sv[1]], rtol=1e-8)
