@@ -148,3 +148,32 @@ def test_backward_error_is_reported_and_a_poor_line_is_refactorised_with_scaling
         assert head[2] < 1e-13
         sol = np.frombuffer(raw[_complex_worker.HEAD_BYTES:], np.complex128).reshape(len(loads), n)
         assert np.abs(sol - u_ref[:, k]).max() < 1e-9 * np.abs(u_ref[:, k]).max()
+
+
+def test_a_short_mumps_workspace_is_grown_in_the_worker(tmp_path):
+    """The saddle point [[0, B], [B^T, 0]] (order 3000, see tests/solvers/test_mumps.py) at ICNTL(14) = 0: MUMPS
+    stops with INFOG(1) = -9 in the worker's complex LDL^T, which the worker reported as a singular line; now it
+    factorises again with more workspace and the solution satisfies A x = f to round-off."""
+    import os
+    import subprocess
+    import sys
+
+    n = 1500
+    B = sp.random(n, n, density=4 / n, random_state=1, format="csr") + sp.eye(n)
+    K = sp.bmat([[None, B], [B.T, None]], format="csr")
+    K.sort_indices()
+    M = sp.eye(2 * n, format="csr")
+    f = np.random.default_rng(9).standard_normal((1, 2 * n))
+    job = {"loads": f, "omega": np.array([0.0]), "eta": np.array([0.0]), "use_D": False, "symmetric": True,
+           "block_size": 1}
+    for name, A in (("K", K), ("M", M)):
+        job.update({f"{name}_indptr": A.indptr, f"{name}_indices": A.indices, f"{name}_data": A.data})
+    np.savez(tmp_path / "job.npz", **job)
+    env = _complex_worker.complex_env()
+    env["PETSC_OPTIONS"] = (os.environ.get("PETSC_OPTIONS", "") + " -direct_mat_mumps_icntl_14 0").strip()
+    driver = ("import sys; from housingfe.solvers import _complex_worker as w; "
+              f"raise SystemExit(w.run({str(tmp_path / 'job.npz')!r}, sys.stdout.buffer))")
+    proc = subprocess.run([sys.executable, "-c", driver], capture_output=True, env=env)
+    assert proc.returncode == 0, proc.stderr.decode()
+    x = np.frombuffer(proc.stdout[_complex_worker.HEAD_BYTES:], np.complex128)
+    assert np.linalg.norm(K @ x - f[0]) < 1e-10 * np.linalg.norm(f)
