@@ -39,10 +39,12 @@ NULL_VECTOR_RATIO = 1e-13
 # The inertia count and the eigensolve both work on K - sigma M in double precision.  When (2 pi f_max)^2 lies below
 # PRECISION_FLOOR of lambda_scale the eigenvalues of interest are round-off against the mesh's highest one (free
 # plates, one element layer, elements 625 thicknesses wide, t/L = 1/10 000: sigma_max at 2.5e-15..4.4e-15 of it,
-# the LDL^T counted 0 of 16 eigenvalues) and solve_modes refuses.  Above the floor the count can still fail on the
-# stiffest element families (S2R at t/L = 1/3333, 3.5e-13: 0 of 16), which a free structure exposes: its known
-# rigid motions must all be counted (solve_modes checks it).  A cantilever's static-range FRF asks for f_max at
-# 1.5e-13 (no mode below it) and gets its exact count of 0; Q2 at t/L = 1/5000 (4e-14) counts and solves right.
+# with the floor switched off the solve finds 11 near-zero modes instead of 6) and solve_modes refuses.  Above the
+# floor a free structure's known rigid motions must still all be counted (solve_modes checks it).  (S2R at t/L =
+# 1/3333, 3.5e-13, once counted 0 of 16: that was a MUMPS factor short of workspace, INFOG(1) = -9, kept silently by
+# PETSc; grown since 2026-11-26, housingfe.solvers.mumps, it solves within 1 % of Kirchhoff.)  A cantilever's
+# static-range FRF asks for f_max at 1.5e-13 (no mode below it) and gets its exact count of 0; Q2 at t/L = 1/5000
+# (4e-14) counts and solves right.
 PRECISION_FLOOR = 1e-14
 # Kept for small dense models that have no matrix scale at hand (housingfe.drivetrain.interior): a frequency ratio.
 RIGID_FREQUENCY_RATIO = 1e-4
