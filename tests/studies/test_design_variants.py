@@ -19,6 +19,7 @@ from housingfe.data import thesis
 from housingfe.errors import InputError
 from housingfe.studies import design_variants as dv
 from housingfe.studies.chain_session import difference_stats, energy_mean_db
+from tests.studies.runup_cli import cli_lwa_curves
 from tests.test_cli import housingfe
 
 COARSE = ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500", "runup.speed_min_rpm=800",
@@ -133,12 +134,7 @@ def test_a_study_run_up_is_the_chain_of_housingfe_run(tmp_path):
     session = ChainSession.from_scene("test-gearbox-runup", COARSE)
     assert session.spec.source_receptance == "coupled" and session.spec.misalignment_model != "none"
     res = session.runup(session.model(session.drivetrain("A", "ball", 2000.0)), 2000.0)
-    out = tmp_path / "run"
-    proc = housingfe("run", "test-gearbox-runup", *[x for s in COARSE for x in ("--set", s)], "--out", str(out))
-    assert proc.returncode == 0, proc.stderr
-    rows = list(csv.DictReader(open(out / "runup.csv")))
-    for route in ("tf_omega", "mesh_force"):
-        run = np.array([float(r["LwA_dB"]) for r in rows if r["route"] == route and r["radiation"] == "erp"])
+    for route, run in cli_lwa_curves("test-gearbox-runup", COARSE, tmp_path / "run").items():
         s, lwa = res.series(route, "erp", 2000.0, "LwA_dB")
         np.testing.assert_allclose(lwa, run, rtol=0, atol=2e-3, err_msg=route)
     rigid = session.runup(session.model(session.drivetrain("A", "ball", 2000.0)), 2000.0,

@@ -18,6 +18,7 @@ import pytest
 
 from housingfe.errors import InputError
 from housingfe.studies import uncertainty as unc
+from tests.studies.runup_cli import cli_lwa_curves
 from tests.test_cli import housingfe
 
 COARSE = ('housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500", "runup.speed_min_rpm=250",
@@ -88,12 +89,7 @@ def test_zero_width_ranges_give_the_deterministic_run(serial, tmp_path):
     scene, _ = load_runup_scene("test-gearbox-runup", list(COARSE))
     res = unc.run_uncertainty("test-gearbox-runup", 2, seed=1, workers=1, overrides=COARSE, families=(),
                               ranges=unc.nominal_ranges(scene))
-    out = tmp_path / "run"
-    proc = housingfe("run", "test-gearbox-runup", *[x for s in COARSE for x in ("--set", s)], "--out", str(out))
-    assert proc.returncode == 0, proc.stderr
-    rows = list(csv.DictReader(open(out / "runup.csv")))
-    for route in ("tf_omega", "mesh_force"):
-        curve = np.array([float(r["LwA_dB"]) for r in rows if r["route"] == route and r["radiation"] == "erp"])
+    for route, curve in cli_lwa_curves("test-gearbox-runup", COARSE, tmp_path / "run").items():
         p5, p50, p95 = res.band("max_lwa_dBA", route)
         assert p5 == p95 == p50
         assert p50 == pytest.approx(curve.max(), abs=2e-3)
