@@ -255,7 +255,7 @@ def engagement_force(pair: GearPair, corrections: Corrections, stiffness: np.nda
 def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffness: np.ndarray,
                                 normal_force: float, load_share: np.ndarray | None = None,
                                 n_slices: int = 256, n_samples: int | None = None,
-                                origin: float = 0.0) -> np.ndarray:
+                                origin: float = 0.0, helix_stagger: bool = True) -> np.ndarray:
     """Engagement/disengagement shock force F_e [N] over one mesh period, distributed over the face width:
     Eq. 2.62 applied per face-width slice of the contact lines, sampled like `engagement_force`.
 
@@ -273,7 +273,11 @@ def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffn
 
     Limits (tests/source/roosmalen/test_dynamics.py): spur gears (eps_beta = 0) with origin = A give exactly
     `engagement_force`; for a uniform load and constant S the harmonics are those of the transverse-section
-    shock (Eq. 2.62 with eps_alpha) times the slices' array factor, |sinc(n eps_beta)| for many slices."""
+    shock (Eq. 2.62 with eps_alpha) times the slices' array factor, |sinc(n eps_beta)| for many slices.
+
+    helix_stagger = False drops the o_j tan(beta_b) term: every slice of a contact line at the same roll position
+    (the pair's transverse, spur-equivalent shock with the same load share and flank gaps; the reference of the
+    envelope bound in housingfe.source.roosmalen.overlap, not an engagement model)."""
     S = np.asarray(stiffness, dtype=float)
     n = S.size if n_samples is None else n_samples
     t = np.arange(n) / n
@@ -304,7 +308,7 @@ def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffn
         w_local = offset if hx == 0 else b - offset           # helix 1 has the opposite hand
         w = w_local + hx * (b + pair.helix_gap)
         for k in range(k_lo, k_hi + 1):
-            s = origin + (t[:, None] + k) * p + offset[None, :] * tb
+            s = origin + (t[:, None] + k) * p + (offset[None, :] * tb if helix_stagger else 0.0 * offset[None, :])
             inside = (s >= A) & (s < E_)
             if not inside.any():
                 continue
