@@ -29,9 +29,10 @@ def _fmt(v):
 
 
 def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict,
-          decompositions: list = ()) -> None:
+          decompositions: list = (), notes: list = ()) -> None:
     """Every output file of a run-up into `folder` (rank 0); decompositions: housingfe.runup.slopes
-    SlopeDecomposition of every curve."""
+    SlopeDecomposition of every curve; notes: lines for the summary about the model's validity (e.g. the source's
+    housingfe.source.roosmalen.overlap.cancellation_note)."""
     totals = [r for _, res in results.values() for r in res.totals]
     outputs.write_csv(folder / "runup.csv", TOTAL_COLUMNS, ([_fmt(r[k]) for k in TOTAL_COLUMNS] for r in totals))
     harm = [r for _, res in results.values() for r in res.harmonic_rows()]
@@ -50,7 +51,8 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
                           ([_fmt(r[k]) for k in slope_terms.SLOPE_COLUMNS]
                            for r in slope_terms.slope_rows(decompositions)))
         slope_terms.plot(folder / "slope_terms.png", decompositions)
-    (folder / "summary.txt").write_text(summary_text(scene, results, gm, check_rows, timings, decompositions) + "\n")
+    (folder / "summary.txt").write_text(summary_text(scene, results, gm, check_rows, timings, decompositions, notes)
+                                        + "\n")
     import dolfinx
 
     outputs.write_json(folder / "runup.json", {
@@ -157,9 +159,10 @@ def _resolution(gm) -> dict | None:
     return res.as_dict() if res is not None else None
 
 
-def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, decompositions: list = ()) -> str:
-    """The console summary: the model, the run-up maxima per route, the checks, which term makes the speed law
-    (one line per curve, and the table of slopes), the time split."""
+def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, decompositions: list = (),
+                 notes: list = ()) -> str:
+    """The console summary: the model, the run-up maxima per route, the notes (one line each), the checks, which
+    term makes the speed law (one line per curve, and the table of slopes), the time split."""
     b = gm.basis
     lines = [f"{scene.scene.name}: coupled gearbox {gm.structure.dofs} DOFs, {len(b.eigenvalues)} modes to "
              f"{b.f_max:.0f} Hz ({b.rigid_count} zero), {len(gm.reduction.vectors)} Ritz vectors; radiating area "
@@ -172,6 +175,7 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
                 i = int(np.argmax(lwa))
                 lines.append(f"  {torque:g} N m  {route:10s} sigma {rad:9s}: max L_WA {lwa[i]:.1f} dB(A) at "
                              f"{s[i]:g} rpm")
+    lines += list(notes)
     lines.append("checks (ours | measured | thesis calc. | pass):")
     for r in check_rows:
         lines.append(f"  {r['quantity']}: {r['ours']} | {_fmt(r['measured'])} | {_fmt(r['thesis_calculated'])} | "

@@ -294,13 +294,15 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         progress.update(note=f"{torque:g} N m: {len(spec.speeds)} speeds, {len(lines.frequency)} lines")
     progress.close()
     check_rows, contributions = checks.evaluate(scene, results, gm)
+    note = source.overlap_note(reference_torque)      # cached operating point: milliseconds
+    notes = [note] if note else []
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
-            report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions)
+            report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes)
     if comm.rank == 0:
-        print(report.summary_text(scene, results, gm, check_rows, timings, decompositions))
+        print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
 

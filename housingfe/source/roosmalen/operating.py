@@ -172,6 +172,14 @@ class SourceModel:
                           mean_compression=float(np.real(d[H])), bearings=bearings, L_omega=level(ms, OMEGA0),
                           L_omega_tooth_band=dyn.tooth_band_level(st), state=st)
 
+    def overlap_note(self, torque_nm: float) -> str | None:
+        """The summary line of housingfe.source.roosmalen.overlap.cancellation_note at a pinion torque [N m]: the
+        face-width engagement's excitation at the helix's cancellation (overlap ratio within 0.1 of a non-zero
+        integer) and how far the envelope bound lies above it at n = 1; None otherwise."""
+        from housingfe.source.roosmalen.overlap import cancellation_note
+
+        return cancellation_note(self.pair, self.corrections, self._point(float(torque_nm)))
+
     def mesh_stiffness(self, torque_nm: float) -> tuple[np.ndarray, np.ndarray]:
         """(S samples over one mesh period [N/m], F_e samples [N]) at a torque, uniformly spaced (the inputs of
         the harmonic balance)."""

@@ -26,6 +26,7 @@ from housingfe.errors import InputError
 from housingfe.outputs import format_table, write_csv, write_json
 from housingfe.source.gears import GearPair, tooth_profile
 from housingfe.source.roosmalen import dynamics as dyn
+from housingfe.source.roosmalen import overlap
 from housingfe.source.stiffness import (
     Corrections,
     MeshModel,
@@ -362,6 +363,9 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
                                  floatfmt="{:.1f}")]
         write_csv(out_dir / "L_omega_vs_measured.csv", ["speed_rpm", "measured_dB", "ours_dB", "difference_dB"],
                   comparison)
+    note = overlap.cancellation_note(pair, corr, op)     # face-width engagement at a near-integer eps_beta
+    if note:
+        summary += ["", note]
     lost = [x.message for x in contact if x.lost]
     write_json(out_dir / "contact_check.json", {"contact_loss": lost, "min_over_mean_mesh_force": min(
         x.min_force_N / x.mean_force_N for x in contact)})
