@@ -148,6 +148,9 @@ def test_cli_writes_the_slope_terms(tmp_path):
         law = [r for r in csv.DictReader(fh) if r["check"] == "speed_law"]
     assert len(law) == 2 and all("made by" in r["note"] for r in law)
     assert "made by" in proc.stdout
+    # set A (eps_beta 1.026) with the default face-width engagement: the overlap note, once (issue 28)
+    notes = [ln for ln in summary.splitlines() if ln.startswith("NOTE: overlap ratio 1.026")]
+    assert len(notes) == 1 and notes[0] in proc.stdout and "Lachenmaier" in notes[0]
 
 
 def test_less_than_a_doubling_of_speed_reports_no_law(tmp_path):
