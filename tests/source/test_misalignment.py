@@ -2,13 +2,11 @@
 share with a linear gap against the closed form of a uniform bed of springs, the lumped model's static tilt against
 statics by hand, and "none" reproducing the aligned model exactly."""
 import math
-import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-import housingfe
+from housingfe.data import thesis
 from housingfe.source.gears import GearPair
 from housingfe.source.misalignment import from_tilts, lumped_misalignment
 from housingfe.source.roosmalen import dynamics as dyn
@@ -22,7 +20,7 @@ from housingfe.source.stiffness import (
     normal_force_from_torque,
 )
 
-REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())["gears"]
+REF = thesis()["gears"]
 PAIR = GearPair.from_table(REF["single_helical"])
 
 

@@ -1,14 +1,13 @@
 """Lumped interior model (van Roosmalen 1994 Sec. 2.5-2.7): statics, energy balance, harmonic balance
 against time integration and exact frequency response, engagement shock, published trends."""
 import math
-import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 import housingfe
+from housingfe.data import thesis
 from housingfe.levels import OMEGA0
 from housingfe.source.gears import GearPair
 from housingfe.source.roosmalen import dynamics as dyn
@@ -20,7 +19,7 @@ from housingfe.source.stiffness import (
     stiffness_curve,
 )
 
-REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())["gears"]
+REF = thesis()["gears"]
 PAIR = GearPair.from_table(REF["single_helical"])
 GEOMETRY = dyn.ShaftGeometry()
 SHAFTS = (ShaftBending(*GEOMETRY.pinion_spans, GEOMETRY.pinion_shaft_diameter),
