@@ -23,7 +23,7 @@ from housingfe.drivetrain.shafts import CircularSection, RigidDisc, Shaft
 from housingfe.errors import InputError
 from housingfe.scene import build_model_from_scene
 from housingfe.solvers import elasticity, harmonic, modal
-from tests.conftest import load_scene
+from tests.conftest import load_scene, mumps_solve
 
 A, B, H, RHO = 0.2, 0.1, 0.05, 7850.0            # block (m, kg/m^3)
 K_SPRING = np.diag([1e6, 2e6, 3e6, 1e4, 2e4, 0.5e4])   # N/m, N m/rad: rigid-body modes 55..190 Hz
@@ -408,13 +408,7 @@ def mpi_case(model) -> dict:
 
     f = system.load(elasticity.rigid_body_vectors(model.V)[2],             # 1 N along z on every FE node
                     {"s:0": [0.0, 100.0, 0.0, 0.0, 0.0, 5.0], "bore": [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]})
-    ksp = PETSc.KSP().create(system.K.getComm())
-    ksp.setOperators(system.K)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    q = system.K.createVecRight()
-    ksp.solve(f, q)
+    q = mumps_solve(system.K, f)
     u = system.expand(q)
     back = system.restrict(u)
     back.axpy(-1.0, q)

@@ -37,7 +37,7 @@ from housingfe.drivetrain.reduction import (
 from housingfe.outputs import MARKER
 from housingfe.scene import build_model_from_scene
 from housingfe.solvers import modal
-from tests.conftest import load_scene
+from tests.conftest import load_scene, mumps_solve
 
 CUTOFF = 6000.0
 MASTERS = ("bolt_1", "bolt_3", "bolt_5", "bolt_7")
@@ -78,20 +78,13 @@ def test_reduced_stiffness_is_modal_plus_static_condensation(box):
 
 
 def test_statics_at_the_masters_are_exact(box):
-    from petsc4py import PETSc
 
     model, masters, red = box
     loads = {m.name: np.array([100.0 * (k + 1), -50.0, 30.0 * k, 1.0, -2.0, 0.5 * k])
              for k, m in enumerate(masters)}
     system = full_system(model, masters)
     f = system.load(None, loads)
-    ksp = PETSc.KSP().create(system.K.getComm())
-    ksp.setOperators(system.K)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    q = system.K.createVecRight()
-    ksp.solve(f, q)
+    q = mumps_solve(system.K, f)
     full = np.concatenate([system.node_displacement(q, m.name) for m in masters])
     K = red.K.copy()
     rhs = np.zeros(len(K))
