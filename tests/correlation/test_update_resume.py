@@ -11,29 +11,8 @@ import sys
 
 import pytest
 
-PLATE = """
-[scene]
-name = "plate"
-kind = "housing"
-description = "free plate, cheap updating problem"
-[geometry]
-kind = "plate"
-a = 0.4
-b = 0.3
-h = 0.005
-[material]
-name = "plate-steel"
-youngs_modulus = 210e9
-poisson_ratio = 0.3
-density = 7850.0
-[mesh]
-element = "hex"
-degree = 2
-size = 0.05
-layers = 1
-[analysis.modal]
-f_max = 1000.0
-"""
+from tests.correlation.free_plate import PLATE_SCENE
+
 SPEC = """
 name = "plate"
 max_evaluations = 20
@@ -82,7 +61,7 @@ def _update(folder, out, *extra):
 def problem(tmp_path_factory):
     """The spec and scene, and the answer of an uninterrupted run (its stderr too)."""
     folder = tmp_path_factory.mktemp("update")
-    (folder / "plate.toml").write_text(PLATE)
+    (folder / "plate.toml").write_text(PLATE_SCENE)
     (folder / "spec.toml").write_text(SPEC)
     proc = subprocess.run(_update(folder, folder / "whole"), capture_output=True, text=True, env=_env(),
                           cwd=folder, timeout=120)
