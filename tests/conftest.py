@@ -28,3 +28,19 @@ def coarse_box_model(comm):
 
     return build_model_from_scene(load_scene("box-free", "mesh.degree=2", "mesh.grading=1",
                                                  "mesh.size=0.04", "analysis.modal.f_max=2500.0"), comm)
+
+
+def mumps_solve(A, b, x=None, factor: str = "lu"):
+    """x of A x = b by a MUMPS factorisation on A's communicator (`factor` "lu", or "cholesky": MUMPS LDL^T of a
+    symmetric A), for the tests' static reference solves; x: the vector to fill (default a new one)."""
+    from petsc4py import PETSc
+
+    ksp = PETSc.KSP().create(A.getComm())
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    ksp.getPC().setType(factor)
+    ksp.getPC().setFactorSolverType("mumps")
+    if x is None:
+        x = A.createVecRight()
+    ksp.solve(b, x)
+    return x

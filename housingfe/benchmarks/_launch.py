@@ -1,7 +1,11 @@
 """Launching a benchmark case on several MPI ranks."""
 from __future__ import annotations
 
+import json
 import os
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 
@@ -29,7 +33,6 @@ def mpi_environment(env: dict | None = None) -> dict:
 def write_worker_result(out: dict, workdir: Path) -> None:
     """The end of a case's worker process: add its peak resident memory (GB, summed over the ranks, each rank's
     own peak or its child processes' if larger) to `out` and write it to workdir/result.json on rank 0."""
-    import json
     import resource
 
     from mpi4py import MPI
@@ -39,3 +42,22 @@ def write_worker_result(out: dict, workdir: Path) -> None:
     out["peak_memory_gb"] = MPI.COMM_WORLD.allreduce(max(self_kb, child_kb)) / 1024**2
     if MPI.COMM_WORLD.rank == 0:
         (Path(workdir) / "result.json").write_text(json.dumps(out))
+
+
+def run_worker(module: str, job: dict, workdir: Path, ranks: int = 1) -> tuple[dict | None, float, str]:
+    """Write `job` (with "workdir") to workdir/job.json and run `python -m module job.json` on `ranks` MPI processes
+    (mpi_launcher, mpi_environment); the worker ends with write_worker_result.  Returns (its result dict with
+    process_wall_s added, None if it failed; the process wall time (s); the last line of its stderr, "failed" if
+    it wrote none)."""
+    path = Path(workdir) / "job.json"
+    path.write_text(json.dumps({**job, "workdir": str(workdir)}))
+    t0 = time.perf_counter()
+    proc = subprocess.run(mpi_launcher(ranks) + [sys.executable, "-m", module, str(path)], capture_output=True,
+                          text=True, env=mpi_environment())
+    wall = time.perf_counter() - t0
+    last = proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed"
+    if proc.returncode != 0:
+        return None, wall, last
+    out = json.loads((Path(workdir) / "result.json").read_text())
+    out["process_wall_s"] = wall
+    return out, wall, last

@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.benchmarks._calculix import run_calculix
-from housingfe.benchmarks._launch import mpi_environment, mpi_launcher, write_worker_result
+from housingfe.benchmarks._launch import mpi_environment, run_worker, write_worker_result
 from housingfe.benchmarks.modal import load_average
 from housingfe.errors import InputError
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
@@ -179,20 +179,12 @@ def _case(kind: str, job: dict) -> dict:
             wall, rss, out = _subprocess([sys.executable, "-m", "housingfe", "inspect", job["bolted"], "--units",
                                           "mm", "--out", tmp])
             return {"process_wall_s": wall, "peak_memory_gb": rss, "report_tail": out.strip().splitlines()[-1]}
-        path = Path(tmp) / "job.json"
-        path.write_text(json.dumps({"kind": kind, **job, "workdir": tmp}))
-        t0 = time.perf_counter()
-        proc = subprocess.run(mpi_launcher(job.get("ranks", 1)) + [sys.executable, "-m",
-                                                                   "housingfe.benchmarks.imported", str(path)],
-                              capture_output=True, text=True, env=mpi_environment())
-        wall = time.perf_counter() - t0
-        if proc.returncode != 0:
-            last = proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed"
+        out, _, last = run_worker("housingfe.benchmarks.imported", {"kind": kind, **job}, Path(tmp),
+                                  job.get("ranks", 1))
+        if out is None:
             if "InputError: " in last:       # the case refused its input (e.g. the memory guard): say so in one line
                 raise InputError(f"bench imported: case {kind}: {last.split('InputError: ', 1)[1]}")
             raise RuntimeError(last)
-        out = json.loads((Path(tmp) / "result.json").read_text())
-        out["process_wall_s"] = wall
         return out
 
 

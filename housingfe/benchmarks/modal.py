@@ -26,7 +26,6 @@ import os
 import re
 import shutil
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -35,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.benchmarks._calculix import run_calculix
-from housingfe.benchmarks._launch import mpi_environment, mpi_launcher, write_worker_result
+from housingfe.benchmarks._launch import run_worker, write_worker_result
 from housingfe.outputs import atomic_output_dir, format_table, write_csv
 
 F_MAX = 4000.0          # Hz, the range of the thesis' free-box study
@@ -166,19 +165,9 @@ def _volume_part_of_inp(text: str, ccx_type: str) -> tuple[str, str]:
 def _case_in_subprocess(code: str, case: dict) -> dict:
     """Run one case in a fresh interpreter; also returns its peak resident memory (GB)."""
     with tempfile.TemporaryDirectory() as tmp:
-        job = Path(tmp) / "job.json"
-        job.write_text(json.dumps({"code": code, "case": case, "workdir": tmp}))
-        t0 = time.perf_counter()
-        proc = subprocess.run(mpi_launcher(case.get("ranks", 1))
-                              + [sys.executable, "-m", "housingfe.benchmarks.modal", str(job)],
-                              capture_output=True, text=True, env=mpi_environment())
-        wall = time.perf_counter() - t0
-        if proc.returncode != 0:
-            return {"error": proc.stderr.strip().splitlines()[-1] if proc.stderr.strip() else "failed",
-                    "process_wall_s": wall}
-        out = json.loads((Path(tmp) / "result.json").read_text())
-        out["process_wall_s"] = wall
-        return out
+        out, wall, last = run_worker("housingfe.benchmarks.modal", {"code": code, "case": case}, Path(tmp),
+                                     case.get("ranks", 1))
+        return out if out is not None else {"error": last, "process_wall_s": wall}
 
 
 def _worker(job_path: str) -> None:

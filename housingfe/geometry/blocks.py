@@ -239,6 +239,22 @@ def build_gmsh_model(model: BlockModel, element: str, size: float, layers: int,
     return {"cells": cell_groups, "facets": facet_groups, "mesher": "transfinite hexahedra (reproducible)"}
 
 
+def distribute_gmsh_model(comm):
+    """The meshed gmsh model of rank 0 as a dolfinx mesh distributed over comm's ranks: (mesh, cell_tags,
+    facet_tags), with the facet-to-cell connectivity the facet tags need.  Finalizes gmsh on rank 0 (also when
+    the import fails): the builders (housingfe.geometry.mesh, the CAD import) initialise it there."""
+    import gmsh
+    from dolfinx.io import gmshio
+
+    try:
+        mesh, cell_tags, facet_tags = gmshio.model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0, gdim=3)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()
+    mesh.topology.create_connectivity(2, 3)
+    return mesh, cell_tags, facet_tags
+
+
 def mesh_tetrahedra(size: float, hxt_fallback: bool = True) -> str:
     """Mesh the current gmsh model with linear tetrahedra of `size` (m) the project's way: every option set,
     Delaunay on one thread (reproducible), slivers refined away, HXT only where that fails (hxt_fallback;

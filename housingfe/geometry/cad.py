@@ -855,9 +855,8 @@ def build_cad_mesh(spec: CadGeometry, element: str, size: float, layers: int, co
     parts of a housingfe.geometry.mesh.HousingMesh (registry.GeometryKind.mesh; volume and centroid from
     OpenCASCADE, quality: the 1 % quantile and median of the shape ratio and the mesher)."""
     import gmsh
-    from dolfinx.io import gmshio
 
-    from housingfe.geometry.blocks import _tet_qualities, mesh_tetrahedra
+    from housingfe.geometry.blocks import _tet_qualities, distribute_gmsh_model, mesh_tetrahedra
 
     if element != "tet":
         raise InputError("mesh.element: an imported CAD housing is meshed with tetrahedra: set element = \"tet\"")
@@ -888,12 +887,7 @@ def build_cad_mesh(spec: CadGeometry, element: str, size: float, layers: int, co
     payload = comm.bcast(payload, root=0)
     if "error" in payload:
         raise InputError(payload["error"])
-    try:
-        mesh, cell_tags, facet_tags = gmshio.model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0, gdim=3)
-    finally:
-        if comm.rank == 0:
-            gmsh.finalize()
-    mesh.topology.create_connectivity(2, 3)
+    mesh, cell_tags, facet_tags = distribute_gmsh_model(comm)
     return {"mesh": mesh, "cell_tags": cell_tags, "facet_tags": facet_tags, "cell_groups": payload["cells"],
             "facet_groups": payload["facets"], "volume": facts.volume, "centroid": facts.centroid,
             "points": payload["points"], "quality": {**payload["quantiles"], "mesher": payload["mesher"]}}

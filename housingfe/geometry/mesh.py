@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from housingfe.errors import InputError
-from housingfe.geometry.blocks import build_gmsh_model, tet_quality
+from housingfe.geometry.blocks import build_gmsh_model, distribute_gmsh_model, tet_quality
 
 # the registry's lookup, with the built-in kinds registered (specs imports their modules)
 from housingfe.geometry.specs import GEOMETRY_KINDS, block_model_for
@@ -107,7 +107,6 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
         parts.setdefault("mesh_time_s", time.perf_counter() - t0)
         return HousingMesh(**parts, quality=quality)
     import gmsh
-    from dolfinx.io import gmshio
 
     model = block_model_for(geometry)
     groups = None
@@ -121,12 +120,7 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
             gmsh.finalize()
             raise
     groups = comm.bcast(groups, root=0)
-    try:
-        mesh, cell_tags, facet_tags = gmshio.model_to_mesh(gmsh.model if comm.rank == 0 else None, comm, 0, gdim=3)
-    finally:
-        if comm.rank == 0:
-            gmsh.finalize()
-    mesh.topology.create_connectivity(2, 3)
+    mesh, cell_tags, facet_tags = distribute_gmsh_model(comm)
     return HousingMesh(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=groups["cells"],
                        facet_groups=groups["facets"], volume=model.volume(), centroid=model.centroid(),
                        element_size=size, element=element, points=model.points,

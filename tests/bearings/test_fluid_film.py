@@ -1,8 +1,6 @@
 """Fluid-film journal bearings: the Reynolds solver against Raimondi–Boyd and the Ocvirk short bearing, and the
 thesis' Sec. 3.5 operating points."""
 import math
-import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,9 +13,10 @@ from housingfe.bearings.fluid_film import (
     short_bearing_film_force,
     short_bearing_load,
 )
+from housingfe.data import thesis
 from housingfe.errors import InputError
 
-REF = tomllib.loads((Path(__file__).parents[2] / "housingfe/data/roosmalen1994.toml").read_text())
+REF = thesis()
 
 
 def thesis_bearing(name):

@@ -11,29 +11,8 @@ import sys
 
 import pytest
 
-PLATE = """
-[scene]
-name = "plate"
-kind = "housing"
-description = "free plate, cheap updating problem"
-[geometry]
-kind = "plate"
-a = 0.4
-b = 0.3
-h = 0.005
-[material]
-name = "plate-steel"
-youngs_modulus = 210e9
-poisson_ratio = 0.3
-density = 7850.0
-[mesh]
-element = "hex"
-degree = 2
-size = 0.05
-layers = 1
-[analysis.modal]
-f_max = 1000.0
-"""
+from tests.correlation.free_plate import PLATE_SCENE
+
 SPEC = """
 name = "plate"
 max_evaluations = 20
@@ -78,11 +57,26 @@ def _update(folder, out, *extra):
     return [sys.executable, "-m", "housingfe", "update", str(folder / "spec.toml"), "--out", str(out), *extra]
 
 
+def _start_update(folder, out, stdout=subprocess.DEVNULL):
+    """`housingfe update` of folder/spec.toml into `out`, running in the background with its stderr piped."""
+    return subprocess.Popen(_update(folder, out), stdout=stdout, stderr=subprocess.PIPE, text=True, env=_env(),
+                            cwd=folder)
+
+
+def _progress_reached(proc, evaluations) -> bool:
+    """Read the running update's progress lines until one counts `evaluations`; False if it ended before."""
+    for line in proc.stderr:
+        m = PROGRESS.match(line)
+        if m and int(m.group(1)) >= evaluations:
+            return True
+    return False
+
+
 @pytest.fixture(scope="module")
 def problem(tmp_path_factory):
     """The spec and scene, and the answer of an uninterrupted run (its stderr too)."""
     folder = tmp_path_factory.mktemp("update")
-    (folder / "plate.toml").write_text(PLATE)
+    (folder / "plate.toml").write_text(PLATE_SCENE)
     (folder / "spec.toml").write_text(SPEC)
     proc = subprocess.run(_update(folder, folder / "whole"), capture_output=True, text=True, env=_env(),
                           cwd=folder, timeout=120)
@@ -111,13 +105,9 @@ def test_killed_update_resumes_with_the_same_answer(problem):
     folder, whole, _ = problem
     out = folder / "killed"
     checkpoint = folder / "killed.partial" / "evaluations.jsonl"
-    proc = subprocess.Popen(_update(folder, out), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                            env=_env(), cwd=folder)
-    for line in proc.stderr:
-        m = PROGRESS.match(line)
-        if m and int(m.group(1)) >= 8:
-            proc.send_signal(signal.SIGKILL)
-            break
+    proc = _start_update(folder, out)
+    assert _progress_reached(proc, 8)
+    proc.send_signal(signal.SIGKILL)
     assert proc.wait(timeout=60) == -signal.SIGKILL
     assert not out.exists()                             # no result folder that looks complete
     finished = checkpoint.read_text().count("\n") - 1   # header line
@@ -143,15 +133,11 @@ def test_checkpoint_of_other_inputs_is_not_used(problem, tmp_path):
     for name in ("plate.toml", "spec.toml"):
         shutil.copy(folder / name, tmp_path / name)
     out = tmp_path / "out"
-    proc = subprocess.Popen(_update(tmp_path, out), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
-                            env=_env(), cwd=tmp_path)
-    for line in proc.stderr:
-        m = PROGRESS.match(line)
-        # early: an evaluation takes ~0.2 s, and on a loaded machine this reader lagged the child by the 16
-        # evaluations after the 4th (it finished, exit 0, before the signal came)
-        if m and int(m.group(1)) >= 1:
-            proc.send_signal(signal.SIGINT)
-            break
+    proc = _start_update(tmp_path, out)
+    # early: an evaluation takes ~0.2 s, and on a loaded machine this reader lagged the child by the 16
+    # evaluations after the 4th (it finished, exit 0, before the signal came)
+    assert _progress_reached(proc, 1)
+    proc.send_signal(signal.SIGINT)
     rest = proc.stderr.read()
     assert proc.wait(timeout=60) == 130
     checkpoint = tmp_path / "out.partial" / "evaluations.jsonl"
@@ -171,12 +157,8 @@ def test_second_run_on_the_same_checkpoint_stops_before_work(problem, tmp_path):
     exit 2; the first finishes with the uninterrupted answer."""
     folder, whole, _ = problem
     out = tmp_path / "out"
-    first = subprocess.Popen(_update(folder, out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                             env=_env(), cwd=folder)
-    for line in first.stderr:
-        m = PROGRESS.match(line)
-        if m and int(m.group(1)) >= 2:
-            break
+    first = _start_update(folder, out, stdout=subprocess.PIPE)
+    assert _progress_reached(first, 2)
     second = subprocess.run(_update(folder, out), capture_output=True, text=True, env=_env(), cwd=folder,
                             timeout=120)
     first.stderr.read()

@@ -16,30 +16,8 @@ from housingfe.correlation.updating import (
     fit,
 )
 from housingfe.errors import InputError
+from tests.correlation.free_plate import PLATE_SCENE
 
-PLATE = """
-[scene]
-name = "ema-plate"
-kind = "housing"
-description = "free plate for the synthetic EMA"
-[geometry]
-kind = "plate"
-a = 0.4
-b = 0.3
-h = 0.005
-[material]
-name = "plate-steel"
-youngs_modulus = 210e9
-poisson_ratio = 0.3
-density = 7850.0
-[mesh]
-element = "hex"
-degree = 2
-size = 0.05
-layers = 1
-[analysis.modal]
-f_max = 1000.0
-"""
 E_TRUE, H_TRUE = 196e9, 0.0053
 MASS_TRUE = 7850.0 * 0.4 * 0.3 * H_TRUE          # kg, exact for the block
 
@@ -53,7 +31,7 @@ def synthetic(tmp_path_factory):
 
     folder = tmp_path_factory.mktemp("ema")
     scene = folder / "plate.toml"
-    scene.write_text(PLATE)
+    scene.write_text(PLATE_SCENE)
     sc, _ = load_housing_scene(str(scene), [f"material.youngs_modulus={E_TRUE}", f"geometry.h={H_TRUE}"])
     basis = modes(build_model_from_scene(sc, MPI.COMM_WORLD), 900.0)
     # 12 measured points on the top face, normal (z) direction: a 4 x 3 grid off the nodal lines' symmetry

@@ -4,12 +4,8 @@ bearings, two gears on a mesh spring, the direct harmonic solver with non-symmet
 total mass from the rigid-body vectors, and 1 against 2 MPI ranks."""
 import json
 import math
-import os
 import re
 import shutil
-import subprocess
-import sys
-from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -23,7 +19,8 @@ from housingfe.drivetrain.shafts import CircularSection, RigidDisc, Shaft
 from housingfe.errors import InputError
 from housingfe.scene import build_model_from_scene
 from housingfe.solvers import elasticity, harmonic, modal
-from tests.conftest import load_scene
+from tests.conftest import load_scene, mumps_solve
+from tests.two_ranks import module_result
 
 A, B, H, RHO = 0.2, 0.1, 0.05, 7850.0            # block (m, kg/m^3)
 K_SPRING = np.diag([1e6, 2e6, 3e6, 1e4, 2e4, 0.5e4])   # N/m, N m/rad: rigid-body modes 55..190 Hz
@@ -408,13 +405,7 @@ def mpi_case(model) -> dict:
 
     f = system.load(elasticity.rigid_body_vectors(model.V)[2],             # 1 N along z on every FE node
                     {"s:0": [0.0, 100.0, 0.0, 0.0, 0.0, 5.0], "bore": [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]})
-    ksp = PETSc.KSP().create(system.K.getComm())
-    ksp.setOperators(system.K)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    q = system.K.createVecRight()
-    ksp.solve(f, q)
+    q = mumps_solve(system.K, f)
     u = system.expand(q)
     back = system.restrict(u)
     back.axpy(-1.0, q)
@@ -468,12 +459,7 @@ def test_two_ranks_give_the_serial_answer(steel_block):
     assert abs(one["mass"] / mass - 1) < 1e-10 and one["restrict_error"] < 1e-14
     if not shutil.which("mpirun"):
         pytest.skip("mpirun not installed")
-    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
-           "OPENBLAS_NUM_THREADS": "1"}
-    proc = subprocess.run([shutil.which("mpirun"), "-n", "2", sys.executable, "-m", "tests.drivetrain.test_coupling"],
-                          capture_output=True, text=True, env=env, timeout=300, cwd=Path(__file__).parents[2])
-    assert proc.returncode == 0, proc.stderr
-    two = json.loads(proc.stdout.strip().splitlines()[-1])
+    two = module_result("tests.drivetrain.test_coupling")
     assert two["ranks"] == 2 and min(two["bore_nodes"]) > 0        # the bore is split between the ranks
     assert sum(two["bore_nodes"]) == one["bore_nodes"][0] and two["size"] == one["size"]
     for kind in ("rbe2", "rbe3", "star"):

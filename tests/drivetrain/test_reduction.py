@@ -13,11 +13,7 @@ patches as masters, cut-off 6 kHz (46 fixed-interface modes + 24 master DOFs fro
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import subprocess
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -37,7 +33,8 @@ from housingfe.drivetrain.reduction import (
 from housingfe.outputs import MARKER
 from housingfe.scene import build_model_from_scene
 from housingfe.solvers import modal
-from tests.conftest import load_scene
+from tests.conftest import load_scene, mumps_solve
+from tests.two_ranks import module_result
 
 CUTOFF = 6000.0
 MASTERS = ("bolt_1", "bolt_3", "bolt_5", "bolt_7")
@@ -78,20 +75,13 @@ def test_reduced_stiffness_is_modal_plus_static_condensation(box):
 
 
 def test_statics_at_the_masters_are_exact(box):
-    from petsc4py import PETSc
 
     model, masters, red = box
     loads = {m.name: np.array([100.0 * (k + 1), -50.0, 30.0 * k, 1.0, -2.0, 0.5 * k])
              for k, m in enumerate(masters)}
     system = full_system(model, masters)
     f = system.load(None, loads)
-    ksp = PETSc.KSP().create(system.K.getComm())
-    ksp.setOperators(system.K)
-    ksp.setType("preonly")
-    ksp.getPC().setType("lu")
-    ksp.getPC().setFactorSolverType("mumps")
-    q = system.K.createVecRight()
-    ksp.solve(f, q)
+    q = mumps_solve(system.K, f)
     full = np.concatenate([system.node_displacement(q, m.name) for m in masters])
     K = red.K.copy()
     rhs = np.zeros(len(K))
@@ -223,12 +213,7 @@ def test_two_ranks_give_the_one_rank_reduced_model(box):
     if not shutil.which("mpirun"):
         pytest.skip("mpirun not installed")
     _, masters, red = box
-    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
-           "OPENBLAS_NUM_THREADS": "1"}
-    proc = subprocess.run([shutil.which("mpirun"), "-n", "2", sys.executable, "-m", "tests.drivetrain.test_reduction"],
-                          capture_output=True, text=True, env=env, timeout=300, cwd=Path(__file__).parents[2])
-    assert proc.returncode == 0, proc.stderr
-    two = json.loads(proc.stdout.strip().splitlines()[-1])
+    two = module_result("tests.drivetrain.test_reduction")
     assert two["ranks"] == 2 and two["n_modes"] == red.n_modes
     one = red.frequencies_with({m.name: K6 for m in masters})
     assert np.max(np.abs(np.array(two["f"]) / one - 1)) < 1e-8

@@ -2,16 +2,14 @@
 process, in another process and on 1 or 2 MPI ranks."""
 import hashlib
 import json
-import os
 import shutil
-import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).parents[2]
+from tests.two_ranks import module_result
+
 # round bores, thin walls and the sliver refinement: the tet path that HXT made irreproducible
 SCENE = ("test-gearbox-interior",)
 # a small tet model for the frequencies
@@ -47,18 +45,8 @@ def frequencies(comm) -> dict:
     return {"dofs": model.dofs, "frequencies_hz": result.frequencies_hz[result.rigid_count:].tolist()}
 
 
-def _env():
-    return {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
-            "OPENBLAS_NUM_THREADS": "1"}
-
-
 def _run(ranks: int, what: str) -> dict:
-    cmd = [sys.executable, "-m", "tests.geometry.test_mesh", what]
-    if ranks > 1:
-        cmd = [shutil.which("mpirun"), "-n", str(ranks), *cmd]
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=_env(), timeout=600, cwd=ROOT)
-    assert proc.returncode == 0, proc.stderr
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    return module_result("tests.geometry.test_mesh", what, ranks=ranks, timeout=600)
 
 
 def test_same_scene_same_tet_mesh_in_one_and_in_two_processes(comm):

@@ -63,13 +63,13 @@ def test_one_speed_of_sound_and_air_density():
     """c and rho of air are defined once (housingfe.levels, the thesis' symbols list); no module hard-codes
     another value as a default, an assignment or a keyword argument."""
     import ast
-    import tomllib
     from pathlib import Path
 
     import housingfe
     from housingfe import levels
+    from housingfe.data import thesis
 
-    table = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())
+    table = thesis()
     assert levels.SPEED_OF_SOUND == table["references"]["c_air_m_per_s"] == 344.0
     assert levels.AIR_DENSITY == table["references"]["rho_air_kg_per_m3"] == 1.2
     assert analytic.SPEED_OF_SOUND is levels.SPEED_OF_SOUND and analytic.AIR_DENSITY is levels.AIR_DENSITY

@@ -10,7 +10,7 @@ from housingfe.response.forced import run as run_forced
 from housingfe.response.observers import SurfaceObserver, responses
 from housingfe.scene import build_model_from_scene
 from housingfe.solvers import elasticity, harmonic, modal
-from tests.conftest import load_scene
+from tests.conftest import load_scene, mumps_solve
 
 # 13 x 9 Q2 elements in plan: the mesh the tolerances of these tests (and of test_observers) were set on; until
 # 2026-11-25 a size of 25 mm gave it, one division more per edge than asked for, through OCC's bounding-box tolerance
@@ -70,7 +70,6 @@ def test_sample_points_converge_to_area_integral(plate_both):
 def test_static_limit_and_resonance_peak_follows_one_over_eta(comm):
     """Cantilever plate: at 1e-3 of the first eigenfrequency the receptance equals the static solve;
     at the first eigenfrequency the peak scales as 1/eta and equals (phi^T f)^2 / (eta omega_1^2)."""
-    from petsc4py import PETSc
 
     scene = harmonic_plate('geometry.edges={x0="clamped"}', "analysis.modal.f_max=400.0")
     model = build_model_from_scene(scene, comm)
@@ -80,13 +79,7 @@ def test_static_limit_and_resonance_peak_follows_one_over_eta(comm):
     observer = SurfaceObserver(model, "top", [], [load])
 
     # static solve K u = f
-    ksp = PETSc.KSP().create(comm)
-    ksp.setOperators(model.K)
-    ksp.setType("preonly")
-    ksp.getPC().setType("cholesky")
-    ksp.getPC().setFactorSolverType("mumps")
-    u = load.vector.duplicate()
-    ksp.solve(load.vector, u)
+    u = mumps_solve(model.K, load.vector, factor="cholesky")
     static = load.vector.dot(u)
 
     peaks = {}

@@ -11,12 +11,11 @@ from housingfe.response.observers import RESPONSE_POINTS
 from housingfe.scene import build_model_from_scene
 from housingfe.solvers import modal
 from tests.conftest import load_scene
+from tests.response.test_reduced import PLATE as TWO_LOAD_PLATE
 
-PLATE = ["geometry.a=0.3", "geometry.b=0.2", "geometry.h=0.005", "mesh.size=0.05", "analysis.modal.f_max=1500.0",
-         'loads=[{name="p1", kind="force", surface="top", point=[0.07, 0.05, 0.005], direction=[0,0,-1]}, '
-         '{name="p2", kind="force", surface="top", point=[0.21, 0.13, 0.005], direction=[0,0.3,-1]}]',
-         "analysis.harmonic.f_max=1500.0", "analysis.harmonic.f_min=100.0", "analysis.harmonic.df=100.0",
-         "analysis.harmonic.sample_points=[]", 'analysis.harmonic.surface="top"', "damping.loss_factor=0.01",
+# the Ritz-reduction tests' plate (FV12, 0.3 x 0.2 x 0.005 m, loads p1 and p2, modes to 1.5 kHz) with a harmonic run
+PLATE = [*TWO_LOAD_PLATE, "analysis.harmonic.f_max=1500.0", "analysis.harmonic.f_min=100.0",
+         "analysis.harmonic.df=100.0", "analysis.harmonic.sample_points=[]", 'analysis.harmonic.surface="top"', "damping.loss_factor=0.01",
          'analysis.harmonic.solver="both"', "analysis.harmonic.residual=true",
          'analysis.harmonic.points=[{name="c", point=[0.15, 0.1, 0.005]}]']
 ETA = 0.01

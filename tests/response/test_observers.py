@@ -22,7 +22,7 @@ from housingfe.response.observers import (
     response_point_samples,
 )
 from housingfe.scene import build_model_from_scene
-from tests.conftest import load_scene
+from tests.conftest import load_scene, mumps_solve
 from tests.response.test_forced import LOADS, PLATE
 
 A, B, H = 0.3, 0.2, 0.005          # the plate of tests.response.test_forced, x in [0, A], y in [0, B], z in [0, H]
@@ -191,7 +191,6 @@ def test_cantilever_point_frf_at_low_frequency_is_the_static_tip_deflection(comm
     an independent static solve; and it lies between beam theory F L^3 / (3 E I) (narrow) and the cylindrical
     bending value (1 - nu^2) F L^3 / (3 E I) (wide plate)."""
     from dolfinx import fem, geometry
-    from petsc4py import PETSc
 
     from housingfe.fe.loads import assemble_load
 
@@ -203,13 +202,8 @@ def test_cantilever_point_frf_at_low_frequency_is_the_static_tip_deflection(comm
     model = build_model_from_scene(scene, comm)
     forced = run_forced(model, scene.analysis.harmonic, scene.loads, scene.damping)
     load = assemble_load(scene.loads[0], model.housing, model.V, model.bcs)
-    ksp = PETSc.KSP().create(comm)
-    ksp.setOperators(model.K)
-    ksp.setType("preonly")
-    ksp.getPC().setType("cholesky")
-    ksp.getPC().setFactorSolverType("mumps")
     u = fem.Function(model.V)
-    ksp.solve(load.vector, u.vector)
+    mumps_solve(model.K, load.vector, u.vector, factor="cholesky")
     u.x.scatter_forward()
     mesh = model.V.mesh
     x = np.array([[A, B / 2, H / 2]])

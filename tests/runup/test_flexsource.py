@@ -4,7 +4,8 @@ coupled test gearbox:
 * the mesh receptance of the Ritz reduction tends to 1/k_ref at zero frequency (the gears turn freely apart from
   the mesh: only the mesh spring resists a static compression) — the static value the balance uses;
 * the rank-one harmonic balance on that receptance equals the full Hill system assembled on every Ritz coordinate
-  of the coupled model (mesh compression per harmonic, 1e-8 of its largest dynamic harmonic);
+  of the coupled model (housingfe.benchmarks.flexsource.full_hill_on_ritz, which the benchmark times too; mesh
+  compression per harmonic, 1e-8 of its largest dynamic harmonic);
 * the first-order (mean-stiffness) solve agrees with the full one within the ripple of S(t) on the lines that
   matter (>= 1 % of the tooth line);
 * the mesh_force route on the coupled lines gives the coupled source's own wheel level (one model, no second
@@ -15,6 +16,7 @@ import math
 import numpy as np
 import pytest
 
+from housingfe.benchmarks.flexsource import full_hill_on_ritz
 from housingfe.runup.chain import (
     coupled_source_lines,
     mesh_receptance,
@@ -22,45 +24,11 @@ from housingfe.runup.chain import (
     runup,
     source_lines,
 )
-from housingfe.source.roosmalen.dynamics import _fourier_coefficients, mesh_harmonic_balance
+from housingfe.source.roosmalen.dynamics import mesh_harmonic_balance
 from housingfe.source.stiffness import normal_force_from_torque
 from tests.runup.conftest import F_LINES, SPEEDS
 
 TORQUE = 2000.0
-
-
-def _full_hill(gm, src, speed, H):
-    """d_n of Z(n Omega) c_n + f sum_k (S - k_ref)_{n-k} f^T c_k = f E_n - F f delta_n0 on the Ritz coordinates
-    (f: the mesh load's projection, d = -f^T c; the zero mode held by a stiffness on it alone)."""
-    red = gm.reduction
-    s = red.system
-    fm = s.Fr[:, red.names.index("mesh")]
-    k = mesh_reference_stiffness(gm)
-    S, shock = src.mesh_stiffness(TORQUE)
-    F = normal_force_from_torque(src.pair, TORQUE)
-    Om = 2 * math.pi * src.pair.tooth_frequency(speed)
-    X = _fourier_coefficients(S, H)
-    X[2 * H] -= k
-    E = _fourier_coefficients(shock, H)[H:3 * H + 1]
-    C = s.Cr + s.D
-    lam = (2 * math.pi * s.frequencies_hz) ** 2
-    rigid = s.Y[:, lam < 1e-6 * lam.max()]
-    assert rigid.shape[1] == 1
-    Ms = 0.5 * (s.Mr + s.Mr.T)
-    m = len(fm)
-    n = np.arange(-H, H + 1)
-    A = np.zeros((n.size * m, n.size * m), complex)
-    rhs = np.zeros(n.size * m, complex)
-    for i, ni in enumerate(n):
-        blk = slice(i * m, (i + 1) * m)
-        A[blk, blk] += s.Kr - (ni * Om) ** 2 * s.Mr + 1j * ni * Om * C
-        if ni == 0:
-            A[blk, blk] += 1e-3 * lam.max() * Ms @ rigid @ rigid.T @ Ms
-        for j, nj in enumerate(n):
-            A[blk, j * m:(j + 1) * m] += X[ni - nj + 2 * H] * np.outer(fm, fm)
-        rhs[blk] = fm * (E[i] - (F if ni == 0 else 0.0))
-    c = np.linalg.solve(A, rhs).reshape(n.size, m)
-    return -(c @ fm)
 
 
 @pytest.mark.slow
@@ -81,7 +49,9 @@ def test_rank_one_balance_equals_the_full_hill_system_on_the_ritz_coordinates(co
     f_t = src.pair.tooth_frequency(speed)
     g = np.concatenate([[1 / k], mesh_receptance(gm, f_t * np.arange(1, H + 1))])
     d = mesh_harmonic_balance(g, F / k, S, shock, k, f_t).compression
-    d_full = _full_hill(gm, src, speed, H)
+    lam = (2 * math.pi * gm.reduction.system.frequencies_hz) ** 2
+    assert np.sum(lam < 1e-6 * lam.max()) == 1     # one zero mode (the gears turning freely), held in the Hill system
+    d_full, _ = full_hill_on_ritz(gm, src, speed, TORQUE, H)
     np.testing.assert_allclose(d, d_full, rtol=0, atol=1e-8 * np.abs(d_full[H + 1:]).max())
 
 

@@ -1,16 +1,16 @@
 """`housingfe source <scene>`: dispatch, outputs and one-line errors with exit code 2."""
 import csv
 import json
-import tomllib
 from pathlib import Path
 
 import pytest
 
 import housingfe
 from housingfe.cli import main
+from housingfe.data import thesis
 
 SCENES = Path(housingfe.__file__).parent / "scenes"
-REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())
+REF = thesis()
 
 
 def _small_scene(tmp_path, extra_source="", name="tiny"):

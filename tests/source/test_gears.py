@@ -1,17 +1,15 @@
 """Gear geometry against the printed digits of van Roosmalen (1994) Appendix F."""
 import math
-import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.optimize import brentq
 
-import housingfe
+from housingfe.data import thesis
 from housingfe.errors import InputError
 from housingfe.source.gears import GearPair, involute, tooth_profile
 
-REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())["gears"]
+REF = thesis()["gears"]
 
 
 def _printed_tolerance(value: float) -> float:

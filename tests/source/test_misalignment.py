@@ -2,13 +2,11 @@
 share with a linear gap against the closed form of a uniform bed of springs, the lumped model's static tilt against
 statics by hand, and "none" reproducing the aligned model exactly."""
 import math
-import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-import housingfe
+from housingfe.data import thesis
 from housingfe.source.gears import GearPair
 from housingfe.source.misalignment import from_tilts, lumped_misalignment
 from housingfe.source.roosmalen import dynamics as dyn
@@ -21,23 +19,17 @@ from housingfe.source.stiffness import (
     flank_gaps,
     normal_force_from_torque,
 )
+from tests.source.thesis_gears import spur_pair
 
-REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())["gears"]
+REF = thesis()["gears"]
 PAIR = GearPair.from_table(REF["single_helical"])
-
-
-def _spur_pair():
-    table = dict(REF["single_helical"], helix_angle_deg=0.0, kind="spur")
-    return GearPair.from_table({k: v for k, v in table.items() if k in (
-        "module_mm", "teeth", "pressure_angle_deg", "helix_angle_deg", "addendum_modification", "face_width_mm",
-        "centre_distance_mm", "addendum_coefficient", "dedendum_coefficient", "rack_tip_radius_factor", "kind")})
 
 
 @pytest.fixture(scope="module")
 def bed():
     """A spur pair whose contact points are independent springs, uniform across the face (no plate coupling, no
     shafts, no body torsion): a bed of springs k per unit width; its aligned approach delta0 at one position."""
-    model = MeshModel(_spur_pair(), shafts=None, n_slices=24, include_plate_coupling=False,
+    model = MeshModel(spur_pair(), shafts=None, n_slices=24, include_plate_coupling=False,
                       include_body_torsion=False)
     force = 40e3
     _, _, delta0 = model.load_distribution(0.0, force)

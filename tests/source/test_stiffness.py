@@ -1,14 +1,12 @@
 """Analytic tooth stiffness (van Roosmalen 1994 Sec. 2.2-2.4) against independent solutions and the
 thesis' published statements."""
 import math
-import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_bvp
 
-import housingfe
+from housingfe.data import thesis
 from housingfe.errors import InputError
 from housingfe.source.gears import GearPair
 from housingfe.source.stiffness import (
@@ -23,7 +21,7 @@ from housingfe.source.stiffness import (
     stiffness_curve,
 )
 
-REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())["gears"]
+REF = thesis()["gears"]
 SHAFTS = (ShaftBending(0.06, 0.06, 0.080), ShaftBending(0.06, 0.06, 0.095))
 
 

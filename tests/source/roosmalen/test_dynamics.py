@@ -1,14 +1,13 @@
 """Lumped interior model (van Roosmalen 1994 Sec. 2.5-2.7): statics, energy balance, harmonic balance
 against time integration and exact frequency response, engagement shock, published trends."""
 import math
-import tomllib
-from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 import housingfe
+from housingfe.data import thesis
 from housingfe.levels import OMEGA0
 from housingfe.source.gears import GearPair
 from housingfe.source.roosmalen import dynamics as dyn
@@ -19,8 +18,9 @@ from housingfe.source.stiffness import (
     normal_force_from_torque,
     stiffness_curve,
 )
+from tests.source.thesis_gears import spur_pair
 
-REF = tomllib.loads((Path(housingfe.__file__).parent / "data" / "roosmalen1994.toml").read_text())["gears"]
+REF = thesis()["gears"]
 PAIR = GearPair.from_table(REF["single_helical"])
 GEOMETRY = dyn.ShaftGeometry()
 SHAFTS = (ShaftBending(*GEOMETRY.pinion_spans, GEOMETRY.pinion_shaft_diameter),
@@ -184,14 +184,6 @@ def test_static_tilt_moment_is_axial_force_times_pitch_radius():
 
 
 # ------------------------------------------------------------------ engagement over the face width
-def _spur_pair():
-    """The test gears' data with a zero helix angle (a spur pair, eps_beta = 0)."""
-    table = dict(REF["single_helical"], helix_angle_deg=0.0, kind="spur")
-    return GearPair.from_table({k: v for k, v in table.items() if k in (
-        "module_mm", "teeth", "pressure_angle_deg", "helix_angle_deg", "addendum_modification", "face_width_mm",
-        "centre_distance_mm", "addendum_coefficient", "dedendum_coefficient", "rack_tip_radius_factor", "kind")})
-
-
 SET_A = Corrections.from_table(REF["profile_corrections"]["A"])
 
 
@@ -199,7 +191,7 @@ SET_A = Corrections.from_table(REF["profile_corrections"]["A"])
 def test_face_width_shock_of_a_spur_pair_is_the_thesis_shock(corrections):
     """eps_beta = 0: every slice of a contact line enters and leaves at once, so the face-width shock is Eq. 2.62
     sample by sample (time-varying S, any load share across the face: a spur line's slices sum to one pair)."""
-    spur = _spur_pair()
+    spur = spur_pair()
     assert spur.overlap_ratio == 0.0
     S = _stiffness_wave(n=256, rel_amp=0.2)
     force = 40e3
