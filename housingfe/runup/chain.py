@@ -310,6 +310,21 @@ def run_source(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max:
     raise InputError(f"source_receptance: {receptance!r} is not one of {', '.join(SOURCE_RECEPTANCES)}")
 
 
+def engagement_rerun(models: dict, source, engagement: str, speeds_rpm, f_lines_max: float,
+                     receptance: str = DEFAULT_SOURCE_RECEPTANCE, routes=("tf_omega", "mesh_force")) -> tuple[dict, float]:
+    """The run-up once more with another engagement shock (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS) on
+    the SAME coupled models {torque N m: GearboxModel} (no new mesh, basis or reduction): the source's operating
+    points keep their stiffness curves, load shares and matrices (SourceModel.with_engagement), so this costs the
+    source's harmonic balances and the routes' reduced solves.  Returns ({torque: RunupResult}, seconds)."""
+    t0 = time.perf_counter()
+    other = source.with_engagement(engagement)
+    out = {}
+    for torque, model in models.items():
+        lines, _ = run_source(model, other, speeds_rpm, [float(torque)], f_lines_max, receptance)
+        out[torque] = runup(model, None, speeds_rpm, [float(torque)], routes=tuple(routes), lines=lines)
+    return out, time.perf_counter() - t0
+
+
 # ------------------------------------------------------------------------------------------------ routes
 @dataclass
 class RouteResult:

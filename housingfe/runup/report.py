@@ -2,7 +2,9 @@
 spectra_<rpm>.csv / .png (like Figs. 5.2/5.5/5.8/5.9), runup.png (like Figs. 5.4/5.7/5.10 with the measured points),
 slope_terms.csv / .png (the speed law split into the chain's terms, housingfe.runup.slopes), checks.csv,
 summary.txt (the console summary) and runup.json (timings, provenance, the modal basis used, checks, modal
-contributions per peak, the slope decomposition)."""
+contributions per peak, the slope decomposition); when the run-up also ran the envelope bound (the face-width default
+at an overlap ratio near an integer, housingfe.runup.scene), runup_envelope_bound.csv (its totals, the columns of
+runup.csv)."""
 from __future__ import annotations
 
 import platform
@@ -22,6 +24,25 @@ HARMONIC_COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "harmonic", 
 CHECK_COLUMNS = ("check", "quantity", "ours", "measured", "thesis_calculated", "goal", "passed", "note")
 
 
+BOUND_CSV = "runup_envelope_bound.csv"
+
+
+def bound_lines(results: dict, bound: dict, radiation: str) -> list[str]:
+    """One summary line per torque: the maxima of L_WA (dB(A), sigma `radiation`) per route with the envelope bound
+    (bound: {torque: RunupResult}) beside the default's (results: {torque: (model, RunupResult)})."""
+    def maxima(res, torque):
+        parts = []
+        for route in res.routes:
+            s, lwa = res.series(route, radiation, torque, "LwA_dB")
+            i = int(np.argmax(lwa))
+            parts.append(f"{lwa[i]:.1f} dB(A) @ {s[i]:g} rpm ({route})")
+        return ", ".join(parts)
+
+    return [f"  {torque:g} N m with the envelope bound: max L_WA {maxima(res, torque)}; default (face-width): "
+            f"{maxima(results[torque][1], torque)}; sigma {radiation}; a bound, not a model ({BOUND_CSV})"
+            for torque, res in bound.items()]
+
+
 def _fmt(v):
     if isinstance(v, float):
         return "" if not np.isfinite(v) else f"{v:.6g}"
@@ -29,12 +50,16 @@ def _fmt(v):
 
 
 def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict,
-          decompositions: list = (), notes: list = ()) -> None:
+          decompositions: list = (), notes: list = (), bound: dict | None = None) -> None:
     """Every output file of a run-up into `folder` (rank 0); decompositions: housingfe.runup.slopes
     SlopeDecomposition of every curve; notes: lines for the summary about the model's validity (e.g. the source's
-    housingfe.source.roosmalen.overlap.cancellation_note)."""
+    housingfe.source.roosmalen.overlap.cancellation_note); bound: {torque: RunupResult} of the envelope bound
+    (engagement "envelope-bound" on the same models) -> runup_envelope_bound.csv."""
     totals = [r for _, res in results.values() for r in res.totals]
     outputs.write_csv(folder / "runup.csv", TOTAL_COLUMNS, ([_fmt(r[k]) for k in TOTAL_COLUMNS] for r in totals))
+    if bound:
+        outputs.write_csv(folder / BOUND_CSV, TOTAL_COLUMNS,
+                          ([_fmt(r[k]) for k in TOTAL_COLUMNS] for res in bound.values() for r in res.totals))
     harm = [r for _, res in results.values() for r in res.harmonic_rows()]
     outputs.write_csv(folder / "runup_harmonics.csv", HARMONIC_COLUMNS,
                       ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for r in harm))

@@ -25,8 +25,12 @@ from housingfe.errors import InputError
 from housingfe.scene import RadiationPlate
 from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table, read_scene_dict
 from housingfe.solvers.blas import single_thread
-from housingfe.source.roosmalen.dynamics import DEFAULT_ENGAGEMENT
+from housingfe.source.roosmalen.dynamics import DEFAULT_ENGAGEMENT, ENGAGEMENT_MODELS
 from housingfe.source.roosmalen.operating import SPEED_RANGE_RPM
+
+# the engagement the run-up also runs (source + routes on the same models) when the default meets an overlap ratio
+# near an integer (housingfe.source.roosmalen.overlap.cancellation_note): its range, not a model adopted
+BOUND_ENGAGEMENT = "envelope-bound"
 
 
 def _gearboxes() -> dict:
@@ -105,8 +109,9 @@ class RunupSpec(_Strict):
     spectrum_speeds_rpm: list[PositiveFloat] = [500.0, 1000.0, 1500.0]
     surface: str = "outer"
     # the source's engagement shock (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS): "face-width" distributes
-    # Eq. 2.62 over the face-width slices; "thesis-2d" is the thesis' two-dimensional shock (the replica)
-    engagement: Literal["face-width", "thesis-2d"] = DEFAULT_ENGAGEMENT
+    # Eq. 2.62 over the face-width slices; "thesis-2d" is the thesis' two-dimensional shock (the replica);
+    # "envelope-bound" the face-width excitation's envelope bound near an integer overlap ratio (a bound, not a model)
+    engagement: Literal[ENGAGEMENT_MODELS] = DEFAULT_ENGAGEMENT
     # the receptance around the mesh in the source's harmonic balance (housingfe.runup.chain.SOURCE_RECEPTANCES):
     # "coupled" = the coupled gearbox (housing, bearings, shafts, gear bodies) from the Ritz reduction;
     # "rigid-bores" = the lumped interior on rigid bores (the thesis' Ch. 2 source)
@@ -115,7 +120,8 @@ class RunupSpec(_Strict):
     # (housingfe.drivetrain.misalignment): "rigid-bores" = static tilt of the FE interior (shafts, bearings at their
     # loaded 6x6 stiffness) on rigid bores at each torque; "coupled" = the same on the flexible housing (one static
     # solve of the coupled model per torque); "lumped" = of the 14-DOF source model; "none" = aligned gears.
-    # Default: "rigid-bores" with the face-width engagement, "none" with the thesis' replica "thesis-2d"
+    # Default: "rigid-bores" with the face-width engagement (and its envelope bound), "none" with the thesis' replica
+    # "thesis-2d"
     misalignment: Optional[Literal["rigid-bores", "coupled", "lumped", "none"]] = None
 
     @property
@@ -296,11 +302,20 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     check_rows, contributions = checks.evaluate(scene, results, gm)
     note = source.overlap_note(reference_torque)      # cached operating point: milliseconds
     notes = [note] if note else []
+    bound = None
+    if note:      # the face-width default at the helix's cancellation: the envelope bound on the same models
+        from housingfe.runup.chain import engagement_rerun
+
+        bound, timings["envelope_bound_s"] = engagement_rerun(
+            {t: m for t, (m, _) in results.items()}, source, BOUND_ENGAGEMENT, spec.speeds, spec.f_max_hz,
+            spec.source_receptance, spec.routes)
+        notes += report.bound_lines(results, bound, scene.radiation.models[0])
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
-            report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes)
+            report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes,
+                         bound)
     if comm.rank == 0:
         print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")

@@ -121,6 +121,13 @@ def test_one_and_two_ranks_agree(tmp_path):
     for ra, rb in zip(a, b):
         for key in ("Lv_dB", "LwA_dB", "L_omega_dB"):
             assert float(ra[key]) == pytest.approx(float(rb[key]), abs=1e-6)
+    # the run-up with the envelope bound on the same models (set A's overlap note): the same on both, printed once
+    a, b = _rows(tmp_path / "one/runup_envelope_bound.csv"), _rows(tmp_path / "two/runup_envelope_bound.csv")
+    assert len(a) == len(b) == 2 * 2 * 3
+    for ra, rb in zip(a, b):
+        for key in ("Lv_dB", "LwA_dB", "L_omega_dB", "L_omega_coupled_dB"):
+            assert (ra[key] == rb[key] == "") or float(ra[key]) == pytest.approx(float(rb[key]), abs=1e-6)
+    assert two.stdout.count("with the envelope bound: max L_WA") == 1
 
 
 @pytest.mark.slow

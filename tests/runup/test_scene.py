@@ -29,11 +29,21 @@ def test_builtin_scenes_validate(name):
     ("runup.torques_nm=[-5.0]", "runup.torques_nm"),
     ("runup.colour=1", "runup.colour"),
     ('runup.engagement="3-d"', "runup.engagement"),
+    ('runup.engagement="envelope-bund"', "runup.engagement"),
 ])
 def test_bad_values_name_the_key(override, key):
     with pytest.raises(InputError) as err:
         load_runup_scene("test-gearbox-runup", [override])
     assert f": {key}" in str(err.value)
+
+
+@pytest.mark.parametrize("engagement, misalignment", [("face-width", "rigid-bores"), ("thesis-2d", "none"),
+                                                       ("envelope-bound", "rigid-bores")])
+def test_engagement_choices_and_their_default_misalignment(engagement, misalignment):
+    """runup.engagement: the three shock models of housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS; the
+    envelope bound keeps the face-width model's load share and so its misalignment."""
+    scene, _ = load_runup_scene("test-gearbox-runup", [f'runup.engagement="{engagement}"'])
+    assert scene.runup.engagement == engagement and scene.runup.misalignment_model == misalignment
 
 
 def test_missing_drivetrain_is_named(tmp_path):
@@ -52,6 +62,8 @@ def test_missing_drivetrain_is_named(tmp_path):
     (["--set", "runup.speed_max_rpm=2000.0"], "outside the range the source supports"),
     # single helical set A on cylindrical roller bearings: the axial tooth force has nothing to carry it
     (["--set", "drivetrain.bearings=cylindrical_roller"], "cannot carry it"),
+    (["--set", "runup.engagement=envelope-bund"],
+     "runup.engagement: Input should be 'face-width', 'thesis-2d' or 'envelope-bound'"),
 ])
 def test_cli_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
     out = tmp_path / "out"

@@ -151,6 +151,20 @@ def test_cli_writes_the_slope_terms(tmp_path):
     # set A (eps_beta 1.026) with the default face-width engagement: the overlap note, once (issue 28)
     notes = [ln for ln in summary.splitlines() if ln.startswith("NOTE: overlap ratio 1.026")]
     assert len(notes) == 1 and notes[0] in proc.stdout and "Lachenmaier" in notes[0]
+    # ... and the run-up with the envelope bound on the same models: one line, its curves in runup_envelope_bound.csv
+    # (the columns of runup.csv), its maxima above the default's (the bound's excitation lies 14-17 dB higher)
+    bound = [ln for ln in summary.splitlines() if "with the envelope bound: max L_WA" in ln]
+    assert len(bound) == 1 and bound[0] in proc.stdout
+    with open(out / "runup.csv") as fh:
+        default = list(csv.DictReader(fh))
+    with open(out / "runup_envelope_bound.csv") as fh:
+        enveloped = list(csv.DictReader(fh))
+    assert list(enveloped[0]) == list(default[0]) and len(enveloped) == len(default)
+    for route in ("tf_omega", "mesh_force"):
+        top = max((float(r["LwA_dB"]), float(r["speed_rpm"])) for r in enveloped
+                  if r["route"] == route and r["radiation"] == "erp")
+        assert f"{top[0]:.1f} dB(A) @ {top[1]:g} rpm ({route})" in bound[0].split("default")[0]
+        assert top[0] > max(float(r["LwA_dB"]) for r in default if r["route"] == route and r["radiation"] == "erp")
 
 
 def test_less_than_a_doubling_of_speed_reports_no_law(tmp_path):

@@ -81,7 +81,8 @@ def test_builtin_gearsets_are_valid_source_scenes():
 
 
 def test_engagement_key_selects_the_shock_model(tmp_path):
-    """source.engagement: "face-width" (default) or "thesis-2d"; anything else is named as the bad key."""
+    """source.engagement: "face-width" (default), "thesis-2d" or "envelope-bound"; anything else is named as the bad
+    key."""
     from housingfe.scenefile import read_scene_dict
     from housingfe.source.roosmalen import run as roosmalen
 
@@ -89,6 +90,8 @@ def test_engagement_key_selects_the_shock_model(tmp_path):
     assert roosmalen.parse(data, str(path)).engagement == "face-width"
     data["source"]["engagement"] = "thesis-2d"
     assert roosmalen.parse(data, str(path)).engagement == "thesis-2d"
+    data["source"]["engagement"] = "envelope-bound"
+    assert roosmalen.parse(data, str(path)).engagement == "envelope-bound"
     data["source"]["engagement"] = "3-d"
     with pytest.raises(housingfe.errors.InputError, match="source.engagement"):
         roosmalen.parse(data, str(path))

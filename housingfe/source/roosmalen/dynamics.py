@@ -33,9 +33,10 @@ from housingfe.levels import OMEGA0, band_sum, level, third_octave_bands
 from housingfe.source.gears import GearPair
 from housingfe.source.stiffness import Corrections, flank_gaps
 
-# the engagement shock models (`engagement` of source and run-up scenes): the thesis' two-dimensional Eq. 2.62, and
-# the same shock per face-width slice of the contact lines (a helical tooth enters and leaves gradually)
-ENGAGEMENT_MODELS = ("face-width", "thesis-2d")
+# the engagement shock models (`engagement` of source and run-up scenes): the thesis' two-dimensional Eq. 2.62, the
+# same shock per face-width slice of the contact lines (a helical tooth enters and leaves gradually), and the envelope
+# bound of the latter near an integer overlap ratio (a bound, not a model: docs/source.md)
+ENGAGEMENT_MODELS = ("face-width", "thesis-2d", "envelope-bound")
 DEFAULT_ENGAGEMENT = "face-width"
 
 N_DOF = 14       # after eliminating the prescribed far-end angle (DOF 15 of the thesis)
@@ -277,7 +278,7 @@ def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffn
 
     helix_stagger = False drops the o_j tan(beta_b) term: every slice of a contact line at the same roll position
     (the pair's transverse, spur-equivalent shock with the same load share and flank gaps; the reference of the
-    envelope bound in housingfe.source.roosmalen.overlap, not an engagement model)."""
+    envelope bound in housingfe.source.roosmalen.overlap and `engagement_force_envelope_bound`)."""
     S = np.asarray(stiffness, dtype=float)
     n = S.size if n_samples is None else n_samples
     t = np.arange(n) / n
@@ -318,14 +319,48 @@ def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffn
     return S * (total - total.mean())
 
 
+def envelope_factor(n, eps_beta: float) -> np.ndarray:
+    """min(1, 1 / (pi n eps_beta)) [-] per harmonic n >= 1: the envelope of |sinc(n eps_beta)|; 1 for eps_beta = 0."""
+    n = np.asarray(n, dtype=float)
+    if eps_beta <= 0.0:
+        return np.ones_like(n)
+    return np.minimum(1.0, 1.0 / (math.pi * n * eps_beta))
+
+
+def engagement_force_envelope_bound(pair: GearPair, corrections: Corrections, stiffness: np.ndarray,
+                                    normal_force: float, load_share: np.ndarray | None = None,
+                                    n_slices: int = 256) -> np.ndarray:
+    """F_e [N] over one mesh period (samples of `stiffness` S(t) [N/m]) whose quasi-static excitation is the envelope
+    bound of housingfe.source.roosmalen.overlap: engagement "envelope-bound", a bound and a sensitivity, not a model.
+
+    Start: the face-width slice model with every slice of a contact line in phase (`engagement_force_face_width`
+    with helix_stagger=False, the same load share and flank gaps: the shock without the helix's cancellation) and its
+    quasi-static mesh compression d_ip = (F - F_e,ip) / S(t).  The scaled quantity is that compression (so the
+    excitation k_m (d - mean d) = k_m x TE), not the shock: each harmonic n >= 1 of d_ip is multiplied by
+    min(1, 1 / (pi n eps_beta)) (`envelope_factor`; phase and the mean kept), d_b = inverse FFT, and
+    F_e = F - S(t) d_b, whose quasi-static compression is d_b exactly.  (Scaling F_e,ip itself would leave the
+    stiffness term F / S(t) unscaled and miss the documented bound.)  Spur gears (eps_beta = 0): the factor is 1
+    and F_e is the face-width shock (to rounding)."""
+    S = np.asarray(stiffness, dtype=float)
+    flat = engagement_force_face_width(pair, corrections, S, normal_force, load_share=load_share, n_slices=n_slices,
+                                       helix_stagger=False)
+    d = quasi_static_compression(S, flat, normal_force)
+    coefficients = np.fft.rfft(d - d.mean())
+    coefficients[1:] *= envelope_factor(np.arange(1, coefficients.size), pair.overlap_ratio)
+    return normal_force - S * (d.mean() + np.fft.irfft(coefficients, S.size))
+
+
 def engagement_shock(model: str, pair: GearPair, corrections: Corrections, stiffness: np.ndarray,
                      normal_force: float, load_share: np.ndarray | None = None) -> np.ndarray:
     """F_e [N] of the engagement model `model` (ENGAGEMENT_MODELS): "thesis-2d" = `engagement_force` (Eq. 2.62,
-    the replica of the thesis), "face-width" = `engagement_force_face_width` with the given load share."""
+    the replica of the thesis), "face-width" = `engagement_force_face_width` with the given load share,
+    "envelope-bound" = `engagement_force_envelope_bound` (the face-width excitation's envelope bound, not a model)."""
     if model == "thesis-2d":
         return engagement_force(pair, corrections, stiffness, normal_force)
     if model == "face-width":
         return engagement_force_face_width(pair, corrections, stiffness, normal_force, load_share=load_share)
+    if model == "envelope-bound":
+        return engagement_force_envelope_bound(pair, corrections, stiffness, normal_force, load_share=load_share)
     raise InputError(f"engagement: {model!r} is not one of {', '.join(ENGAGEMENT_MODELS)}")
 
 

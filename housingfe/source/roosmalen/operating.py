@@ -13,6 +13,7 @@ x(t) = x_mean + Re(sum_n A_n exp(i 2 pi n f_tooth t)).
 """
 from __future__ import annotations
 
+import copy
 import math
 import numbers
 from dataclasses import dataclass
@@ -171,6 +172,17 @@ class SourceModel:
                           mesh_force=force, transmission_error=te, mean_mesh_force=float(np.real(st.mesh_force[H])),
                           mean_compression=float(np.real(d[H])), bearings=bearings, L_omega=level(ms, OMEGA0),
                           L_omega_tooth_band=dyn.tooth_band_level(st), state=st)
+
+    def with_engagement(self, engagement: str) -> "SourceModel":
+        """The same source with another engagement shock model (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS,
+        e.g. "envelope-bound"); the operating points computed so far keep their stiffness curve, load share and
+        matrices and only recompute F_e (OperatingPoint.with_engagement), so a re-run costs the harmonic balances."""
+        if engagement not in dyn.ENGAGEMENT_MODELS:
+            raise InputError(f"engagement: {engagement!r} is not one of {', '.join(dyn.ENGAGEMENT_MODELS)}")
+        other = copy.copy(self)
+        other.engagement = engagement
+        other._points = {t: op.with_engagement(self.pair, self.corrections, engagement) for t, op in self._points.items()}
+        return other
 
     def overlap_note(self, torque_nm: float) -> str | None:
         """The summary line of housingfe.source.roosmalen.overlap.cancellation_note at a pinion torque [N m]: the

@@ -11,28 +11,23 @@ The envelope bound replaces the sinc by its envelope: the quasi-static excitatio
 d = (F - F_e) / S(t), of the same slice model with every slice of a contact line in phase (zero helix stagger: the
 transverse, spur-equivalent shock with the same load share and flank gaps), harmonic n multiplied by
 min(1, 1 / (pi n eps_beta)).  It is a bound and a sensitivity (what the helix would leave if it reduced each
-harmonic only by the envelope of its sinc), not a model: no run uses it for a level.
+harmonic only by the envelope of its sinc), not a model adopted.  The engagement option "envelope-bound"
+(dynamics.engagement_force_envelope_bound: the shock whose quasi-static excitation is this bound at every harmonic)
+carries it through the chain, e.g. `housingfe run test-gearbox-runup --set runup.engagement=envelope-bound`; the
+run-up summary prints its maxima beside the default's when the note below triggers.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from housingfe.source.gears import GearPair
 from housingfe.source.roosmalen import dynamics as dyn
+from housingfe.source.roosmalen.dynamics import envelope_factor  # noqa: F401  (min(1, 1/(pi n eps_beta)), re-exported)
 from housingfe.source.stiffness import Corrections
 
 NEAR_INTEGER = 0.1        # |eps_beta - round(eps_beta)| at or under this, round(eps_beta) >= 1: "near an integer"
-
-
-def envelope_factor(n, eps_beta: float) -> np.ndarray:
-    """min(1, 1 / (pi n eps_beta)) [-] per harmonic n >= 1: the envelope of |sinc(n eps_beta)|; 1 for eps_beta = 0."""
-    n = np.asarray(n, dtype=float)
-    if eps_beta <= 0.0:
-        return np.ones_like(n)
-    return np.minimum(1.0, 1.0 / (math.pi * n * eps_beta))
 
 
 def harmonic_amplitudes(samples: np.ndarray, harmonics: int) -> np.ndarray:

@@ -6,7 +6,8 @@ so, as in Appendix F):
 
     [source]              model, torque_Nm, speed_min_rpm, speed_max_rpm, speed_steps, spectrum_speeds_rpm,
                           torque_run_Nm, harmonics, stiffness_positions, slices, torque_configuration,
-                          engagement ("face-width" default | "thesis-2d": the thesis' Eq. 2.62 replica)
+                          engagement ("face-width" default | "thesis-2d": the thesis' Eq. 2.62 replica |
+                          "envelope-bound": the face-width excitation's envelope bound, a bound, not a model)
     [source.gears]        Appendix F data (module_mm, teeth, ..., power_kW, max_speed_rpm)
     [source.corrections]  pinion_um, pinion_mm, wheel_um, wheel_mm, ... (Appendix F, as measured)
     [source.shafts]       bearing spans, shaft diameters, torsion shafts 1-4, coupling inertias
@@ -15,6 +16,7 @@ so, as in Appendix F):
 """
 from __future__ import annotations
 
+import copy
 from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Annotated, Literal, Optional, Union
@@ -116,7 +118,7 @@ class SourceTable(_Strict):
     stiffness_positions: int = Field(32, ge=4, le=512)
     slices: int = Field(16, ge=2, le=200)
     torque_configuration: Literal[1, 2] = 2
-    engagement: Literal["face-width", "thesis-2d"] = dyn.DEFAULT_ENGAGEMENT
+    engagement: Literal[dyn.ENGAGEMENT_MODELS] = dyn.DEFAULT_ENGAGEMENT
     measured_L_omega_dB: Optional[dict[str, float]] = None
     gears: GearsTable
     corrections: CorrectionsTable = CorrectionsTable()
@@ -157,7 +159,8 @@ def build(table: SourceTable, scene_path: str = "scene"):
 class OperatingPoint:
     """Stiffness curve, matrices, shock force and preload for one pinion torque [N m].  engagement: the shock
     model (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS): "face-width" (default) distributes Eq. 2.62 over the
-    face-width slices with the load share of `face_load_share`, "thesis-2d" is the thesis' Eq. 2.62.
+    face-width slices with the load share of `face_load_share`, "thesis-2d" is the thesis' Eq. 2.62, "envelope-bound"
+    the envelope bound of the face-width excitation (same load share; dynamics.engagement_force_envelope_bound).
     lead_gap [m/m]: the misalignment under load (MeshModel.lead_gap, housingfe.source.misalignment), in the
     stiffness curve and the load share (0: aligned gears, exactly as before)."""
 
@@ -165,6 +168,7 @@ class OperatingPoint:
                  engagement: str = dyn.DEFAULT_ENGAGEMENT, lead_gap: float = 0.0):
         self.torque = torque
         self.engagement = engagement
+        self.n_positions = n_positions
         self.lead_gap = float(lead_gap)
         if self.lead_gap != 0.0:
             model = replace(model, lead_gap=self.lead_gap)
@@ -174,10 +178,23 @@ class OperatingPoint:
         t = np.arange(n_samples) / n_samples
         self.S = np.interp(t, self.curve.position, self.curve.stiffness, period=1.0)
         self.load_share = (face_load_share(model, self.normal_force, n_positions=n_positions)
-                           if engagement == "face-width" else None)
+                           if engagement in ("face-width", "envelope-bound") else None)
         self.shock = dyn.engagement_shock(engagement, pair, corr, self.S, self.normal_force, self.load_share)
         self.mats = dyn.assemble(pair, interior, self.curve.mean)
         self.f0 = dyn.preload_force(self.mats, torque)
+
+    def with_engagement(self, pair: GearPair, corr: Corrections, engagement: str) -> "OperatingPoint":
+        """This operating point with another engagement shock model (ENGAGEMENT_MODELS): the stiffness curve, load
+        share, matrices and preload reused (the load share computed if this point has none), only F_e recomputed
+        (milliseconds; exactly what a new OperatingPoint with that engagement holds)."""
+        if engagement not in dyn.ENGAGEMENT_MODELS:
+            raise InputError(f"engagement: {engagement!r} is not one of {', '.join(dyn.ENGAGEMENT_MODELS)}")
+        other = copy.copy(self)
+        other.engagement = engagement
+        if other.load_share is None and engagement != "thesis-2d":
+            other.load_share = face_load_share(self.mesh_model, self.normal_force, n_positions=self.n_positions)
+        other.shock = dyn.engagement_shock(engagement, pair, corr, self.S, self.normal_force, other.load_share)
+        return other
 
     def steady_state(self, pair: GearPair, speed_rpm: float, harmonics: int) -> dyn.SteadyState:
         return dyn.harmonic_balance(self.mats, self.S, self.shock, self.f0, pair.tooth_frequency(speed_rpm),

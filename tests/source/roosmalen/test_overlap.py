@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 import housingfe
+import housingfe.errors
 from housingfe.source.gears import GearPair
 from housingfe.source.roosmalen import dynamics as dyn
 from housingfe.source.roosmalen import overlap as ov
@@ -109,6 +110,68 @@ def test_bound_near_an_integer_overlap_ratio_is_the_envelope_over_the_sinc():
     assert expected == pytest.approx(21.9, abs=0.1)
 
 
+# ------------------------------------------------------------------ the engagement option "envelope-bound"
+@pytest.mark.parametrize("load_share", [None, np.linspace(0.7, 1.3, 24)[None, :]])
+def test_envelope_bound_engagement_has_the_bound_as_its_quasi_static_excitation(load_share):
+    """Set A's gears and corrections (eps_beta 1.026), a time-varying S: the quasi-static excitation k_m (d - mean d)
+    of engagement "envelope-bound" is, harmonic by harmonic, the documented bound (in-phase excitation x
+    min(1, 1/(pi n eps_beta))), to rounding.  The scaled quantity is the compression, not the shock: scaling the
+    in-phase shock's harmonics instead leaves F / S(t) unscaled and misses the bound by more than 1 dB at n = 1."""
+    S = _stiffness_wave()
+    shock = dyn.engagement_shock("envelope-bound", PAIR, SET_A, S, FORCE, load_share)
+    face_width = dyn.engagement_shock("face-width", PAIR, SET_A, S, FORCE, load_share)
+    b = ov.envelope_bound(PAIR, SET_A, S, FORCE, face_width, load_share, K_MEAN, harmonics=3)
+    ours = ov.harmonic_amplitudes(ov.quasi_static_excitation(S, shock, FORCE, K_MEAN), 3)
+    np.testing.assert_allclose(ours, b.bound, rtol=1e-12)
+    assert np.all(b.above_dB > 5.0)                  # and it is not the face-width excitation
+    # its mean compression is the in-phase model's (the static state is kept)
+    flat = ov.in_phase_shock(PAIR, SET_A, S, FORCE, load_share)
+    assert np.mean(dyn.quasi_static_compression(S, shock, FORCE)) == pytest.approx(
+        np.mean(dyn.quasi_static_compression(S, flat, FORCE)), rel=1e-12)
+    c = np.fft.rfft(flat)
+    c[1:] *= ov.envelope_factor(np.arange(1, c.size), PAIR.overlap_ratio)
+    shock_scaled = ov.harmonic_amplitudes(ov.quasi_static_excitation(S, np.fft.irfft(c, S.size), FORCE, K_MEAN), 1)
+    assert abs(20 * math.log10(shock_scaled[0] / b.bound[0])) > 1.0
+
+
+def test_envelope_bound_engagement_of_a_spur_pair_is_face_width():
+    """eps_beta = 0: envelope 1, no stagger: the option is the face-width shock (to rounding)."""
+    spur = _spur_pair()
+    S = _stiffness_wave()
+    share = np.linspace(0.8, 1.2, 16)[None, :]
+    ref = dyn.engagement_shock("face-width", spur, SET_A, S, FORCE, share)
+    ours = dyn.engagement_shock("envelope-bound", spur, SET_A, S, FORCE, share)
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-9 * np.ptp(ref))
+
+
+def test_with_engagement_is_a_new_operating_point_with_that_engagement():
+    """SourceModel.with_engagement reuses the stiffness curve, load share and matrices and recomputes F_e only: the
+    same shock and steady state as a source built with that engagement (set A, a coarse stiffness curve)."""
+    from housingfe.scenefile import read_scene_dict
+    from housingfe.source.roosmalen import run as rs
+    from housingfe.source.roosmalen.operating import SourceModel
+
+    data, path = read_scene_dict(str(SCENES / "gearset-A.toml"))
+    table = rs.parse(data, str(path))
+    pair, corr, geometry, interior, model = rs.build(table, str(path))
+    model = replace(model, n_slices=6)
+
+    def source(engagement):
+        return SourceModel(pair, corr, interior, geometry, mesh_model=model, stiffness_positions=6, harmonics=8,
+                           engagement=engagement)
+
+    default = source("face-width")
+    default.operating_point(1000.0, 2000.0)
+    other, fresh = default.with_engagement("envelope-bound"), source("envelope-bound")
+    assert other.engagement == "envelope-bound" and default.engagement == "face-width"
+    np.testing.assert_array_equal(other.mesh_stiffness(2000.0)[1], fresh.mesh_stiffness(2000.0)[1])
+    np.testing.assert_array_equal(other.operating_point(1000.0, 2000.0).mesh_force,
+                                  fresh.operating_point(1000.0, 2000.0).mesh_force)
+    assert not np.array_equal(default.mesh_stiffness(2000.0)[1], other.mesh_stiffness(2000.0)[1])
+    with pytest.raises(housingfe.errors.InputError, match="engagement: 'envelope-bund' is not one of"):
+        default.with_engagement("envelope-bund")
+
+
 def test_near_integer():
     assert ov.near_integer(1.026) and ov.near_integer(0.95) and ov.near_integer(2.08)
     assert not ov.near_integer(1.139) and not ov.near_integer(0.5) and not ov.near_integer(0.05)
@@ -167,3 +230,14 @@ def test_source_summary_notes_the_cancellation_for_set_a_only(tmp_path):
     proc = _source(_trimmed_scene(tmp_path, "b", {"engagement": '"thesis-2d"'}), out2)
     assert proc.returncode == 0, proc.stderr
     assert "NOTE: overlap ratio" not in (out2 / "summary.txt").read_text() + proc.stdout
+    # the bound as the engagement option: no note (it is not the default's cancellation), and the tooth band lies
+    # above the default's (its excitation at n = 1 lies `above` dB higher)
+    out3 = tmp_path / "c"
+    proc = _source(_trimmed_scene(tmp_path, "c", {"engagement": '"envelope-bound"'}), out3)
+    assert proc.returncode == 0, proc.stderr
+    assert "NOTE: overlap ratio" not in (out3 / "summary.txt").read_text() + proc.stdout
+
+    def tooth_band(folder):
+        return [float(ln.split(",")[3]) for ln in (folder / "runup.csv").read_text().splitlines()[1:]]
+
+    assert all(b > a + 5.0 for a, b in zip(tooth_band(out), tooth_band(out3)))
