@@ -19,8 +19,9 @@ Outputs (write_npz, write_dmig): a documented npz (K, M, the DOF table, master c
 frequencies, provenance) and Nastran DMIG bulk data (KAAX / MAAX, masters as GRIDs, modal coordinates as
 SPOINTs), which read_dmig reads back.
 
-MPI: everything is PETSc/dolfinx on any number of ranks; K_r and M_r are summed from the ranks' rows, so 1 and
-2 ranks give the same reduced matrices (to round-off).
+MPI: everything is PETSc/dolfinx on any number of ranks; K_r and M_r are summed from the ranks' rows and each
+mode's arbitrary sign is fixed by its coupling to the masters (fix_mode_signs), so 1 and 2 ranks give the same
+reduced matrices (to round-off).
 """
 from __future__ import annotations
 
@@ -143,7 +144,7 @@ def craig_bampton(model, masters: list[Master], cutoff_hz: float, tol: float = 1
     t3 = time.perf_counter()
 
     T = np.column_stack([v.getArray(readonly=True) for v in phi] + [psi]) if phi else psi
-    Kr, Mr = _project(K, T), _project(M, T)
+    Kr, Mr = fix_mode_signs(_project(K, T), _project(M, T), len(phi))
     for v in phi:
         v.destroy()
     for A in (K_fixed, M_fixed):
@@ -157,6 +158,23 @@ def craig_bampton(model, masters: list[Master], cutoff_hz: float, tol: float = 1
                           "projection_s": t4 - t3, "reduction_s": t4 - t0},
                          {"fe_dofs": int(model.dofs), "ranks": int(comm.size)})
     return out
+
+
+def fix_mode_signs(Kr: np.ndarray, Mr: np.ndarray, n_modes: int) -> tuple[np.ndarray, np.ndarray]:
+    """The reduced K, M with each fixed-interface mode's sign fixed.  An eigenvector's sign is arbitrary: the
+    eigensolver's start vector and the MPI layout pick it, and it flips the sign of that mode's row and column of
+    the modal-master mass coupling.  Each mode is turned so that its coupling to the master DOFs, weighted by
+    1/sqrt(j) (generic weights: a symmetric pair of masters does not cancel), is positive; a mode without
+    coupling leaves both matrices unchanged either way.  So the same housing gives the same K_r, M_r (and DMIG)
+    on any number of ranks.  (Modes of one repeated frequency may still come out as another basis of their
+    eigenspace.)"""
+    if n_modes == 0:
+        return Kr, Mr
+    weights = 1.0 / np.sqrt(np.arange(1, Mr.shape[0] - n_modes + 1))
+    signs = np.ones(Mr.shape[0])
+    signs[:n_modes] = np.where(Mr[:n_modes, n_modes:] @ weights < 0.0, -1.0, 1.0)
+    flip = np.outer(signs, signs)
+    return Kr * flip, Mr * flip
 
 
 def _mat_dense(A: PETSc.Mat, X: np.ndarray) -> np.ndarray:

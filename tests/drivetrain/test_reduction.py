@@ -8,7 +8,8 @@ patches as masters, cut-off 6 kHz (46 fixed-interface modes + 24 master DOFs fro
   (Rayleigh–Ritz) and lie within 1 % below 0.4 x cut-off and 2.5 % below 0.5 x cut-off (measured 0.16 % and
   1.46 %); the free box (masters tied) likewise (measured 0.46 % and 0.83 %);
 * the Nastran DMIG export reads back to the matrices (1e-9, 10 significant digits), the npz holds the documented
-  fields, and 2 MPI ranks give the 1-rank reduced model.
+  fields, and 2 MPI ranks give the 1-rank reduced model: the same frequencies and the same K_r, M_r entry by
+  entry (each fixed-interface mode's arbitrary sign fixed by its coupling to the masters).
 """
 from __future__ import annotations
 
@@ -26,6 +27,7 @@ from housingfe.drivetrain.reduction import (
     Master,
     ReducedHousing,
     craig_bampton,
+    fix_mode_signs,
     read_dmig,
     write_dmig,
     write_npz,
@@ -201,11 +203,33 @@ def test_reduce_a_cad_housing_at_its_bore_selectors(tmp_path):
         assert np.array_equal(default[key], named[key]), key
 
 
+def test_mode_signs_do_not_change_the_reduced_model(box):
+    """Flipping any fixed-interface modes (eigenvectors are defined up to sign) changes K_r, M_r only by
+    S K S, S M S; after fix_mode_signs every choice of signs gives the same matrices, and the frequencies with
+    the bearing springs are unchanged by it."""
+    _, masters, red = box
+    n = red.n_modes
+    coupled = np.abs(red.M[:n, n:]).max(axis=1) > 1e-8 * np.abs(red.M[:n, n:]).max()
+    assert coupled.sum() >= n // 2, "too few modes coupled to the masters to test anything"
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        signs = np.ones(len(red.M))
+        signs[:n] = rng.choice([-1.0, 1.0], n)
+        flipped = np.outer(signs, signs)
+        K, M = fix_mode_signs(red.K * flipped, red.M * flipped, n)
+        np.testing.assert_array_equal(M, red.M)
+        np.testing.assert_array_equal(K, red.K)
+    again = ReducedHousing(*fix_mode_signs(red.K, red.M, n), red.frequencies_hz, red.masters, red.cutoff_hz)
+    np.testing.assert_allclose(again.frequencies_with({m.name: K6 for m in masters}),
+                               red.frequencies_with({m.name: K6 for m in masters}), rtol=1e-12)
+
+
 def mpi_case(comm) -> dict:
     _, masters, red = reduce_box(comm)
     return {"ranks": comm.size, "n_modes": red.n_modes,
             "f": red.frequencies_with({m.name: K6 for m in masters}).tolist(),
-            "static": np.linalg.eigvalsh(red.K[red.n_modes:, red.n_modes:]).tolist()}
+            "static": np.linalg.eigvalsh(red.K[red.n_modes:, red.n_modes:]).tolist(),
+            "K": red.K.tolist(), "M": red.M.tolist()}
 
 
 @pytest.mark.mpi
@@ -219,6 +243,9 @@ def test_two_ranks_give_the_one_rank_reduced_model(box):
     assert np.max(np.abs(np.array(two["f"]) / one - 1)) < 1e-8
     static = np.linalg.eigvalsh(red.K[red.n_modes:, red.n_modes:])
     assert np.allclose(two["static"][6:], static[6:], rtol=1e-8)
+    # the matrices themselves (what the DMIG export hands over), not only their invariants
+    for key, one_rank in (("K", red.K), ("M", red.M)):
+        assert np.max(np.abs(np.array(two[key]) - one_rank)) <= 1e-8 * np.max(np.abs(one_rank)), key
 
 
 if __name__ == "__main__":      # mpirun -n 2 python -m tests.drivetrain.test_reduction: the 2-rank half
