@@ -65,7 +65,8 @@ def only_rows(results: Path, quick: bool = False, failures: list[str] | None = N
     """The check rows of issue 28 alone (`housingfe validate --only runup-checks`): the default run-up's tagged rows,
     the design-variant study's (study_rows), the quasi-static excitation's (source_rows.excitation_rows) and the
     checks no other provider makes (runup_checks_rows), each from the same cached computation the full validate
-    uses.  A failed computation is appended to failures (its rows are missing)."""
+    uses, and after them the envelope bound's reported rows 28.bound.* (not checks: checks.as_bound).  A failed
+    computation is appended to failures (its rows are missing)."""
     from housingfe.verification import source_rows, study_rows, validate
     from housingfe.verification.checks import check_rows
 
