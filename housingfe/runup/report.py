@@ -4,7 +4,9 @@ slope_terms.csv / .png (the speed law split into the chain's terms, housingfe.ru
 summary.txt (the console summary) and runup.json (timings, provenance, the modal basis used, checks, modal
 contributions per peak, the slope decomposition); when the run-up also ran the envelope bound (the face-width default
 at an overlap ratio near an integer, housingfe.runup.scene), runup_envelope_bound.csv (its totals, the columns of
-runup.csv)."""
+runup.csv), runup_envelope_bound_harmonics.csv (its lines, the columns of runup_harmonics.csv) and runup.json's
+"envelope_bound" (its checks and peak contributions, housingfe.runup.checks.evaluate on the bound's curves: what
+`housingfe validate` reports as the rows 28.bound.*, beside the checks, not judged)."""
 from __future__ import annotations
 
 import platform
@@ -25,6 +27,7 @@ CHECK_COLUMNS = ("check", "quantity", "ours", "measured", "thesis_calculated", "
 
 
 BOUND_CSV = "runup_envelope_bound.csv"
+BOUND_HARMONICS_CSV = "runup_envelope_bound_harmonics.csv"
 
 
 def bound_lines(results: dict, bound: dict, radiation: str) -> list[str]:
@@ -50,16 +53,21 @@ def _fmt(v):
 
 
 def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict,
-          decompositions: list = (), notes: list = (), bound: dict | None = None) -> None:
+          decompositions: list = (), notes: list = (), bound: dict | None = None,
+          bound_checks: tuple | None = None) -> None:
     """Every output file of a run-up into `folder` (rank 0); decompositions: housingfe.runup.slopes
     SlopeDecomposition of every curve; notes: lines for the summary about the model's validity (e.g. the source's
     housingfe.source.roosmalen.overlap.cancellation_note); bound: {torque: RunupResult} of the envelope bound
-    (engagement "envelope-bound" on the same models) -> runup_envelope_bound.csv."""
+    (engagement "envelope-bound" on the same models) -> runup_envelope_bound.csv and
+    runup_envelope_bound_harmonics.csv; bound_checks: (check rows, peak contributions) of the bound's curves
+    (housingfe.runup.checks.evaluate) -> runup.json "envelope_bound"."""
     totals = [r for _, res in results.values() for r in res.totals]
     outputs.write_csv(folder / "runup.csv", TOTAL_COLUMNS, ([_fmt(r[k]) for k in TOTAL_COLUMNS] for r in totals))
     if bound:
         outputs.write_csv(folder / BOUND_CSV, TOTAL_COLUMNS,
                           ([_fmt(r[k]) for k in TOTAL_COLUMNS] for res in bound.values() for r in res.totals))
+        outputs.write_csv(folder / BOUND_HARMONICS_CSV, HARMONIC_COLUMNS,
+                          ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for res in bound.values() for r in res.harmonic_rows()))
     harm = [r for _, res in results.values() for r in res.harmonic_rows()]
     outputs.write_csv(folder / "runup_harmonics.csv", HARMONIC_COLUMNS,
                       ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for r in harm))
@@ -89,6 +97,9 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "ritz_reanalysis": {f"{t:g}": m.reduction.frequencies_hz[:12].tolist() for t, (m, _) in results.items()},
         "checks": check_rows, "peak_contributions": contributions,
         "slope_terms": [d.to_json() for d in decompositions],
+        "envelope_bound": None if not bound_checks else {
+            "engagement": "envelope-bound", "what": "a bound, not the model (docs/source.md)", "totals": BOUND_CSV,
+            "harmonics": BOUND_HARMONICS_CSV, "checks": bound_checks[0], "peak_contributions": bound_checks[1]},
         "area_level_dB": next(iter(results.values()))[1].area_level_db,
         "provenance": {"python": platform.python_version(), "dolfinx": dolfinx.__version__,
                        "machine": platform.machine(), "mpi_ranks": gm.structure.V.mesh.comm.size},

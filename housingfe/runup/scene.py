@@ -302,7 +302,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     check_rows, contributions = checks.evaluate(scene, results, gm)
     note = source.overlap_note(reference_torque)      # cached operating point: milliseconds
     notes = [note] if note else []
-    bound = None
+    bound = bound_checks = None
     if note:      # the face-width default at the helix's cancellation: the envelope bound on the same models
         from housingfe.runup.chain import engagement_rerun
 
@@ -310,12 +310,16 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
             {t: m for t, (m, _) in results.items()}, source, BOUND_ENGAGEMENT, spec.speeds, spec.f_max_hz,
             spec.source_receptance, spec.routes)
         notes += report.bound_lines(results, bound, scene.radiation.models[0])
+        # the same checks on the bound's curves (the validate rows 28.bound.*: reported beside the checks, not judged)
+        t1 = time.perf_counter()
+        bound_checks = checks.evaluate(scene, {t: (results[t][0], res) for t, res in bound.items()}, gm)
+        timings["envelope_bound_checks_s"] = time.perf_counter() - t1
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
             report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes,
-                         bound)
+                         bound, bound_checks)
     if comm.rank == 0:
         print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")

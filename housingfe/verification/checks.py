@@ -4,7 +4,9 @@ A check row is an ordinary validate row (housingfe.verification.published.row: s
 unit, source, note) with these fields added (`tag`):
 
 * check_id — stable name, "28.<group>.<what>[.<variant>][.<route>]", e.g. "28.default.max_lwa.mesh_force"; the
-  groups, in the issue's order: replica, default, excitation, speed_law, l_omega, variants (CHECK_GROUPS);
+  groups, in the issue's order: replica, default, excitation, speed_law, l_omega, variants (CHECK_GROUPS), and
+  bound: the envelope bound's rows "28.bound.<the check's id after 28.>" (`as_bound`), reported beside the checks,
+  never judged, without a band and counted apart;
 * measured, thesis_calculated — the published numbers beside ours (either may be None);
 * tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
 * passed — "yes", "no" or "" (a report row: nothing to pass);
@@ -32,7 +34,11 @@ from pathlib import Path
 
 import numpy as np
 
-CHECK_GROUPS = ("replica", "default", "excitation", "speed_law", "l_omega", "variants")
+CHECK_GROUPS = ("replica", "default", "excitation", "speed_law", "l_omega", "variants", "bound")
+# the rows of the envelope bound (engagement "envelope-bound", docs/source.md): a check's value with the bound in
+# place of the default's excitation, reported beside the checks (passed "", no band), never judged nor counted
+BOUND_GROUP = "bound"
+BOUND_WHY = "envelope bound (engagement envelope-bound): a bound, not the model; docs/source.md"
 CHECK_COLUMNS = ("check_id", "quantity", "ours", "measured", "thesis_calculated", "tolerance", "passed", "band", "why",
                  "unit", "scene", "source")
 NO_BAND = "—"
@@ -81,6 +87,25 @@ def is_check(row: dict) -> bool:
     return bool(row.get("check_id"))
 
 
+def is_bound(row: dict) -> bool:
+    """A row of the envelope bound (28.bound.*): reported, not a check."""
+    return is_check(row) and row["check_id"].split(".")[1] == BOUND_GROUP
+
+
+def as_bound(row: dict) -> dict:
+    """The envelope bound's counterpart of a check row made by the check's own row function on the bound's data:
+    check_id 28.bound.<the check's id after "28.">, ours / measured / thesis calculated as made, passed "" (reported),
+    no tolerance and no band, `why` saying that it is a bound (BOUND_WHY) before what made the number."""
+    if not is_check(row) or is_bound(row):
+        raise ValueError(f"as_bound: {row.get('check_id')!r} is not a check row")
+    why = f"{BOUND_WHY}; {row['why']}" if row.get("why") else BOUND_WHY
+    row.update(check_id=f"28.{BOUND_GROUP}.{row['check_id'][3:]}", passed="", tolerance="", why=why,
+               note=f"reported, not judged: {why}", band=None)
+    for key in ("band_passes", "band_note"):
+        row.pop(key, None)
+    return row
+
+
 def check_rows(rows) -> list[dict]:
     """The check rows of `rows`, in the issue's order of groups (stable within a group)."""
     found = [r for r in rows if is_check(r)]
@@ -99,7 +124,7 @@ def attach_bands(rows, bands) -> int:
     without an entry show "—"."""
     n = 0
     for r in rows:
-        if not (is_check(r) and r["check_id"] in bands):
+        if not (is_check(r) and r["check_id"] in bands) or is_bound(r):      # the bound's rows have no band
             continue
         entry = bands[r["check_id"]]
         if isinstance(entry, dict):
@@ -197,13 +222,18 @@ def _cells(r: dict) -> list[str]:
 
 
 def checks_markdown(rows) -> str:
-    """The check rows of `rows` as a Markdown table (the columns of CHECK_COLUMNS) and a count line."""
+    """The check rows of `rows` as a Markdown table (the columns of CHECK_COLUMNS) and a count line; the envelope
+    bound's rows (28.bound.*) are counted apart: they are not checks."""
     found = check_rows(rows)
     lines = ["| " + " | ".join(CHECK_COLUMNS) + " |", "|" + "---|" * len(CHECK_COLUMNS)]
     lines += ["| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in _cells(r)) + " |" for r in found]
+    bound = sum(is_bound(r) for r in found)
+    checks = len(found) - bound
     passed = sum(r.get("passed") == "yes" for r in found)
     failed = sum(r.get("passed") == "no" for r in found)
-    lines += ["", f"{len(found)} checks: {passed} passed, {failed} failed, {len(found) - passed - failed} reported"]
+    lines += ["", f"{checks} checks: {passed} passed, {failed} failed, {checks - passed - failed} reported"
+              + (f"; and {bound} rows of the envelope bound (28.bound.*), reported: a bound, not the model" if bound
+                 else "")]
     return "\n".join(lines) + "\n"
 
 

@@ -19,6 +19,13 @@ and from the design-variant study's cached result (<results>/study-validate/, ho
 * 28.replica.max_lwa — the thesis replica (engagement thesis-2d, the rigid-bore source's L_omega times TF_omega,
   sigma = 1, gear set A, ball bearings, 2000 N m): max L_WA within 1.5 dB of the thesis' calculated 89.4 dB(A).
 
+and, where the default run-up also ran the envelope bound (set A's overlap ratio near an integer: runup_envelope_bound.csv,
+runup_envelope_bound_harmonics.csv and runup.json "envelope_bound"), the rows of the envelope bound (`bound_chain_rows`,
+checks.as_bound: reported beside the checks, never judged, no band; a bound, not the model, docs/source.md):
+
+* 28.bound.default.max_lwa.<route>, .max_lwa_harmonic.<route>, .peaks.<route> and 28.bound.l_omega.flexible.<speed>rpm
+  — the same row functions as the checks' (validate.run_check_rows, max_harmonic_row, peak_rows) on the bound's data.
+
 Nothing is computed here that validate does not compute anyway: with both caches valid these rows take well under
 a second; with quick and a stale cache they are left out (a note on the console).  `only_rows` collects every check
 row of issue 28 (these and the ones tagged by the other providers) for `housingfe validate --only runup-checks`.
@@ -47,6 +54,7 @@ def published_rows(results: Path | None = None, quick: bool = False) -> list[dic
     found = validate.runup_folder(validate.DEFAULT_RUNUP, (), results, quick)
     if found is not None:
         out += default_chain_rows(*found)
+        out += bound_chain_rows(*found)
     folder = study_rows.study_folder(results, quick)
     if folder is not None:
         out += replica_rows(folder)
@@ -57,7 +65,8 @@ def only_rows(results: Path, quick: bool = False, failures: list[str] | None = N
     """The check rows of issue 28 alone (`housingfe validate --only runup-checks`): the default run-up's tagged rows,
     the design-variant study's (study_rows), the quasi-static excitation's (source_rows.excitation_rows) and the
     checks no other provider makes (runup_checks_rows), each from the same cached computation the full validate
-    uses.  A failed computation is appended to failures (its rows are missing)."""
+    uses, and after them the envelope bound's reported rows 28.bound.* (not checks: checks.as_bound).  A failed
+    computation is appended to failures (its rows are missing)."""
     from housingfe.verification import source_rows, study_rows, validate
     from housingfe.verification.checks import check_rows
 
@@ -92,6 +101,30 @@ def default_chain_rows(label: str, folder: Path) -> list[dict]:
     rad = data["scene_settings"]["radiation"]["models"][0]
     return chain_rows(label, rad, _read_csv(folder / "runup.csv"), _read_csv(folder / "runup_harmonics.csv"),
                       data["peak_contributions"])
+
+
+# the checks whose counterpart with the envelope bound is reported (28.bound.<id after 28.>)
+BOUND_CHECKS = ("default.max_lwa.", "default.max_lwa_harmonic.", "default.peaks.", "l_omega.flexible.")
+
+
+def bound_chain_rows(label: str, folder: Path) -> list[dict]:
+    """The envelope bound's rows (module docstring) from a run-up result folder; none when the run did not run the
+    bound (no runup_envelope_bound.csv, or a result written before its lines and checks were kept)."""
+    from housingfe.runup.report import BOUND_CSV, BOUND_HARMONICS_CSV
+    from housingfe.verification import validate
+
+    data = json.loads((folder / "runup.json").read_text())
+    bound = data.get("envelope_bound")
+    if not bound or not (folder / BOUND_CSV).is_file() or not (folder / BOUND_HARMONICS_CSV).is_file():
+        return []
+    rad = data["scene_settings"]["radiation"]["models"][0]
+    scene = f"{label} (envelope bound)"
+    rows = validate.run_check_rows(scene, bound["checks"])
+    rows += chain_rows(scene, rad, _read_csv(folder / BOUND_CSV), _read_csv(folder / BOUND_HARMONICS_CSV),
+                       bound["peak_contributions"])
+    kept = [r for r in ck.check_rows(rows) if r["check_id"][3:].startswith(BOUND_CHECKS)]
+    kept.sort(key=lambda r: next(i for i, p in enumerate(BOUND_CHECKS) if r["check_id"][3:].startswith(p)))
+    return [ck.as_bound(r) for r in kept]
 
 
 def chain_rows(label: str, rad: str, totals: list[dict], harm: list[dict], peak_contributions: list[dict]

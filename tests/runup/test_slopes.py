@@ -10,6 +10,7 @@
 * The CLI writes slope_terms.csv / .png, the slope lines in summary.txt and the speed-law check naming a term.
 """
 import csv
+import json
 import math
 
 import numpy as np
@@ -165,6 +166,20 @@ def test_cli_writes_the_slope_terms(tmp_path):
                   if r["route"] == route and r["radiation"] == "erp")
         assert f"{top[0]:.1f} dB(A) @ {top[1]:g} rpm ({route})" in bound[0].split("default")[0]
         assert top[0] > max(float(r["LwA_dB"]) for r in default if r["route"] == route and r["radiation"] == "erp")
+    # the bound's lines and its checks on the same curves (validate's rows 28.bound.*): the lines sum to its totals
+    with open(out / "runup_envelope_bound_harmonics.csv") as fh:
+        lines = list(csv.DictReader(fh))
+    with open(out / "runup_harmonics.csv") as fh:
+        assert list(lines[0]) == list(next(csv.DictReader(fh)))
+    for r in enveloped:
+        mine = [float(x["LwA_dB"]) for x in lines if (x["route"], x["radiation"], x["speed_rpm"])
+                == (r["route"], r["radiation"], r["speed_rpm"])]
+        assert 10 * np.log10(np.sum(10 ** (np.array(mine) / 10))) == pytest.approx(float(r["LwA_dB"]), abs=2e-4)
+    bound_checks = json.loads((out / "runup.json").read_text())["envelope_bound"]["checks"]
+    for route in ("tf_omega", "mesh_force"):
+        top = max(float(r["LwA_dB"]) for r in enveloped if r["route"] == route and r["radiation"] == "erp")
+        assert next(c["ours"] for c in bound_checks if c["check"] == "LwA_max" and c["quantity"].startswith(route)) \
+            == round(top, 1)
 
 
 def test_less_than_a_doubling_of_speed_reports_no_law(tmp_path):

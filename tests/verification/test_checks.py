@@ -298,3 +298,115 @@ def test_bands_of_the_uncertainty_run_carry_band_pass_count_and_note(tmp_path):
     path.write_text(json.dumps({"format": "something-else", "checks": {}}))
     with pytest.raises(InputError, match="format"):
         ck.read_bands(path)
+
+
+# ----------------------------------------------------------------------- the envelope bound's rows (28.bound.*)
+def _write_bound(folder):
+    """The run's envelope bound beside _write_runup's default (set A's overlap note): the same speeds; the tooth line
+    at 100 dB everywhere and 105 dB at 1200 rpm (it carries the bound's maximum there), the 2nd harmonic at 80 dB;
+    one L_WA peak at 1200 rpm made by n = 1 on a 540 Hz mode; L_omega on the flexible housing 101.5 dB at 500 rpm.
+    runup_envelope_bound.csv, runup_envelope_bound_harmonics.csv and runup.json's "envelope_bound" as the run-up
+    writes them (housingfe.runup.report)."""
+    from housingfe.runup.report import BOUND_CSV, BOUND_HARMONICS_CSV
+
+    harm, tot = [], []
+    for s in np.arange(400.0, 1501.0, 100.0):
+        f1 = 0.4 * s
+        for n, lv in {1: 105.0 if s == 1200 else 100.0, 2: 80.0}.items():
+            harm.append({"route": ROUTE, "radiation": "erp", "torque_nm": 2000, "speed_rpm": s, "harmonic": n,
+                         "frequency_hz": n * f1, "L_omega_dB": 110.0, "TF_omega_dB": "", "L_omega_coupled_dB": 101.5,
+                         "Lv_dB": lv, "L_sigma_dB": 0, "Lw_dB": lv, "LwA_dB": lv})
+        lwa = 10 * math.log10(sum(10 ** (r["LwA_dB"] / 10) for r in harm if r["speed_rpm"] == s))
+        tot.append({"route": ROUTE, "radiation": "erp", "torque_nm": 2000, "speed_rpm": s, "LwA_dB": lwa})
+    for name, rows in ((BOUND_HARMONICS_CSV, harm), (BOUND_CSV, tot)):
+        with open(folder / name, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+            w.writeheader()
+            w.writerows(rows)
+    checks = [{"check": "LwA_max", "quantity": f"{ROUTE}: max L_WA dB(A) (1200 rpm, 2000 N m, sigma erp)",
+               "ours": round(max(r["LwA_dB"] for r in tot), 1), "measured": 100.5, "thesis_calculated": 89.4,
+               "goal": "within 3 dB of measured", "passed": "yes", "note": ""},
+              {"check": "L_omega_flexible", "quantity": "flexible housing: L_omega tooth band dB at 500 rpm",
+               "ours": 101.5, "measured": 109.9, "thesis_calculated": None, "goal": "within 6 dB of measured",
+               "passed": "no", "note": "how"}]
+    peak = {"route": ROUTE, "torque_nm": 2000.0, "speed_rpm": 1200.0, "harmonic": 1, "line_hz": 480.0,
+            "line_share_of_LwA": 0.99, "modes": [{"frequency_hz": 540.0, "share": 0.8, "interior_share": 0.5}]}
+    data = json.loads((folder / "runup.json").read_text())
+    data["envelope_bound"] = {"engagement": "envelope-bound", "checks": checks, "peak_contributions": [peak]}
+    (folder / "runup.json").write_text(json.dumps(data))
+
+
+def test_the_bound_rows_are_reported_with_the_bounds_numbers_and_leave_the_checks_alone(tmp_path):
+    default_checks = [{"check": "LwA_max", "quantity": f"{ROUTE}: max L_WA dB(A) (900 rpm, 2000 N m, sigma erp)",
+                       "ours": 100.2, "measured": 100.5, "thesis_calculated": 89.4, "goal": "within 3 dB of measured",
+                       "passed": "yes", "note": ""}]
+    _write_runup(tmp_path, default_checks)
+
+    def rows():
+        out = validate.run_check_rows("test-gearbox-runup", default_checks)
+        out += runup_checks_rows.default_chain_rows("test-gearbox-runup", tmp_path)
+        return out + runup_checks_rows.bound_chain_rows("test-gearbox-runup", tmp_path)
+
+    alone = rows()
+    assert not any(ck.is_bound(r) for r in alone)          # no bound files: no bound rows
+    _write_bound(tmp_path)
+    both = rows()
+    assert [r for r in both if not ck.is_bound(r)] == alone  # the checks' rows are the same with the bound beside
+    bound = {r["check_id"]: r for r in both if ck.is_bound(r)}
+    assert list(bound) == [f"28.bound.default.max_lwa.{ROUTE}", f"28.bound.default.max_lwa_harmonic.{ROUTE}",
+                           f"28.bound.default.peaks.{ROUTE}", "28.bound.l_omega.flexible.500rpm"]
+    for r in bound.values():
+        assert (r["passed"], r["tolerance"], r["band"]) == ("", "", None)
+        assert r["why"].startswith("envelope bound (engagement envelope-bound): a bound, not the model; docs/source.md")
+    top = bound[f"28.bound.default.max_lwa.{ROUTE}"]
+    assert (top["ours"], top["measured"], top["thesis_calculated"]) == (105.0, 100.5, 89.4)
+    # the bound's maximum: 1200 rpm, tooth line 105 dB over a 2nd harmonic at 80 dB: n = 1 (the default's is n = 2)
+    n = bound[f"28.bound.default.max_lwa_harmonic.{ROUTE}"]
+    assert n["ours"] == 1 and "(1200 rpm, 105.0 dB(A))" in n["quantity"] and n["measured"] == "1 or 2"
+    peaks = bound[f"28.bound.default.peaks.{ROUTE}"]
+    # 1200 rpm is 100 rpm from 1300-1350 and made by a 540 Hz mode: that window only
+    assert peaks["ours"] == "1200 (n = 1, mode 540 Hz)" and "; 1 of 3 matched; " in peaks["why"]
+    flexible = bound["28.bound.l_omega.flexible.500rpm"]
+    assert (flexible["ours"], flexible["measured"]) == (101.5, 109.9)
+    # counted apart: the checks' line is the one without the bound, then the bound's rows; no band attaches to them
+    table = ck.checks_markdown(both)
+    assert ck.checks_markdown(alone).splitlines()[-1] + "; and 4 rows of the envelope bound (28.bound.*), reported: " \
+        "a bound, not the model" == table.splitlines()[-1]
+    assert ck.attach_bands(both, {f"28.bound.default.max_lwa.{ROUTE}": (90.0, 110.0)}) == 0
+    assert ck.band_text(top) == ck.NO_BAND and f"| 28.bound.default.max_lwa.{ROUTE} |" in table
+    validate.write_outputs(both, tmp_path / "out", None)
+    with open(tmp_path / "out" / "checks.csv") as fh:
+        written = {r["check_id"]: r for r in csv.DictReader(fh)}
+    assert (written[f"28.bound.default.max_lwa.{ROUTE}"]["passed"], written[f"28.bound.default.max_lwa.{ROUTE}"]["band"]) \
+        == ("report", "")
+
+
+def test_the_bound_study_rows_are_reported_and_only_the_bound_s_jobs_give_them():
+    d = {"route": "mesh_force", "variant": "D", "mean_diff_dB": 2.6, "sd_diff_dB": 1.0, "measured_mean_dB": -0.3,
+         "measured_sd_dB": 3.1, "thesis_calc_mean_dB": -5.1, "thesis_calc_sd_dB": 0.2, "LwA_max_dBA": 90.0,
+         "at_rpm": 1000.0, "measured_max_dBA": 99.2, "thesis_calc_max_dBA": None}
+    # the uncorrected set has no measured mean (no check), only the thesis' calculated +3.5 dB
+    uncorrected = {**d, "variant": "uncorrected", "mean_diff_dB": 4.2, "measured_mean_dB": None, "measured_sd_dB": None,
+                   "thesis_calc_mean_dB": 3.5, "thesis_calc_sd_dB": None, "measured_max_dBA": None}
+    data = {"family": "profile-corrections", "engagement": "envelope-bound", "source": "src", "reference": "A",
+            "rows": [d, uncorrected], "rankings": [], "torque_law": []}
+    rows = {r["check_id"]: r for r in study_rows.bound_rows(data)}
+    assert list(rows) == ["28.bound.variants.mean.profile-corrections.D.mesh_force",
+                          "28.bound.variants.mean.profile-corrections.uncorrected.mesh_force",
+                          "28.bound.variants.correction_d.mesh_force"]
+    mean, unc, corr = rows.values()
+    assert (mean["ours"], mean["measured"], mean["thesis_calculated"], mean["passed"]) == (2.6, -0.3, -5.1, "")
+    assert (unc["ours"], unc["measured"], unc["thesis_calculated"], unc["passed"]) == (4.2, None, 3.5, "")
+    assert (corr["ours"], corr["thesis_calculated"], corr["passed"]) == (2.9, 4.8, "")   # |2.6 + 0.3| vs |-5.1 + 0.3|
+    # the checks of the same data with the default engagement: the study's rows as they were, none of them bound
+    face_width = study_rows.study_rows({**data, "engagement": "face-width"})
+    assert [r["check_id"] for r in face_width if ck.is_check(r)] == [
+        "28.variants.mean.profile-corrections.D.mesh_force", "28.variants.correction_d.mesh_force"]
+    assert all(r["why"].startswith(ck.BOUND_WHY) and r["scene"] == "study profile-corrections (envelope-bound)"
+               for r in rows.values())
+    with pytest.raises(ValueError):
+        study_rows.bound_rows({**data, "engagement": "face-width"})
+    # validate runs the bound for the single helical families alone, in the study's one cached computation
+    bound_jobs = [(f, o) for f, o, _ in study_rows.JOBS if "runup.engagement=envelope-bound" in o]
+    assert bound_jobs == [("profile-corrections", ("runup.engagement=envelope-bound",)),
+                          ("bearings", ("runup.engagement=envelope-bound",))]
