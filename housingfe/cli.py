@@ -57,8 +57,12 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from housingfe.benchmarks import _dispatch as bench
 
-    only = [n for n in (args.only or "").split(",") if n]
-    cases = [n for n in (args.cases or "").split(",") if n]
+    only = [n.strip() for n in (args.only or "").split(",") if n.strip()]
+    cases = [n.strip() for n in (args.cases or "").split(",") if n.strip()]
+    # an empty list given is not "all of them": `--only ""` would start the whole suite (hours)
+    for flag, given, names in (("--only", args.only, only), ("--cases", args.cases, cases)):
+        if given is not None and not names:
+            raise InputError(f"bench: {flag}: {given!r} names nothing; give comma-separated names")
     bench.main(args.which, out_dir=args.out, quick=args.quick, only=only or None, notes_only=args.notes,
                resume=args.resume, size_mm=args.size, cases=cases or None, rounds=args.rounds)
     return 0

@@ -523,7 +523,7 @@ COMMAND_CASES = [
     ("bench-resume-not-kept", ["bench", "frf", "--resume"], ["--resume", "frf does not keep its runs"]),
     ("bench-resume-with-notes", ["bench", "all", "--notes", "--resume"], ["--resume", "--notes"]),
     ("bench-size-not-taken", ["bench", "frf", "--size", "10"], ["--size", "frf does not take it", "imported"]),
-    ("bench-size-negative", ["bench", "imported", "--size", "-5"], ["--size", "-5 must be positive"]),
+    ("bench-size-negative", ["bench", "imported", "--size", "-5"], ["--size", "-5 must be a finite positive"]),
     ("bench-cases-unknown", ["bench", "imported", "--cases", "housingfe1,housingfe3"],
      ["--cases", "unknown case housingfe3", "housingfe2"]),
     ("bench-cases-calculix-alone", ["bench", "imported", "--cases", "calculix"], ["--cases", "needs housingfe1"]),
@@ -614,8 +614,61 @@ def test_console_script_end_to_end(args, tmp_path):
     assert not (tmp_path / "results").exists()
 
 
+
+
+# ---------------------------------------------------------------- the CLI sweep: every sub-command as a user hits it
+# Each case is the console script in a fresh folder holding a few files of the user's (SWEEP_FILES); it must stop
+# with exit 2, one line naming what is wrong, no traceback, and leave the folder exactly as it was (no result, no
+# partial output, nothing of the user's changed).  Cases found by the sweep over the 20 sub-commands; each was a
+# traceback, a silent acceptance or work started before the refusal.
+SWEEP_FILES = {"afile": "precious", "userdir/keep.txt": "precious", "binary.toml": bytes(range(128, 256)) * 4}
+
+
+def _sweep_folder(tmp_path: Path) -> Path:
+    for name, content in SWEEP_FILES.items():
+        path = tmp_path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    return tmp_path
+
+
+def _snapshot(folder: Path) -> dict:
+    return {p.relative_to(folder).as_posix(): (p.read_bytes() if p.is_file() else None)
+            for p in sorted(folder.rglob("*"))}
+
+
+def _sweep(argv: list[str], needles: list[str], tmp_path: Path) -> None:
+    folder = _sweep_folder(tmp_path)
+    before = _snapshot(folder)
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1",
+               PYTHONPATH=os.pathsep.join([str(Path(cli.__file__).parent.parent), os.environ.get("PYTHONPATH", "")]))
+    proc = subprocess.run([str(HOUSINGFE), *argv], cwd=folder, capture_output=True, text=True, timeout=120,
+                          env=env, check=False)
+    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    assert len(lines) == 1 and "error: " in lines[0], lines
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+    assert _snapshot(folder) == before, "the refused command left or changed files"
+
+
+SWEEP_CASES = [
+    # `--only ""` / `--cases ","` named nothing and started the whole suite (every benchmark / case: hours)
+    ("bench-only-empty", ["bench", "all", "--only", ","], ["--only", "names nothing"]),
+    ("bench-cases-empty", ["bench", "imported", "--cases", ""], ["--cases", "names nothing"]),
+    # inf passed `--size > 0`, wrote results/bench-imported.inputs/ and was refused by the scene made from it
+    ("bench-size-infinite", ["bench", "imported", "--size", "inf"], ["--size", "inf must be a finite positive"]),
+]
+
+
+@pytest.mark.parametrize("argv, needles", [c[1:] for c in SWEEP_CASES], ids=[c[0] for c in SWEEP_CASES])
+def test_cli_sweep_refuses_before_any_work(argv, needles, tmp_path):
+    _sweep(argv, needles, tmp_path)
+
+
 CORPUS_SIZE = (len(SCENE_CASES) + len(MESH_CASES) + 1 + len(COARSE_CASES) + len(SET_CASES) + 2 * len(FILE_CASE_NAMES) + 1
-               + len(SOURCE_CASES) + len(COMMAND_CASES) + 5)
+               + len(SOURCE_CASES) + len(COMMAND_CASES) + 5 + len(SWEEP_CASES))
 
 
 def test_corpus_is_at_least_fifty_cases():
