@@ -659,6 +659,15 @@ SWEEP_CASES = [
     ("bench-cases-empty", ["bench", "imported", "--cases", ""], ["--cases", "names nothing"]),
     # inf passed `--size > 0`, wrote results/bench-imported.inputs/ and was refused by the scene made from it
     ("bench-size-infinite", ["bench", "imported", "--size", "inf"], ["--size", "inf must be a finite positive"]),
+    # correlate: a non-positive --f-max was a ValueError traceback after meshing, --loss-factor was not checked,
+    # an --export into a folder (or a missing one) a traceback after the solve, with <name>.tmp left behind
+    ("correlate-f-max-negative", ["correlate", "box-free", "--export", "x.uff", "--f-max", "-100"],
+     ["--f-max", "-100 Hz must be a finite positive"]),
+    ("correlate-loss-factor", ["correlate", "box-free", "--export", "x.uff", "--loss-factor", "1.5"],
+     ["--loss-factor", "1.5 is not in [0, 1)"]),
+    ("correlate-export-folder", ["correlate", "box-free", "--export", "userdir"], ["userdir", "--export", "folder"]),
+    ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
+     ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]
 
 
