@@ -621,7 +621,8 @@ def test_console_script_end_to_end(args, tmp_path):
 # with exit 2, one line naming what is wrong, no traceback, and leave the folder exactly as it was (no result, no
 # partial output, nothing of the user's changed).  Cases found by the sweep over the 20 sub-commands; each was a
 # traceback, a silent acceptance or work started before the refusal.
-SWEEP_FILES = {"afile": "precious", "userdir/keep.txt": "precious", "binary.toml": bytes(range(128, 256)) * 4}
+SWEEP_FILES = {"afile": "precious", "userdir/keep.txt": "precious", "binary.toml": bytes(range(128, 256)) * 4,
+               "typo-bands.json": '{"28.defualt.max_lwa.mesh_force": [80.0, 90.0]}'}
 
 
 def _sweep_folder(tmp_path: Path) -> Path:
@@ -666,6 +667,14 @@ SWEEP_CASES = [
     ("correlate-loss-factor", ["correlate", "box-free", "--export", "x.uff", "--loss-factor", "1.5"],
      ["--loss-factor", "1.5 is not in [0, 1)"]),
     ("correlate-export-folder", ["correlate", "box-free", "--export", "userdir"], ["userdir", "--export", "folder"]),
+    # validate: --json into a folder was a traceback after the computation (minutes to hours), --results naming a
+    # file a NotADirectoryError traceback; a band under a misspelt check id was silently never shown
+    ("validate-json-folder", ["validate", "--only", "runup-checks", "--json", "userdir", "--out", "v", "--results",
+                              "r"], ["userdir", "--json", "is a folder"]),
+    ("validate-results-file", ["validate", "--only", "runup-checks", "--results", "afile", "--out", "v"],
+     ["afile", "--results", "is a file"]),
+    ("validate-bands-typo", ["validate", "--only", "runup-checks", "--bands", "typo-bands.json", "--out", "v",
+                             "--results", "r"], ["typo-bands.json", "28.defualt.max_lwa.mesh_force", "not a check id"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]
