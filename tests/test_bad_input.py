@@ -621,8 +621,28 @@ def test_console_script_end_to_end(args, tmp_path):
 # with exit 2, one line naming what is wrong, no traceback, and leave the folder exactly as it was (no result, no
 # partial output, nothing of the user's changed).  Cases found by the sweep over the 20 sub-commands; each was a
 # traceback, a silent acceptance or work started before the refusal.
+UPDATE_SPEC = """name = "sweep"
+[[parameters]]
+name = "h"
+keys = ["geometry.height"]
+lower = 0.1
+upper = 0.3
+start = 0.2
+[[targets]]
+name = "m"
+scene = "box-free"
+kind = "mass"
+value = 24.5
+"""
 SWEEP_FILES = {"afile": "precious", "userdir/keep.txt": "precious", "binary.toml": bytes(range(128, 256)) * 4,
-               "typo-bands.json": '{"28.defualt.max_lwa.mesh_force": [80.0, 90.0]}'}
+               "typo-bands.json": '{"28.defualt.max_lwa.mesh_force": [80.0, 90.0]}',
+               # update specs, each with one defect (UPDATE_SPEC alone is valid: tests/correlation/test_cli.py)
+               "multistart-name.toml": UPDATE_SPEC.replace("[[parameters]]", "multistart = [{hh = 0.15}]\n[[parameters]]"),
+               "multistart-bounds.toml": UPDATE_SPEC.replace("[[parameters]]", "multistart = [{h = 5.0}]\n[[parameters]]"),
+               "override-scene-typo.toml": UPDATE_SPEC + '[search_overrides]\n"box-fre" = ["mesh.size=0.06"]\n',
+               "override-key-typo.toml": UPDATE_SPEC + '[search_overrides]\n"box-free" = ["mesh.sise=0.06"]\n',
+               "duplicate-target.toml": UPDATE_SPEC + '[[targets]]\nname = "m"\nscene = "box-free"\nkind = "mass"\n'
+                                                      'value = 20.0\n'}
 
 
 def _sweep_folder(tmp_path: Path) -> Path:
@@ -675,6 +695,17 @@ SWEEP_CASES = [
      ["afile", "--results", "is a file"]),
     ("validate-bands-typo", ["validate", "--only", "runup-checks", "--bands", "typo-bands.json", "--out", "v",
                              "--results", "r"], ["typo-bands.json", "28.defualt.max_lwa.mesh_force", "not a check id"]),
+    # update: a multistart naming no parameter was refused after the first solves, one outside the bounds not at
+    # all (least_squares then fails at that start), overrides of a misspelt scene were never applied, a bad search
+    # override was refused only after the confirmation mesh was solved, two targets of one name were accepted
+    ("update-multistart-name", ["update", "multistart-name.toml", "--out", "u"], ["multistart.0.hh", "not a parameter"]),
+    ("update-multistart-bounds", ["update", "multistart-bounds.toml", "--out", "u"],
+     ["multistart.0.h", "[lower, upper] = [0.1, 0.3]"]),
+    ("update-override-scene-typo", ["update", "override-scene-typo.toml", "--out", "u"],
+     ["search_overrides.box-fre", "no target uses this scene"]),
+    ("update-override-key-typo", ["update", "override-key-typo.toml", "--out", "u"],
+     ["search_overrides.box-free", "mesh.sise: unknown key"]),
+    ("update-duplicate-target", ["update", "duplicate-target.toml", "--out", "u"], ["targets.1.name", "used twice"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]
