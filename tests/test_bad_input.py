@@ -641,6 +641,7 @@ SWEEP_FILES = {"afile": "precious", "userdir/keep.txt": "precious", "binary.toml
                "multistart-bounds.toml": UPDATE_SPEC.replace("[[parameters]]", "multistart = [{h = 5.0}]\n[[parameters]]"),
                "override-scene-typo.toml": UPDATE_SPEC + '[search_overrides]\n"box-fre" = ["mesh.size=0.06"]\n',
                "override-key-typo.toml": UPDATE_SPEC + '[search_overrides]\n"box-free" = ["mesh.sise=0.06"]\n',
+               "plates-row.toml": 'plates = [["side", 1, "big", 1.3, 0.005, 2000.0]]\n',
                "duplicate-target.toml": UPDATE_SPEC + '[[targets]]\nname = "m"\nscene = "box-free"\nkind = "mass"\n'
                                                       'value = 20.0\n'}
 
@@ -706,6 +707,10 @@ SWEEP_CASES = [
     ("update-override-key-typo", ["update", "override-key-typo.toml", "--out", "u"],
      ["search_overrides.box-free", "mesh.sise: unknown key"]),
     ("update-duplicate-target", ["update", "duplicate-target.toml", "--out", "u"], ["targets.1.name", "used twice"]),
+    # radiation foller: a plate table that is not UTF-8, or a row with a word for a number, was a traceback
+    ("foller-binary-table", ["radiation", "foller", "binary.toml"], ["binary.toml", "not a UTF-8 text file"]),
+    ("foller-row-not-a-number", ["radiation", "foller", "plates-row.toml"],
+     ["plates-row.toml: plates[0]: area_m2: must be a number"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]

@@ -407,3 +407,16 @@ def test_inspect_refuses_a_file_as_its_folder_before_reading(case, tmp_path):
     assert_refused(housingfe("inspect", *args, cwd=tmp_path), *needles)
     assert (tmp_path / "afile").read_text() == "precious"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "folder.stp", "part.stp"]
+
+
+def test_foller_default_folder_is_named_after_the_table_not_its_path(tmp_path):
+    """`housingfe radiation foller tables/box.toml` wrote results/radiation-foller-tables/box/ (the path pasted
+    into the folder name; an absolute path gave results/radiation-foller-/home/...)."""
+    (tmp_path / "tables").mkdir()
+    (tmp_path / "tables" / "box.toml").write_text(
+        'plates = [{name = "side", count = 4, area_m2 = 0.06, perimeter_m = 1.0, thickness_m = 0.008, '
+        'fc_hz = 1500.0}]\n')
+    proc = housingfe("radiation", "foller", "tables/box.toml", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert [p.name for p in (tmp_path / "results").iterdir()] == ["radiation-foller-box"]
+    assert (tmp_path / "results" / "radiation-foller-box" / "foller.csv").is_file()
