@@ -69,19 +69,18 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_mesh_picture(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from mpi4py import MPI
 
     from housingfe.fe.model import element_size
     from housingfe.geometry import build_mesh
     from housingfe.geometry.pictures import mesh_picture
+    from housingfe.outputs import check_files_folder
     from housingfe.scene import load_housing_scene
 
-    out = Path(args.out)
+    out = check_files_folder(args.out)
+    scenes = {name: load_housing_scene(name)[0] for name in args.scenes}    # every scene checked before any mesh
     out.mkdir(parents=True, exist_ok=True)
-    for name in args.scenes:
-        scene, _ = load_housing_scene(name)
+    for name, scene in scenes.items():
         size = element_size(scene.mesh, scene.geometry, scene.analysis.f_max, scene.material.resolve())
         hm = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, MPI.COMM_SELF,
                         grading=scene.mesh.grading, layer_size=scene.mesh.layer_size)

@@ -711,6 +711,12 @@ SWEEP_CASES = [
     ("foller-binary-table", ["radiation", "foller", "binary.toml"], ["binary.toml", "not a UTF-8 text file"]),
     ("foller-row-not-a-number", ["radiation", "foller", "plates-row.toml"],
      ["plates-row.toml: plates[0]: area_m2: must be a number"]),
+    # mesh-picture / scene-reference: a file as --out was a FileExistsError traceback; mesh-picture made docs/img/
+    # and meshed (and drew) the good scenes before refusing a bad one named after them
+    ("mesh-picture-out-file", ["mesh-picture", "box-free", "--out", "afile"], ["afile", "is a file, not a folder"]),
+    ("mesh-picture-bad-second-scene", ["mesh-picture", "box-free", "no-such-scene"], ["no-such-scene: no such scene"]),
+    ("scene-reference-out-file", ["scene-reference", "--out", "afile/sub", "--no-pictures"],
+     ["afile/sub", "afile is a file, not a folder"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]

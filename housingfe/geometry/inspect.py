@@ -30,6 +30,7 @@ def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir:
     from housingfe.geometry.cad import CAD_SUFFIXES, gmsh_session, read_cad
     from housingfe.geometry.selectors import bore_candidates, flat_candidates
     from housingfe.materials import LIBRARY
+    from housingfe.outputs import check_files_folder
 
     path = Path(path)
     if material not in LIBRARY:
@@ -40,8 +41,7 @@ def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir:
         raise InputError(f"{path}: no such file")
     if path.suffix.lower() not in CAD_SUFFIXES:
         raise InputError(f"{path}: not a CAD file by its name (expected {', '.join(CAD_SUFFIXES)})")
-    out = Path(out_dir) if out_dir is not None else path.parent
-    _check_out_folder(out)
+    out = check_files_folder(out_dir if out_dir is not None else path.parent)
     t0 = time.perf_counter()
     with gmsh_session():
         facts = read_cad(path, units, key=None)
@@ -76,15 +76,6 @@ def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir:
         report["picture"] = png
     report["total_s"] = time.perf_counter() - t0
     return report
-
-
-def _check_out_folder(out: Path) -> None:
-    """InputError unless `out` is a folder or can be made one (checked before the CAD file is read)."""
-    place = out
-    while not place.exists() and place != place.parent:
-        place = place.parent
-    if place.exists() and not place.is_dir():
-        raise InputError(f"{out}: --out: {place} is a file, not a folder")
 
 
 def _read_or_none(path: Path) -> str | None:
