@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
 from housingfe.errors import InputError, SolverError
@@ -109,6 +110,12 @@ def _register_extension(name: str, sub) -> None:
 class _OneLineParser(argparse.ArgumentParser):
     """argparse prints its usage block before an error; the project's rule is one line naming the problem
     (and the sub-command's --help for the usage), exit 2."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # Python 3.11 takes "-1e4" for an option (only -123 and -1.5 count as negative numbers), so
+        # `--load 0 -1e4 0 0 0` was "expected 5 arguments"; as from Python 3.13, -<digit> and -.<digit> are numbers
+        self._negative_number_matcher = re.compile(r"-\.?\d")
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
