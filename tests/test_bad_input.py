@@ -717,6 +717,12 @@ SWEEP_CASES = [
     ("mesh-picture-bad-second-scene", ["mesh-picture", "box-free", "no-such-scene"], ["no-such-scene: no such scene"]),
     ("scene-reference-out-file", ["scene-reference", "--out", "afile/sub", "--no-pictures"],
      ["afile/sub", "afile is a file, not a folder"]),
+    # bearing-variants --torque -5 said "stiffness: total force must be > 0 N, got -110.9"; reduce --cutoff inf
+    # passed the check, built the model and did not finish
+    ("bearing-variants-torque", ["bearing-variants", "--torque", "-5", "--out", "bv"],
+     ["--torque", "-5 must be a pinion torque > 0 N m"]),
+    ("reduce-cutoff-infinite", ["reduce", "test-gearbox-interior", "--cutoff", "inf", "--out", "r"],
+     ["--cutoff", "inf Hz must be a finite positive"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]

@@ -84,8 +84,8 @@ def run_reduce(scene_name: str, cutoff_hz: float, *, masters=None, out_dir=None,
     from housingfe.scene import build_model_from_scene, load_housing_scene
     from housingfe.solvers.modal import solve_modes
 
-    if not cutoff_hz > 0:
-        raise InputError(f"--cutoff: {cutoff_hz} Hz must be positive")
+    if not (cutoff_hz > 0 and np.isfinite(cutoff_hz)):     # inf built the model, then never finished
+        raise InputError(f"--cutoff: {cutoff_hz} Hz must be a finite positive frequency")
     comm = MPI.COMM_WORLD
     say = print if comm.rank == 0 else (lambda *a, **k: None)
     scene, path = load_housing_scene(scene_name, list(overrides))
