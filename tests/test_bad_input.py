@@ -723,6 +723,10 @@ SWEEP_CASES = [
      ["--torque", "-5 must be a pinion torque > 0 N m"]),
     ("reduce-cutoff-infinite", ["reduce", "test-gearbox-interior", "--cutoff", "inf", "--out", "r"],
      ["--cutoff", "inf Hz must be a finite positive"]),
+    # a cut-off far above what the mesh resolves meshed the housing, then the eigensolver failed (exit 3, PETSc's
+    # error stack on stderr): now the resolution check of `run` is applied at the cut-off, before meshing
+    ("reduce-cutoff-above-the-mesh", ["reduce", "test-gearbox-interior", "--cutoff", "1e6", "--out", "r"],
+     ["--cutoff", "above what the scene's mesh resolves", "far too coarse", "mesh.allow_coarse"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]
