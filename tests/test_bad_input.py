@@ -727,6 +727,12 @@ SWEEP_CASES = [
     # error stack on stderr): now the resolution check of `run` is applied at the cut-off, before meshing
     ("reduce-cutoff-above-the-mesh", ["reduce", "test-gearbox-interior", "--cutoff", "1e6", "--out", "r"],
      ["--cutoff", "above what the scene's mesh resolves", "far too coarse", "mesh.allow_coarse"]),
+    # uncertainty --range outside what the input can be: a clearance position of 5 Group N ranges ran to a result;
+    # a 95 deg contact angle failed half a minute later in the bearing model, not naming --range
+    ("uncertainty-range-unphysical", ["uncertainty", "--range", "clearance_position=5:6", "--out", "u"],
+     ["--range clearance_position", "5: must be a position within the Group N clearance range"]),
+    ("uncertainty-range-fails-late", ["uncertainty", "--range", "spherical_contact_angle_deg=95:100", "--out", "u"],
+     ["--range spherical_contact_angle_deg", "95: must be a contact angle in [0, 90) deg"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]
