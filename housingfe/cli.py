@@ -190,6 +190,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        out = getattr(args, "out", None)
+        if out is not None and not str(out).strip():
+            # `--out "$UNSET"` fell back to the default folder (replacing the result there)
+            raise InputError(f"--out: {out!r} is an empty path; give a folder, or leave --out out for the default")
         return int(args.func(args) or 0)
     except InputError as exc:
         print(f"housingfe: error: {exc}", file=sys.stderr)

@@ -733,6 +733,11 @@ SWEEP_CASES = [
      ["--range clearance_position", "5: must be a position within the Group N clearance range"]),
     ("uncertainty-range-fails-late", ["uncertainty", "--range", "spherical_contact_angle_deg=95:100", "--out", "u"],
      ["--range spherical_contact_angle_deg", "95: must be a contact angle in [0, 90) deg"]),
+    # `--out ""` (a shell variable that was not set) wrote into the default folder, replacing the result there
+    ("out-empty", ["run", "box-free", "--out", ""], ["--out", "empty path"]),
+    # a housing or source scene given to a run-up command: its keys were named as unknown run-up keys
+    ("runup-command-housing-scene", ["runup-causes", "test-gearbox"],
+     ["test-gearbox.toml: scene.kind: 'housing'", "takes a run-up scene", "housingfe run"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]
