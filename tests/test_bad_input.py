@@ -738,6 +738,9 @@ SWEEP_CASES = [
     # a housing or source scene given to a run-up command: its keys were named as unknown run-up keys
     ("runup-command-housing-scene", ["runup-causes", "test-gearbox"],
      ["test-gearbox.toml: scene.kind: 'housing'", "takes a run-up scene", "housingfe run"]),
+    # the list of known configurations named "ball" twice
+    ("misalignment-bearings", ["misalignment", "--bearings", "balll", "--out", "m"],
+     ["bearings: 'balll' unknown (known: ball, angular_contact,"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]
