@@ -741,6 +741,9 @@ SWEEP_CASES = [
     # the list of known configurations named "ball" twice
     ("misalignment-bearings", ["misalignment", "--bearings", "balll", "--out", "m"],
      ["bearings: 'balll' unknown (known: ball, angular_contact,"]),
+    # source-spectrum --harmonics above the samples per mesh period: an IndexError traceback
+    ("source-spectrum-harmonics", ["source-spectrum", "gearset-A", "--harmonics", "100000", "--out", "s"],
+     ["gearset-A.toml: --harmonics: 100000", "at most 127 harmonics"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
 ]
