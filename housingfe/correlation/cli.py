@@ -95,6 +95,10 @@ def _cmd_correlate(args: argparse.Namespace) -> int:
     f_max = args.f_max or (1.25 * float(measured.frequencies_hz.max()) if measured is not None
                            else scene.analysis.f_max)
     model = build_model_from_scene(scene, MPI.COMM_WORLD)
+    if args.export is not None:       # more points than the outer surface has facets: refused before the solve
+        from housingfe.response.observers import sample_points
+
+        sample_points(model.housing, "outer", args.points, key="--points")
     basis = modes(model, f_max)
     name = Path(args.scene).stem
     out_dir = args.out or f"results/correlate-{name}"
@@ -201,7 +205,7 @@ def export_uff(basis, path: str, count: int, loss_factor: float) -> None:
     from housingfe.response.observers import sample_points
 
     structure = basis.structure
-    samples = sample_points(structure.housing, "outer", count)
+    samples = sample_points(structure.housing, "outer", count, key="--points")
     n = len(samples.points)
     pts = np.repeat(samples.points, 3, axis=0)
     dirs = np.tile(np.eye(3), (n, 1))
