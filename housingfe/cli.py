@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
 from housingfe.errors import InputError, SolverError
@@ -57,27 +58,30 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from housingfe.benchmarks import _dispatch as bench
 
-    only = [n for n in (args.only or "").split(",") if n]
-    cases = [n for n in (args.cases or "").split(",") if n]
+    only = [n.strip() for n in (args.only or "").split(",") if n.strip()]
+    cases = [n.strip() for n in (args.cases or "").split(",") if n.strip()]
+    # an empty list given is not "all of them": `--only ""` would start the whole suite (hours)
+    for flag, given, names in (("--only", args.only, only), ("--cases", args.cases, cases)):
+        if given is not None and not names:
+            raise InputError(f"bench: {flag}: {given!r} names nothing; give comma-separated names")
     bench.main(args.which, out_dir=args.out, quick=args.quick, only=only or None, notes_only=args.notes,
                resume=args.resume, size_mm=args.size, cases=cases or None, rounds=args.rounds)
     return 0
 
 
 def _cmd_mesh_picture(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from mpi4py import MPI
 
     from housingfe.fe.model import element_size
     from housingfe.geometry import build_mesh
     from housingfe.geometry.pictures import mesh_picture
+    from housingfe.outputs import check_files_folder
     from housingfe.scene import load_housing_scene
 
-    out = Path(args.out)
+    out = check_files_folder(args.out)
+    scenes = {name: load_housing_scene(name)[0] for name in args.scenes}    # every scene checked before any mesh
     out.mkdir(parents=True, exist_ok=True)
-    for name in args.scenes:
-        scene, _ = load_housing_scene(name)
+    for name, scene in scenes.items():
         size = element_size(scene.mesh, scene.geometry, scene.analysis.f_max, scene.material.resolve())
         hm = build_mesh(scene.geometry, scene.mesh.element, size, scene.mesh.layers, MPI.COMM_SELF,
                         grading=scene.mesh.grading, layer_size=scene.mesh.layer_size)
@@ -106,6 +110,12 @@ def _register_extension(name: str, sub) -> None:
 class _OneLineParser(argparse.ArgumentParser):
     """argparse prints its usage block before an error; the project's rule is one line naming the problem
     (and the sub-command's --help for the usage), exit 2."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # Python 3.11 takes "-1e4" for an option (only -123 and -1.5 count as negative numbers), so
+        # `--load 0 -1e4 0 0 0` was "expected 5 arguments"; as from Python 3.13, -<digit> and -.<digit> are numbers
+        self._negative_number_matcher = re.compile(r"-\.?\d")
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
@@ -180,6 +190,10 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        out = getattr(args, "out", None)
+        if out is not None and not str(out).strip():
+            # `--out "$UNSET"` fell back to the default folder (replacing the result there)
+            raise InputError(f"--out: {out!r} is an empty path; give a folder, or leave --out out for the default")
         return int(args.func(args) or 0)
     except InputError as exc:
         print(f"housingfe: error: {exc}", file=sys.stderr)

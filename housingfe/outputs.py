@@ -107,6 +107,25 @@ def check_output_place(out_dir: str | os.PathLike, inputs: Iterable[str | os.Pat
     return out
 
 
+def check_files_folder(out_dir: str | os.PathLike) -> Path:
+    """For commands that write named files into a folder (docs pictures, a scene skeleton) rather than a result
+    folder: InputError, before any work, unless `out_dir` is a folder or can be made one (no file on its path,
+    its nearest existing folder writable).  Nothing is created.  Returns the path."""
+    out = Path(out_dir)
+    if not str(out_dir).strip():
+        raise _fail(out, "empty path")
+    if out.exists() and not out.is_dir():
+        raise _fail(out, "is a file, not a folder; give another --out")
+    place = Path(os.path.abspath(out))
+    while not place.exists():
+        place = place.parent
+    if not place.is_dir():
+        raise _fail(out, f"{place} is a file, not a folder")
+    if not os.access(place, os.W_OK):
+        raise _fail(out, f"cannot write in {place}")
+    return out
+
+
 def _check_writable(out: Path) -> None:
     """InputError unless a folder can be created beside `out` (in its nearest existing ancestor)."""
     place = Path(os.path.abspath(out)).parent

@@ -436,7 +436,9 @@ def _anchor(title: str) -> str:
 
 def write_reference(out_dir: Path, pictures: bool = True) -> list[Path]:
     """Write <out_dir>/scene-reference.md and, with pictures, <out_dir>/img/geometry-<kind>.png; the paths."""
-    out_dir = Path(out_dir)
+    from housingfe.outputs import check_files_folder
+
+    out_dir = check_files_folder(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     page = out_dir / "scene-reference.md"
     page.write_text(scene_reference("img"))

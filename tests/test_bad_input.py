@@ -523,7 +523,7 @@ COMMAND_CASES = [
     ("bench-resume-not-kept", ["bench", "frf", "--resume"], ["--resume", "frf does not keep its runs"]),
     ("bench-resume-with-notes", ["bench", "all", "--notes", "--resume"], ["--resume", "--notes"]),
     ("bench-size-not-taken", ["bench", "frf", "--size", "10"], ["--size", "frf does not take it", "imported"]),
-    ("bench-size-negative", ["bench", "imported", "--size", "-5"], ["--size", "-5 must be positive"]),
+    ("bench-size-negative", ["bench", "imported", "--size", "-5"], ["--size", "-5 must be a finite positive"]),
     ("bench-cases-unknown", ["bench", "imported", "--cases", "housingfe1,housingfe3"],
      ["--cases", "unknown case housingfe3", "housingfe2"]),
     ("bench-cases-calculix-alone", ["bench", "imported", "--cases", "calculix"], ["--cases", "needs housingfe1"]),
@@ -614,8 +614,152 @@ def test_console_script_end_to_end(args, tmp_path):
     assert not (tmp_path / "results").exists()
 
 
+
+
+# ---------------------------------------------------------------- the CLI sweep: every sub-command as a user hits it
+# Each case is the console script in a fresh folder holding a few files of the user's (SWEEP_FILES); it must stop
+# with exit 2, one line naming what is wrong, no traceback, and leave the folder exactly as it was (no result, no
+# partial output, nothing of the user's changed).  Cases found by the sweep over the 20 sub-commands; each was a
+# traceback, a silent acceptance or work started before the refusal.
+UPDATE_SPEC = """name = "sweep"
+[[parameters]]
+name = "h"
+keys = ["geometry.height"]
+lower = 0.1
+upper = 0.3
+start = 0.2
+[[targets]]
+name = "m"
+scene = "box-free"
+kind = "mass"
+value = 24.5
+"""
+SWEEP_FILES = {"afile": "precious", "userdir/keep.txt": "precious", "binary.toml": bytes(range(128, 256)) * 4,
+               "typo-bands.json": '{"28.defualt.max_lwa.mesh_force": [80.0, 90.0]}',
+               # update specs, each with one defect (UPDATE_SPEC alone is valid: tests/correlation/test_cli.py)
+               "multistart-name.toml": UPDATE_SPEC.replace("[[parameters]]", "multistart = [{hh = 0.15}]\n[[parameters]]"),
+               "multistart-bounds.toml": UPDATE_SPEC.replace("[[parameters]]", "multistart = [{h = 5.0}]\n[[parameters]]"),
+               "override-scene-typo.toml": UPDATE_SPEC + '[search_overrides]\n"box-fre" = ["mesh.size=0.06"]\n',
+               "override-key-typo.toml": UPDATE_SPEC + '[search_overrides]\n"box-free" = ["mesh.sise=0.06"]\n',
+               "plates-row.toml": 'plates = [["side", 1, "big", 1.3, 0.005, 2000.0]]\n',
+               "duplicate-target.toml": UPDATE_SPEC + '[[targets]]\nname = "m"\nscene = "box-free"\nkind = "mass"\n'
+                                                      'value = 20.0\n'}
+
+
+def _sweep_folder(tmp_path: Path) -> Path:
+    for name, content in SWEEP_FILES.items():
+        path = tmp_path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(content if isinstance(content, bytes) else content.encode())
+    return tmp_path
+
+
+def _snapshot(folder: Path) -> dict:
+    return {p.relative_to(folder).as_posix(): (p.read_bytes() if p.is_file() else None)
+            for p in sorted(folder.rglob("*"))}
+
+
+def _sweep(argv: list[str], needles: list[str], tmp_path: Path) -> None:
+    folder = _sweep_folder(tmp_path)
+    before = _snapshot(folder)
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1",
+               PYTHONPATH=os.pathsep.join([str(Path(cli.__file__).parent.parent), os.environ.get("PYTHONPATH", "")]))
+    proc = subprocess.run([str(HOUSINGFE), *argv], cwd=folder, capture_output=True, text=True, timeout=120,
+                          env=env, check=False)
+    lines = [line for line in proc.stderr.splitlines() if line.strip()]
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stderr, proc.stderr
+    assert len(lines) == 1 and "error: " in lines[0], lines
+    for needle in needles:
+        assert needle in lines[0], (needle, lines[0])
+    assert _snapshot(folder) == before, "the refused command left or changed files"
+
+
+SWEEP_CASES = [
+    # `--only ""` / `--cases ","` named nothing and started the whole suite (every benchmark / case: hours)
+    ("bench-only-empty", ["bench", "all", "--only", ","], ["--only", "names nothing"]),
+    ("bench-cases-empty", ["bench", "imported", "--cases", ""], ["--cases", "names nothing"]),
+    # inf passed `--size > 0`, wrote results/bench-imported.inputs/ and was refused by the scene made from it
+    ("bench-size-infinite", ["bench", "imported", "--size", "inf"], ["--size", "inf must be a finite positive"]),
+    # correlate: a non-positive --f-max was a ValueError traceback after meshing, --loss-factor was not checked,
+    # an --export into a folder (or a missing one) a traceback after the solve, with <name>.tmp left behind
+    ("correlate-f-max-negative", ["correlate", "box-free", "--export", "x.uff", "--f-max", "-100"],
+     ["--f-max", "-100 Hz must be a finite positive"]),
+    ("correlate-loss-factor", ["correlate", "box-free", "--export", "x.uff", "--loss-factor", "1.5"],
+     ["--loss-factor", "1.5 is not in [0, 1)"]),
+    ("correlate-export-folder", ["correlate", "box-free", "--export", "userdir"], ["userdir", "--export", "folder"]),
+    # validate: --json into a folder was a traceback after the computation (minutes to hours), --results naming a
+    # file a NotADirectoryError traceback; a band under a misspelt check id was silently never shown
+    ("validate-json-folder", ["validate", "--only", "runup-checks", "--json", "userdir", "--out", "v", "--results",
+                              "r"], ["userdir", "--json", "is a folder"]),
+    ("validate-results-file", ["validate", "--only", "runup-checks", "--results", "afile", "--out", "v"],
+     ["afile", "--results", "is a file"]),
+    ("validate-bands-typo", ["validate", "--only", "runup-checks", "--bands", "typo-bands.json", "--out", "v",
+                             "--results", "r"], ["typo-bands.json", "28.defualt.max_lwa.mesh_force", "not a check id"]),
+    # update: a multistart naming no parameter was refused after the first solves, one outside the bounds not at
+    # all (least_squares then fails at that start), overrides of a misspelt scene were never applied, a bad search
+    # override was refused only after the confirmation mesh was solved, two targets of one name were accepted
+    ("update-multistart-name", ["update", "multistart-name.toml", "--out", "u"], ["multistart.0.hh", "not a parameter"]),
+    ("update-multistart-bounds", ["update", "multistart-bounds.toml", "--out", "u"],
+     ["multistart.0.h", "[lower, upper] = [0.1, 0.3]"]),
+    ("update-override-scene-typo", ["update", "override-scene-typo.toml", "--out", "u"],
+     ["search_overrides.box-fre", "no target uses this scene"]),
+    ("update-override-key-typo", ["update", "override-key-typo.toml", "--out", "u"],
+     ["search_overrides.box-free", "mesh.sise: unknown key"]),
+    ("update-duplicate-target", ["update", "duplicate-target.toml", "--out", "u"], ["targets.1.name", "used twice"]),
+    # radiation foller: a plate table that is not UTF-8, or a row with a word for a number, was a traceback
+    ("foller-binary-table", ["radiation", "foller", "binary.toml"], ["binary.toml", "not a UTF-8 text file"]),
+    ("foller-row-not-a-number", ["radiation", "foller", "plates-row.toml"],
+     ["plates-row.toml: plates[0]: area_m2: must be a number"]),
+    # mesh-picture / scene-reference: a file as --out was a FileExistsError traceback; mesh-picture made docs/img/
+    # and meshed (and drew) the good scenes before refusing a bad one named after them
+    ("mesh-picture-out-file", ["mesh-picture", "box-free", "--out", "afile"], ["afile", "is a file, not a folder"]),
+    ("mesh-picture-bad-second-scene", ["mesh-picture", "box-free", "no-such-scene"], ["no-such-scene: no such scene"]),
+    ("scene-reference-out-file", ["scene-reference", "--out", "afile/sub", "--no-pictures"],
+     ["afile/sub", "afile is a file, not a folder"]),
+    # bearing-variants --torque -5 said "stiffness: total force must be > 0 N, got -110.9"; reduce --cutoff inf
+    # passed the check, built the model and did not finish
+    ("bearing-variants-torque", ["bearing-variants", "--torque", "-5", "--out", "bv"],
+     ["--torque", "-5 must be a pinion torque > 0 N m"]),
+    ("reduce-cutoff-infinite", ["reduce", "test-gearbox-interior", "--cutoff", "inf", "--out", "r"],
+     ["--cutoff", "inf Hz must be a finite positive"]),
+    # a cut-off far above what the mesh resolves meshed the housing, then the eigensolver failed (exit 3, PETSc's
+    # error stack on stderr): now the resolution check of `run` is applied at the cut-off, before meshing
+    ("reduce-cutoff-above-the-mesh", ["reduce", "test-gearbox-interior", "--cutoff", "1e6", "--out", "r"],
+     ["--cutoff", "above what the scene's mesh resolves", "far too coarse", "mesh.allow_coarse"]),
+    # uncertainty --range outside what the input can be: a clearance position of 5 Group N ranges ran to a result;
+    # a 95 deg contact angle failed half a minute later in the bearing model, not naming --range
+    ("uncertainty-range-unphysical", ["uncertainty", "--range", "clearance_position=5:6", "--out", "u"],
+     ["--range clearance_position", "5: must be a position within the Group N clearance range"]),
+    ("uncertainty-range-fails-late", ["uncertainty", "--range", "spherical_contact_angle_deg=95:100", "--out", "u"],
+     ["--range spherical_contact_angle_deg", "95: must be a contact angle in [0, 90) deg"]),
+    # `--out ""` (a shell variable that was not set) wrote into the default folder, replacing the result there
+    ("out-empty", ["run", "box-free", "--out", ""], ["--out", "empty path"]),
+    # a housing or source scene given to a run-up command: its keys were named as unknown run-up keys
+    ("runup-command-housing-scene", ["runup-causes", "test-gearbox"],
+     ["test-gearbox.toml: scene.kind: 'housing'", "takes a run-up scene", "housingfe run"]),
+    # the list of known configurations named "ball" twice
+    ("misalignment-bearings", ["misalignment", "--bearings", "balll", "--out", "m"],
+     ["bearings: 'balll' unknown (known: ball, angular_contact,"]),
+    # source-spectrum --harmonics above the samples per mesh period: an IndexError traceback
+    ("source-spectrum-harmonics", ["source-spectrum", "gearset-A", "--harmonics", "100000", "--out", "s"],
+     ["gearset-A.toml: --harmonics: 100000", "at most 127 harmonics"]),
+    # correlate --export --points above the outer surface's facets: refused after the modal solve, naming
+    # analysis.harmonic.sample_points (a scene key the user never wrote); now after meshing, before the solve
+    ("correlate-points-too-many", ["correlate", "box-free", "--export", "x.uff", "--points", "10000000"],
+     ["--points: 10000000 points asked for", "facets"]),
+    ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
+     ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
+]
+
+
+@pytest.mark.parametrize("argv, needles", [c[1:] for c in SWEEP_CASES], ids=[c[0] for c in SWEEP_CASES])
+def test_cli_sweep_refuses_before_any_work(argv, needles, tmp_path):
+    _sweep(argv, needles, tmp_path)
+
+
 CORPUS_SIZE = (len(SCENE_CASES) + len(MESH_CASES) + 1 + len(COARSE_CASES) + len(SET_CASES) + 2 * len(FILE_CASE_NAMES) + 1
-               + len(SOURCE_CASES) + len(COMMAND_CASES) + 5)
+               + len(SOURCE_CASES) + len(COMMAND_CASES) + 5 + len(SWEEP_CASES))
 
 
 def test_corpus_is_at_least_fifty_cases():

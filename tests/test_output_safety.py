@@ -371,3 +371,52 @@ def test_check_output_place_accepts_results_and_empty_folders(tmp_path):
         outputs.check_output_place(tables, own_files=("validate.csv", "validate.md"))
     with pytest.raises(InputError, match="input file"):
         outputs.check_output_place(marked, inputs=[marked / "modes.json"])
+
+
+# ---------------------------------------------------------------- commands that write single files (the CLI sweep)
+NIST_STEP = Path(__file__).parent / "geometry" / "data" / "nist_ftc_06_asme1_rd.stp"
+
+
+def test_inspect_keeps_an_edited_scene_skeleton(tmp_path):
+    """`housingfe inspect part.stp` writes part-scene.toml beside the part for the user to edit; a second inspect
+    replaced the edited scene without a word.  Now it is refused (the picture is not written either), and an
+    unedited skeleton from the same inputs is still rewritten."""
+    shutil.copy(NIST_STEP, tmp_path / "part.stp")
+    first = housingfe("inspect", "part.stp", "--no-picture", cwd=tmp_path)
+    assert first.returncode == 0, first.stderr
+    again = housingfe("inspect", "part.stp", "--no-picture", cwd=tmp_path)     # unedited: same text, allowed
+    assert again.returncode == 0, again.stderr
+    skeleton = tmp_path / "part-scene.toml"
+    edited = skeleton.read_text().replace('element = "tet"', 'element = "tet"   # mine')
+    skeleton.write_text(edited)
+    assert_refused(housingfe("inspect", "part.stp", cwd=tmp_path), "part-scene.toml", "does not overwrite")
+    assert skeleton.read_text() == edited
+    assert not (tmp_path / "part-inspect.png").exists()
+
+
+@pytest.mark.parametrize("case", ["out-is-a-file", "out-under-a-file", "cad-file-is-a-folder"])
+def test_inspect_refuses_a_file_as_its_folder_before_reading(case, tmp_path):
+    """A file given as --out (or a folder under one) was a FileExistsError / NotADirectoryError traceback after
+    the CAD file was read; a folder named like a CAD file was 'no such file'."""
+    shutil.copy(NIST_STEP, tmp_path / "part.stp")
+    (tmp_path / "afile").write_text("precious")
+    (tmp_path / "folder.stp").mkdir()
+    args, needles = {"out-is-a-file": (["part.stp", "--out", "afile"], ["afile", "is a file, not a folder"]),
+                     "out-under-a-file": (["part.stp", "--out", "afile/sub"], ["afile/sub", "is a file"]),
+                     "cad-file-is-a-folder": (["folder.stp"], ["folder.stp", "is a folder, not a CAD file"])}[case]
+    assert_refused(housingfe("inspect", *args, cwd=tmp_path), *needles)
+    assert (tmp_path / "afile").read_text() == "precious"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile", "folder.stp", "part.stp"]
+
+
+def test_foller_default_folder_is_named_after_the_table_not_its_path(tmp_path):
+    """`housingfe radiation foller tables/box.toml` wrote results/radiation-foller-tables/box/ (the path pasted
+    into the folder name; an absolute path gave results/radiation-foller-/home/...)."""
+    (tmp_path / "tables").mkdir()
+    (tmp_path / "tables" / "box.toml").write_text(
+        'plates = [{name = "side", count = 4, area_m2 = 0.06, perimeter_m = 1.0, thickness_m = 0.008, '
+        'fc_hz = 1500.0}]\n')
+    proc = housingfe("radiation", "foller", "tables/box.toml", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert [p.name for p in (tmp_path / "results").iterdir()] == ["radiation-foller-box"]
+    assert (tmp_path / "results" / "radiation-foller-box" / "foller.csv").is_file()

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import importlib
+import math
 import pkgutil
 from pathlib import Path
 
@@ -68,8 +69,8 @@ def _tuning(which: str, module, given: dict) -> dict:
             users = [n for n in available() if n != "all"
                      and key in inspect.signature(importlib.import_module(f"housingfe.benchmarks.{n}").main).parameters]
             raise InputError(f"bench: {option[key]}: {which} does not take it (those that do: {', '.join(users)})")
-        if key != "cases" and not value > 0:
-            raise InputError(f"bench: {option[key]}: {value:g} must be positive")
+        if key != "cases" and not (value > 0 and math.isfinite(value)):
+            raise InputError(f"bench: {option[key]}: {value:g} must be a finite positive number")
         if key == "cases" and hasattr(module, "selected_cases"):
             module.selected_cases(value)
         out[key] = value

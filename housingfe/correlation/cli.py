@@ -4,6 +4,7 @@ from an update spec, housingfe.correlation.updating)."""
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 import numpy as np
@@ -71,6 +72,12 @@ def _cmd_correlate(args: argparse.Namespace) -> int:
         raise InputError(f"--threshold: {args.threshold} is not in [0, 1]")
     if args.points < 1:
         raise InputError(f"--points: {args.points} must be at least 1")
+    if args.f_max is not None and not (args.f_max > 0 and np.isfinite(args.f_max)):
+        raise InputError(f"--f-max: {args.f_max:g} Hz must be a finite positive frequency")
+    if not 0.0 <= args.loss_factor < 1.0:
+        raise InputError(f"--loss-factor: {args.loss_factor:g} is not in [0, 1)")
+    if args.export is not None:
+        check_export_path(args.export)
     from mpi4py import MPI
 
     from housingfe.correlation import uff
@@ -88,6 +95,10 @@ def _cmd_correlate(args: argparse.Namespace) -> int:
     f_max = args.f_max or (1.25 * float(measured.frequencies_hz.max()) if measured is not None
                            else scene.analysis.f_max)
     model = build_model_from_scene(scene, MPI.COMM_WORLD)
+    if args.export is not None:       # more points than the outer surface has facets: refused before the solve
+        from housingfe.response.observers import sample_points
+
+        sample_points(model.housing, "outer", args.points, key="--points")
     basis = modes(model, f_max)
     name = Path(args.scene).stem
     out_dir = args.out or f"results/correlate-{name}"
@@ -96,6 +107,19 @@ def _cmd_correlate(args: argparse.Namespace) -> int:
     else:
         export_uff(basis, args.export, args.points, args.loss_factor)
     return 0
+
+
+def check_export_path(path: str) -> None:
+    """InputError, before the solve, unless `path` can be written as a file: not a folder, in an existing
+    folder."""
+    target = Path(path)
+    if target.is_dir():
+        raise InputError(f"{path}: --export: is a folder; give a file name, e.g. {target / 'modes.uff'}")
+    folder = target.parent
+    if not folder.is_dir():
+        raise InputError(f"{path}: --export: {folder} is not an existing folder")
+    if not os.access(folder, os.W_OK):
+        raise InputError(f"{path}: --export: cannot write in {folder}")
 
 
 def correlate_measured(basis, measured, out_dir, threshold: float, loss_factor: float, source: str,
@@ -181,7 +205,7 @@ def export_uff(basis, path: str, count: int, loss_factor: float) -> None:
     from housingfe.response.observers import sample_points
 
     structure = basis.structure
-    samples = sample_points(structure.housing, "outer", count)
+    samples = sample_points(structure.housing, "outer", count, key="--points")
     n = len(samples.points)
     pts = np.repeat(samples.points, 3, axis=0)
     dirs = np.tile(np.eye(3), (n, 1))

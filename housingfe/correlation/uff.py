@@ -307,8 +307,12 @@ def write_uff(path: str | Path, nodes: Nodes, modes: ModeSet | None = None, frfs
     tmp = path.with_name(path.name + ".tmp")
     if tmp.exists():
         tmp.unlink()
-    pyuff.UFF(str(tmp)).write_sets(sets, mode="add")
-    tmp.replace(path)
+    try:
+        pyuff.UFF(str(tmp)).write_sets(sets, mode="add")
+        tmp.replace(path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)     # no half-written file left beside the one asked for
+        raise
 
 
 def _dir_code(d: np.ndarray) -> int:

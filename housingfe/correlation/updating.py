@@ -116,6 +116,34 @@ class UpdateSpec(_Strict):
     max_evaluations: int = Field(60, ge=1)
     fd_step: PositiveFloat = 0.02   # forward-difference step, fraction of each parameter's range
 
+    @model_validator(mode="after")
+    def _check(self):
+        # checked here, on reading the spec: the fit found them only after its first solves, or never
+        for what, items in (("parameters", self.parameters), ("targets", self.targets)):
+            seen = set()
+            for i, item in enumerate(items):
+                if item.name in seen:
+                    raise ValueError(f"{what}.{i}.name: {item.name!r} is used twice (the names identify "
+                                     f"the {what} in the results)")
+                seen.add(item.name)
+        bounds = {p.name: (p.lower, p.upper) for p in self.parameters}
+        for k, start in enumerate(self.multistart):
+            for name, value in start.items():
+                if name not in bounds:
+                    raise ValueError(f"multistart.{k}.{name}: not a parameter name ({', '.join(bounds)})")
+                lower, upper = bounds[name]
+                if not lower <= value <= upper:
+                    raise ValueError(f"multistart.{k}.{name}: {value:g} must lie within [lower, upper] = "
+                                     f"[{lower:g}, {upper:g}]")
+        scenes = {t.scene for t in self.targets}
+        for what in ("scene_overrides", "search_overrides", "confirm_overrides"):
+            for scene in getattr(self, what):
+                if scene not in scenes:
+                    # a misspelt scene's overrides were silently never applied (e.g. the coarse search mesh)
+                    raise ValueError(f"{what}.{scene}: no target uses this scene (targets' scenes: "
+                                     f"{', '.join(sorted(scenes))})")
+        return self
+
 
 def load_update_spec(path: str) -> UpdateSpec:
     """Read an updating spec (TOML); InputError naming the file and key."""
@@ -166,8 +194,16 @@ class SceneResult:
 def check_parameter_keys(spec: UpdateSpec) -> None:
     """InputError "<scene>: <key>: ..." for a parameter key that no scene of the spec defines (a parameter
     overrides an existing value; a misspelt key would otherwise add a new one)."""
+    from housingfe.scene import load_housing_scene
+
     scenes = {t.scene for t in spec.targets}
     data = {s: _scene_data(spec, s) for s in scenes}
+    for s in sorted(scenes):       # every override checked before the first solve, not at the first one using it
+        for what in ("search_overrides", "confirm_overrides"):
+            try:
+                load_housing_scene(s, list(spec.scene_overrides.get(s, [])) + list(getattr(spec, what).get(s, [])))
+            except InputError as exc:
+                raise InputError(f"{what}.{s}: {exc}") from None
     for p in spec.parameters:
         for key in p.keys:
             if not any(_present(d, key) for d in data.values()):

@@ -465,7 +465,7 @@ def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 20
         raise InputError(f"test_gearbox: gear_set: {gear_set!r} unknown (known: {', '.join(GEAR_SETS)})")
     from housingfe.bearings.configurations import configurations
 
-    known = ["ball", *configurations()]
+    known = list(dict.fromkeys(["ball", *configurations()]))     # "ball" is a configuration too: named once
     if bearings not in known:
         raise InputError(f"test_gearbox: bearings: {bearings!r} unknown (known: {', '.join(known)})")
     axis = (0.0, 1.0, 0.0)

@@ -30,14 +30,18 @@ def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir:
     from housingfe.geometry.cad import CAD_SUFFIXES, gmsh_session, read_cad
     from housingfe.geometry.selectors import bore_candidates, flat_candidates
     from housingfe.materials import LIBRARY
+    from housingfe.outputs import check_files_folder
 
     path = Path(path)
     if material not in LIBRARY:
         raise InputError(f"--material: {material!r} is not in the library ({', '.join(LIBRARY)})")
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder, not a CAD file")
     if not path.is_file():
         raise InputError(f"{path}: no such file")
     if path.suffix.lower() not in CAD_SUFFIXES:
         raise InputError(f"{path}: not a CAD file by its name (expected {', '.join(CAD_SUFFIXES)})")
+    out = check_files_folder(out_dir if out_dir is not None else path.parent)
     t0 = time.perf_counter()
     with gmsh_session():
         facts = read_cad(path, units, key=None)
@@ -54,10 +58,17 @@ def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir:
               "thin_wall_m": facts.thin_wall, "thinnest_ray_m": facts.thinnest_ray, "bores": bores,
               "bore_count": len(all_bores),
               "flats": flats, "notes": facts.notes, "read_s": read_s}
-    out = Path(out_dir) if out_dir is not None else path.parent
-    out.mkdir(parents=True, exist_ok=True)
     skeleton = out / f"{path.stem}-scene.toml"
-    skeleton.write_text(scene_skeleton(report, os.path.relpath(path.resolve(), out.resolve()), material))
+    text = scene_skeleton(report, os.path.relpath(path.resolve(), out.resolve()), material)
+    if skeleton.exists() and _read_or_none(skeleton) != text:
+        # the skeleton is meant to be edited: an edited one is the user's scene, never replaced
+        raise InputError(f"{skeleton}: exists and is not the skeleton inspect writes now (edited, or from other "
+                         "inputs); inspect does not overwrite it: rename or delete it, or give another --out")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+        skeleton.write_text(text)
+    except OSError as exc:
+        raise InputError(f"{out}: --out: cannot write the skeleton there ({exc.strerror})") from None
     report["skeleton"] = skeleton
     if picture:
         png = out / f"{path.stem}-inspect.png"
@@ -65,6 +76,13 @@ def inspect_cad(path: Path, units: str = "mm", material: str = "steel", out_dir:
         report["picture"] = png
     report["total_s"] = time.perf_counter() - t0
     return report
+
+
+def _read_or_none(path: Path) -> str | None:
+    try:
+        return path.read_text()
+    except (OSError, UnicodeDecodeError):
+        return None
 
 
 def _v(x) -> str:

@@ -81,8 +81,8 @@ def cmd_foller(args: argparse.Namespace) -> int:
     print(format_table(["quantity", "ours", "printed (App. E)" if published else ""], rows))
     print(f"compact (eq. 4.15): {'yes' if result.is_compact else 'no'}; slope 25 dB/decade "
           "(App. E prints 'dB/octave'; its numbers follow from dB/decade)")
-    out = Path(args.out or f"results/radiation-foller-{args.table.replace('builtin:', '')}")
-    out = out if not str(out).endswith(".toml") else out.with_suffix("")
+    # the default folder is named after the table, not its path (`/x/plates.toml` made results/radiation-foller-/x/plates)
+    out = Path(args.out or f"results/radiation-foller-{Path(args.table.replace('builtin:', '')).stem}")
     with atomic_output_dir(out) as tmp:
         write_csv(tmp / "foller.csv",
                   ["band_nominal_hz", "band_center_hz", "L_piston_db", "L_plates_db", "L_sigma_db"],

@@ -233,10 +233,26 @@ _TABLE_KEYS = set(_ROW_KEYS) | {"youngs_modulus_pa", "density_kg_m3", "poisson_r
 
 
 def _plate_from_row(row, where: str) -> Plate:
+    """A Plate from a table row; InputError "<where>: <key>: ..." (the file and row) for any bad value."""
+    try:
+        return _plate_from_row_unchecked(row, where)
+    except InputError as exc:
+        message = str(exc)
+        raise InputError(message if message.startswith(where) else f"{where}: {message}") from None
+
+
+def _number(value, where: str, key: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"{where}: {key}: must be a number, got {value!r}")
+    return float(value)
+
+
+def _plate_from_row_unchecked(row, where: str) -> Plate:
     if isinstance(row, list):
         if len(row) != 6:
             raise InputError(f"{where}: a row needs [name, count, area_m2, perimeter_m, thickness_m, fc_hz]")
-        return Plate(str(row[0]), row[1], *[float(v) for v in row[2:]])
+        keys = ("area_m2", "perimeter_m", "thickness_m", "fc_hz")
+        return Plate(str(row[0]), row[1], *[_number(v, where, k) for k, v in zip(keys, row[2:])])
     if not isinstance(row, dict):
         raise InputError(f"{where}: a plate must be a table or a 6-element row")
     unknown = set(row) - _TABLE_KEYS
@@ -253,6 +269,8 @@ def _plate_from_row(row, where: str) -> Plate:
                      row["fc_hz"])
     if len(material) != 3:
         raise InputError(f"{where}: fc_hz: missing (or give youngs_modulus_pa, density_kg_m3, poisson_ratio)")
+    for key in material:
+        _number(row[key], where, key)
     return Plate.from_material(str(row["name"]), row["count"], row["area_m2"], row["perimeter_m"],
                                row["thickness_m"], row["youngs_modulus_pa"], row["density_kg_m3"],
                                row["poisson_ratio"])
@@ -291,14 +309,9 @@ def load_plate_table(spec: str) -> tuple[list[Plate], float]:
         if key not in BUILTIN_TABLES:
             raise InputError(f"{spec}: unknown built-in table (choose {', '.join(BUILTIN_TABLES)})")
         return plates_from_table(published_appendix_e(BUILTIN_TABLES[key]), spec), SPEED_OF_SOUND
-    path = Path(spec)
-    try:
-        with open(path, "rb") as fh:
-            data = tomllib.load(fh)
-    except OSError as exc:
-        raise InputError(f"{spec}: cannot read ({exc.strerror})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{spec}: not valid TOML ({exc})") from None
+    from housingfe.scenefile import load_toml_file
+
+    data = load_toml_file(Path(spec))     # one line for a missing, unreadable, non-UTF-8 or malformed file
     unknown = set(data) - _USER_FILE_KEYS
     if unknown:
         raise InputError(f"{spec}: {min(unknown)}: unknown key")

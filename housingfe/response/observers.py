@@ -101,14 +101,16 @@ def surface_outline(housing, surface: str) -> tuple[np.ndarray, np.ndarray]:
     return vertices, index.reshape(-1, 3)
 
 
-def sample_points(housing, surface: str, count: int, seed: int = 0) -> SamplePoints:
+def sample_points(housing, surface: str, count: int, seed: int = 0,
+                  key: str = "analysis.harmonic.sample_points") -> SamplePoints:
     """`count` area-weighted sample points on `surface`: points are shared out among the surface's atomic
     groups (plates) in proportion to area; inside a group, area-weighted k-means on the facet midpoints
     gives clusters; each point is the facet midpoint nearest its cluster centre and carries the cluster's
-    area.  Deterministic (fixed seed) and identical on every rank."""
+    area.  Deterministic (fixed seed) and identical on every rank.  `key`: the input named when count exceeds
+    the surface's facets."""
     mids, normals, areas, groups = _surface_facet_data(housing, surface)
     if count > len(areas):
-        raise InputError(f"analysis.harmonic.sample_points: {count} points asked for, but surface {surface!r} has "
+        raise InputError(f"{key}: {count} points asked for, but surface {surface!r} has "
                          f"only {len(areas)} facets (one point per facet at most)")
     total = areas.sum()
     tags = np.unique(groups)

@@ -205,6 +205,11 @@ def load_runup_scene(name_or_path: str, overrides: list[str] | None = None) -> t
     """Read and validate a run-up scene; InputError naming the file and key on any problem."""
     data, path = read_scene_dict(name_or_path)
     apply_overrides(data, overrides or [])
+    kind = data.get("scene", {}).get("kind") if isinstance(data.get("scene"), dict) else None
+    if kind in ("housing", "source"):      # else its housing keys were reported as unknown run-up keys
+        raise InputError(f"{path}: scene.kind: {kind!r}: this command takes a run-up scene (kind = \"runup\", "
+                         f"e.g. test-gearbox-runup); run a {kind} scene with `housingfe "
+                         f"{'run' if kind == 'housing' else 'source'}`")
     housing = data.get("housing")
     if isinstance(housing, dict) and isinstance(housing.get("scene"), str):
         # a housing scene file beside the run-up scene (an imported housing) is found from anywhere

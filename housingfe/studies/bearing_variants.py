@@ -370,5 +370,7 @@ def register_cli(subparsers) -> None:
 
 
 def _cmd(args: argparse.Namespace) -> int:
+    if not (args.torque > 0 and np.isfinite(args.torque)):      # else "stiffness: total force must be > 0 N"
+        raise InputError(f"bearing-variants: --torque: {args.torque:g} must be a pinion torque > 0 N m")
     run_study(args.scene, args.configs, args.out, args.set or [], args.torque)
     return 0

@@ -72,6 +72,24 @@ def scene_masters(scene, model, surfaces: list[str] | None) -> list:
     return [Master(n, n, cp.surface_centre(model, n)) for n in names]
 
 
+def check_cutoff_resolved(scene, cutoff_hz: float) -> None:
+    """InputError before meshing when the scene's mesh (sized for its analysis.f_max) is far too coarse for
+    modes up to the cut-off (housingfe.fe.resolution; mesh.allow_coarse lets it run).  A cut-off far above what
+    the mesh resolves asked the eigensolver for (nearly) every mode of the model: it failed after meshing."""
+    from housingfe.fe.model import element_size
+    from housingfe.fe.resolution import check_resolution, walls_of
+
+    if cutoff_hz <= scene.analysis.f_max or walls_of(scene.geometry) is None:
+        return      # below f_max the model's own check holds; an imported mesh's resolution is not assessed
+    material = scene.material.resolve()
+    size = element_size(scene.mesh, scene.geometry, scene.analysis.f_max, material)
+    try:
+        check_resolution(scene.geometry, scene.mesh, size, cutoff_hz, material)
+    except InputError as exc:
+        raise InputError(f"--cutoff: {cutoff_hz:g} Hz is above what the scene's mesh resolves "
+                         f"(analysis.f_max {scene.analysis.f_max:g} Hz): {exc}") from None
+
+
 def run_reduce(scene_name: str, cutoff_hz: float, *, masters=None, out_dir=None, overrides=(), check=False) -> Path:
     """Build the scene's housing model, reduce it (craig_bampton) and write the result folder atomically;
     returns its path."""
@@ -84,11 +102,12 @@ def run_reduce(scene_name: str, cutoff_hz: float, *, masters=None, out_dir=None,
     from housingfe.scene import build_model_from_scene, load_housing_scene
     from housingfe.solvers.modal import solve_modes
 
-    if not cutoff_hz > 0:
-        raise InputError(f"--cutoff: {cutoff_hz} Hz must be positive")
+    if not (cutoff_hz > 0 and np.isfinite(cutoff_hz)):     # inf built the model, then never finished
+        raise InputError(f"--cutoff: {cutoff_hz} Hz must be a finite positive frequency")
     comm = MPI.COMM_WORLD
     say = print if comm.rank == 0 else (lambda *a, **k: None)
     scene, path = load_housing_scene(scene_name, list(overrides))
+    check_cutoff_resolved(scene, cutoff_hz)
     out_dir = Path(out_dir or f"results/reduce-{Path(scene_name).stem}")
     t0 = time.perf_counter()
     model = build_model_from_scene(scene, comm)

@@ -142,6 +142,37 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
 )}
 
 
+# What each input can physically be (lower, lower included, upper, upper included, what it is): a --range outside
+# it is refused when read.  Before, a clearance position of 5 (5 Group N ranges) or a negative shaft diameter scale
+# ran to a result, and an impossible contact angle or span failed a minute later in a bearing or interior model
+# without naming --range.  The helix deviation is in units of f_Hbeta of DIN 3962 / ISO 1328 quality 5; quality 12,
+# the coarsest class, allows 2^(7/2) = 11.3 times that.
+HELIX_QUALITY_12 = 2.0 ** 3.5
+PHYSICAL_LIMITS: dict[str, tuple] = {
+    "damping_ratio": (0.0, False, 1.0, False, "a modal damping ratio (0 < zeta < 1)"),
+    "clearance_position": (0.0, True, 1.0, True, "a position within the Group N clearance range (0 ... 1)"),
+    "groove_inner": (0.5, False, math.inf, False, "a groove conformity (f > 0.5: the groove larger than the ball)"),
+    "groove_outer": (0.5, False, math.inf, False, "a groove conformity (f > 0.5: the groove larger than the ball)"),
+    "spherical_contact_angle_deg": (0.0, True, 90.0, False, "a contact angle in [0, 90) deg"),
+    "tapered_e_scale": (0.0, False, math.inf, False, "a factor > 0"),
+    "quill_diameter_scale": (0.0, False, math.inf, False, "a factor > 0"),
+    "quill_length_scale": (0.0, False, math.inf, False, "a factor > 0"),
+    "coupling_inertia_scale": (0.0, False, math.inf, False, "a factor > 0"),
+    "lumped_bearing_span_m": (0.0, False, math.inf, False, "a length > 0 m"),
+    "appendix_c_bearing_scale": (0.0, False, math.inf, False, "a factor > 0"),
+    "source_loss_factor": (0.0, False, 1.0, False, "a loss factor (0 < eta < 1)"),
+    "helix_deviation_pinion": (-HELIX_QUALITY_12, True, HELIX_QUALITY_12, True,
+                               f"at most ±{HELIX_QUALITY_12:.3g} f_Hbeta (quality 12, the coarsest class)"),
+    "helix_deviation_wheel": (-HELIX_QUALITY_12, True, HELIX_QUALITY_12, True,
+                              f"at most ±{HELIX_QUALITY_12:.3g} f_Hbeta (quality 12, the coarsest class)"),
+}
+
+
+def _physical(name: str, value: float) -> bool:
+    lo, lo_in, hi, hi_in, _ = PHYSICAL_LIMITS[name]
+    return (value >= lo if lo_in else value > lo) and (value <= hi if hi_in else value < hi)
+
+
 def parse_ranges(items) -> dict[str, tuple]:
     """--range NAME=LOW:HIGH or NAME=VALUE (zero width) -> {name: (low, high)}; radiation=MODEL[,MODEL...] ->
     {"radiation": (models...)}.  Unknown names, unparsable or reversed ranges -> InputError."""
@@ -167,6 +198,9 @@ def parse_ranges(items) -> dict[str, tuple]:
             raise InputError(f"--range {name}: low {lo:g} above high {hi:g}")
         if PARAMETERS[name].distribution == "loguniform" and lo <= 0:
             raise InputError(f"--range {name}: {lo:g}: must be > 0 (log-uniform)")
+        for value in (lo, hi):
+            if not _physical(name, value):
+                raise InputError(f"--range {name}: {value:g}: must be {PHYSICAL_LIMITS[name][4]}")
         out[name] = (lo, hi)
     return out
 

@@ -177,14 +177,27 @@ def read_bands(path) -> dict:
                                  f"{passes!r}")
             if not isinstance(entry.get("note", ""), str):
                 raise InputError(f"{path}: checks.{key}.note: must be text")
+            _check_id_of_band(path, f"checks.{key}", key)
             out[key] = {"band": band, "passes": passes, "samples": n, "note": entry.get("note", "")}
         return out
     out = {}
     for key, value in data.items():
         if not _finite_pair(value):
             raise InputError(f"{path}: {key}: must be [low, high] with finite numbers, low <= high, not {value!r}")
+        _check_id_of_band(path, key, key)
         out[key] = (float(value[0]), float(value[1]))
     return out
+
+
+def _check_id_of_band(path, where: str, check_id: str) -> None:
+    """A band's key must be a check id (28.<group>.<what>...): a misspelt group would match no row and the band
+    would silently not be shown.  (Ids of checks this validate run does not make are fine: a --quick run.)"""
+    from housingfe.errors import InputError
+
+    parts = check_id.split(".")
+    if len(parts) < 3 or parts[0] != "28" or parts[1] not in CHECK_GROUPS or not all(parts[2:]):
+        raise InputError(f"{path}: {where}: not a check id (28.<group>.<what>..., group one of "
+                         f"{', '.join(CHECK_GROUPS)})")
 
 
 def band_text(row: dict) -> str:

@@ -26,6 +26,7 @@ import hashlib
 import importlib
 import json
 import math
+import os
 import subprocess
 import sys
 import time
@@ -104,6 +105,10 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
 
     t0 = time.perf_counter()
     results = Path(results_dir) if results_dir is not None else RESULTS
+    if results.exists() and not results.is_dir():
+        raise InputError(f"{results}: --results: is a file, not a folder (the folder of the cached FE results)")
+    if json_path is not None:
+        check_json_path(Path(json_path))
     if results.resolve() == Path(out_dir).resolve() or Path(out_dir).resolve() in results.resolve().parents:
         raise InputError(f"{out_dir}: --out: holds the FE result cache {results}/ (--results); give a folder of "
                          f"its own, e.g. {results}/validate")
@@ -610,6 +615,20 @@ def format_rows(rows: list[dict], width: int = 120) -> str:
         return text if len(text) <= n else text[:n - 1] + "…"
 
     return format_table(COLUMNS, [c[:6] + [cut(c[6], source_w), cut(c[7], note_w)] for c in cells], width=width)
+
+
+def check_json_path(path: Path) -> None:
+    """InputError, before any computation, unless --json `path` can be written as a file (its missing folders
+    are made)."""
+    if path.is_dir():
+        raise InputError(f"{path}: --json: is a folder; give a file name, e.g. {path / 'validate.json'}")
+    place = path.parent
+    while not place.exists() and place != place.parent:
+        place = place.parent
+    if not place.is_dir():
+        raise InputError(f"{path}: --json: {place} is a file, not a folder")
+    if not os.access(place, os.W_OK):
+        raise InputError(f"{path}: --json: cannot write in {place}")
 
 
 def write_outputs(rows: list[dict], out_dir: Path, json_path) -> None:

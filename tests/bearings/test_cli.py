@@ -109,3 +109,23 @@ def test_bad_geometry_exit_2_one_line(capsys, tmp_path):
     _one_line_exit_2(capsys, ["bearing", "6312", "--geometry", str(toml), *load], "not both")
     # an angular contact bearing loaded axially the wrong way cannot carry it
     _one_line_exit_2(capsys, ["bearing", *GEOMETRY, "--load", "0", "-1000", "-8000", "0", "0"], "cannot carry")
+
+
+def test_negative_loads_in_scientific_notation_are_numbers(tmp_path):
+    """`--load 0 -1e4 0 0 0` (the sweep of the sub-commands): Python 3.11's argparse took -1e4 for an option and
+    stopped with 'expected 5 arguments'; it is the same load as -10000 (console script, as a user types it)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1",
+               PYTHONPATH=os.pathsep.join([str(Path(__file__).parents[2]), os.environ.get("PYTHONPATH", "")]))
+    proc = subprocess.run([str(Path(sys.executable).with_name("housingfe")), "bearing", "6312", "--load", "0", "-1e4",
+                           "-2.5e3", "0", "0", "--preload-axial", "-1E2", "--json"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=120, env=env, check=False)
+    assert proc.returncode == 0, proc.stderr
+    data = json.loads(proc.stdout)
+    assert data["load"][:3] == [0.0, -10000.0, -2600.0]
+    ref = bearing_stiffness("6312", [0, -10000, -2600, 0, 0])
+    assert np.allclose(data["K"], ref.K, rtol=1e-12, atol=0)

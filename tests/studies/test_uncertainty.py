@@ -56,6 +56,23 @@ def test_latin_hypercube_samples():
         unc.parse_ranges(["groove_inner=2:1"])
 
 
+def test_every_range_lies_within_what_its_input_can_be():
+    """Each numeric parameter has physical limits (a --range outside them is refused when read) and its own
+    range and nominal value lie inside them; the edges behave as stated (open or closed)."""
+    numeric = {name for name, p in unc.PARAMETERS.items() if p.distribution != "choice"}
+    assert set(unc.PHYSICAL_LIMITS) == numeric
+    for name in numeric:
+        p = unc.PARAMETERS[name]
+        assert unc.parse_ranges([f"{name}={p.low!r}:{p.high!r}"]) == {name: (p.low, p.high)}
+        if p.nominal is not None:
+            assert unc.parse_ranges([f"{name}={p.nominal!r}"]) == {name: (p.nominal, p.nominal)}
+    assert unc.parse_ranges(["clearance_position=0:1"]) == {"clearance_position": (0.0, 1.0)}
+    for item in ("groove_outer=0.5:0.53", "damping_ratio=0.02:1", "helix_deviation_wheel=-12:0",
+                 "spherical_contact_angle_deg=0:90", "quill_diameter_scale=0:1"):
+        with pytest.raises(InputError, match=f"--range {item.split('=')[0]}: .*must be"):
+            unc.parse_ranges([item])
+
+
 @pytest.fixture(scope="module")
 def serial():
     return unc.run_uncertainty("test-gearbox-runup", 3, seed=7, workers=1, overrides=COARSE, families=())

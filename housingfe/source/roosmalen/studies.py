@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from housingfe.errors import InputError
 from housingfe.outputs import format_table, write_csv
 from housingfe.source.gears import GearPair
 from housingfe.source.stiffness import MeshModel, stiffness_curve
@@ -130,6 +131,10 @@ def excitation_spectrum(scenes=SPECTRUM_SCENES, harmonics: int = 15, torque_nm: 
         label = scene.get("scene", {}).get("name", str(name))
         op = rs.OperatingPoint(pair, corr, interior, model, torque, table.stiffness_positions, engagement="face-width")
         shocks = {"thesis-2d": dyn.engagement_force(pair, corr, op.S, op.normal_force), "face-width": op.shock}
+        highest = min(s.size for s in shocks.values()) // 2 - 1     # below Nyquist of the samples per period
+        if harmonics > highest:
+            raise InputError(f"{path}: --harmonics: {harmonics}: the mesh period is sampled at "
+                             f"{2 * (highest + 1)} points here: at most {highest} harmonics")
         for engagement, shock in shocks.items():
             d = (op.normal_force - shock) / op.S
             excitation = op.curve.mean * (d - d.mean())
