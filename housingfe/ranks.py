@@ -3,7 +3,8 @@ rank together (docs/cluster.md).
 
 * `on_rank_zero(fn)`: a serial step (a gear source model, `housingfe describe`) runs on rank 0 alone; the other
   ranks wait without spinning and return its value or raise its InputError / SolverError, so the output is
-  written and printed once and every rank exits the same way.
+  written and printed once and every rank exits the same way.  A serial step must not communicate on
+  MPI.COMM_WORLD; PETSc, if not started yet, is started on rank 0's MPI.COMM_SELF (its start is collective).
 * `stop_together(line, code)`: after an error on this rank.  Errors found collectively (rank 0 decides and
   broadcasts, or every rank checks the same input) stop every rank at the same moment: the line is printed once
   (rank 0) and every rank exits with `code`.  An error found on one rank alone would leave that rank in
@@ -49,6 +50,18 @@ def _wait(request):
         time.sleep(_POLL_S)
 
 
+def _petsc_on_this_rank() -> None:
+    """Initialise PETSc on MPI.COMM_SELF unless it is initialised already.  PetscInitialize is collective on its
+    world (it broadcasts the options): a serial step that imports a module importing petsc4py waited there for
+    the other ranks for ever (`mpirun -n 2 housingfe describe test-gearbox-runup`)."""
+    if "petsc4py.PETSc" in sys.modules:
+        return
+    import petsc4py
+    from mpi4py import MPI
+
+    petsc4py.init(comm=MPI.COMM_SELF)
+
+
 def on_rank_zero(fn, comm=None):
     """fn() on rank 0 of `comm` alone (default: world(); without several ranks fn() is simply called).  The
     other ranks wait and return rank 0's return value (it must pickle), or raise the InputError / SolverError it
@@ -59,6 +72,7 @@ def on_rank_zero(fn, comm=None):
     if comm.rank == 0:
         outcome = ("crash", "stopped")
         try:
+            _petsc_on_this_rank()
             value = fn()
             outcome = ("ok", value)
             return value

@@ -70,12 +70,13 @@ def test_a_source_scene_runs_once_on_two_ranks_and_gives_the_one_rank_files(tmp_
 
 
 def test_serial_commands_say_so_and_print_once_and_drivers_refuse():
-    """describe (serial) prints its text once on two ranks, with one note that it is serial; bench starts
-    processes of its own and refuses mpirun with one line, exit 2."""
-    one, _ = _run(["-m", "housingfe", "describe", "box-free"])
-    two, _ = _run(["-m", "housingfe", "describe", "box-free"], ranks=2)
+    """describe (serial) prints its text once on two ranks, with one note that it is serial (a run-up scene: its
+    modules import petsc4py, whose start is collective, and rank 0 waited there for the idle rank for ever); bench
+    starts processes of its own and refuses mpirun with one line, exit 2."""
+    one, _ = _run(["-m", "housingfe", "describe", "test-gearbox-runup"])
+    two, _ = _run(["-m", "housingfe", "describe", "test-gearbox-runup"], ranks=2, timeout=60)
     assert one.returncode == two.returncode == 0, two.stderr
-    assert two.stdout == one.stdout and "scene box-free" in one.stdout
+    assert two.stdout == one.stdout and "run-up scene test-gearbox-runup" in one.stdout
     assert _errors(two.stderr) == ["housingfe: note: `describe` is serial: rank 0 runs it, the other 1 rank(s) "
                                    "wait (it needs no mpirun)"]
     bench, _ = _run(["-m", "housingfe", "bench", "modal", "--quick"], ranks=2)
