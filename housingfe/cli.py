@@ -107,8 +107,16 @@ class _OneLineParser(argparse.ArgumentParser):
     """argparse prints its usage block before an error; the project's rule is one line naming the problem
     (and the sub-command's --help for the usage), exit 2."""
 
+    # under mpirun every rank parses the command line: ranks other than 0 keep --help and usage errors to
+    # themselves (main sets it), so they are printed once
+    quiet = False
+
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
+
+    def _print_message(self, message, file=None):
+        if not self.quiet:
+            super()._print_message(message, file)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -185,9 +193,10 @@ def main(argv: list[str] | None = None) -> int:
     from housingfe import ranks
 
     logging.disable(logging.INFO)  # FFCx/distutils report each JIT compile at INFO
+    comm = ranks.world()
+    _OneLineParser.quiet = comm is not None and comm.rank != 0
     parser = build_parser()
     args = parser.parse_args(argv)
-    comm = ranks.world()
     mode = getattr(args, "mpi", "collective")
     try:
         if comm is not None and mode == "refuse":

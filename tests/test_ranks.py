@@ -79,6 +79,12 @@ def test_serial_commands_say_so_and_print_once_and_drivers_refuse():
     assert two.stdout == one.stdout and "run-up scene test-gearbox-runup" in one.stdout
     assert _errors(two.stderr) == ["housingfe: note: `describe` is serial: rank 0 runs it, the other 1 rank(s) "
                                    "wait (it needs no mpirun)"]
+    # every rank parses the command line; --help and a usage error are printed by rank 0 alone
+    help_one, _ = _run(["-m", "housingfe", "describe", "--help"])
+    help_two, _ = _run(["-m", "housingfe", "describe", "--help"], ranks=2)
+    assert help_two.returncode == 0 and help_two.stdout == help_one.stdout
+    usage, _ = _run(["-m", "housingfe", "describe"], ranks=2)
+    assert usage.returncode == 2 and usage.stderr.count("error: the following arguments are required") == 1
     bench, _ = _run(["-m", "housingfe", "bench", "modal", "--quick"], ranks=2)
     assert bench.returncode == 2
     errors = _errors(bench.stderr)
