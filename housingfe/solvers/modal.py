@@ -658,7 +658,8 @@ def modes(structure, f_max: float, *, tol: float = 1e-10, check: bool = True) ->
 
     K = structure.K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
     result = solve_modes(K, structure.M, f_max, tol=tol, null_space=known_null_space(structure))
-    orient_modes(result.vectors, structure.V, structure.to_housing)
+    if getattr(structure, "V", None) is not None:     # a bare K, M stand-in has no coordinates to orient by
+        orient_modes(result.vectors, structure.V, getattr(structure, "to_housing", lambda vec: vec))
     basis = ModalBasis(**{f.name: getattr(result, f.name) for f in dataclasses.fields(ModalResult)},
                        structure=structure)
     if check:
