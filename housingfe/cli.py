@@ -117,8 +117,16 @@ class _OneLineParser(argparse.ArgumentParser):
         # `--load 0 -1e4 0 0 0` was "expected 5 arguments"; as from Python 3.13, -<digit> and -.<digit> are numbers
         self._negative_number_matcher = re.compile(r"-\.?\d")
 
+    # under mpirun every rank parses the command line: ranks other than 0 keep --help and usage errors to
+    # themselves (main sets it), so they are printed once
+    quiet = False
+
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see `{self.prog} --help`)\n")
+
+    def _print_message(self, message, file=None):
+        if not self.quiet:
+            super()._print_message(message, file)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -135,7 +143,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=_cmd_run)
 
     p = sub.add_parser("scenes", help="list the built-in scenes")
-    p.set_defaults(func=_cmd_scenes)
+    p.set_defaults(func=_cmd_scenes, mpi="serial")
 
     p = sub.add_parser("validate", help="our results next to the published ones")
     p.add_argument("scenes", nargs="*", help="restrict to these scenes")
@@ -149,7 +157,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="runup-checks: the check rows of issue 28 alone (checks.md; docs/runup.md)")
     p.add_argument("--bands", default=None, metavar="FILE",
                    help="JSON {check_id: [low, high]}: the model's uncertainty band of each check (checks.md)")
-    p.set_defaults(func=_cmd_validate)
+    p.set_defaults(func=_cmd_validate, mpi="refuse")
 
     p = sub.add_parser("bench", help="speed-against-error benchmarks (tables, CSV, PNG)")
     from housingfe.benchmarks._dispatch import available
@@ -170,12 +178,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="run only these cases, comma-separated (benchmarks that take them: imported)")
     p.add_argument("--rounds", type=int, default=None, metavar="N",
                    help="interleaved rounds instead of the default (benchmarks that take them: imported)")
-    p.set_defaults(func=_cmd_bench)
+    p.set_defaults(func=_cmd_bench, mpi="refuse")
 
     p = sub.add_parser("mesh-picture", help="PNG of a scene's mesh coloured by feature (for the docs)")
     p.add_argument("scenes", nargs="+", help="built-in scene names or TOML paths")
     p.add_argument("--out", default="docs/img", help="folder for <scene>-mesh.png")
-    p.set_defaults(func=_cmd_mesh_picture)
+    p.set_defaults(func=_cmd_mesh_picture, mpi="serial")
 
     for name in _EXTENSIONS:
         _register_extension(name, sub)
@@ -183,24 +191,38 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the `housingfe` console script; returns the process exit code."""
+    """Entry point of the `housingfe` console script; returns the process exit code.
+
+    Under mpirun / srun with several ranks (docs/cluster.md): a command runs on every rank (the default: the FE
+    commands are collective), or, if its parser sets `mpi="serial"`, on rank 0 alone while the others wait, or,
+    with `mpi="refuse"` (drivers that start processes of their own), not at all: one line and exit 2.  An error
+    stops every rank together (housingfe.ranks.stop_together): its line printed once, never one rank left
+    waiting in a collective."""
     import logging
 
+    from housingfe import ranks
+
     logging.disable(logging.INFO)  # FFCx/distutils report each JIT compile at INFO
+    comm = ranks.world()
+    _OneLineParser.quiet = comm is not None and comm.rank != 0
     parser = build_parser()
     args = parser.parse_args(argv)
+    mode = getattr(args, "mpi", "collective")
     try:
         out = getattr(args, "out", None)
         if out is not None and not str(out).strip():
             # `--out "$UNSET"` fell back to the default folder (replacing the result there)
             raise InputError(f"--out: {out!r} is an empty path; give a folder, or leave --out out for the default")
+        if comm is not None and mode == "refuse":
+            raise InputError(f"{args.command}: runs its cases in processes of its own (its MPI cases start their "
+                             "own mpirun): start it without mpirun / srun")
+        if comm is not None and mode == "serial":
+            return ranks.on_rank_zero(lambda: _serial(args, comm), comm)
         return int(args.func(args) or 0)
     except InputError as exc:
-        print(f"housingfe: error: {exc}", file=sys.stderr)
-        return 2
+        return ranks.stop_together(f"housingfe: error: {exc}", 2, comm)
     except SolverError as exc:
-        print(f"housingfe: solver error: {exc}", file=sys.stderr)
-        return 3
+        return ranks.stop_together(f"housingfe: solver error: {exc}", 3, comm)
     except KeyboardInterrupt:
         print("housingfe: interrupted", file=sys.stderr)
         return 130
@@ -210,10 +232,24 @@ def main(argv: list[str] | None = None) -> int:
 
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+    except Exception:
+        if comm is None:
+            raise
+        import traceback
+
+        traceback.print_exc()
+        return ranks.stop_together(None, 1, comm)
     finally:
         from housingfe import outputs
 
         outputs.release_all()     # output places reserved by a command that stopped before writing
+
+
+def _serial(args: argparse.Namespace, comm) -> int:
+    """A serial command on rank 0 of several: say so once, then run it."""
+    print(f"housingfe: note: `{args.command}` is serial: rank 0 runs it, the other {comm.size - 1} rank(s) wait "
+          "(it needs no mpirun)", file=sys.stderr, flush=True)
+    return int(args.func(args) or 0)
 
 
 if __name__ == "__main__":

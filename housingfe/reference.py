@@ -575,13 +575,13 @@ def register_cli(subparsers) -> None:
                                                "without solving")
     p.add_argument("scene", help="built-in scene name or path to a TOML file")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value (repeatable)")
-    p.set_defaults(func=_cmd_describe)
+    p.set_defaults(func=_cmd_describe, mpi="serial")
     p = subparsers.add_parser("scene-reference", help="write docs/scene-reference.md (every scene key; geometry "
                                                       "kinds with surfaces and pictures) from the schema")
     p.add_argument("--out", default="docs", help="folder for scene-reference.md and img/geometry-<kind>.png "
                                                  "(default docs)")
     p.add_argument("--no-pictures", action="store_true", help="the page only")
-    p.set_defaults(func=_cmd_reference)
+    p.set_defaults(func=_cmd_reference, mpi="serial")
 
 
 __all__ = ["describe", "field_unit", "scene_reference", "write_reference"]

@@ -19,11 +19,14 @@ def _runup_runner(name_or_path: str, out_dir: str | None = None, overrides: list
 
 
 def _source_runner(name_or_path: str, out_dir: str | None = None, overrides: list[str] | None = None) -> Path:
+    from housingfe.ranks import on_rank_zero
     from housingfe.source.cli import run
 
     if overrides:
         raise InputError(f"{name_or_path}: --set: source scenes take no overrides (edit a copy of the scene)")
-    return run(name_or_path, out_dir)
+    # the gear source models are serial: under mpirun rank 0 runs and writes the folder, the other ranks wait
+    # (two writers raced for the folder's lock and one stopped with 'another housingfe run is writing it')
+    return on_rank_zero(lambda: run(name_or_path, out_dir))
 
 
 # scene kind -> runner (a registry: a new kind of scene is one entry); "housing" is run_housing_scene below

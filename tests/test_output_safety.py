@@ -173,6 +173,10 @@ def test_other_commands_refuse_a_user_folder_too(work):
     (mine / "notes.txt").write_text("precious")
     assert_refused(housingfe("source", "gearset-A", "--out", "mine", cwd=work), "mine", "not a housingfe result")
     assert_refused(housingfe("bench", "scenes", "--quick", "--out", "mine", cwd=work), "mine")
+    # reduce checks the place before the model (it refused only after the reduction; tiny.toml has no bores, so a
+    # later check would stop at 'no masters' instead)
+    assert_refused(housingfe("reduce", "tiny.toml", "--cutoff", "2000", "--out", "mine", cwd=work), "mine",
+                   "not a housingfe result")
     assert_refused(housingfe("validate", "--quick", "--results", work / "cache", "--out", "mine", cwd=work), "mine")
     assert_refused(housingfe("validate", "--quick", "--results", work / "cache", "--out", work / "cache", cwd=work),
                    "--out", "result cache")

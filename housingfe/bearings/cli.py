@@ -60,7 +60,7 @@ def register(subparsers) -> None:
                    help="hold the tilt at zero (shaft held by a second bearing); MX, MY are then outputs")
     p.add_argument("--json", action="store_true",
                    help="print JSON {displacement (deflection under the load), K (tangent), secant_stiffness, ...}")
-    p.set_defaults(func=_cmd_bearing)
+    p.set_defaults(func=_cmd_bearing, mpi="serial")
 
 
 def _geometry_table_from_file(path: str) -> dict:

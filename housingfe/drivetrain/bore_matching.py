@@ -117,6 +117,9 @@ def fit_cylinder(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, 
     z = fit.x
     ax = axis + z[0] * e1 + z[1] * e2
     ax = ax / np.linalg.norm(ax)
+    # the axis' sign is arbitrary (eigh of facets whose order depends on the MPI partition): its largest component
+    # positive, so 1 and 2 ranks report the same axis
+    ax = ax if ax[np.argmax(np.abs(ax))] > 0 else -ax
     dev = float(np.sqrt(np.mean(fit.fun ** 2)))
     return ax, c0 + z[2] * e1 + z[3] * e2, float(z[4]), dev
 

@@ -261,4 +261,4 @@ def register_cli(subparsers) -> None:
     p.add_argument("--models", nargs="+", default=["none", "lumped", "rigid-bores"],
                    help=f"misalignment models ({', '.join(MISALIGNMENT_MODELS)})")
     p.add_argument("--out", default="results/misalignment", help="result folder")
-    p.set_defaults(func=_cmd_misalignment)
+    p.set_defaults(func=_cmd_misalignment, mpi="serial")

@@ -19,9 +19,9 @@ Outputs (write_npz, write_dmig): a documented npz (K, M, the DOF table, master c
 frequencies, provenance) and Nastran DMIG bulk data (KAAX / MAAX, masters as GRIDs, modal coordinates as
 SPOINTs), which read_dmig reads back.
 
-MPI: everything is PETSc/dolfinx on any number of ranks; K_r and M_r are summed from the ranks' rows and each
-mode's arbitrary sign is fixed by its coupling to the masters (fix_mode_signs), so 1 and 2 ranks give the same
-reduced matrices (to round-off).
+MPI: everything is PETSc/dolfinx on any number of ranks; K_r and M_r are summed from the ranks' rows, the modes
+come oriented (solvers.modal.orient_modes) and each mode's sign is then fixed by its coupling to the masters
+(fix_mode_signs), so 1 and 2 ranks give the same reduced matrices (to round-off).
 """
 from __future__ import annotations
 
@@ -100,7 +100,7 @@ class ReducedHousing:
 def craig_bampton(model, masters: list[Master], cutoff_hz: float, tol: float = 1e-10) -> ReducedHousing:
     """Craig–Bampton reduction of a HousingModel to rbe2 bore masters (see the module docstring), fixed-interface
     modes below cutoff_hz (Hz).  Collective; the same ReducedHousing on every rank."""
-    from housingfe.solvers.modal import solve_modes
+    from housingfe.solvers.modal import orient_modes, solve_modes
 
     if not masters:
         raise InputError("reduce: no masters (give bore surfaces)")
@@ -125,6 +125,9 @@ def craig_bampton(model, masters: list[Master], cutoff_hz: float, tol: float = 1
     if fixed.rigid_count:
         raise SolverError(f"reduce: {fixed.rigid_count} zero-frequency modes with the masters held: the masters "
                           "do not hold the housing (a part not connected to any bore?)")
+    # the same sign of each mode on any number of ranks, so that the files are too (M_r's modal rows flipped sign
+    # between 1 and 2 ranks)
+    orient_modes(fixed.vectors, model.V, lambda q: system.fe_vector(q, model.V))
     phi = list(fixed.vectors)
     t2 = time.perf_counter()
 

@@ -209,4 +209,4 @@ def register_cli(subparsers) -> None:
     p.add_argument("--out", default=None, help="folder for <stem>-inspect.png and <stem>-scene.toml "
                                                 "(default: the file's folder)")
     p.add_argument("--no-picture", action="store_true", help="skip the PNG")
-    p.set_defaults(func=_cmd_inspect)
+    p.set_defaults(func=_cmd_inspect, mpi="serial")

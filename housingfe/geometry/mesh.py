@@ -109,17 +109,25 @@ def build_mesh(geometry, element: str, size: float, layers: int, comm, grading: 
     import gmsh
 
     model = block_model_for(geometry)
-    groups = None
+    groups = error = None
     if comm.rank == 0:
         gmsh.initialize()
         try:
             gmsh.option.setNumber("General.Terminal", 0)
             gmsh.model.add("housing")
             groups = build_gmsh_model(model, element, size, layers, grading, layer_size)
-        except Exception:
+        except Exception as exc:
             gmsh.finalize()
-            raise
-    groups = comm.bcast(groups, root=0)
+            error = exc
+    # rank 0 alone meshes: its error (a bore breaking out of a wall, hexes asked for round bores) is every rank's,
+    # else the others wait in the broadcast for ever (mpirun -n 2 hung on `--set mesh.element="hex"`)
+    failure = None if error is None else (isinstance(error, InputError), str(error))
+    groups, failure = comm.bcast((groups, failure), root=0)
+    if error is not None:
+        raise error
+    if failure is not None:
+        is_input, text = failure
+        raise InputError(text) if is_input else RuntimeError(f"rank 0 failed to mesh: {text}")
     mesh, cell_tags, facet_tags = distribute_gmsh_model(comm)
     return HousingMesh(mesh=mesh, cell_tags=cell_tags, facet_tags=facet_tags, cell_groups=groups["cells"],
                        facet_groups=groups["facets"], volume=model.volume(), centroid=model.centroid(),

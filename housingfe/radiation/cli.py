@@ -107,4 +107,4 @@ def register(subparsers) -> None:
     q.add_argument("--out", default=None, help="result folder (default results/radiation-foller-<name>)")
     q.add_argument("--fmin", type=float, default=50.0, help="lowest 1/3-octave band centre [Hz]")
     q.add_argument("--fmax", type=float, default=10000.0, help="highest 1/3-octave band centre [Hz]")
-    q.set_defaults(func=cmd_foller)
+    q.set_defaults(func=cmd_foller, mpi="serial")

@@ -90,14 +90,18 @@ def write_modal_outputs(folder: Path, model, result, summary: dict, comm, output
     which (paraview, pictures, mode_pictures: a housingfe.scene.OutputSpec or anything with those attributes)."""
     if output.paraview:
         write_modes_xdmf(folder / "modes.xdmf", model, result, comm)
+    # the shapes of every rank's part of the mesh, gathered on rank 0 for the picture (collective; modes.png was
+    # left out on more than one rank)
+    shapes = mode_shapes_on_rank_zero(model, result, output.mode_pictures, comm) \
+        if output.pictures and output.mode_pictures else None
     if comm.rank != 0:
         return
     write_json(folder / "modes.json", summary)
     (folder / "summary.txt").write_text(modal_summary_text(summary) + "\n")
     if output.pictures:
         plot_frequencies(folder / "frequencies.png", summary)
-        if comm.size == 1 and output.mode_pictures:
-            plot_mode_shapes(folder / "modes.png", model, result, output.mode_pictures)
+        if shapes is not None:
+            plot_mode_shapes(folder / "modes.png", shapes)
 
 
 def write_modes_xdmf(path: Path, model, result, comm) -> None:
@@ -147,42 +151,75 @@ def plot_frequencies(path: Path, summary: dict) -> None:
     plt.close(fig)
 
 
-def plot_mode_shapes(path: Path, model, result, count: int) -> None:
-    """Off-screen picture of the first elastic mode shapes (pyvista, deformed surface coloured by |u|)."""
+def mode_shapes_on_rank_zero(model, result, count: int, comm) -> dict | None:
+    """The first `count` elastic mode shapes of `result` as vertex (P1) fields on the whole mesh, gathered on rank 0
+    (collective; None on the other ranks and when there is no elastic mode): {"topology", "cell_types", "points",
+    "shapes": [(title, u (points, 3))]} for plot_mode_shapes.  Each rank sends its own cells, in global vertex
+    numbers, so the grid is the same on any number of ranks."""
+    import numpy as np
+    from dolfinx import fem, plot
+
+    n_rigid = result.rigid_count
+    modes = list(range(n_rigid, min(n_rigid + count, len(result.vectors))))
+    if not modes:
+        return None
+    mesh = model.V.mesh
+    V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
+    topology, cell_types, x = plot.create_vtk_mesh(V1)
+    index_map = V1.dofmap.index_map
+    global_ids = index_map.local_to_global(np.arange(index_map.size_local + index_map.num_ghosts, dtype=np.int32))
+    owned = mesh.topology.index_map(mesh.topology.dim).size_local      # the first cells; the rest are ghosts
+    cells = topology.reshape(len(cell_types), -1)[:owned].copy()         # [n, v_1..v_n] per cell, one cell type
+    cells[:, 1:] = global_ids[cells[:, 1:]]
+    parts = comm.gather((cells, cell_types[:owned], global_ids, x), root=0)
+    uh, u1 = fem.Function(model.V), fem.Function(V1)
+    fields = []
+    for i in modes:
+        result.vectors[i].copy(uh.vector)
+        uh.x.scatter_forward()
+        u1.interpolate(uh)
+        fields.append(comm.gather(u1.x.array.reshape(-1, 3).copy(), root=0))
+    if comm.rank != 0:
+        return None
+    n_points = index_map.size_global
+    points = np.zeros((n_points, 3))
+    for _, _, ids, xs in parts:
+        points[ids] = xs
+    shapes = []
+    for k, (i, per_rank) in enumerate(zip(modes, fields)):
+        u = np.zeros((n_points, 3))
+        for (_, _, ids, _), values in zip(parts, per_rank):
+            u[ids] = values
+        shapes.append((f"mode {k + 1}: {result.frequencies_hz[i]:.1f} Hz", u))
+    return {"topology": np.concatenate([c.ravel() for c, _, _, _ in parts]),
+            "cell_types": np.concatenate([t for _, t, _, _ in parts]), "points": points, "shapes": shapes}
+
+
+def plot_mode_shapes(path: Path, shapes: dict) -> None:
+    """Off-screen picture of mode shapes (mode_shapes_on_rank_zero's dict; pyvista, deformed surface coloured by
+    |u|)."""
     import os
 
     os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     import numpy as np
     import pyvista
-    from dolfinx import fem, plot
 
     pyvista.OFF_SCREEN = True
-    n_rigid = result.rigid_count
-    modes = list(range(n_rigid, min(n_rigid + count, len(result.vectors))))
-    if not modes:
-        return
-    mesh = model.V.mesh
-    V1 = fem.VectorFunctionSpace(mesh, ("Lagrange", 1))
-    topology, cell_types, x = plot.create_vtk_mesh(V1)
+    topology, cell_types, x = shapes["topology"], shapes["cell_types"], shapes["points"]
     size = float(np.ptp(x, axis=0).max())
-    uh, u1 = fem.Function(model.V), fem.Function(V1)
-    cols = min(3, len(modes))
-    rows = (len(modes) + cols - 1) // cols
+    count = len(shapes["shapes"])
+    cols = min(3, count)
+    rows = (count + cols - 1) // cols
     plotter = pyvista.Plotter(shape=(rows, cols), off_screen=True, window_size=(420 * cols, 340 * rows))
-    freqs = result.frequencies_hz
-    for k, i in enumerate(modes):
-        result.vectors[i].copy(uh.vector)
-        uh.x.scatter_forward()
-        u1.interpolate(uh)
+    for k, (title, u) in enumerate(shapes["shapes"]):
         full = pyvista.UnstructuredGrid(topology, cell_types, x)
-        u = u1.x.array.reshape(-1, 3)
         full.point_data["u"] = u
         full.point_data["|u|"] = np.linalg.norm(u, axis=1)
         surface = full.extract_surface(algorithm="dataset_surface")
         warped = surface.warp_by_vector("u", factor=0.06 * size / max(np.abs(u).max(), 1e-30))
         plotter.subplot(k // cols, k % cols)
         plotter.add_mesh(warped, scalars="|u|", show_scalar_bar=False, cmap="viridis")
-        plotter.add_text(f"mode {k + 1}: {freqs[i]:.1f} Hz", font_size=10)
+        plotter.add_text(title, font_size=10)
         plotter.view_isometric()
     plotter.screenshot(str(path))
     plotter.close()

@@ -604,6 +604,49 @@ def known_null_space(structure) -> list | None:
     return structure.rigid_body_vectors() if free else None
 
 
+# a fixed field of the coordinates normalised to the mesh's bounding box (no symmetry of a box or plate) that
+# orient_modes measures each mode's sign against: wave vectors and phases (rad) of its x, y and z component
+_ORIENT_WAVES = ((2.9, 4.1, 3.3, 0.3), (3.7, -2.3, 4.4, 1.1), (-4.3, 3.1, 2.6, 2.0))
+# a product below this share of |field| |mode| leaves the sign as the solver gave it (round-off decides there)
+_ORIENT_MIN_SHARE = 1e-9
+
+
+def orient_modes(vectors: list, V, to_housing=lambda vec: vec) -> None:
+    """Give each eigenvector (PETSc Vecs, flipped in place) the sign that makes its housing field's product with a
+    fixed smooth field of the coordinates positive.  An eigenvector's sign is arbitrary and the eigensolver's start
+    vectors depend on the partition: 1 and 2 MPI ranks gave the same modes with opposite signs (exported UFF mode
+    shapes, the reduced housing's mass coupling).  The product is a sum over the global DOFs, so every number of
+    ranks picks the same sign.  Modes of a repeated eigenvalue get a sign, not a unique basis of their subspace.
+    V: the housing's displacement space; to_housing: structure DOFs -> housing field (Structure.to_housing)."""
+    if not vectors:
+        return
+    from dolfinx import fem
+    from mpi4py import MPI
+
+    comm = V.mesh.comm
+    x = V.mesh.geometry.x
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    if len(x):
+        lo, hi = x.min(axis=0), x.max(axis=0)
+    comm.Allreduce(MPI.IN_PLACE, lo, op=MPI.MIN)
+    comm.Allreduce(MPI.IN_PLACE, hi, op=MPI.MAX)
+    span = np.where(hi > lo, hi - lo, 1.0)
+
+    def field(points):
+        u = (points - lo[:, None]) / span[:, None]
+        return np.vstack([np.cos(a * u[0] + b * u[1] + c * u[2] + phase) for a, b, c, phase in _ORIENT_WAVES])
+
+    g = fem.Function(V)
+    g.interpolate(field)
+    g.x.scatter_forward()
+    g_norm = g.vector.norm()
+    for vec in vectors:
+        h = to_housing(vec)
+        product = g.vector.dot(h)
+        if product < -_ORIENT_MIN_SHARE * g_norm * h.norm():
+            vec.scale(-1.0)
+
+
 def modes(structure, f_max: float, *, tol: float = 1e-10, check: bool = True) -> ModalBasis:
     """All modes of a structure (housingfe.fe.structure.Structure: K, M, expected_zero_modes) below f_max (Hz),
     complete by the inertia count (solve_modes; SolverError if not).  Eigenvalues in rad^2/s^2, vectors
@@ -615,6 +658,8 @@ def modes(structure, f_max: float, *, tol: float = 1e-10, check: bool = True) ->
 
     K = structure.K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
     result = solve_modes(K, structure.M, f_max, tol=tol, null_space=known_null_space(structure))
+    if getattr(structure, "V", None) is not None:     # a bare K, M stand-in has no coordinates to orient by
+        orient_modes(result.vectors, structure.V, getattr(structure, "to_housing", lambda vec: vec))
     basis = ModalBasis(**{f.name: getattr(result, f.name) for f in dataclasses.fields(ModalResult)},
                        structure=structure)
     if check:

@@ -76,4 +76,4 @@ def register_cli(subparsers) -> None:
     p = subparsers.add_parser("source", help="gear excitation source: stiffness, L_omega, bearing spectra")
     p.add_argument("scene", help="built-in source scene (e.g. gearset-A) or path to a TOML file")
     p.add_argument("--out", default=None, help="result folder (default results/<scene name>)")
-    p.set_defaults(func=_cmd_source)
+    p.set_defaults(func=_cmd_source, mpi="serial")

@@ -98,7 +98,7 @@ def run_reduce(scene_name: str, cutoff_hz: float, *, masters=None, out_dir=None,
     import housingfe
     from housingfe.drivetrain import coupling as cp
     from housingfe.drivetrain.reduction import craig_bampton, write_dmig, write_npz
-    from housingfe.outputs import atomic_output_dir, write_csv
+    from housingfe.outputs import atomic_output_dir, reserve_output, write_csv
     from housingfe.scene import build_model_from_scene, load_housing_scene
     from housingfe.solvers.modal import solve_modes
 
@@ -109,6 +109,7 @@ def run_reduce(scene_name: str, cutoff_hz: float, *, masters=None, out_dir=None,
     scene, path = load_housing_scene(scene_name, list(overrides))
     check_cutoff_resolved(scene, cutoff_hz)
     out_dir = Path(out_dir or f"results/reduce-{Path(scene_name).stem}")
+    reserve_output(out_dir, comm, inputs=[path])     # a bad or busy output place stops here, before the model
     t0 = time.perf_counter()
     model = build_model_from_scene(scene, comm)
     t_model = time.perf_counter() - t0
