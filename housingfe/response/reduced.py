@@ -53,6 +53,10 @@ class ReducedSystem:
 
 # a re-analysis projects the change of the matrices when it touches at most this share of the rows
 CHANGE_SHARE = 0.05
+# unit-load solutions remembered per reduction (RitzReduction.unit_coordinates): a run-up at one torque asks for
+# three frequency sets (the coupled source's receptance at every harmonic, its lines for the mesh and the wheel
+# torque); each set costs (vectors x lines) complex numbers, ~1.3 MB for 91 vectors and 900 lines
+UNIT_SOLUTIONS = 8
 
 
 class RitzReduction:
@@ -186,15 +190,36 @@ class RitzReduction:
         for j, name in enumerate(self.names):
             if name in amplitudes:
                 a[j] = np.broadcast_to(np.asarray(amplitudes[name], complex), f.shape)
-        s = self.system
-        eta = np.zeros(len(f)) if s.D is not None else self.damping.hysteretic(f)
-        C = s.Cr if s.D is None else s.Cr + s.D
         c = np.zeros((len(self.vectors), len(f)), complex)
-        omega = 2 * math.pi * f
-        for j in range(len(self.names)):        # one batched solve per load, weighted by its amplitudes
+        for j, name in enumerate(self.names):   # one batched solve per load, weighted by its amplitudes
             if np.any(a[j]):
-                c += harmonic.solve_reduced(s.Kr, s.Mr, C, omega, eta, s.Fr[:, j:j + 1])[0] * a[j][None, :]
+                c += self.unit_coordinates(f, name) * a[j][None, :]
         return c
+
+    def unit_coordinates(self, frequencies, name: str) -> np.ndarray:
+        """(vectors, lines) complex Ritz coordinates of the unit load `name` (amplitude 1 in its unit) at
+        `frequencies` (Hz): one batched solve of the reduced system, remembered for the last UNIT_SOLUTIONS
+        frequency sets (read-only arrays).  A run-up asks for the same lines several times (the coupled source's
+        wheel rotation, the mesh_force route, a re-run with another engagement shock, housingfe.runup.chain
+        .engagement_rerun), and the solve (~0.1 s per 500 lines) does not depend on the load amplitudes.  The memo
+        belongs to this reduction's system and damping: a re-analysis or another damping starts afresh."""
+        f = np.asarray(frequencies, float)
+        j = self.names.index(name)
+        memo = self.__dict__.get("_unit_memo")
+        if memo is None or memo[0] is not self.system or memo[1] is not self.damping:
+            memo = self._unit_memo = (self.system, self.damping, {})
+        solutions = memo[2]
+        key = (name, f.shape, f.tobytes())
+        if key not in solutions:
+            s = self.system
+            eta = np.zeros(len(f)) if s.D is not None else self.damping.hysteretic(f)
+            C = s.Cr if s.D is None else s.Cr + s.D
+            c = harmonic.solve_reduced(s.Kr, s.Mr, C, 2 * math.pi * f, eta, s.Fr[:, j:j + 1])[0]
+            c.setflags(write=False)
+            while len(solutions) >= UNIT_SOLUTIONS:
+                solutions.pop(next(iter(solutions)))          # the oldest
+            solutions[key] = c
+        return solutions[key]
 
     def evaluate(self, frequencies, amplitudes: dict):
         """The summed response (housingfe.response.observers.LoadResponse with amplitude 1: the amplitudes are in

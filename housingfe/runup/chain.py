@@ -244,13 +244,9 @@ def mesh_receptance(model: GearboxModel, frequencies_hz) -> np.ndarray:
     1 / k_ref exactly (`coupled_source_lines`): the gears turn freely apart from the mesh, so only the mesh spring
     resists a static mesh compression."""
     red = model.reduction
-    s = red.system
-    f = np.asarray(frequencies_hz, float)
     j = red.names.index("mesh")
-    eta = np.zeros(len(f)) if s.D is not None else red.damping.hysteretic(f)
-    C = s.Cr if s.D is None else s.Cr + s.D
-    c = harmonic.solve_reduced(s.Kr, s.Mr, C, 2 * math.pi * f, eta, s.Fr[:, j:j + 1])[0]
-    return s.Fr[:, j] @ c
+    # the reduction remembers the solve: a re-run with another engagement shock reuses it (engagement_rerun)
+    return red.system.Fr[:, j] @ red.unit_coordinates(frequencies_hz, "mesh")
 
 
 @single_thread

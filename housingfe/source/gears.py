@@ -509,15 +509,21 @@ def tooth_profile(pair: GearPair, gear: int, n_radii: int = 120) -> dict[str, np
     c, s = np.cos(phis)[:, None], np.sin(phis)[:, None]
     gx, gy = X * c - Y * s, X * s + Y * c
     R = np.hypot(gx, gy).ravel()
-    theta = np.arctan2(gx, gy).ravel()
-    order = np.argsort(R)
-    R, theta = R[order], theta[order]
     radii = np.linspace(rf, ra, n_radii)
     # Narrow radius windows keep the bias small: the flank angle changes ~tan(alpha) * window / r.
     window = 2e-4 * pair.module
-    lo = np.searchsorted(R, radii - window)
-    hi = np.searchsorted(R, radii + window)
-    half = np.array([theta[a:b].min() if b > a else np.nan for a, b in zip(lo, hi)])
+    # the tooth boundary at radii[k]: the smallest polar angle of the points with radii[k] - window <= R <
+    # radii[k] + window.  The windows do not overlap (2 window << the radii's spacing), so each point belongs to
+    # at most one: the last window whose lower edge lies at or below it (no sort of the 10^6 points)
+    lower, upper = radii - window, radii + window
+    if not np.all(upper[:-1] <= lower[1:]):
+        raise ValueError(f"tooth_profile: n_radii = {n_radii} is too fine for the radius window {window:g} m")
+    k = np.searchsorted(lower, R, side="right") - 1
+    inside = np.flatnonzero((k >= 0) & (R < upper[np.maximum(k, 0)]))
+    theta = np.arctan2(gx.ravel()[inside], gy.ravel()[inside])
+    half = np.full(n_radii, np.inf)
+    np.minimum.at(half, k[inside], theta)
+    half[np.isinf(half)] = np.nan                       # an empty window (as before: filled below or NaN)
     half[0] = half[1] if np.isnan(half[0]) else half[0]
     rb = float(pair.base_diameter[gear]) / 2
     psi_b = (math.pi / 2 + 2 * x * math.tan(pair.pressure_angle)) / pair.teeth[gear] \
