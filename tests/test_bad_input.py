@@ -23,6 +23,7 @@ from hypothesis import strategies as st
 
 from housingfe import cli
 from housingfe.scenefile import SCENE_DIR
+from tests.correlation.test_cli import SPEC
 
 # A valid, cheap housing scene: every section present, so each case changes exactly one thing.
 BASE = {
@@ -621,19 +622,7 @@ def test_console_script_end_to_end(args, tmp_path):
 # with exit 2, one line naming what is wrong, no traceback, and leave the folder exactly as it was (no result, no
 # partial output, nothing of the user's changed).  Cases found by the sweep over the 20 sub-commands; each was a
 # traceback, a silent acceptance or work started before the refusal.
-UPDATE_SPEC = """name = "sweep"
-[[parameters]]
-name = "h"
-keys = ["geometry.height"]
-lower = 0.1
-upper = 0.3
-start = 0.2
-[[targets]]
-name = "m"
-scene = "box-free"
-kind = "mass"
-value = 24.5
-"""
+UPDATE_SPEC = SPEC    # a valid update spec (tests/correlation/test_cli.py); each defect below is one edit of it
 SWEEP_FILES = {"afile": "precious", "userdir/keep.txt": "precious", "binary.toml": bytes(range(128, 256)) * 4,
                "typo-bands.json": '{"28.defualt.max_lwa.mesh_force": [80.0, 90.0]}',
                # update specs, each with one defect (UPDATE_SPEC alone is valid: tests/correlation/test_cli.py)
