@@ -234,6 +234,14 @@ def _cmd_misalignment(args) -> int:
     for t in args.torques:
         if not (np.isfinite(t) and t > 0):
             raise InputError(f"misalignment: --torques: {t:g} must be a pinion torque > 0 N m")
+    from housingfe.source.roosmalen.run import scene_pair
+
+    for g in args.gear_sets:          # beyond the teeth's strength: no load distribution (docs/source.md)
+        pair = scene_pair(GEAR_SETS[g])
+        for t in args.torques:
+            problem = pair.torque_problem(t)
+            if problem is not None:
+                raise InputError(f"misalignment: --torques: gear set {g}: {problem}")
     for m in args.models:
         mis.check_model(m, MISALIGNMENT_MODELS)
     out = Path(args.out)

@@ -32,6 +32,7 @@ The basic rack (h_aP*, h_fP*, rho_fP*) may differ per gear: give a pair instead 
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -59,6 +60,61 @@ def inverse_involute(value: float) -> float:
         if abs(step) < 1e-15:
             break
     return a
+
+
+# ----------------------------------------------------------------------------- physical operating limits
+# A pinion torque or speed beyond these is no operating point of any steel gear (docs/source.md, "Operating
+# limits").  They are bounds of physics, not of the model: far above every realistic overload, never tuned.
+#
+# Unit tooth load F_t / (b m_n): ISO 6336-3 gives the nominal tooth-root stress sigma_F0 = F_t / (b m_n) Y_F Y_S
+# Y_beta, with Y_F Y_S >= 4 for teeth of the standard basic rack (its minimum, near x = +0.5..1 and z -> inf) and
+# Y_beta >= 0.75, so sigma_F0 >= 3 F_t / (b m_n).  The strongest material of ISO 6336-5 (case-hardened wrought
+# steel, grade ME: sigma_Flim = 525 MPa, sigma_FE = 2 sigma_Flim) with the static life factor Y_NT = 2.5 carries
+# at most 2625 MPa in the root.  Above 2625 / 3 = 875 N/mm^2 the teeth of any steel gear break at the first
+# load.  For the thesis' set A at its test torque of 2000 N m (F_bn = 41.5 kN, Appendix F) the unit load is
+# 164 N/mm^2: the limit is 5.3 x that (10.6 kN m), 3.5 x for the double helical set, while ISO 6336-1's
+# application factor K_A for heavy shocks is 2.25.
+UNIT_TOOTH_LOAD_LIMIT_PA = 2625e6 / 3.0
+# Pitch-line velocity: a solid steel disc whose rim runs at v carries (3 + nu) / 8 rho v^2 at its centre, 3.2 GPa
+# at 1000 m/s (rho = 7850 kg/m^3, nu = 0.3), beyond the tensile strength of any steel: the wheel bursts.  The
+# fastest gears in service (turbo gears, API 613 / ISO 13691) run at pitch-line velocities of up to about 200 m/s.
+PITCH_LINE_VELOCITY_LIMIT_M_S = 1000.0
+
+
+def unit_tooth_load(torque: float, pitch_diameter: float, face_width: float, module: float) -> float:
+    """F_t / (b m_n) [N/m^2] of a gear carrying `torque` [N m] on pitch diameter d [m] (F_t = 2 T / d), face
+    width b [m] (all helices) and normal module m_n [m] (ISO 6336-3's nominal root-stress load)."""
+    return 2.0 * torque / pitch_diameter / (face_width * module)
+
+
+def torque_problem(torque, pitch_diameter: float, face_width: float, module: float) -> str | None:
+    """Why `torque` [N m] on a gear (pitch diameter, face width over all helices and normal module, m) is no
+    operating torque, or None.  Refused: not a finite number > 0, or a unit tooth load F_t / (b m_n) above
+    UNIT_TOOTH_LOAD_LIMIT_PA (the teeth of any steel gear break)."""
+    if isinstance(torque, bool) or not isinstance(torque, numbers.Real) or not math.isfinite(torque) or torque <= 0:
+        return f"{torque!r} must be a finite torque > 0 N m"
+    load = unit_tooth_load(torque, pitch_diameter, face_width, module)
+    if load > UNIT_TOOTH_LOAD_LIMIT_PA:
+        highest = torque * UNIT_TOOTH_LOAD_LIMIT_PA / load
+        return (f"{torque:g} N m loads the teeth with F_t/(b m_n) = {load / 1e6:.4g} N/mm^2, above the "
+                f"{UNIT_TOOTH_LOAD_LIMIT_PA / 1e6:g} N/mm^2 at which the teeth of any steel gear break (ISO 6336-3/-5 "
+                f"static strength); this gear carries at most {highest:.4g} N m (docs/source.md: operating limits)")
+    return None
+
+
+def speed_problem(speed_rpm, pitch_diameter: float) -> str | None:
+    """Why `speed_rpm` [rev/min] of a gear of pitch diameter [m] is no operating speed, or None.  Refused: not a
+    finite number > 0, or a pitch-line velocity above PITCH_LINE_VELOCITY_LIMIT_M_S (the wheel bursts)."""
+    if isinstance(speed_rpm, bool) or not isinstance(speed_rpm, numbers.Real) or not math.isfinite(speed_rpm) \
+            or speed_rpm <= 0:
+        return f"{speed_rpm!r} must be a finite speed > 0 rev/min"
+    velocity = math.pi * pitch_diameter * speed_rpm / 60.0
+    if velocity > PITCH_LINE_VELOCITY_LIMIT_M_S:
+        highest = speed_rpm * PITCH_LINE_VELOCITY_LIMIT_M_S / velocity
+        return (f"{speed_rpm:g} rev/min is a pitch-line velocity of {velocity:.4g} m/s, above the "
+                f"{PITCH_LINE_VELOCITY_LIMIT_M_S:g} m/s at which a steel wheel bursts; this gear runs at most "
+                f"{highest:.4g} rev/min (docs/source.md: operating limits)")
+    return None
 
 
 def _pair(value, key: str, where: str) -> tuple[float, float]:
@@ -399,6 +455,16 @@ class GearPair:
     def pitch_line_velocity(self, pinion_speed_rpm: float) -> float:
         """v = pi d1 n1 / 60 [m/s]."""
         return math.pi * float(self.pitch_diameter[0]) * pinion_speed_rpm / 60.0
+
+    def torque_problem(self, pinion_torque) -> str | None:
+        """Why a pinion torque [N m] is no operating torque of this pair, or None (module `torque_problem`: over
+        the pinion's pitch diameter, the face width in contact over all helices and the normal module)."""
+        return torque_problem(pinion_torque, float(self.pitch_diameter[0]), self.total_contact_width, self.module)
+
+    def speed_problem(self, pinion_speed_rpm) -> str | None:
+        """Why a pinion speed [rev/min] is no operating speed of this pair, or None (module `speed_problem`: the
+        pitch-line velocity is the same on both gears)."""
+        return speed_problem(pinion_speed_rpm, float(self.pitch_diameter[0]))
 
     def tooth_frequency(self, pinion_speed_rpm: float) -> float:
         """Tooth (mesh) frequency z1 n1 / 60 [Hz]."""

@@ -525,10 +525,22 @@ class StiffnessCurve:
         return np.fft.fft(self.stiffness) / self.stiffness.size
 
 
-def stiffness_curve(model: MeshModel, total_force: float, n_positions: int = 32) -> StiffnessCurve:
-    """Mesh stiffness over one mesh period at a total normal tooth force [N] (Sec. 2.4)."""
+def check_tooth_force(pair: GearPair, total_force: float) -> None:
+    """InputError unless a total normal tooth force [N] is > 0 and within the teeth's strength (the pinion torque
+    T1 = F_bn r_b1 cos(beta_b) checked by GearPair.torque_problem): beyond it the teeth of any steel gear break,
+    Weber's Hertzian approach loses its validity (contact half-widths of the order of the tooth thickness) and the
+    load distribution has no physical answer.  Callers that know the scene key or option check the torque first."""
     if not total_force > 0:
         raise InputError(f"stiffness: total force must be > 0 N, got {total_force}")
+    torque = total_force * float(pair.base_diameter[0]) / 2 * math.cos(pair.base_helix_angle)
+    problem = pair.torque_problem(torque)
+    if problem is not None:
+        raise InputError(f"stiffness: normal tooth force {total_force:.4g} N, pinion torque {problem}")
+
+
+def stiffness_curve(model: MeshModel, total_force: float, n_positions: int = 32) -> StiffnessCurve:
+    """Mesh stiffness over one mesh period at a total normal tooth force [N] (Sec. 2.4)."""
+    check_tooth_force(model.pair, total_force)
     pbt = model.pair.transverse_base_pitch
     pos = np.arange(n_positions) / n_positions
     out = [model.stiffness_at(x * pbt, total_force) for x in pos]
@@ -552,8 +564,7 @@ def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = N
     flanks then carry the linear gap, and F_i / delta (delta: the approach of the face that carries most) is the
     point's stiffness times its compatibility (delta - gap) / delta: the share is the LOAD share of the misaligned
     mesh, zero where the gap exceeds the approach (contact loss: `contact_loss_fraction`)."""
-    if not total_force > 0:
-        raise InputError(f"stiffness: total force must be > 0 N, got {total_force}")
+    check_tooth_force(model.pair, total_force)
     bare = MeshModel(model.pair, shafts=model.shafts, corrections=Corrections(), n_slices=model.n_slices,
                      torque_configuration=model.torque_configuration,
                      include_plate_coupling=model.include_plate_coupling,

@@ -372,5 +372,13 @@ def register_cli(subparsers) -> None:
 def _cmd(args: argparse.Namespace) -> int:
     if not (args.torque > 0 and np.isfinite(args.torque)):      # else "stiffness: total force must be > 0 N"
         raise InputError(f"bearing-variants: --torque: {args.torque:g} must be a pinion torque > 0 N m")
+    from housingfe.bearings.configurations import configurations
+    from housingfe.source.roosmalen.run import scene_pair
+
+    known = configurations()
+    for gear_set in sorted({known[c].gear_set for c in (args.configs or known) if c in known}):
+        problem = scene_pair(GEAR_SCENES[gear_set]).torque_problem(args.torque)
+        if problem is not None:       # beyond the teeth's strength: no load distribution (docs/source.md)
+            raise InputError(f"bearing-variants: --torque: gear set {gear_set}: {problem}")
     run_study(args.scene, args.configs, args.out, args.set or [], args.torque)
     return 0

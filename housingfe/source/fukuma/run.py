@@ -35,6 +35,7 @@ from typing import Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from housingfe.errors import InputError
 from housingfe.outputs import format_table, write_csv, write_json
 from housingfe.scenefile import SceneInfo, parse_table
 
@@ -147,6 +148,20 @@ def build_pair(sc: FukumaScene):
     return pair, geo
 
 
+def check_operating_points(sc: FukumaScene, geo, scene_path: str) -> None:
+    """InputError naming the first speed or torque of the scene that is no operating point of its gears `geo` (a
+    GearPair: GearPair.speed_problem / torque_problem, docs/source.md).  torque_Nm = 0 is accepted: the model is
+    linear and only records it."""
+    speeds = [("loads.speed_rpm", sc.loads.speed_rpm)]
+    speeds += [(f"sweep.speeds_rpm.{i}", s) for i, s in enumerate(sc.sweep.speeds_rpm)]
+    problems = [(key, geo.speed_problem(s)) for key, s in speeds]
+    if sc.loads.torque_Nm != 0:
+        problems.append(("loads.torque_Nm", geo.torque_problem(sc.loads.torque_Nm)))
+    for key, problem in problems:
+        if problem is not None:
+            raise InputError(f"{scene_path}: {key}: {problem}")
+
+
 def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
     """Run a Fukuma scene: influence coefficients, equivalent inertia and radial / axial conversion ratios
     over the gear position (CSV + PNG), bearing force and moment spectra at the listed gear positions, the
@@ -155,7 +170,8 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
 
     sc = parse_scene(scene, scene_path)
     out_dir = Path(out_dir)
-    pair, _ = build_pair(sc)
+    pair, geo = build_pair(sc)
+    check_operating_points(sc, geo, scene_path)
     sw = sc.sweep
     zs = np.linspace(sw.z_min, sw.z_max, sw.points)
     rows, ratios = [], {rpm: [] for rpm in sw.speeds_rpm}

@@ -157,6 +157,9 @@ class SourceModel:
             raise InputError(f"operating_point: torque_nm: {torque_nm!r} must be a finite number > 0 N m (the "
                              "mesh stiffness is computed at the loaded tooth deflection; an unloaded mesh is not "
                              "supported)")
+        problem = self.pair.torque_problem(float(torque_nm))
+        if problem is not None:
+            raise InputError(f"operating_point: torque_nm: {problem}")
         op = self._point(float(torque_nm))
         st = op.steady_state(self.pair, float(speed_rpm), self.harmonics)
         h = op.mats.h

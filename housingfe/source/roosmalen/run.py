@@ -17,6 +17,7 @@ so, as in Appendix F):
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Annotated, Literal, Optional, Union
@@ -134,6 +135,16 @@ def parse(scene: dict, scene_path: str) -> SourceTable:
     return parse_table(SourceTable, scene.get("source", {}), scene_path, prefix="source.")
 
 
+def scene_pair(name_or_path: str) -> GearPair:
+    """The GearPair of a roosmalen source scene (built-in name or TOML path), e.g. to check an operating torque
+    (GearPair.torque_problem) before any computation."""
+    from housingfe.scenefile import read_scene_dict
+
+    scene, path = read_scene_dict(name_or_path)
+    table = parse(scene, str(path))
+    return GearPair.from_table(table.gears.model_dump(exclude_none=True), where=f"{path}: source.gears")
+
+
 def build(table: SourceTable, scene_path: str = "scene"):
     """GearPair, Corrections, ShaftGeometry, LumpedInterior and MeshModel from a validated table."""
     gears = table.gears.model_dump(exclude_none=True)
@@ -201,6 +212,31 @@ class OperatingPoint:
                                     H=harmonics)
 
 
+def check_operating_points(table: SourceTable, pair: GearPair, scene_path: str) -> None:
+    """InputError naming the key of the first torque or speed of the scene that is no operating point of the pair
+    (GearPair.torque_problem / speed_problem: beyond the teeth's strength, or a wheel that bursts)."""
+    g = table.gears
+    torques = [("source.torque_Nm", table.torque_Nm)]
+    torques += [(f"source.torque_run_Nm.{i}", t) for i, t in enumerate(table.torque_run_Nm)]
+    speeds = [("source.speed_min_rpm", table.speed_min_rpm), ("source.speed_max_rpm", table.speed_max_rpm),
+              ("source.torque_run_speed_rpm", table.torque_run_speed_rpm),
+              ("source.gears.max_speed_rpm", g.max_speed_rpm)]
+    speeds += [(f"source.spectrum_speeds_rpm.{i}", s) for i, s in enumerate(table.spectrum_speeds_rpm)]
+    for key, speed in speeds:
+        problem = pair.speed_problem(speed)
+        if problem is not None:
+            raise InputError(f"{scene_path}: {key}: {problem}")
+    for key, torque in torques:
+        problem = pair.torque_problem(torque)
+        if problem is not None:
+            raise InputError(f"{scene_path}: {key}: {problem}")
+    rated = g.power_kW * 1e3 / (g.max_speed_rpm * math.pi / 30.0)     # the Appendix F table's pinion torque
+    problem = pair.torque_problem(rated)
+    if problem is not None:
+        raise InputError(f"{scene_path}: source.gears.power_kW: {g.power_kW:g} kW at {g.max_speed_rpm:g} rev/min, "
+                         f"pinion torque {problem}")
+
+
 def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     """Compute everything a roosmalen source scene asks for and write it into `out_dir` (exists)."""
     import matplotlib
@@ -211,6 +247,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     if table.speed_min_rpm >= table.speed_max_rpm:
         raise InputError(f"{scene_path}: source.speed_max_rpm: must exceed speed_min_rpm")
     pair, corr, geometry, interior, model = build(table, scene_path)
+    check_operating_points(table, pair, scene_path)
     g = table.gears
     name = scene.get("scene", {}).get("name", Path(scene_path).stem)
 

@@ -247,6 +247,12 @@ def _cmd_spectrum(args: argparse.Namespace) -> int:
         scene, path = load_scene(name)
         if scene["source"]["model"] != "roosmalen":
             raise InputError(f"{path}: source.model: source-spectrum needs 'roosmalen', not {scene['source']['model']!r}")
+        if args.torque is not None:
+            from housingfe.source.roosmalen.run import scene_pair
+
+            problem = scene_pair(str(path)).torque_problem(args.torque)
+            if problem is not None:
+                raise InputError(f"{path}: --torque: {problem}")
     rows = excitation_spectrum(scenes, harmonics=args.harmonics, torque_nm=args.torque)
     out_dir = Path(args.out)
     with atomic_output_dir(out_dir) as tmp:

@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from housingfe.errors import InputError
 from housingfe.outputs import format_table, write_csv, write_json
 from housingfe.scenefile import SceneInfo, parse_table
 from housingfe.source.trueman import data
@@ -171,17 +172,40 @@ def _critical_outputs(sc: TruemanScene, out_dir: Path) -> list:
     return rows
 
 
-def helical_mesh_geometry() -> dict:
-    """Parallel 1:1 drawshaft mesh of Table 2.1 (20 T, normal diametral pitch 12, 20 deg, 45 deg helix)
-    from the shared gear geometry: pitch radius [m], normal pressure and helix angles [rad]."""
+def helical_mesh_pair():
+    """GearPair of the parallel 1:1 drawshaft mesh of Table 2.1 (20 T, normal diametral pitch 12, 20 deg, 45 deg
+    helix, 0.8125 in face width)."""
     from housingfe.source.gears import GearPair
 
     module = data.INCH / 12.0
     helix, alpha = math.radians(45.0), math.radians(20.0)
-    pair = GearPair(module=module, teeth=(20, 20), pressure_angle=alpha, helix_angle=helix,
+    return GearPair(module=module, teeth=(20, 20), pressure_angle=alpha, helix_angle=helix,
                     profile_shift=(0.0, 0.0), face_width=(0.8125 * data.INCH,) * 2,
                     centre_distance=20 * module / math.cos(helix), name="Trueman Table 2.1 drawshaft mesh")
-    return {"pitch_radius": float(pair.pitch_diameter[0]) / 2.0, "pressure_angle": alpha, "helix_angle": helix}
+
+
+def helical_mesh_geometry() -> dict:
+    """Parallel 1:1 drawshaft mesh of Table 2.1 (20 T, normal diametral pitch 12, 20 deg, 45 deg helix)
+    from the shared gear geometry: pitch radius [m], normal pressure and helix angles [rad]."""
+    pair = helical_mesh_pair()
+    return {"pitch_radius": float(pair.pitch_diameter[0]) / 2.0, "pressure_angle": pair.pressure_angle,
+            "helix_angle": pair.helix_angle}
+
+
+def check_operating_points(sc: "TruemanScene", scene_path: str) -> None:
+    """InputError naming the first [forced] speed or torque that is no operating point of the drawshaft mesh
+    (GearPair.speed_problem / torque_problem, docs/source.md).  Speeds are drawroll r.p.m., checked on the
+    drawshaft gears' pitch circle."""
+    f = sc.forced
+    if f is None:
+        return
+    pair = helical_mesh_pair()
+    problems = [(key, pair.speed_problem(getattr(f, key))) for key in ("speed_min_rpm", "speed_max_rpm",
+                                                                       "histogram_rpm")]
+    problems.append(("mean_mesh_torque_Nm", pair.torque_problem(f.mean_mesh_torque_Nm)))
+    for key, problem in problems:
+        if problem is not None:
+            raise InputError(f"{scene_path}: forced.{key}: {problem}")
 
 
 def _forced_outputs(sc: TruemanScene, out_dir: Path) -> dict:
@@ -306,6 +330,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> None:
     dynamic mesh loads over speed with min/mean/max envelopes, the tooth-separation flags and the
     fundamental gear-mesh force spectrum.  Writes into the existing folder `out_dir`."""
     sc = parse_scene(scene, scene_path)
+    check_operating_points(sc, scene_path)
     out_dir = Path(out_dir)
     rows = _critical_outputs(sc, out_dir)
     summary = {"scene": sc.scene.name, "critical_speeds_rpm": "critical_speeds.json"}
