@@ -486,12 +486,48 @@ SOURCE_CASES = [
     ("source-gears-unknown", _set("source.gears.colour", "red"), ["source.gears.colour"]),
     ("source-housing-kind", _set("scene.kind", "housing"), ["scene.kind"]),
     ("source-missing-section", _del("source"), ["source"]),
+    # torques beyond the teeth's strength and speeds at which the wheel bursts (GearPair.torque_problem /
+    # speed_problem, docs/source.md): 1e12 N m was "solver error: load distribution did not converge" (exit 3),
+    # 1e9 rev/min ran to a result
+    ("source-torque-beyond-strength", _set("source.torque_Nm", 1e12),
+     ["source.torque_Nm", "875 N/mm^2 at which the teeth of any steel gear break", "at most 1.065e+04 N m"]),
+    ("source-torque-run-beyond-strength", _set("source.torque_run_Nm", [400.0, 20000.0]),
+     ["source.torque_run_Nm.1", "875 N/mm^2"]),
+    ("source-torque-nan", _set("source.torque_Nm", float("nan")), ["source.torque_Nm", "finite"]),
+    ("source-speed-zero", _set("source.speed_min_rpm", 0.0), ["source.speed_min_rpm"]),
+    ("source-speed-bursts", _set("source.speed_max_rpm", 1e9), ["source.speed_max_rpm", "1000 m/s", "bursts"]),
+    ("source-spectrum-speed-bursts", _set("source.spectrum_speeds_rpm", [500.0, 1e9]),
+     ["source.spectrum_speeds_rpm.1", "1000 m/s"]),
 ]
 
 
 @pytest.mark.parametrize("change, needles", [c[1:] for c in SOURCE_CASES], ids=[c[0] for c in SOURCE_CASES])
 def test_bad_source_scene_is_rejected(change, needles, tmp_path, capsys):
     data = _source_base()
+    change(data)
+    path = tmp_path / "source.toml"
+    path.write_text(to_toml(data))
+    out = tmp_path / "out"
+    code, err = _run_cli(["source", str(path), "--out", str(out)], capsys)
+    _expect_one_line_error(code, err, needles, tmp_path, out)
+
+
+# the Fukuma and Trueman source models: the same limits on their gears (Fukuma's torque is only recorded: 0 is valid)
+OTHER_SOURCE_CASES = [
+    ("fukuma-torque-beyond-strength", "fukuma-series-a", _set("loads.torque_Nm", 1e12),
+     ["loads.torque_Nm", "875 N/mm^2"]),
+    ("fukuma-speed-bursts", "fukuma-series-a", _set("sweep.speeds_rpm", [700.0, 1e9]),
+     ["sweep.speeds_rpm.1", "1000 m/s"]),
+    ("trueman-torque-beyond-strength", "trueman-type-a", _set("forced.mean_mesh_torque_Nm", 1e12),
+     ["forced.mean_mesh_torque_Nm", "875 N/mm^2"]),
+    ("trueman-speed-bursts", "trueman-type-a", _set("forced.speed_max_rpm", 1e9), ["forced.speed_max_rpm", "1000 m/s"]),
+]
+
+
+@pytest.mark.parametrize("scene, change, needles", [c[1:] for c in OTHER_SOURCE_CASES],
+                         ids=[c[0] for c in OTHER_SOURCE_CASES])
+def test_impossible_operating_point_of_other_source_models_is_rejected(scene, change, needles, tmp_path, capsys):
+    data = tomllib.loads((SCENE_DIR / f"{scene}.toml").read_text())
     change(data)
     path = tmp_path / "source.toml"
     path.write_text(to_toml(data))
@@ -739,6 +775,32 @@ SWEEP_CASES = [
      ["--points: 10000000 points asked for", "facets"]),
     ("correlate-export-no-folder", ["correlate", "box-free", "--export", "nowhere/x.uff"],
      ["nowhere/x.uff", "--export", "nowhere is not an existing folder"]),
+    # a torque beyond the teeth's strength (GearPair.torque_problem, docs/source.md): each command that takes one
+    # ended in "housingfe: solver error: stiffness: load distribution did not converge at u = 0.000e+00 m" (exit 3;
+    # bearing-variants after 3 s of work); the other impossible values (0, < 0, nan, inf) were already refused
+    ("source-spectrum-torque-beyond-strength", ["source-spectrum", "gearset-A", "--torque", "1e12", "--out", "s"],
+     ["gearset-A.toml: --torque: 1e+12 N m", "875 N/mm^2", "at most 1.065e+04 N m"]),
+    ("source-spectrum-torque-nan", ["source-spectrum", "gearset-A", "--torque", "nan", "--out", "s"],
+     ["--torque: nan must be a pinion torque > 0 N m"]),
+    ("misalignment-torque-beyond-strength", ["misalignment", "--torques", "2000", "1e12", "--out", "m"],
+     ["--torques: gear set A: 1e+12 N m", "875 N/mm^2"]),
+    ("misalignment-torque-zero", ["misalignment", "--torques", "0", "--out", "m"], ["--torques: 0 must be"]),
+    ("bearing-variants-torque-beyond-strength", ["bearing-variants", "--torque", "1e12", "--out", "bv"],
+     ["--torque: gear set", "875 N/mm^2"]),
+    ("bearing-variants-torque-inf", ["bearing-variants", "--torque", "inf", "--out", "bv"], ["--torque: inf"]),
+    ("runup-torque-beyond-strength", ["run", "test-gearbox-runup", "--set", "runup.torques_nm=[1e12]", "--out", "r"],
+     ["runup.torques_nm.0: 1e+12 N m", "875 N/mm^2"]),
+    ("runup-torque-negative", ["run", "test-gearbox-runup", "--set", "runup.torques_nm=[-5.0]", "--out", "r"],
+     ["runup.torques_nm.0"]),
+    ("uncertainty-torque-beyond-strength", ["uncertainty", "--set", "runup.torques_nm=[2000.0, 1e12]", "--out", "u"],
+     ["runup.torques_nm.1: 1e+12 N m", "875 N/mm^2"]),
+    # run-up speeds: 0 and 1e9 rev/min were refused already; a spectrum speed outside the run-up was skipped silently
+    ("runup-speed-zero", ["run", "test-gearbox-runup", "--set", "runup.speed_min_rpm=0", "--out", "r"],
+     ["runup.speed_min_rpm"]),
+    ("runup-speed-huge", ["run", "test-gearbox-runup", "--set", "runup.speed_max_rpm=1e9", "--out", "r"],
+     ["runup.speed_max_rpm", "outside the range the source supports"]),
+    ("runup-spectrum-speed-huge", ["run", "test-gearbox-runup", "--set", "runup.spectrum_speeds_rpm=[1e9]", "--out",
+                                   "r"], ["runup.spectrum_speeds_rpm: 1e+09 rev/min", "outside the range"]),
 ]
 
 
@@ -748,7 +810,8 @@ def test_cli_sweep_refuses_before_any_work(argv, needles, tmp_path):
 
 
 CORPUS_SIZE = (len(SCENE_CASES) + len(MESH_CASES) + 1 + len(COARSE_CASES) + len(SET_CASES) + 2 * len(FILE_CASE_NAMES) + 1
-               + len(SOURCE_CASES) + len(COMMAND_CASES) + 5 + len(SWEEP_CASES))
+               + len(SOURCE_CASES) + len(OTHER_SOURCE_CASES) + len(COMMAND_CASES) + 5
+               + len(SWEEP_CASES))
 
 
 def test_corpus_is_at_least_fifty_cases():

@@ -7,6 +7,7 @@ from scipy.optimize import brentq
 
 from housingfe.data import thesis
 from housingfe.errors import InputError
+from housingfe.source import gears
 from housingfe.source.gears import GearPair, involute, tooth_profile
 
 REF = thesis()["gears"]
@@ -206,3 +207,43 @@ def test_basic_rack_per_gear():
 def test_from_table_without_centre_distance_is_zero_backlash():
     table = {k: v for k, v in REF["single_helical"].items() if k != "centre_distance_mm"}
     assert GearPair.from_table(table).centre_distance == pytest.approx(0.200, abs=1e-7)
+
+
+# ---------------------------------------------------------------- physical operating limits (docs/source.md)
+def test_unit_tooth_load_of_set_a_at_its_test_torque(single):
+    # by hand: d1 = 24 x 4 mm / cos 12 deg = 98.145 mm, F_t = 2 x 2000 N m / d1 = 40.76 kN over b = 62 mm, m_n = 4 mm
+    d1 = 24 * 4e-3 / math.cos(math.radians(12.0))
+    assert float(single.pitch_diameter[0]) == pytest.approx(d1, rel=1e-12)
+    load = gears.unit_tooth_load(2000.0, d1, 0.062, 4e-3)
+    assert load == pytest.approx(2 * 2000.0 / d1 / (0.062 * 4e-3), rel=1e-12)
+    assert load / 1e6 == pytest.approx(164.3, abs=0.05)          # N/mm^2
+    assert single.torque_problem(2000.0) is None
+
+
+def test_torque_limit_is_the_static_root_strength_over_the_least_form_factor(single, double):
+    # 2625 MPa (ISO 6336-5 ME case-hardened, sigma_FE = 1050 MPa, static Y_NT = 2.5) over Y_F Y_S Y_beta >= 3
+    assert gears.UNIT_TOOTH_LOAD_LIMIT_PA == pytest.approx(875e6)
+    for pair, width, module in ((single, 0.062, 4e-3), (double, 2 * 0.023, 3.5e-3)):
+        highest = gears.UNIT_TOOTH_LOAD_LIMIT_PA * width * module * float(pair.pitch_diameter[0]) / 2
+        assert pair.torque_problem(0.999 * highest) is None
+        problem = pair.torque_problem(1.001 * highest)
+        assert "875 N/mm^2" in problem and f"{highest:.4g} N m" in problem, problem
+    # far beyond realistic overload (ISO 6336-1 K_A <= 2.25) for the thesis' sets at their 2000 N m test torque
+    assert 875e6 * 0.062 * 4e-3 * float(single.pitch_diameter[0]) / 2 / 2000.0 == pytest.approx(5.33, abs=0.01)
+
+
+@pytest.mark.parametrize("torque", [0.0, -5.0, float("nan"), float("inf"), 1e12, True, "2000"])
+def test_impossible_torques_are_refused(single, torque):
+    assert single.torque_problem(torque) is not None
+
+
+@pytest.mark.parametrize("speed", [0.0, -5.0, float("nan"), float("inf"), 1e9])
+def test_impossible_speeds_are_refused(single, speed):
+    assert single.speed_problem(speed) is not None
+
+
+def test_speed_limit_is_a_pitch_line_velocity_of_1000_m_per_s(single):
+    highest = 1000.0 * 60.0 / (math.pi * float(single.pitch_diameter[0]))      # 194.6e3 rev/min
+    assert highest == pytest.approx(194.6e3, rel=1e-3)
+    assert single.speed_problem(0.999 * highest) is None and single.speed_problem(1500.0) is None
+    assert "1000 m/s" in single.speed_problem(1.001 * highest)
