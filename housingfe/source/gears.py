@@ -71,8 +71,8 @@ def inverse_involute(value: float) -> float:
 # Y_beta >= 0.75, so sigma_F0 >= 3 F_t / (b m_n).  The strongest material of ISO 6336-5 (case-hardened wrought
 # steel, grade ME: sigma_Flim = 525 MPa, sigma_FE = 2 sigma_Flim) with the static life factor Y_NT = 2.5 carries
 # at most 2625 MPa in the root.  Above 2625 / 3 = 875 N/mm^2 the teeth of any steel gear break at the first
-# load.  For the thesis' set A at its test torque of 2000 N m (F_bn = 41.5 kN, Appendix F) the unit load is
-# 164 N/mm^2: the limit is 5.3 x that (10.6 kN m), 3.5 x for the double helical set, while ISO 6336-1's
+# load.  For the thesis' set A at its test torque of 2000 N m (F_t = 40.8 kN over 62 mm, m_n = 4 mm) the unit load
+# is 164 N/mm^2: the limit is 5.3 x that (10.6 kN m), 3.5 x for the double helical set, while ISO 6336-1's
 # application factor K_A for heavy shocks is 2.25.
 UNIT_TOOTH_LOAD_LIMIT_PA = 2625e6 / 3.0
 # Pitch-line velocity: a solid steel disc whose rim runs at v carries (3 + nu) / 8 rho v^2 at its centre, 3.2 GPa
