@@ -436,7 +436,7 @@ class MeshModel:
         arg = fl["t0"] * fl["t1"] * math.pi * E * L / (2 * rho_v * (1 - nu**2) * F)
         # arg = (2 t0 / a)(2 t1 / a) with a the Hertzian half-width: Weber's formula holds for a well below the
         # tooth thicknesses and turns negative (a contact that pulls) for arg < exp(nu / (1 - nu)).  Within the
-        # torque limit (GearPair.unit_load_problem) that happens only on slivers of a contact line at the ends of
+        # torque limit (GearPair.torque_problem) that happens only on slivers of a contact line at the ends of
         # the path of contact (segment widths of nm), whose negative compliance made the iteration cycle; an
         # approach is never negative, so it is held at zero there
         return 2 * F * (1 - nu**2) / (math.pi * E * L) * np.maximum(np.log(np.maximum(arg, 1.0)) - nu / (1 - nu),
