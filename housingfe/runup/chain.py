@@ -221,9 +221,13 @@ def _check_mesh_moment(mesh_moment: str) -> None:
 
 def shuttle_moments(source, torque_nm: float, harmonics: np.ndarray) -> np.ndarray:
     """The shuttling moment M_n = F W_n / sqrt(2) (complex rms, N m) at the tooth harmonics n (array of ints >= 1):
-    F the transmitted normal force [N] at the pinion torque [N m], W_n the one-sided harmonic n of the mesh load's
-    axial centre of pressure w_c [m] (SourceModel.centre_of_pressure: the load distributions of the source's
-    stiffness curve, same time origin as S(t) and F_e(t)).  The amplitude of the unit load "shuttle" (`unit_loads`).
+    F the transmitted normal force [N] at the pinion torque [N m], W_n the one-sided harmonic n of the moment arm
+    w_c + tan(beta_b) s_c [m] of the mesh load's centre of pressure (SourceModel.centre_of_pressure: the load
+    distributions of the source's stiffness curve, same time origin as S(t) and F_e(t); CentreOfPressure
+    .moment_arm_harmonics; beta_b = 0 for a double helical pair as in the FE normal, Drivetrain.gear_forces).  The
+    s term is small (at most 2.4 N m against 98-157 N m of the axial term at n = 1 for sets A-D at 2000 N m,
+    benchmarks/experiments/shuttling) but lies on the same axis, so it is kept.  The amplitude of the unit load
+    "shuttle" (`unit_loads`).
 
     First order: applied on the coupled model holding the mean mesh stiffness, this is exact superposition of the
     constant force's moving point; the product of the stiffness ripple with the moment's own mesh deflection is
@@ -231,7 +235,9 @@ def shuttle_moments(source, torque_nm: float, harmonics: np.ndarray) -> np.ndarr
     from housingfe.source.stiffness import normal_force_from_torque
 
     n = np.asarray(harmonics, int)
-    arm = source.centre_of_pressure(float(torque_nm)).axial_arm_harmonics(int(n.max()) if n.size else 1)
+    pair = source.pair
+    tan_bb = 0.0 if pair.kind == "double_helical" else math.tan(pair.base_helix_angle)
+    arm = source.centre_of_pressure(float(torque_nm)).moment_arm_harmonics(tan_bb, int(n.max()) if n.size else 1)
     F = normal_force_from_torque(source.pair, float(torque_nm))
     return F * arm[n - 1] / math.sqrt(2.0)
 

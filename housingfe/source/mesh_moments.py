@@ -54,6 +54,18 @@ class CentreOfPressure:
         """(harmonics,) one-sided complex amplitudes [m] of s_c, n = 1..harmonics."""
         return one_sided_harmonics(self.position, self.line_centre, harmonics, n_samples)
 
+    def moment_arm_harmonics(self, tan_base_helix: float, harmonics: int, n_samples: int = N_SAMPLES) -> np.ndarray:
+        """(harmonics,) one-sided complex amplitudes [m] of the moment arm w_c + tan(beta_b) s_c.
+
+        A force F n (n = cos(beta_b) d + sin(beta_b) a in the plane of action, d along growing s) whose point moves
+        by ds along d and dw along the direction e_w in which w grows (e_w = -a for the MeshModel's hand:
+        housingfe.drivetrain.description.Drivetrain.mesh_face_direction) changes its moment by
+        F (dw + tan(beta_b) ds) (e_w x n): the shift along the contact line is what counts, the shift along n's
+        own line gives none.  tan_base_helix: tan(beta_b) of the normal the moment is applied with (0 for a
+        double helical pair, whose halves' terms cancel)."""
+        arm = self.axial_centre + float(tan_base_helix) * self.line_centre
+        return one_sided_harmonics(self.position, arm, harmonics, n_samples)
+
 
 def one_sided_harmonics(position: np.ndarray, values: np.ndarray, harmonics: int,
                         n_samples: int = N_SAMPLES) -> np.ndarray:

@@ -142,7 +142,8 @@ def test_shuttle_loads_are_the_mesh_force_with_its_point_moved(gear_set):
     """The unit load of the shuttling moment: the mesh force pair of F with its contact point moved by dw along the
     direction in which the MeshModel's w grows changes only the moments, by +/- F dw (e_w x n); and that direction is
     the MeshModel's hand: its contact lines s = s0 + w tan(beta_b) must lie on the flank, i.e. normal to the FE
-    contact normal n (whose axial part is +sin(beta_b) along the shaft axis)."""
+    contact normal n (whose axial part is +sin(beta_b) along the shaft axis); a shift along the line of action adds
+    tan(beta_b) ds to the arm on the same axis."""
     from dataclasses import replace
 
     d = test_gearbox(gear_set)
@@ -167,6 +168,14 @@ def test_shuttle_loads_are_the_mesh_force_with_its_point_moved(gear_set):
         assert abs(line @ n) < 1e-12
         # the other hand would not lie on the flank
         assert abs((math.tan(pair.base_helix_angle) * d_t - e_w) @ n) > 0.3
+        # a shift ds along the line of action acts on the same axis: moment F (dw + tan(beta_b) ds) (e_w x n)
+        # (housingfe.source.mesh_moments.CentreOfPressure.moment_arm_harmonics)
+        ds = 2e-3
+        both = d.mesh_node_loads(F, replace(forces, point=forces.point + dw * e_w + ds * d_t))
+        arm = dw + math.tan(pair.base_helix_angle) * ds
+        for node in base:
+            np.testing.assert_allclose(both[node] - base[node], d.shuttle_node_loads(F * arm, forces)[node],
+                                       atol=1e-9 * F)
     m = np.cross(e_w, n)
     assert np.linalg.norm(m) == pytest.approx(math.cos(0.0 if gear_set == "double_helical"
                                                         else pair.base_helix_angle), rel=1e-12)

@@ -95,8 +95,8 @@ def test_reanalysis_at_another_torque_matches_a_fresh_basis(coarse):
 
 
 def test_shuttle_lines_are_the_force_times_the_centre_of_pressure_harmonics():
-    """Lines.shuttle_moment (complex rms N m) = F W_n / sqrt 2 with W_n the harmonics of the axial centre of pressure
-    of a load distribution computed afresh (housingfe.source.mesh_moments.centre_of_pressure_curve) at the source's
+    """Lines.shuttle_moment (complex rms N m) = F W_n / sqrt 2 with W_n the harmonics of the moment arm w_c +
+    tan(beta_b) s_c of the centre of pressure of a load distribution computed afresh (housingfe.source.mesh_moments.centre_of_pressure_curve) at the source's
     positions: the reuse of the stiffness curve's distributions changes nothing; "none" leaves them out."""
     from housingfe.source.mesh_moments import centre_of_pressure_curve
     from housingfe.source.stiffness import normal_force_from_torque
@@ -109,7 +109,7 @@ def test_shuttle_lines_are_the_force_times_the_centre_of_pressure_harmonics():
     np.testing.assert_array_equal(plain.mesh_excitation, lines.mesh_excitation)
     F = normal_force_from_torque(src.pair, 2000.0)
     cop = centre_of_pressure_curve(src.mesh_model, F, src.stiffness_positions)
-    W = cop.axial_arm_harmonics(int(lines.harmonic.max()))
+    W = cop.moment_arm_harmonics(math.tan(src.pair.base_helix_angle), int(lines.harmonic.max()))
     np.testing.assert_allclose(lines.shuttle_moment, F * W[lines.harmonic - 1] / math.sqrt(2.0), rtol=1e-9)
     # set A at 2000 N m: the first harmonic is tens of N m (the centre moves millimetres over a 60 mm face)
     assert 20.0 < abs(lines.shuttle_moment[0]) * math.sqrt(2.0) < 500.0
