@@ -7,9 +7,10 @@
 
 Per run, once (`build_gearbox_model`): the housing coupled with the drivetrain's FE reduction (shafts, gears,
 bearings as 6x6 matrices at star connections to the bores, the gear mesh), its complete modal basis to
-basis_factor x the highest line, and a Ritz reduction (housingfe.response.reduced) on the two unit loads the routes
-need: a torque of 1 N m about the wheel axis at the wheel centre, and a unit compressive pair along the gear-mesh
-normal (the loads the gear-mesh element carries).  Per speed and torque: the source's operating point
+basis_factor x the highest line, and a Ritz reduction (housingfe.response.reduced) on the unit loads the routes
+need: a torque of 1 N m about the wheel axis at the wheel centre, a unit compressive pair along the gear-mesh
+normal (the loads the gear-mesh element carries), and the moment pair of the shuttling moment (the mesh force's
+point moved along the gear axis, `unit_loads`; applied with runup.mesh_moment = "shuttling").  Per speed and torque: the source's operating point
 (housingfe.source.roosmalen.operating), then each route's L_v per tooth harmonic, then each radiator's L_sigma and L_W.
 
 Routes (`ROUTES`, a registry: `@register_route(name)`):
@@ -61,7 +62,7 @@ def register_route(name: str):
 class GearboxModel:
     """The coupled gearbox of a run-up (see the module docstring): drivetrain (housingfe.drivetrain.description
     .Drivetrain), structure (CoupledInterior), basis (ModalBasis), reduction (RitzReduction on the loads
-    "wheel_torque" and "mesh"), radiators {name: Radiator}, wheel node and axis, the highest line (Hz), the
+    "wheel_torque", "mesh" and "shuttle", `unit_loads`), radiators {name: Radiator}, wheel node and axis, the highest line (Hz), the
     interior energy share of each basis mode, timings (s)."""
 
     drivetrain: object
@@ -130,7 +131,8 @@ def build_gearbox_model(housing_model, drivetrain, f_lines_max: float, *, dampin
                         basis_factor: float = 1.5, radiators: dict | None = None,
                         surface: str = "outer") -> GearboxModel:
     """Couple `housing_model` (HousingModel with the bores of the drivetrain's bearings) with `drivetrain`, compute
-    its complete modal basis to basis_factor x f_lines_max (Hz) and the Ritz reduction of the two unit loads.
+    its complete modal basis to basis_factor x f_lines_max (Hz) and the Ritz reduction of the unit loads
+    (`unit_loads`).
     damping_ratio: modal xi (Sec. 5.4: 0.04); radiators: {name: Radiator} (their extra points are kept)."""
     from housingfe.drivetrain.interior import build_interior
 
