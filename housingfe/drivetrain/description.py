@@ -303,6 +303,34 @@ class Drivetrain:
             out[node] = np.concatenate([f, np.cross(arm, n) * sign * force])
         return out
 
+    def mesh_face_direction(self) -> np.ndarray:
+        """Unit vector (housing frame) along which the mesh model's axial position w grows (MeshModel w: from its
+        face w = 0 over the gear; housingfe.source.stiffness).
+
+        The hand comes from the FE contact normal (`gear_forces`): n = cos(beta_b) d + sin(beta_b) a, with d along
+        the transverse line of action in the direction of growing s (from T1 to T2: the force on the wheel, pinion
+        driving) and a the pinion's shaft axis.  A contact line lies on the flank, so it is normal to n; in the
+        MeshModel it runs s = s0 + w tan(beta_b), i.e. along tan(beta_b) d + (dw/da) a, and normal to n only with
+        dw/da = -1: w grows along -a, the MeshModel's face w = 0 sits at the +a end of the gear.  For a spur or a
+        double helical set (whose FE normal has no axial part) the same -a is a convention: a spur pair's centre
+        does not move axially, a symmetric double helical pair's halves move it in opposite senses."""
+        a = np.asarray(self.shaft("pinion").axis, float)
+        return -a / np.linalg.norm(a)
+
+    def shuttle_node_loads(self, moment: complex = 1.0, forces: GearForces | None = None) -> dict:
+        """{gear node: (6,) load [N, N m]} of the mesh force's contact point moved along the gear axis: the
+        `moment` [N m] = F dw of a normal mesh force F [N] whose point moves by dw [m] along `mesh_face_direction`
+        (w grows): the forces do not change, the moments about the gear centres change by +/- F (dw e_w x n):
+        +moment (e_w x n) on the wheel, -moment (e_w x n) on the pinion (as `mesh_node_loads`: +F n on the wheel).
+        Self-equilibrated; |e_w x n| = cos(beta_b)."""
+        forces = forces or self.gear_forces()
+        m = np.cross(self.mesh_face_direction(), forces.direction) * moment
+        out = {}
+        for name, sign in (("pinion", -1.0), ("wheel", 1.0)):
+            node = f"{name}:{self.shaft_nodes(name)[1]['gear']}"
+            out[node] = np.concatenate([np.zeros(3, dtype=np.result_type(m)), sign * m])
+        return out
+
     def gear_forces(self) -> GearForces:
         """Mean tooth force and mean mesh stiffness at `torque`, placed in the housing: the line of action in the
         transverse plane at the operating pressure angle from the common tangent, tilted out of it by the base

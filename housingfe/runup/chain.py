@@ -7,9 +7,10 @@
 
 Per run, once (`build_gearbox_model`): the housing coupled with the drivetrain's FE reduction (shafts, gears,
 bearings as 6x6 matrices at star connections to the bores, the gear mesh), its complete modal basis to
-basis_factor x the highest line, and a Ritz reduction (housingfe.response.reduced) on the two unit loads the routes
-need: a torque of 1 N m about the wheel axis at the wheel centre, and a unit compressive pair along the gear-mesh
-normal (the loads the gear-mesh element carries).  Per speed and torque: the source's operating point
+basis_factor x the highest line, and a Ritz reduction (housingfe.response.reduced) on the unit loads the routes
+need: a torque of 1 N m about the wheel axis at the wheel centre, a unit compressive pair along the gear-mesh
+normal (the loads the gear-mesh element carries), and the moment pair of the shuttling moment (the mesh force's
+point moved along the gear axis, `unit_loads`; applied with runup.mesh_moment = "shuttling").  Per speed and torque: the source's operating point
 (housingfe.source.roosmalen.operating), then each route's L_v per tooth harmonic, then each radiator's L_sigma and L_W.
 
 Routes (`ROUTES`, a registry: `@register_route(name)`):
@@ -61,7 +62,7 @@ def register_route(name: str):
 class GearboxModel:
     """The coupled gearbox of a run-up (see the module docstring): drivetrain (housingfe.drivetrain.description
     .Drivetrain), structure (CoupledInterior), basis (ModalBasis), reduction (RitzReduction on the loads
-    "wheel_torque" and "mesh"), radiators {name: Radiator}, wheel node and axis, the highest line (Hz), the
+    "wheel_torque", "mesh" and "shuttle", `unit_loads`), radiators {name: Radiator}, wheel node and axis, the highest line (Hz), the
     interior energy share of each basis mode, timings (s)."""
 
     drivetrain: object
@@ -99,13 +100,17 @@ class GearboxModel:
 
 def unit_loads(structure, drivetrain) -> tuple[dict, str, np.ndarray]:
     """({"wheel_torque": 1 N m about the wheel axis at the wheel centre, "mesh": unit compressive pair along the
-    FE mesh normal}, wheel node name, wheel axis) as coupled load vectors."""
+    FE mesh normal, "shuttle": the moment pair of 1 N m = F dw of the mesh force's point moved along the gear axis
+    (Drivetrain.shuttle_node_loads: +(e_w x n) on the wheel, -(e_w x n) on the pinion, e_w the direction in which
+    the mesh model's w grows)}, wheel node name, wheel axis) as coupled load vectors."""
     wheel = f"wheel:{drivetrain.shaft_nodes('wheel')[1]['gear']}"
     axis = np.asarray(drivetrain.shaft("wheel").axis, float)
     axis /= np.linalg.norm(axis)
     torque = structure.node_load(wheel, "moment", axis, "runup.wheel_torque")
     mesh = structure.system.load(node_loads={k: np.real(v) for k, v in drivetrain.mesh_node_loads(1.0).items()})
-    return {"wheel_torque": torque, "mesh": mesh}, wheel, axis
+    shuttle = structure.system.load(node_loads={k: np.real(v) for k, v in
+                                                drivetrain.shuttle_node_loads(1.0).items()})
+    return {"wheel_torque": torque, "mesh": mesh, "shuttle": shuttle}, wheel, axis
 
 
 def bearing_pairs(structure) -> list:
@@ -126,7 +131,8 @@ def build_gearbox_model(housing_model, drivetrain, f_lines_max: float, *, dampin
                         basis_factor: float = 1.5, radiators: dict | None = None,
                         surface: str = "outer") -> GearboxModel:
     """Couple `housing_model` (HousingModel with the bores of the drivetrain's bearings) with `drivetrain`, compute
-    its complete modal basis to basis_factor x f_lines_max (Hz) and the Ritz reduction of the two unit loads.
+    its complete modal basis to basis_factor x f_lines_max (Hz) and the Ritz reduction of the unit loads
+    (`unit_loads`).
     damping_ratio: modal xi (Sec. 5.4: 0.04); radiators: {name: Radiator} (their extra points are kept)."""
     from housingfe.drivetrain.interior import build_interior
 
@@ -190,11 +196,61 @@ class Lines:
     # L_omega and points stay the rigid-bore source's (the input of the thesis' route tf_omega, eq. 5.5)
     receptance: str = "rigid-bores"
     L_omega_flexible: np.ndarray | None = None
+    # the shuttling moment per line (complex rms N m on the unit load "shuttle": F times harmonic n of the mesh
+    # load's axial centre of pressure, MESH_MOMENTS); None: not applied (mesh_moment = "none")
+    shuttle_moment: np.ndarray | None = None
+
+    def mesh_amplitudes(self) -> dict:
+        """{unit load name: complex rms amplitude per line} of the mesh excitation the mesh_force route applies:
+        "mesh" (N), and "shuttle" (N m) where the shuttling moment is on."""
+        out = {"mesh": self.mesh_excitation}
+        if self.shuttle_moment is not None:
+            out["shuttle"] = self.shuttle_moment
+        return out
+
+
+# the mesh moment applied with the mesh excitation on the coupled model (scene key runup.mesh_moment): "shuttling" =
+# the moment of the mesh force whose centre of pressure moves axially over the face as the contact lines move
+# (housingfe.source.mesh_moments; docs/source.md "The shuttling moment (issue 28)"), "none" = the force alone
+MESH_MOMENTS = ("shuttling", "none")
+DEFAULT_MESH_MOMENT = "none"
+
+
+def _check_mesh_moment(mesh_moment: str) -> None:
+    if mesh_moment not in MESH_MOMENTS:
+        raise InputError(f"mesh_moment: {mesh_moment!r} is not one of {', '.join(MESH_MOMENTS)}")
+
+
+def shuttle_moments(source, torque_nm: float, harmonics: np.ndarray) -> np.ndarray:
+    """The shuttling moment M_n = F W_n / sqrt(2) (complex rms, N m) at the tooth harmonics n (array of ints >= 1):
+    F the transmitted normal force [N] at the pinion torque [N m], W_n the one-sided harmonic n of the moment arm
+    w_c + tan(beta_b) s_c [m] of the mesh load's centre of pressure (SourceModel.centre_of_pressure: the load
+    distributions of the source's stiffness curve, same time origin as S(t) and F_e(t); CentreOfPressure
+    .moment_arm_harmonics; beta_b = 0 for a double helical pair as in the FE normal, Drivetrain.gear_forces).  The
+    s term is small (at most 2.4 N m against 98-157 N m of the axial term at n = 1 for sets A-D at 2000 N m,
+    benchmarks/experiments/shuttling) but lies on the same axis, so it is kept.  The amplitude of the unit load
+    "shuttle" (`unit_loads`).
+
+    First order: applied on the coupled model holding the mean mesh stiffness, this is exact superposition of the
+    constant force's moving point; the product of the stiffness ripple with the moment's own mesh deflection is
+    dropped (docs/source.md, "The shuttling moment (issue 28)")."""
+    from housingfe.source.stiffness import normal_force_from_torque
+
+    n = np.asarray(harmonics, int)
+    pair = source.pair
+    tan_bb = 0.0 if pair.kind == "double_helical" else math.tan(pair.base_helix_angle)
+    arm = source.centre_of_pressure(float(torque_nm)).moment_arm_harmonics(tan_bb, int(n.max()) if n.size else 1)
+    F = normal_force_from_torque(source.pair, float(torque_nm))
+    return F * arm[n - 1] / math.sqrt(2.0)
 
 
 @single_thread
-def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float) -> tuple[Lines, float]:
-    """The source's lines up to f_lines_max (Hz) at every speed (rev/min) and torque (N m); also the time (s)."""
+def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float,
+                 mesh_moment: str = DEFAULT_MESH_MOMENT) -> tuple[Lines, float]:
+    """The source's lines up to f_lines_max (Hz) at every speed (rev/min) and torque (N m); also the time (s).
+    mesh_moment (MESH_MOMENTS): "shuttling" adds the shuttling moment per line (Lines.shuttle_moment,
+    `shuttle_moments`) for the mesh_force route; the rigid-bore source's own L_omega does not contain it."""
+    _check_mesh_moment(mesh_moment)
     t0 = time.perf_counter()
     cols = {k: [] for k in ("torque", "speed", "harmonic", "frequency", "L_omega", "mesh_excitation", "point")}
     points = []
@@ -219,6 +275,12 @@ def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float) -> tuple[Li
                   points)
     lines.harmonic = lines.harmonic.astype(int)
     lines.point = lines.point.astype(int)
+    if mesh_moment == "shuttling":
+        moment = np.zeros(len(lines.frequency), complex)
+        for torque in torques_nm:
+            at = lines.torque == float(torque)
+            moment[at] = shuttle_moments(source, float(torque), lines.harmonic[at])
+        lines.shuttle_moment = moment
     return lines, time.perf_counter() - t0
 
 
@@ -251,7 +313,8 @@ def mesh_receptance(model: GearboxModel, frequencies_hz) -> np.ndarray:
 
 @single_thread
 def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max: float, *,
-                         first_order: bool = False, harmonics: int | None = None) -> tuple[Lines, float]:
+                         first_order: bool = False, harmonics: int | None = None,
+                         mesh_moment: str = DEFAULT_MESH_MOMENT) -> tuple[Lines, float]:
     """The source's lines (`source_lines`, the rigid-bore source's L_omega kept for the tf_omega route) with the
     mesh excitation from the harmonic balance of the time-varying mesh solved on the coupled gearbox instead of the
     rigid-bore lumped interior (housingfe.source.roosmalen.dynamics.mesh_harmonic_balance
@@ -260,14 +323,16 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
     g(0) = 1 / k_ref).  mesh_excitation is W_n - k_ref d_n (what the mesh_force route applies); L_omega_flexible is
     the wheel's level on the coupled model (what the mesh_force route's L_omega_coupled then is, too).  model: the
     GearboxModel at the torque (one torque per model: another torque changes the bearings, `with_drivetrain`).  first_order: the mean-stiffness solve (quasi-static transmission
-    error on the mean system).  harmonics: H of the balance (default: the source's).  Returns (Lines, seconds)."""
+    error on the mean system).  harmonics: H of the balance (default: the source's).  mesh_moment (MESH_MOMENTS):
+    "shuttling" applies the shuttling moment (`shuttle_moments`) with the mesh excitation, in L_omega_flexible too.
+    Returns (Lines, seconds)."""
     from housingfe.source.roosmalen.dynamics import mesh_harmonic_balance
     from housingfe.source.stiffness import normal_force_from_torque
 
     t0 = time.perf_counter()
     H = int(harmonics or source.harmonics)
     k_ref = mesh_reference_stiffness(model)
-    rigid, _ = source_lines(source, speeds_rpm, torques_nm, f_lines_max)
+    rigid, _ = source_lines(source, speeds_rpm, torques_nm, f_lines_max, mesh_moment)
     cols = {k: [] for k in ("frequency", "mesh_excitation")}
     for torque in torques_nm:
         S, shock = source.mesh_stiffness(float(torque))
@@ -287,27 +352,29 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
         raise InputError("source_receptance: the coupled and the rigid-bore source have different lines")
     mesh_exc = np.array(cols["mesh_excitation"], complex)
     # the wheel's rotation from its kept node values alone (the surface quantities are the routes' business)
-    c = model.reduction.coefficients(freq, {"mesh": mesh_exc})
+    lines = replace(rigid, mesh_excitation=mesh_exc, receptance="coupled")
+    c = model.reduction.coefficients(freq, lines.mesh_amplitudes())
     node = model.reduction.reduced.points[node_key(model.wheel_node)]
     rot = (model.wheel_axis / np.linalg.norm(model.wheel_axis)) @ (node[3:6] @ c)
-    lines = replace(rigid, mesh_excitation=mesh_exc, receptance="coupled",
-                    L_omega_flexible=levels.level(np.abs(2 * math.pi * freq * rot) ** 2, levels.OMEGA0))
+    lines.L_omega_flexible = levels.level(np.abs(2 * math.pi * freq * rot) ** 2, levels.OMEGA0)
     return lines, time.perf_counter() - t0
 
 
 def run_source(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max: float,
-               receptance: str = DEFAULT_SOURCE_RECEPTANCE) -> tuple[Lines, float]:
+               receptance: str = DEFAULT_SOURCE_RECEPTANCE, mesh_moment: str = DEFAULT_MESH_MOMENT
+               ) -> tuple[Lines, float]:
     """The source's lines with the receptance of `receptance` (SOURCE_RECEPTANCES): `coupled_source_lines` or
-    `source_lines` (the rigid-bore lumped source)."""
+    `source_lines` (the rigid-bore lumped source); mesh_moment (MESH_MOMENTS) applied with the mesh excitation."""
     if receptance == "coupled":
-        return coupled_source_lines(model, source, speeds_rpm, torques_nm, f_lines_max)
+        return coupled_source_lines(model, source, speeds_rpm, torques_nm, f_lines_max, mesh_moment=mesh_moment)
     if receptance == "rigid-bores":
-        return source_lines(source, speeds_rpm, torques_nm, f_lines_max)
+        return source_lines(source, speeds_rpm, torques_nm, f_lines_max, mesh_moment)
     raise InputError(f"source_receptance: {receptance!r} is not one of {', '.join(SOURCE_RECEPTANCES)}")
 
 
 def engagement_rerun(models: dict, source, engagement: str, speeds_rpm, f_lines_max: float,
-                     receptance: str = DEFAULT_SOURCE_RECEPTANCE, routes=("tf_omega", "mesh_force")) -> tuple[dict, float]:
+                     receptance: str = DEFAULT_SOURCE_RECEPTANCE, routes=("tf_omega", "mesh_force"),
+                     mesh_moment: str = DEFAULT_MESH_MOMENT) -> tuple[dict, float]:
     """The run-up once more with another engagement shock (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS) on
     the SAME coupled models {torque N m: GearboxModel} (no new mesh, basis or reduction): the source's operating
     points keep their stiffness curves, load shares and matrices (SourceModel.with_engagement), so this costs the
@@ -316,7 +383,7 @@ def engagement_rerun(models: dict, source, engagement: str, speeds_rpm, f_lines_
     other = source.with_engagement(engagement)
     out = {}
     for torque, model in models.items():
-        lines, _ = run_source(model, other, speeds_rpm, [float(torque)], f_lines_max, receptance)
+        lines, _ = run_source(model, other, speeds_rpm, [float(torque)], f_lines_max, receptance, mesh_moment)
         out[torque] = runup(model, None, speeds_rpm, [float(torque)], routes=tuple(routes), lines=lines)
     return out, time.perf_counter() - t0
 
@@ -361,14 +428,20 @@ def tf_omega_route(model: GearboxModel, lines: Lines) -> RouteResult:
 
 @register_route("mesh_force")
 def mesh_force_route(model: GearboxModel, lines: Lines) -> RouteResult:
-    """The mesh excitation F_n - k_m d_n (complex rms, N) on the coupled model's gear mesh, at every line."""
+    """The mesh excitation F_n - k_m d_n (complex rms, N) on the coupled model's gear mesh, at every line, with the
+    shuttling moment (Lines.shuttle_moment, N m) where it is on.  The excitation level stays L_F of the force: with
+    the moment on, the transfer L_v - L_F holds the moment's share (the names say so)."""
     f = lines.frequency
-    c = model.reduction.coefficients(f, {"mesh": lines.mesh_excitation})
+    c = model.reduction.coefficients(f, lines.mesh_amplitudes())
     resp = model.reduction.response_of(f, c)
     L_F = levels.level(np.abs(lines.mesh_excitation) ** 2, levels.F0)
+    if lines.shuttle_moment is None:
+        names = ("L_F, mesh excitation F_n - k_m d_n (dB re 1 N)", "L_v - L_F (dB re 5e-8 m/s per N)")
+    else:
+        names = ("L_F, mesh excitation F_n - k_m d_n (dB re 1 N; the shuttling moment applied with it is not in "
+                 "this level)", "L_v - L_F (dB re 5e-8 m/s per N; includes the response to the shuttling moment)")
     return RouteResult("mesh_force", resp.velocity_level_db, resp, c, _wheel_omega_level(model, resp, f),
-                       excitation_db=L_F, excitation_name="L_F, mesh excitation F_n - k_m d_n (dB re 1 N)",
-                       transfer_name="L_v - L_F (dB re 5e-8 m/s per N)")
+                       excitation_db=L_F, excitation_name=names[0], transfer_name=names[1])
 
 
 # ------------------------------------------------------------------------------------------------ run-up

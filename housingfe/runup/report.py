@@ -91,6 +91,7 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
     outputs.write_json(folder / "runup.json", {
         "scene": scene.scene.name, "description": scene.scene.description,
         "scene_settings": scene.model_dump(mode="json"),
+        "mesh_moment": scene.runup.mesh_moment_model,     # in effect (the setting may leave it to the default)
         "timings_s": timings,
         "modal_basis": gm.summary(),
         "housing_resolution": _resolution(gm),
@@ -211,6 +212,9 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
                 i = int(np.argmax(lwa))
                 lines.append(f"  {torque:g} N m  {route:10s} sigma {rad:9s}: max L_WA {lwa[i]:.1f} dB(A) at "
                              f"{s[i]:g} rpm")
+    if scene.runup.mesh_moment_model == "shuttling" and "mesh_force" in scene.runup.routes:
+        lines.append("mesh moment: the shuttling moment (runup.mesh_moment) is applied with the mesh excitation on "
+                     "mesh_force (docs/source.md, 'The shuttling moment'); tf_omega does not contain it")
     lines += list(notes)
     lines.append("checks (ours | measured | thesis calc. | pass):")
     for r in check_rows:

@@ -123,6 +123,21 @@ class RunupSpec(_Strict):
     # Default: "rigid-bores" with the face-width engagement (and its envelope bound), "none" with the thesis' replica
     # "thesis-2d"
     misalignment: Optional[Literal["rigid-bores", "coupled", "lumped", "none"]] = None
+    # the mesh moment applied with the mesh excitation on the coupled model (housingfe.runup.chain.MESH_MOMENTS):
+    # "shuttling" = the moment of the mesh force whose centre of pressure moves axially over the face as the
+    # contact lines move (issue 28; docs/source.md "The shuttling moment"), on the mesh_force route; "none" = the
+    # force alone.  Default: housingfe.runup.chain.DEFAULT_MESH_MOMENT, and "none" with the thesis' replica
+    # "thesis-2d"
+    mesh_moment: Optional[Literal["shuttling", "none"]] = None
+
+    @property
+    def mesh_moment_model(self) -> str:
+        """The mesh moment in effect (see `mesh_moment`)."""
+        from housingfe.runup.chain import DEFAULT_MESH_MOMENT
+
+        if self.mesh_moment is not None:
+            return self.mesh_moment
+        return "none" if self.engagement == "thesis-2d" else DEFAULT_MESH_MOMENT
 
     @property
     def misalignment_model(self) -> str:
@@ -303,7 +318,8 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         t1 = time.perf_counter()
         m = gm if torque == reference_torque else with_drivetrain(gm, drivetrains[torque])
         timings[f"reanalysis_{torque:g}Nm_s"] = time.perf_counter() - t1 if m is not gm else 0.0
-        lines, t_src = run_source(m, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance)
+        lines, t_src = run_source(m, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance,
+                                  spec.mesh_moment_model)
         timings["source_s"] = timings.get("source_s", 0.0) + t_src
         res = runup(m, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
         for k, v in res.timings.items():
@@ -323,7 +339,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
 
         bound, timings["envelope_bound_s"] = engagement_rerun(
             {t: m for t, (m, _) in results.items()}, source, BOUND_ENGAGEMENT, spec.speeds, spec.f_max_hz,
-            spec.source_receptance, spec.routes)
+            spec.source_receptance, spec.routes, spec.mesh_moment_model)
         notes += report.bound_lines(results, bound, scene.radiation.models[0])
         # the same checks on the bound's curves (the validate rows 28.bound.*: reported beside the checks, not judged)
         t1 = time.perf_counter()

@@ -490,25 +490,44 @@ class MeshModel:
         raise SolverError(f"stiffness: load distribution did not converge at u = {u:.3e} m")
 
     def stiffness_at(self, u: float, total_force: float, rel_step: float = 1e-3) -> dict[str, float]:
-        """Mean approach delta [m] and mesh stiffness [N/m] (dF / d delta, eq. 2.55) at position u."""
+        """Mean approach delta [m] and mesh stiffness [N/m] (dF / d delta, eq. 2.55) at position u; also the
+        centre of pressure of the load distribution at total_force (`load_centre`): axial_centre w_c and
+        line_centre s_c [m]."""
         cache: dict = {}      # the compliance matrix does not depend on the load
-        _, F, d0 = self.load_distribution(u, total_force, _cache=cache)
+        pts, F, d0 = self.load_distribution(u, total_force, _cache=cache)
         _, _, d1 = self.load_distribution(u, total_force * (1 + rel_step), _cache=cache)
         k = total_force * rel_step / (d1 - d0)
-        return {"delta": d0, "stiffness": k, "n_points": int(np.count_nonzero(F > 0))}
+        _, w_c, s_c = load_centre(pts, F)
+        return {"delta": d0, "stiffness": k, "n_points": int(np.count_nonzero(F > 0)), "axial_centre": w_c,
+                "line_centre": s_c}
+
+
+def load_centre(points: dict[str, np.ndarray], forces: np.ndarray) -> tuple[float, float, float]:
+    """(total force [N], axial centre w_c [m], centre along the line of action s_c [m]) of a load distribution
+    over contact points (`MeshModel.contact_points`): the centre of pressure sum F_i x_i / sum F_i, with w the
+    axial position over the gear (MeshModel's w, from its face w = 0) and s measured from T1."""
+    forces = np.asarray(forces, float)
+    total = float(forces.sum())
+    if not total > 0:
+        raise SolverError("stiffness: a centre of pressure needs a positive total force")
+    return total, float(forces @ points["w"]) / total, float(forces @ points["s"]) / total
 
 
 @dataclass
 class StiffnessCurve:
     """Mesh stiffness over one mesh period.  position: u / p_bt in [0, 1); stiffness: normal mesh
     stiffness [N/m]; per_width: s = stiffness / total face width [N/m^2] (1 N/(mm um) = 1e9 N/m^2);
-    deflection: mean normal approach [m] at the given load."""
+    deflection: mean normal approach [m] at the given load; axial_centre, line_centre: the centre of
+    pressure w_c, s_c [m] of the load distribution at each position (`load_centre`; the shuttling moment's
+    arm, housingfe.source.mesh_moments)."""
 
     position: np.ndarray
     stiffness: np.ndarray
     per_width: np.ndarray
     deflection: np.ndarray
     total_force: float
+    axial_centre: np.ndarray | None = None
+    line_centre: np.ndarray | None = None
 
     @property
     def mean(self) -> float:
@@ -546,7 +565,9 @@ def stiffness_curve(model: MeshModel, total_force: float, n_positions: int = 32)
     out = [model.stiffness_at(x * pbt, total_force) for x in pos]
     k = np.array([o["stiffness"] for o in out])
     return StiffnessCurve(position=pos, stiffness=k, per_width=k / model.pair.total_contact_width,
-                          deflection=np.array([o["delta"] for o in out]), total_force=total_force)
+                          deflection=np.array([o["delta"] for o in out]), total_force=total_force,
+                          axial_centre=np.array([o["axial_centre"] for o in out]),
+                          line_centre=np.array([o["line_centre"] for o in out]))
 
 
 def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = None,

@@ -193,7 +193,7 @@ class ChainSession:
 
         spec, drivetrain = self.spec, model.drivetrain
         misalignment = spec.misalignment_model
-        if spec.source_receptance == "rigid-bores" and misalignment == "none":
+        if spec.source_receptance == "rigid-bores" and misalignment == "none" and spec.mesh_moment_model == "none":
             return self.lines(drivetrain, torque)
         if misalignment == "coupled":          # the static tilt of this drivetrain on the flexible housing
             from housingfe.drivetrain.misalignment import coupled_misalignment
@@ -209,7 +209,7 @@ class ChainSession:
         source = drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
                                          misalignment=misalignment)
         lines, seconds = run_source(model, source, spec.speeds, [float(torque)], spec.f_max_hz,
-                                    spec.source_receptance)
+                                    spec.source_receptance, spec.mesh_moment_model)
         self.timings["source_s"] = self.timings.get("source_s", 0.0) + seconds
         return lines
 

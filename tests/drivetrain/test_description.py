@@ -135,3 +135,47 @@ def test_lumped_mesh_loads_map_onto_the_fe_mesh_loads(gear_set):
         np.testing.assert_allclose(d.lumped_to_housing(-h[dofs]), fe[node], atol=1e-12)
     # action = reaction: the forces cancel
     np.testing.assert_allclose(fe["pinion:8"][:3] + fe["wheel:8"][:3], 0.0, atol=1e-15)
+
+
+@pytest.mark.parametrize("gear_set", ["A", "double_helical"])
+def test_shuttle_loads_are_the_mesh_force_with_its_point_moved(gear_set):
+    """The unit load of the shuttling moment: the mesh force pair of F with its contact point moved by dw along the
+    direction in which the MeshModel's w grows changes only the moments, by +/- F dw (e_w x n); and that direction is
+    the MeshModel's hand: its contact lines s = s0 + w tan(beta_b) must lie on the flank, i.e. normal to the FE
+    contact normal n (whose axial part is +sin(beta_b) along the shaft axis); a shift along the line of action adds
+    tan(beta_b) ds to the arm on the same axis."""
+    from dataclasses import replace
+
+    d = test_gearbox(gear_set)
+    forces = d.gear_forces()
+    e_w = d.mesh_face_direction()
+    F, dw = 4.4e4, 3e-3
+    moved = replace(forces, point=forces.point + dw * e_w)
+    base, shifted = d.mesh_node_loads(F, forces), d.mesh_node_loads(F, moved)
+    shuttle = d.shuttle_node_loads(F * dw, forces)
+    assert set(shuttle) == set(base)
+    for node in base:
+        np.testing.assert_allclose(shifted[node] - base[node], shuttle[node], atol=1e-9 * F)
+        assert np.allclose(shuttle[node][:3], 0.0)
+    n = forces.direction
+    pair = d.gears.pair
+    axis = np.asarray(d.shaft("pinion").axis, float)
+    if gear_set == "A":
+        d_t = n - (n @ axis) * axis
+        d_t /= np.linalg.norm(d_t)                      # transverse line of action, growing s
+        line = math.tan(pair.base_helix_angle) * d_t + e_w      # the MeshModel's contact line per unit w
+        assert n @ axis == pytest.approx(math.sin(pair.base_helix_angle), rel=1e-12)
+        assert abs(line @ n) < 1e-12
+        # the other hand would not lie on the flank
+        assert abs((math.tan(pair.base_helix_angle) * d_t - e_w) @ n) > 0.3
+        # a shift ds along the line of action acts on the same axis: moment F (dw + tan(beta_b) ds) (e_w x n)
+        # (housingfe.source.mesh_moments.CentreOfPressure.moment_arm_harmonics)
+        ds = 2e-3
+        both = d.mesh_node_loads(F, replace(forces, point=forces.point + dw * e_w + ds * d_t))
+        arm = dw + math.tan(pair.base_helix_angle) * ds
+        for node in base:
+            np.testing.assert_allclose(both[node] - base[node], d.shuttle_node_loads(F * arm, forces)[node],
+                                       atol=1e-9 * F)
+    m = np.cross(e_w, n)
+    assert np.linalg.norm(m) == pytest.approx(math.cos(0.0 if gear_set == "double_helical"
+                                                        else pair.base_helix_angle), rel=1e-12)

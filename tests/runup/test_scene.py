@@ -30,6 +30,7 @@ def test_builtin_scenes_validate(name):
     ("runup.colour=1", "runup.colour"),
     ('runup.engagement="3-d"', "runup.engagement"),
     ('runup.engagement="envelope-bund"', "runup.engagement"),
+    ('runup.mesh_moment="shutling"', "runup.mesh_moment"),
 ])
 def test_bad_values_name_the_key(override, key):
     with pytest.raises(InputError) as err:
@@ -44,6 +45,15 @@ def test_engagement_choices_and_their_default_misalignment(engagement, misalignm
     envelope bound keeps the face-width model's load share and so its misalignment."""
     scene, _ = load_runup_scene("test-gearbox-runup", [f'runup.engagement="{engagement}"'])
     assert scene.runup.engagement == engagement and scene.runup.misalignment_model == misalignment
+
+
+@pytest.mark.parametrize("overrides, moment", [([], "none"), (['runup.engagement="thesis-2d"'], "none"),
+                                               (['runup.mesh_moment="shuttling"'], "shuttling"),
+                                               (['runup.engagement="thesis-2d"', 'runup.mesh_moment="none"'], "none")])
+def test_mesh_moment_choices(overrides, moment):
+    """runup.mesh_moment: the shuttling moment on or off; the thesis' replica keeps "none" unless asked."""
+    scene, _ = load_runup_scene("test-gearbox-runup", overrides)
+    assert scene.runup.mesh_moment_model == moment
 
 
 def test_missing_drivetrain_is_named(tmp_path):

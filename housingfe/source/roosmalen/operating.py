@@ -195,6 +195,14 @@ class SourceModel:
 
         return cancellation_note(self.pair, self.corrections, self._point(float(torque_nm)))
 
+    def centre_of_pressure(self, torque_nm: float):
+        """The centre of pressure of the mesh load over one mesh period at a pinion torque [N m]
+        (housingfe.source.mesh_moments.CentreOfPressure: w_c, s_c [m] at the stiffness curve's positions, the load
+        distributions of the operating point's stiffness curve reused; its harmonics share S(t)'s time origin)."""
+        from housingfe.source.mesh_moments import CentreOfPressure
+
+        return CentreOfPressure.of_curve(self._point(float(torque_nm)).curve)
+
     def mesh_stiffness(self, torque_nm: float) -> tuple[np.ndarray, np.ndarray]:
         """(S samples over one mesh period [N/m], F_e samples [N]) at a torque, uniformly spaced (the inputs of
         the harmonic balance)."""
