@@ -213,7 +213,7 @@ class Lines:
 # the moment of the mesh force whose centre of pressure moves axially over the face as the contact lines move
 # (housingfe.source.mesh_moments; docs/source.md "The shuttling moment (issue 28)"), "none" = the force alone
 MESH_MOMENTS = ("shuttling", "none")
-DEFAULT_MESH_MOMENT = "none"
+DEFAULT_MESH_MOMENT = "shuttling"
 
 
 def _check_mesh_moment(mesh_moment: str) -> None:
