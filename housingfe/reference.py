@@ -455,7 +455,13 @@ def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: 
     named surfaces (area, normals, features), points, bores, supports, loads, analyses, and the mesh (element
     size and the rule that set it, estimated DOFs and memory).  mesh_f_max (Hz): the frequency the mesh is made for,
     when another scene (a run-up) meshes this housing for its own range; default the scene's analyses."""
-    from housingfe.fe.model import MEMORY_BASE_BYTES, MEMORY_PER_DOF_BYTES, element_size
+    from housingfe.fe.model import (
+        DERIVED_SIZE_DIGITS,
+        MEMORY_BASE_BYTES,
+        MEMORY_PER_DOF_BYTES,
+        derived_element_size,
+        element_size,
+    )
     from housingfe.geometry.mesh import estimate_dofs
     from housingfe.geometry.registry import block_model_for
     from housingfe.geometry.surfaces import bounding_box
@@ -532,9 +538,11 @@ def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: 
     material = scene.material.resolve()
     f_mesh = a.f_max if mesh_f_max is None else mesh_f_max
     size = element_size(m, g, f_mesh, material)
+    unrounded = derived_element_size(m, g, f_mesh, material)
     rule = "mesh.size" if m.size is not None else (
         f"bending wavelength of the thinnest wall ({g.min_thickness * 1e3:g} mm) at {f_mesh:g} Hz / "
-        f"mesh.elements_per_wavelength = {m.elements_per_wavelength:g}")
+        f"mesh.elements_per_wavelength = {m.elements_per_wavelength:g} = {unrounded * 1e3:.7g} mm, rounded down to "
+        f"{DERIVED_SIZE_DIGITS} significant digits")
     dofs = estimate_dofs(g, m.element, m.degree, size, m.layers, m.layer_size)
     memory = MEMORY_BASE_BYTES + MEMORY_PER_DOF_BYTES * dofs
     out += ["", f"mesh: {m.element} degree {m.degree}, element size {size * 1e3:.3g} mm ({rule}), "

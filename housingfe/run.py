@@ -177,6 +177,9 @@ def modal_summary(model, result, checks: dict, wall_time_s: float) -> dict:
         "element": f"{model.housing.element}{'27' if model.housing.element == 'hex' else '10'}"
                    if model.element_degree == 2 else f"{model.housing.element} P{model.element_degree}",
         "element_size_m": model.housing.element_size,
+        # the size the resolution rule gave before it was rounded down to 3 significant digits (reproducible
+        # meshes, housingfe.fe.model.quantise_derived_size); null when mesh.size was given
+        "element_size_unrounded_m": getattr(model, "derived_element_size", None),
         "mesh_quality": model.housing.quality,
         "mpi_ranks": model.V.mesh.comm.size,
         "timings_s": {**model.timings, **result.timings},

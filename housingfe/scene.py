@@ -53,8 +53,10 @@ class MaterialSpec(_Strict):
 
 class MeshSpec(_Strict):
     """Discretisation.  The element size follows from the highest frequency of interest unless `size` is
-    given: size = bending wavelength of the thinnest wall at f_max / elements_per_wavelength.  A model whose
-    estimated memory exceeds the machine's available memory stops before meshing unless allow_large."""
+    given: size = bending wavelength of the thinnest wall at f_max / elements_per_wavelength, rounded down to 3
+    significant digits (so that the mesh does not depend on the last digits of a computed wall thickness); a
+    given `size` is used as written.  A model whose estimated memory exceeds the machine's available memory
+    stops before meshing unless allow_large."""
 
     element: Literal["hex", "tet"] = "hex"
     degree: Literal[1, 2, 3] = 2

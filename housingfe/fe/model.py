@@ -6,6 +6,7 @@ housingfe.scene.build_model_from_scene.
 """
 from __future__ import annotations
 
+import math
 import sys
 import time
 from dataclasses import dataclass, field
@@ -58,6 +59,8 @@ class HousingModel:
     element_degree: int = 2
     reduced_integration: bool = False
     resolution: object = None   # housingfe.fe.resolution.Resolution of the mesh at f_max (measured on the mesh)
+    # the element size (m) the resolution rule gave before quantise_derived_size; None when mesh.size was given
+    derived_element_size: float | None = None
 
     # ----------------------------------------------------------------------- the Structure protocol
     C = None               # no viscous damping matrix on the bare housing
@@ -115,16 +118,53 @@ class HousingModel:
         return D
 
 
-def element_size(mesh, geometry, f_max: float, material: Material) -> float:
-    """Element size (m): explicit mesh.size, or the bending wavelength of the geometry's thinnest wall at f_max
-    (Hz) divided by mesh.elements_per_wavelength.  mesh: a housingfe.scene.MeshSpec; geometry: a geometry spec."""
-    if mesh.size is not None:
-        return mesh.size
-    if geometry.min_thickness is None:      # an imported mesh brings its own elements
-        return 0.0
+# Significant digits a DERIVED element size keeps, rounded down (quantise_derived_size).  3 digits: a step of 0.1-1 %
+# of the size, so the mesh is at most 1 % finer than the resolution rule asks and never coarser.
+DERIVED_SIZE_DIGITS = 3
+
+
+def quantise_derived_size(size: float, digits: int = DERIVED_SIZE_DIGITS) -> float:
+    """A derived element size (m) rounded DOWN to `digits` significant digits (0.0254309 -> 0.0254).
+
+    Why: the mesh must not depend on the last digits of a computed wall thickness.  On NIST FTC-06 at 6 kHz a
+    2e-7 relative change of the estimated thin wall (the ray caster in float32 or float64) moved the size from
+    0.02543090 to 0.02543089 m, and that decided whether gmsh's sliver refinement split the chamfers' slivers:
+    12 378 or 8 152 tetrahedra, a mode near f_max there or not (docs/cad.md).  Rounded to a coarse grid, a size
+    changes only where the computed value crosses a grid point (a 1e-3 to 1e-2 relative step), not with every
+    round-off.  Down, so that the elements-per-wavelength rule still holds: a finer mesh, never a coarser one
+    (at most 1 % finer at 3 digits).  The digits are those of the shortest decimal that gives the float back
+    (repr), so a size already on the grid (0.0254) stays as it is."""
+    from decimal import ROUND_FLOOR, Decimal
+
+    if not (size > 0.0 and math.isfinite(size)):
+        return size
+    exact = Decimal(repr(size))
+    step = Decimal(1).scaleb(exact.adjusted() - digits + 1)
+    return float(exact.quantize(step, rounding=ROUND_FLOOR))
+
+
+def derived_element_size(mesh, geometry, f_max: float, material: Material) -> float | None:
+    """The element size (m) the resolution rule gives before quantise_derived_size: the bending wavelength of the
+    geometry's thinnest wall at f_max (Hz) divided by mesh.elements_per_wavelength; None when the size is not
+    derived (mesh.size given, or an imported mesh without a wall thickness)."""
+    if mesh.size is not None or geometry.min_thickness is None:
+        return None
     wavelength = bending_wavelength(f_max, geometry.min_thickness,
                                     material.youngs_modulus, material.poisson_ratio, material.density)
     return wavelength / mesh.elements_per_wavelength
+
+
+def element_size(mesh, geometry, f_max: float, material: Material) -> float:
+    """Element size (m): explicit mesh.size exactly as written, or the bending wavelength of the geometry's
+    thinnest wall at f_max (Hz) divided by mesh.elements_per_wavelength, rounded down to DERIVED_SIZE_DIGITS
+    significant digits (quantise_derived_size: reproducible across machines); 0 for an imported mesh.
+    mesh: a housingfe.scene.MeshSpec; geometry: a geometry spec.  Every size the package derives comes from here."""
+    if mesh.size is not None:
+        return mesh.size
+    derived = derived_element_size(mesh, geometry, f_max, material)
+    if derived is None:                     # an imported mesh brings its own elements
+        return 0.0
+    return quantise_derived_size(derived)
 
 
 def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regions: dict | None = None,
@@ -165,7 +205,8 @@ def build_model(geometry, material: Material, mesh, f_max: float, comm, *, regio
     resolution = assess(geometry, mesh, wall_element_sizes(geometry, housing), f_max, material,
                         "longest cell edge in each wall") if walls_known else None
     return HousingModel(housing, material, V, bcs, K, M, 6 if free else 0, timings, materials,
-                        element_degree=mesh.degree, reduced_integration=reduced, resolution=resolution)
+                        element_degree=mesh.degree, reduced_integration=reduced, resolution=resolution,
+                        derived_element_size=derived_element_size(mesh, geometry, f_max, material))
 
 
 def check_element_quality(quality: dict, size: float, wall: float | None, element: str) -> str:

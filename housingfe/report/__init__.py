@@ -12,10 +12,12 @@ def modal_summary_text(summary: dict) -> str:
     """The human-readable summary of a modal run (summary.txt and the terminal)."""
     f = summary["frequencies_hz"]
     resolution = summary.get("resolution")
+    unrounded = summary.get("element_size_unrounded_m")
+    derived = f" rounded down from {unrounded * 1e3:.7g} mm" if unrounded else ""
     lines = [
         f"scene {summary['scene']}: {summary['description']}",
-        f"{summary['dofs']} DOFs ({summary['element']}, element size {summary['element_size_m'] * 1e3:.1f} mm, "
-        f"{summary['mpi_ranks']} MPI rank(s)), wall time {summary['wall_time_s']:.1f} s",
+        f"{summary['dofs']} DOFs ({summary['element']}, element size {summary['element_size_m'] * 1e3:.4g} mm"
+        f"{derived}, {summary['mpi_ranks']} MPI rank(s)), wall time {summary['wall_time_s']:.1f} s",
         f"{len(f)} elastic modes below {summary['f_max_hz']:g} Hz; "
         f"complete (of the discrete model): {summary['complete']} (inertia count "
         f"{summary['eigenvalues_below_f_max_by_inertia']} incl. {len(summary['rigid_body_frequencies_hz'])} "
