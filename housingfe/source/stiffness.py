@@ -499,7 +499,7 @@ class MeshModel:
         k = total_force * rel_step / (d1 - d0)
         _, w_c, s_c = load_centre(pts, F)
         return {"delta": d0, "stiffness": k, "n_points": int(np.count_nonzero(F > 0)), "axial_centre": w_c,
-                "line_centre": s_c}
+                "line_centre": s_c, "unit_friction": friction_resultants(self.pair, pts, F, self.total_width)}
 
 
 def load_centre(points: dict[str, np.ndarray], forces: np.ndarray) -> tuple[float, float, float]:
@@ -513,13 +513,67 @@ def load_centre(points: dict[str, np.ndarray], forces: np.ndarray) -> tuple[floa
     return total, float(forces @ points["w"]) / total, float(forces @ points["s"]) / total
 
 
+FRICTION_RESULTANTS = ("force", "pinion_torque", "wheel_torque", "tilt_moment")
+
+
+def friction_resultants(pair: GearPair, points: dict[str, np.ndarray], forces: np.ndarray, total_width: float,
+                        mu: float = 1.0) -> dict[str, float]:
+    """Resultants of Coulomb sliding friction mu F_i at the contact points of a load distribution (normal forces
+    F_i [N] at `MeshModel.contact_points`; mu [-]), pinion driving.
+
+    Parallel axes: the flanks' relative motion is a rotation about the pitch line (the line through the pitch point
+    C parallel to the axes), so the sliding velocity of the pinion on the wheel at a point s [m] from T1 is
+    (omega_1 + omega_2)(s - s_P) along -e_f, with s_P = r_b1 tan(alpha_wt) the pitch point and e_f the unit vector
+    from the pinion centre to T1 (in the transverse plane, normal to the plane of action: tangent to the flank of a
+    helical gear too; e_f = d x e_1, d from T1 to T2, e_1 the pinion's rotation vector).  The friction on the pinion
+    is +mu F_i sgn(s_i - s_P) e_f, on the wheel the opposite; its sign flips at the pitch point.  Returns
+
+      force:         mu sum F_i sgn(s_i - s_P) [N], the friction force on the pinion along e_f;
+      pinion_torque: -mu sum F_i s_i sgn(s_i - s_P) [N m] about the pinion's rotation vector (lever s_i from T1;
+                     negative brakes: recess);
+      wheel_torque:  +mu sum F_i (L - s_i) sgn(s_i - s_P) [N m] about the wheel's rotation vector (lever L - s_i
+                     from T2, L = T1T2);
+      tilt_moment:   mu sum F_i sgn(s_i - s_P) (w_i - total_width/2) [N m]: the friction force's moment about the
+                     gear middle, vector tilt_moment (e_w x e_f) on the pinion and the opposite on the wheel (e_w the
+                     direction in which w grows).
+
+    Their power is -mu (omega_1 + omega_2) sum F_i |s_i - s_P| <= 0 (dissipation).
+
+    A point stands for its segment of contact line (`MeshModel.contact_points`: axial width, s = s0 + o tan(beta_b)),
+    over which its force is spread evenly: a segment that straddles the pitch point is split there, each part with
+    its own share of F_i and its own centroid (s, w), so the sign flips exactly at s_P, not at a segment's middle."""
+    forces = np.asarray(forces, float)
+    s = np.asarray(points["s"], float)
+    w = np.asarray(points["w"], float)
+    s_pitch = float(pair.base_diameter[0]) / 2 * math.tan(pair.operating_pressure_angle)
+    tan_bb = math.tan(pair.base_helix_angle)
+    half = 0.5 * np.asarray(points["width"], float) * tan_bb           # half the segment's extent along s [m]
+    spread = half > 0
+    safe = np.where(spread, half, 1.0)
+    above = np.where(spread, np.clip((s + half - s_pitch) / (2 * safe), 0.0, 1.0), 0.5 * (1 + np.sign(s - s_pitch)))
+    below = np.where(spread, 1.0 - above, 0.5 * (1 - np.sign(s - s_pitch)))
+    s_above = np.where(spread, 0.5 * (np.maximum(s_pitch, s - half) + s + half), s)
+    s_below = np.where(spread, 0.5 * (s - half + np.minimum(s_pitch, s + half)), s)
+    # w along a segment: w_local = o on helix 0, b - o on helix 1 (the opposite hand), s grows with o
+    dw_ds = np.where(np.asarray(points["helix"]) == 0, 1.0, -1.0) / tan_bb if tan_bb > 0 else np.zeros_like(s)
+    mid = 0.5 * total_width
+    F = float(mu) * forces
+    signed = F * (above - below)
+    line = F * (above * s_above - below * s_below)
+    tilt = F * (above * (w + (s_above - s) * dw_ds - mid) - below * (w + (s_below - s) * dw_ds - mid))
+    return {"force": float(signed.sum()), "pinion_torque": float(-line.sum()),
+            "wheel_torque": float(pair.line_of_action_length * signed.sum() - line.sum()),
+            "tilt_moment": float(tilt.sum())}
+
+
 @dataclass
 class StiffnessCurve:
     """Mesh stiffness over one mesh period.  position: u / p_bt in [0, 1); stiffness: normal mesh
     stiffness [N/m]; per_width: s = stiffness / total face width [N/m^2] (1 N/(mm um) = 1e9 N/m^2);
     deflection: mean normal approach [m] at the given load; axial_centre, line_centre: the centre of
     pressure w_c, s_c [m] of the load distribution at each position (`load_centre`; the shuttling moment's
-    arm, housingfe.source.mesh_moments)."""
+    arm, housingfe.source.mesh_moments); unit_friction: {name: (n_positions,)} the sliding-friction resultants per
+    unit friction coefficient at each position (`friction_resultants` with mu = 1: N, N m)."""
 
     position: np.ndarray
     stiffness: np.ndarray
@@ -528,6 +582,7 @@ class StiffnessCurve:
     total_force: float
     axial_centre: np.ndarray | None = None
     line_centre: np.ndarray | None = None
+    unit_friction: dict | None = None
 
     @property
     def mean(self) -> float:
@@ -567,7 +622,9 @@ def stiffness_curve(model: MeshModel, total_force: float, n_positions: int = 32)
     return StiffnessCurve(position=pos, stiffness=k, per_width=k / model.pair.total_contact_width,
                           deflection=np.array([o["delta"] for o in out]), total_force=total_force,
                           axial_centre=np.array([o["axial_centre"] for o in out]),
-                          line_centre=np.array([o["line_centre"] for o in out]))
+                          line_centre=np.array([o["line_centre"] for o in out]),
+                          unit_friction={k: np.array([o["unit_friction"][k] for o in out])
+                                         for k in FRICTION_RESULTANTS})
 
 
 def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = None,
