@@ -87,3 +87,29 @@ def test_no_size_on_the_ladder_passing_is_refused_in_one_line_naming_the_sizes_t
     named = run.stderr.split("finer sizes of the ladder tried: ")[1]
     assert [float(part.split(" mm")[0]) for part in named.split(", ")] == [s * 1e3 for s in sizes]
     assert not (tmp_path / "res").exists()
+
+
+def test_a_finer_size_the_memory_guard_refuses_ends_the_ladder(tmp_path, monkeypatch):
+    """3 mm slab at 80 Hz: the derived 101 mm mesh is refused (flat tetrahedra); with the memory available set
+    between the guard's estimates at 101 and 90.9 mm, the ladder stops before meshing 90.9 mm and the refusal
+    names both."""
+    from mpi4py import MPI
+
+    from housingfe.errors import InputError
+    from housingfe.fe import model as model_module
+    from housingfe.scene import load_housing_scene
+
+    scene = load_housing_scene(str(_slab(tmp_path, 0.003, 80.0)))[0]
+    size = element_size(scene.mesh, scene.geometry, 80.0, scene.material.resolve())
+    assert size_ladder(size)[:2] == [0.101, 0.0909]
+    need = [model_module.check_model_size(scene.geometry, scene.mesh, s, MPI.COMM_SELF)["memory_bytes"]
+            for s in (0.101, 0.0909)]
+    assert need[1] > need[0]
+    between = int((need[0] + need[1]) / 2)
+    monkeypatch.setattr(model_module, "available_memory_bytes", lambda: (between, 2 * between))
+    with pytest.raises(InputError) as exc:
+        model_module.mesh_on_size_ladder(scene.geometry, scene.mesh, size, MPI.COMM_SELF, derived=True)
+    message = str(exc.value)
+    assert message.startswith("mesh.size: element quality")
+    assert "ladder tried: 101 mm " in message and "the next finer size, 90.9 mm, exceeds the memory guard" in message
+    assert "81.8 mm" not in message
