@@ -248,8 +248,8 @@ def mesh_on_size_ladder(geometry, mesh, size: float, comm, *, derived: bool) -> 
         if i:
             try:
                 check_model_size(geometry, mesh, s, comm)
-            except InputError as exc:
-                memory_stop = (s, str(exc))
+            except InputError:
+                memory_stop = s
                 break
         housing = build_mesh(geometry, mesh.element, s, mesh.layers, comm, grading=mesh.grading,
                              layer_size=mesh.layer_size)
@@ -275,7 +275,7 @@ def mesh_on_size_ladder(geometry, mesh, size: float, comm, *, derived: bool) -> 
         return housing, tries
     if len(tries) == 1 and memory_stop is None:
         raise refusal
-    more = (f"; the next finer size, {memory_stop[0] * 1e3:g} mm, exceeds the memory guard" if memory_stop else "")
+    more = f"; the next finer size, {memory_stop * 1e3:g} mm, exceeds the memory guard" if memory_stop else ""
     raise InputError(f"{refusal} (derived size and the finer sizes of the ladder tried: {_tried(tries)}{more})")
 
 

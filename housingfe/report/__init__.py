@@ -59,11 +59,14 @@ def modal_summary_text(summary: dict) -> str:
 
 def ladder_line(tries: list[dict]) -> str:
     """The sizes a derived element size's mesh was tried at, with the share of the volume in slivers of each."""
+    from housingfe.fe.model import MAX_SLIVER_VOLUME_FRACTION, MIN_ELEMENT_QUALITY
+
     def share(t):
         f = t.get("low_volume_fraction")
         return f"{f:.1e} of the volume in slivers" if f is not None else f"worst element {t['min']:.3f}"
 
-    return "element sizes tried (a mesh passes with at most 1e-3 of its volume in elements below quality 0.05): " + \
+    return (f"element sizes tried (a mesh passes with at most {MAX_SLIVER_VOLUME_FRACTION:g} of its volume in "
+            f"elements below quality {MIN_ELEMENT_QUALITY:g}): ") + \
         "; ".join(f"{t['size_m'] * 1e3:.4g} mm: {t['elements']} elements, {share(t)}"
                   f"{' (used)' if t['passed'] else ''}" for t in tries)
 
