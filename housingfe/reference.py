@@ -461,6 +461,7 @@ def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: 
         MEMORY_PER_DOF_BYTES,
         derived_element_size,
         element_size,
+        size_ladder,
     )
     from housingfe.geometry.mesh import estimate_dofs
     from housingfe.geometry.registry import block_model_for
@@ -542,7 +543,8 @@ def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: 
     rule = "mesh.size" if m.size is not None else (
         f"bending wavelength of the thinnest wall ({g.min_thickness * 1e3:g} mm) at {f_mesh:g} Hz / "
         f"mesh.elements_per_wavelength = {m.elements_per_wavelength:g} = {unrounded * 1e3:.7g} mm, rounded down to "
-        f"{DERIVED_SIZE_DIGITS} significant digits")
+        f"{DERIVED_SIZE_DIGITS} significant digits; only if that mesh fails the quality rule, finer: "
+        f"{', '.join(format(s * 1e3, 'g') for s in size_ladder(size)[1:])} mm")
     dofs = estimate_dofs(g, m.element, m.degree, size, m.layers, m.layer_size)
     memory = MEMORY_BASE_BYTES + MEMORY_PER_DOF_BYTES * dofs
     out += ["", f"mesh: {m.element} degree {m.degree}, element size {size * 1e3:.3g} mm ({rule}), "

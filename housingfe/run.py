@@ -180,6 +180,9 @@ def modal_summary(model, result, checks: dict, wall_time_s: float) -> dict:
         # the size the resolution rule gave before it was rounded down to 3 significant digits (reproducible
         # meshes, housingfe.fe.model.quantise_derived_size); null when mesh.size was given
         "element_size_unrounded_m": getattr(model, "derived_element_size", None),
+        # the meshes made for a derived size, first the derived one: finer sizes of the ladder only where the quality
+        # rule refused it (housingfe.fe.model.mesh_on_size_ladder); null when mesh.size was given
+        "element_size_tries": getattr(model, "element_size_tries", None),
         "mesh_quality": model.housing.quality,
         "mpi_ranks": model.V.mesh.comm.size,
         "timings_s": {**model.timings, **result.timings},

@@ -14,6 +14,10 @@ def modal_summary_text(summary: dict) -> str:
     resolution = summary.get("resolution")
     unrounded = summary.get("element_size_unrounded_m")
     derived = f" rounded down from {unrounded * 1e3:.7g} mm" if unrounded else ""
+    tries = summary.get("element_size_tries") or []
+    if len(tries) > 1:      # the derived size's mesh was refused by the quality rule: finer on the size ladder
+        derived = (f", {len(tries) - 1} step(s) finer than the derived {tries[0]['size_m'] * 1e3:.4g} mm"
+                   f"{derived} (sliver rule)")
     lines = [
         f"scene {summary['scene']}: {summary['description']}",
         f"{summary['dofs']} DOFs ({summary['element']}, element size {summary['element_size_m'] * 1e3:.4g} mm"
@@ -22,6 +26,7 @@ def modal_summary_text(summary: dict) -> str:
         f"complete (of the discrete model): {summary['complete']} (inertia count "
         f"{summary['eigenvalues_below_f_max_by_inertia']} incl. {len(summary['rigid_body_frequencies_hz'])} "
         f"rigid-body modes)" + (f"; {_error_clause(resolution)}" if resolution else ""),
+        *([ladder_line(tries)] if len(tries) > 1 else []),
         f"max relative residual {max(summary['residuals'], default=0.0):.1e}",
         f"mass {summary['mass_kg']:.3f} kg (geometry)"
         + (f", {summary['mass_from_rigid_modes_kg']:.3f} kg (rigid-body modes)"
@@ -50,6 +55,20 @@ def modal_summary_text(summary: dict) -> str:
             [[r["quantity"], "-" if r["ours"] is None else r["ours"], r["published"], r["unit"], r["source"]]
              for r in summary["published"]]))
     return "\n".join(lines)
+
+
+def ladder_line(tries: list[dict]) -> str:
+    """The sizes a derived element size's mesh was tried at, with the share of the volume in slivers of each."""
+    from housingfe.fe.model import MAX_SLIVER_VOLUME_FRACTION, MIN_ELEMENT_QUALITY
+
+    def share(t):
+        f = t.get("low_volume_fraction")
+        return f"{f:.1e} of the volume in slivers" if f is not None else f"worst element {t['min']:.3f}"
+
+    return (f"element sizes tried (a mesh passes with at most {MAX_SLIVER_VOLUME_FRACTION:g} of its volume in "
+            f"elements below quality {MIN_ELEMENT_QUALITY:g}): ") + \
+        "; ".join(f"{t['size_m'] * 1e3:.4g} mm: {t['elements']} elements, {share(t)}"
+                  f"{' (used)' if t['passed'] else ''}" for t in tries)
 
 
 def _error_clause(resolution: dict) -> str:

@@ -96,3 +96,47 @@ def test_free_modes_of_the_nist_part_run_with_its_slivers_reported(tmp_path):
     f20, f15 = (np.asarray(m["frequencies_hz"][:3]) for m in (coarse, fine))
     assert len(coarse["frequencies_hz"]) >= 3 and 1000 < f20[0] < 1300
     assert np.max(np.abs(f20 / f15 - 1)) < 0.01
+
+
+def test_the_ftc06_skeleton_runs_as_written_on_a_finer_size_of_the_ladder(tmp_path):
+    """The user's path: `housingfe inspect` writes the skeleton, its [[supports]] block uncommented (F1 fixed),
+    `housingfe run` at the skeleton's 2 kHz.  The derived 44.0 mm mesh leaves more than 1e-3 of the volume in
+    slivers (the quality rule refuses it, as `--set mesh.size=0.044` still is); the run goes on at the next
+    size of the fixed ladder, 0.9 x 44.0 = 39.6 mm, whose slivers fill less, and says so in modes.json,
+    summary.txt and on stderr (docs/cad.md "As a user runs it")."""
+    from housingfe.fe.model import MAX_SLIVER_VOLUME_FRACTION
+
+    shutil.copy(NIST_FTC_06, tmp_path / NIST_FTC_06.name)
+    inspect = subprocess.run([sys.executable, "-m", "housingfe", "inspect", NIST_FTC_06.name, "--units", "mm"],
+                             capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert inspect.returncode == 0, inspect.stderr
+    skeleton = tmp_path / "nist_ftc_06_asme1_rd-scene.toml"
+    commented = '# [[supports]]\n# surface = "F1"\n# kind = "fixed"\n'
+    assert commented in skeleton.read_text()
+    skeleton.write_text(skeleton.read_text().replace(commented, commented.replace("# ", "")))
+
+    run = subprocess.run([sys.executable, "-m", "housingfe", "run", skeleton.name, "--out", "res"],
+                         capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    modes = json.loads((tmp_path / "res" / "modes.json").read_text())
+    tries = modes["element_size_tries"]
+    assert [t["size_m"] for t in tries] == [0.044, 0.0396]
+    assert tries[0]["low_volume_fraction"] > MAX_SLIVER_VOLUME_FRACTION and not tries[0]["passed"]
+    assert 0 < tries[1]["low_volume_fraction"] <= MAX_SLIVER_VOLUME_FRACTION and tries[1]["passed"]
+    assert modes["element_size_m"] == 0.0396 and modes["mesh_quality"]["elements"] == tries[1]["elements"]
+    assert modes["complete"] and modes["rigid_body_frequencies_hz"] == []
+    summary = (tmp_path / "res" / "summary.txt").read_text()
+    assert "element size 39.6 mm, 1 step(s) finer than the derived 44 mm rounded down from 44.04" in summary
+    assert f"44 mm: {tries[0]['elements']} elements, {tries[0]['low_volume_fraction']:.1e} of the volume" in summary
+    assert "39.6 mm" in summary and "(used)" in summary
+    assert "housingfe: note: mesh: the derived element size 44 mm left" in run.stderr
+    assert "meshed at 39.6 mm instead" in run.stderr
+
+    # a size written in the scene is meshed as written and refused as before: one line, exit 2, no results
+    explicit = subprocess.run([sys.executable, "-m", "housingfe", "run", skeleton.name, "--out", "res44",
+                               "--set", "mesh.size=0.044"], capture_output=True, text=True, timeout=600, cwd=tmp_path)
+    assert explicit.returncode == 2
+    assert explicit.stderr.count("\n") == 1 and "Traceback" not in explicit.stderr
+    assert explicit.stderr.startswith(f"housingfe: error: {skeleton.name}: mesh.size: element quality")
+    assert f"{tries[0]['low_volume_fraction']:.1e} of the volume" in explicit.stderr
+    assert "ladder" not in explicit.stderr and not (tmp_path / "res44").exists()
