@@ -47,11 +47,11 @@ def test_engagement_choices_and_their_default_misalignment(engagement, misalignm
     assert scene.runup.engagement == engagement and scene.runup.misalignment_model == misalignment
 
 
-@pytest.mark.parametrize("overrides, moment", [([], "none"), (['runup.engagement="thesis-2d"'], "none"),
+@pytest.mark.parametrize("overrides, moment", [([], "shuttling"), (['runup.engagement="thesis-2d"'], "none"),
                                                (['runup.mesh_moment="shuttling"'], "shuttling"),
                                                (['runup.engagement="thesis-2d"', 'runup.mesh_moment="none"'], "none")])
 def test_mesh_moment_choices(overrides, moment):
-    """runup.mesh_moment: the shuttling moment on or off; the thesis' replica keeps "none" unless asked."""
+    """runup.mesh_moment: the shuttling moment on (the default) or off; the thesis' replica keeps "none" unless asked."""
     scene, _ = load_runup_scene("test-gearbox-runup", overrides)
     assert scene.runup.mesh_moment_model == moment
 
