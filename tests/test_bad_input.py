@@ -503,7 +503,11 @@ SOURCE_CASES = [
 
 @pytest.mark.parametrize("change, needles", [c[1:] for c in SOURCE_CASES], ids=[c[0] for c in SOURCE_CASES])
 def test_bad_source_scene_is_rejected(change, needles, tmp_path, capsys):
-    data = _source_base()
+    _expect_source_scene_refused(_source_base(), change, needles, tmp_path, capsys)
+
+
+def _expect_source_scene_refused(data, change, needles, tmp_path, capsys):
+    """`housingfe source` on the scene `data` with `change` applied: one line naming `needles`, exit 2, no folder."""
     change(data)
     path = tmp_path / "source.toml"
     path.write_text(to_toml(data))
@@ -527,13 +531,8 @@ OTHER_SOURCE_CASES = [
 @pytest.mark.parametrize("scene, change, needles", [c[1:] for c in OTHER_SOURCE_CASES],
                          ids=[c[0] for c in OTHER_SOURCE_CASES])
 def test_impossible_operating_point_of_other_source_models_is_rejected(scene, change, needles, tmp_path, capsys):
-    data = tomllib.loads((SCENE_DIR / f"{scene}.toml").read_text())
-    change(data)
-    path = tmp_path / "source.toml"
-    path.write_text(to_toml(data))
-    out = tmp_path / "out"
-    code, err = _run_cli(["source", str(path), "--out", str(out)], capsys)
-    _expect_one_line_error(code, err, needles, tmp_path, out)
+    _expect_source_scene_refused(tomllib.loads((SCENE_DIR / f"{scene}.toml").read_text()), change, needles, tmp_path,
+                                 capsys)
 
 
 # ---------------------------------------------------------------- housingfe bearing
