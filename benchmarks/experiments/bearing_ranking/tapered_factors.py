@@ -14,7 +14,8 @@ their own frames (common.py): as computed; moment rows/columns zeroed; translati
 terms zeroed; the translations scaled to the ball bearing's radial size (K -> S K S).  A changed K acts
 everywhere the FE bearings act: the coupled model (transfer and the coupled source's receptance) and the static
 mesh misalignment (the rigid-bore tilt of the FE interior).  Each with the shuttling moment (default) and with
-runup.mesh_moment = "none", every difference taken to ball bearings with the same mesh moment.
+runup.mesh_moment = "none" (the TE path alone) and with the shuttling moment alone (the TE-driven mesh force of the
+same lines zeroed: the moment's own path), every difference taken to ball bearings with the same setting.
 
 Per variant and route: L_WA(variant) - L_WA(ball) per speed, mean and s.d. over 800-1500 rpm, for the total (every
 harmonic to f_max) and the tooth-frequency line alone; the max L_WA.
@@ -30,6 +31,7 @@ import math
 import os
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -41,6 +43,9 @@ from runup_factors import Patched, metrics  # noqa: E402
 TORQUE = 2000.0
 ROUTES = ("tf_omega", "mesh_force")
 FLOATING = ("pinion_back", "wheel_back")
+LOCATING = ("pinion_front", "wheel_front")
+# the default (the shuttling moment with the TE-driven mesh force), the TE path alone, the moment's path alone
+MESH_MOMENT_SETTINGS = ("shuttling", "none", "alone")
 
 
 def moments_of(other_spec):
@@ -124,7 +129,9 @@ def shaft_bending(drivetrain) -> dict:
 
 def variant_lines(session, model, drivetrain, mesh_moment: str):
     """The scene's source lines (as ChainSession.scene_lines / `housingfe run`) for a possibly patched drivetrain:
-    its rigid-bore mesh misalignment from ITS FE bearings (the patched K), the coupled source on `model`."""
+    its rigid-bore mesh misalignment from ITS FE bearings (the patched K), the coupled source on `model`.
+    mesh_moment: "shuttling", "none" (housingfe.runup.chain.MESH_MOMENTS) or "alone" (the shuttling moment without
+    the TE-driven mesh force: its own path on mesh_force)."""
     from housingfe.drivetrain.misalignment import rigid_bore_misalignment
     from housingfe.runup.chain import run_source
 
@@ -133,12 +140,16 @@ def variant_lines(session, model, drivetrain, mesh_moment: str):
         raise SystemExit(f"this experiment expects the default misalignment 'rigid-bores', got "
                          f"{spec.misalignment_model!r}")
     gap = rigid_bore_misalignment(drivetrain).lead_gap
+    alone = mesh_moment == "alone"
+    mesh_moment = "shuttling" if alone else mesh_moment
 
     def law(_torque: float) -> float:
         return gap
     law.model = "rigid-bores"
     source = drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement, misalignment=law)
     lines, _ = run_source(model, source, spec.speeds, [TORQUE], spec.f_max_hz, spec.source_receptance, mesh_moment)
+    if alone:        # the shuttling moment's path by itself: the TE-driven mesh force of the same lines removed
+        lines = replace(lines, mesh_excitation=np.zeros_like(lines.mesh_excitation))
     return lines, gap
 
 
@@ -168,6 +179,14 @@ def main(argv=None):
     tap = session.drivetrain("B", "tapered_roller", TORQUE)
     sa = session.drivetrain("B", "self_aligning", TORQUE)
     ball_spec, tap_spec, sa_spec = ball.to_coupling_spec(), tap.to_coupling_spec(), sa.to_coupling_spec()
+
+    # the catalogue-derived contact angle: e x 0.85 / 1.15 (the uncertainty run's range of tapered_e_scale)
+    from housingfe.bearings.catalogue import estimated_internals
+
+    e_specs = {}
+    for scale in (0.85, 1.15):
+        with estimated_internals(tapered_e_scale=scale):
+            e_specs[scale] = tap.to_coupling_spec()
 
     # the matrices at the statics loads beside the shafts' bending
     bend = shaft_bending(ball)
@@ -199,6 +218,9 @@ def main(argv=None):
         ("tapered_roller", "axial-radial k_xz, k_yz zeroed", patched(tap, zero_couplings(True, False))),
         ("tapered_roller", "force-tilt couplings zeroed", patched(tap, zero_couplings(False, True))),
         ("tapered_roller", "axial-radial and force-tilt couplings zeroed", patched(tap, zero_couplings(True, True))),
+        *[("tapered_roller", f"catalogue e x {scale:g} (contact angle {math.degrees(math.atan(e * scale / 1.5)):.1f} / "
+           f"{math.degrees(math.atan(e2 * scale / 1.5)):.1f} deg)", patched(tap, positions_of(e_specs[scale], LOCATING)))
+          for scale, e, e2 in ((0.85, 0.35, 0.43), (1.15, 0.35, 0.43))],
         ("tapered_roller", "self-aligning at the floating positions (both shaft ends stiff)",
          patched(tap, positions_of(sa_spec, FLOATING))),
         ("self_aligning", "as computed (moment rows/columns zero by construction)", sa),
@@ -214,7 +236,7 @@ def main(argv=None):
     ball_model = session.model(ball, "ball")
     print(f"housing + ball basis {time.perf_counter() - t0:.0f} s", flush=True)
     refs = {}
-    for mm in ("shuttling", "none"):
+    for mm in MESH_MOMENT_SETTINGS:
         lines, gap = variant_lines(session, ball_model, ball, mm)
         refs[mm] = session.runup(ball_model, TORQUE, lines=lines)
     rows = []
@@ -231,14 +253,14 @@ def main(argv=None):
         spec_v = dt.to_coupling_spec()
         psd = min_eigenvalue_ratio(spec_v)
         model = session.model(dt, f"{cfg}: {name}")
-        for mm in ("shuttling", "none"):
+        for mm in MESH_MOMENT_SETTINGS:
             lines, gap = variant_lines(session, model, dt, mm)
             res = session.runup(model, TORQUE, lines=lines)
             for route in ROUTES:
                 rows.append({"configuration": cfg, "variant": name, "mesh_moment": mm, "route": route,
                              "min_eig_ratio": psd, "lead_gap": gap, "mean_LwA_dBA": mean_level(res, route),
                              **metrics(res, refs[mm], route)})
-        sel = rows[-4:]
+        sel = [r for r in rows[-2 * len(MESH_MOMENT_SETTINGS):] if r["route"] == "mesh_force"]
         print(f"{cfg}: {name} (min eig/max {psd:.1e}) " + "; ".join(
             f"{r['mesh_moment']}/{r['route']} {r['mean_total_dB']:+.2f}±{r['sd_total_dB']:.2f} "
             f"tooth {r['mean_tooth_dB']:+.2f}±{r['sd_tooth_dB']:.2f} (L_WA {r['mean_LwA_dBA']:.1f})" for r in sel)
