@@ -134,7 +134,7 @@ class RunupSpec(_Strict):
     # "iso13989" = the mean coefficient of ISO/TR 13989-1 at each speed and torque (oil 0.049 Pa s, Ra 0.4 um,
     # assumed) -- that formula was written from memory and is NOT verified against the standard's text, hence off by
     # default; or a number = a fixed mean coefficient, 0 < mu < 0.3
-    mesh_friction: Union[Literal["none", "iso13989"], float] = "none"
+    mesh_friction: Union[Literal["none", "iso13989"], float] = Field("none", json_schema_extra={"unit": "-"})
 
     @property
     def mesh_moment_model(self) -> str:
