@@ -1,4 +1,4 @@
-"""What the sliding friction would do to the run-up (issue 28): a measurement, the chain untouched, nothing tuned.
+"""What the sliding friction does to the run-up (issue 28): a measurement beside the chain's runup.mesh_friction, nothing tuned.
 
 Since the friction is a run-up option (scene key runup.mesh_friction), the unit loads and amplitudes here are the
 chain's (housingfe.runup.chain.unit_loads with friction, friction_lines; Drivetrain.friction_node_loads): this script
