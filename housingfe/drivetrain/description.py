@@ -51,6 +51,10 @@ from housingfe.source.stiffness import (
 
 Vector3 = tuple[float, float, float]
 SHAFTS = ("pinion", "wheel")
+# the sliding-friction resultants (housingfe.source.stiffness.FRICTION_RESULTANTS) -> their unit loads on the coupled
+# model (Drivetrain.friction_node_loads; housingfe.runup.chain.unit_loads with friction on)
+FRICTION_LOADS = {"force": "friction_force", "pinion_torque": "friction_pinion_torque",
+                  "wheel_torque": "friction_wheel_torque", "tilt_moment": "friction_tilt"}
 _GEAR_FORCES: dict = {}        # Drivetrain.gear_forces per what it depends on (repr)
 
 
@@ -330,6 +334,45 @@ class Drivetrain:
             node = f"{name}:{self.shaft_nodes(name)[1]['gear']}"
             out[node] = np.concatenate([np.zeros(3, dtype=np.result_type(m)), sign * m])
         return out
+
+    def friction_directions(self, forces: GearForces | None = None) -> dict:
+        """Housing-frame unit vectors of the sliding-friction resultants (housingfe.source.stiffness
+        .friction_resultants): "d" the transverse line of action from T1 to T2 (the FE normal without its axial
+        part), "e_f" from the pinion centre to T1 (normal to the plane of action, in the transverse plane), "e_1"
+        = e_f x d the pinion's rotation vector (pinion driving; friction_resultants: e_f = d x e_1), "e_2" = -e_1
+        the wheel's, "tilt" = e_w x e_f (e_w: `mesh_face_direction`)."""
+        forces = forces or self.gear_forces()
+        a = np.asarray(self.shaft("pinion").axis, float)
+        a /= np.linalg.norm(a)
+        n = forces.direction
+        d = n - (n @ a) * a
+        d /= np.linalg.norm(d)
+        c = np.asarray(self.shaft("wheel").centre, float) - np.asarray(self.shaft("pinion").centre, float)
+        c -= (c @ a) * a
+        # centre to centre = (r_b1 + r_b2) e_f + T1T2 d: its part normal to d points along e_f
+        e_f = c - (c @ d) * d
+        e_f /= np.linalg.norm(e_f)
+        e_1 = np.cross(e_f, d)
+        return {"d": d, "e_f": e_f, "e_1": e_1, "e_2": -e_1, "tilt": np.cross(self.mesh_face_direction(), e_f)}
+
+    def friction_node_loads(self, resultant: str, amount: complex = 1.0, forces: GearForces | None = None) -> dict:
+        """{gear node: (6,) load [N, N m]} of one sliding-friction resultant (`FRICTION_LOADS`' keys, as
+        housingfe.source.stiffness.friction_resultants returns them) of size `amount`: "force" [N] +e_f on the
+        pinion and -e_f on the wheel (at the gear centres), "pinion_torque" [N m] about e_1 on the pinion,
+        "wheel_torque" [N m] about e_2 on the wheel, "tilt_moment" [N m] +(e_w x e_f) on the pinion and the
+        opposite on the wheel (`friction_directions`).  The force pair and the two torques are not
+        self-equilibrated each; with the amounts of one load distribution they are (the torques carry the
+        levers s and L - s of the force about the two centres, and the centres lie (r_b1 + r_b2) e_f + L d
+        apart), the tilt pair is."""
+        if resultant not in FRICTION_LOADS:
+            raise InputError(f"mesh_friction: {resultant!r} is not one of {', '.join(FRICTION_LOADS)}")
+        e = self.friction_directions(forces)
+        z = np.zeros(3)
+        pinion, wheel = {"force": ((e["e_f"], z), (-e["e_f"], z)), "pinion_torque": ((z, e["e_1"]), (z, z)),
+                         "wheel_torque": ((z, z), (z, e["e_2"])),
+                         "tilt_moment": ((z, e["tilt"]), (z, -e["tilt"]))}[resultant]
+        return {f"{name}:{self.shaft_nodes(name)[1]['gear']}": np.concatenate(parts) * amount
+                for name, parts in (("pinion", pinion), ("wheel", wheel))}
 
     def gear_forces(self) -> GearForces:
         """Mean tooth force and mean mesh stiffness at `torque`, placed in the housing: the line of action in the

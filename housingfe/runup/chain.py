@@ -10,7 +10,8 @@ bearings as 6x6 matrices at star connections to the bores, the gear mesh), its c
 basis_factor x the highest line, and a Ritz reduction (housingfe.response.reduced) on the unit loads the routes
 need: a torque of 1 N m about the wheel axis at the wheel centre, a unit compressive pair along the gear-mesh
 normal (the loads the gear-mesh element carries), and the moment pair of the shuttling moment (the mesh force's
-point moved along the gear axis, `unit_loads`; applied with runup.mesh_moment = "shuttling").  Per speed and torque: the source's operating point
+point moved along the gear axis, `unit_loads`; applied with runup.mesh_moment = "shuttling"); with the sliding
+friction on (runup.mesh_friction, `MESH_FRICTIONS`) also its four resultants' unit loads.  Per speed and torque: the source's operating point
 (housingfe.source.roosmalen.operating), then each route's L_v per tooth harmonic, then each radiator's L_sigma and L_W.
 
 Routes (`ROUTES`, a registry: `@register_route(name)`):
@@ -36,6 +37,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from housingfe import levels
+from housingfe.drivetrain.description import FRICTION_LOADS
 from housingfe.errors import InputError
 from housingfe.radiation.power import area_level_db
 from housingfe.response.observers import node_key
@@ -62,7 +64,7 @@ def register_route(name: str):
 class GearboxModel:
     """The coupled gearbox of a run-up (see the module docstring): drivetrain (housingfe.drivetrain.description
     .Drivetrain), structure (CoupledInterior), basis (ModalBasis), reduction (RitzReduction on the loads
-    "wheel_torque", "mesh" and "shuttle", `unit_loads`), radiators {name: Radiator}, wheel node and axis, the highest line (Hz), the
+    "wheel_torque", "mesh" and "shuttle", and the friction loads where built with friction, `unit_loads`), radiators {name: Radiator}, wheel node and axis, the highest line (Hz), the
     interior energy share of each basis mode, timings (s)."""
 
     drivetrain: object
@@ -98,11 +100,14 @@ class GearboxModel:
         return out
 
 
-def unit_loads(structure, drivetrain) -> tuple[dict, str, np.ndarray]:
+def unit_loads(structure, drivetrain, friction: bool = False) -> tuple[dict, str, np.ndarray]:
     """({"wheel_torque": 1 N m about the wheel axis at the wheel centre, "mesh": unit compressive pair along the
     FE mesh normal, "shuttle": the moment pair of 1 N m = F dw of the mesh force's point moved along the gear axis
     (Drivetrain.shuttle_node_loads: +(e_w x n) on the wheel, -(e_w x n) on the pinion, e_w the direction in which
-    the mesh model's w grows)}, wheel node name, wheel axis) as coupled load vectors."""
+    the mesh model's w grows)}, wheel node name, wheel axis) as coupled load vectors.  friction: also the unit
+    loads of the four sliding-friction resultants (FRICTION_LOADS: "friction_force" 1 N, "friction_pinion_torque",
+    "friction_wheel_torque", "friction_tilt" 1 N m; Drivetrain.friction_node_loads), only then: without friction
+    the reduction has no static vectors of theirs."""
     wheel = f"wheel:{drivetrain.shaft_nodes('wheel')[1]['gear']}"
     axis = np.asarray(drivetrain.shaft("wheel").axis, float)
     axis /= np.linalg.norm(axis)
@@ -110,7 +115,11 @@ def unit_loads(structure, drivetrain) -> tuple[dict, str, np.ndarray]:
     mesh = structure.system.load(node_loads={k: np.real(v) for k, v in drivetrain.mesh_node_loads(1.0).items()})
     shuttle = structure.system.load(node_loads={k: np.real(v) for k, v in
                                                 drivetrain.shuttle_node_loads(1.0).items()})
-    return {"wheel_torque": torque, "mesh": mesh, "shuttle": shuttle}, wheel, axis
+    loads = {"wheel_torque": torque, "mesh": mesh, "shuttle": shuttle}
+    if friction:
+        for resultant, name in FRICTION_LOADS.items():
+            loads[name] = structure.system.load(node_loads=drivetrain.friction_node_loads(resultant))
+    return loads, wheel, axis
 
 
 def bearing_pairs(structure) -> list:
@@ -129,11 +138,12 @@ def bearing_pairs(structure) -> list:
 @single_thread
 def build_gearbox_model(housing_model, drivetrain, f_lines_max: float, *, damping_ratio: float = 0.04,
                         basis_factor: float = 1.5, radiators: dict | None = None,
-                        surface: str = "outer") -> GearboxModel:
+                        surface: str = "outer", friction: bool = False) -> GearboxModel:
     """Couple `housing_model` (HousingModel with the bores of the drivetrain's bearings) with `drivetrain`, compute
     its complete modal basis to basis_factor x f_lines_max (Hz) and the Ritz reduction of the unit loads
     (`unit_loads`).
-    damping_ratio: modal xi (Sec. 5.4: 0.04); radiators: {name: Radiator} (their extra points are kept)."""
+    damping_ratio: modal xi (Sec. 5.4: 0.04); radiators: {name: Radiator} (their extra points are kept);
+    friction: the friction unit loads too (a run-up with runup.mesh_friction on, `has_friction_loads`)."""
     from housingfe.drivetrain.interior import build_interior
 
     t0 = time.perf_counter()
@@ -143,7 +153,7 @@ def build_gearbox_model(housing_model, drivetrain, f_lines_max: float, *, dampin
     t1 = time.perf_counter()
     basis = modal.modes(structure, f_basis)
     t2 = time.perf_counter()
-    loads, wheel, axis = unit_loads(structure, drivetrain)
+    loads, wheel, axis = unit_loads(structure, drivetrain, friction)
     extra = {}
     for radiator in radiators.values():
         extra.update(radiator.extra_points(structure))
@@ -160,19 +170,25 @@ def build_gearbox_model(housing_model, drivetrain, f_lines_max: float, *, dampin
 @single_thread
 def with_drivetrain(model: GearboxModel, drivetrain) -> GearboxModel:
     """The same housing and Ritz vectors with another drivetrain of the same layout (gear set, torque, bearings):
-    its coupled K, M, C projected on the vectors (a Rayleigh-Ritz re-analysis, seconds instead of a new basis)."""
+    its coupled K, M, C projected on the vectors (a Rayleigh-Ritz re-analysis, seconds instead of a new basis).
+    The unit loads are the model's (with the friction loads where it has them)."""
     from housingfe.drivetrain.interior import build_interior
 
     t0 = time.perf_counter()
     structure = build_interior(model.housing_model, drivetrain.to_coupling_spec(),
                                model.basis.f_max)
-    loads, wheel, axis = unit_loads(structure, drivetrain)
+    loads, wheel, axis = unit_loads(structure, drivetrain, has_friction_loads(model))
     if wheel != model.wheel_node:
         raise InputError("drivetrain: another shaft layout than the model's (the wheel node moved): build a new "
                          "gearbox model")
     reduction = model.reduction.reanalyse(structure, loads)
     return replace(model, drivetrain=drivetrain, structure=structure, reduction=reduction,
                    timings={**model.timings, "reanalysis_s": time.perf_counter() - t0})
+
+
+def has_friction_loads(model: GearboxModel) -> bool:
+    """Whether the model's Ritz reduction holds the friction unit loads (`build_gearbox_model(friction=True)`)."""
+    return all(name in model.reduction.names for name in FRICTION_LOADS.values())
 
 
 # ------------------------------------------------------------------------------------------------ lines
@@ -199,13 +215,19 @@ class Lines:
     # the shuttling moment per line (complex rms N m on the unit load "shuttle": F times harmonic n of the mesh
     # load's axial centre of pressure, MESH_MOMENTS); None: not applied (mesh_moment = "none")
     shuttle_moment: np.ndarray | None = None
+    # the sliding friction per line: {friction unit load name (FRICTION_LOADS): complex rms N or N m} and the mean
+    # friction coefficient of each line [-] (`friction_lines`); None: not applied (mesh_friction = "none")
+    friction: dict | None = None
+    friction_mu: np.ndarray | None = None
 
     def mesh_amplitudes(self) -> dict:
         """{unit load name: complex rms amplitude per line} of the mesh excitation the mesh_force route applies:
-        "mesh" (N), and "shuttle" (N m) where the shuttling moment is on."""
+        "mesh" (N), "shuttle" (N m) where the shuttling moment is on, the friction loads where friction is on."""
         out = {"mesh": self.mesh_excitation}
         if self.shuttle_moment is not None:
             out["shuttle"] = self.shuttle_moment
+        if self.friction is not None:
+            out.update(self.friction)
         return out
 
 
@@ -244,13 +266,70 @@ def shuttle_moments(source, torque_nm: float, harmonics: np.ndarray) -> np.ndarr
     return F * arm[n - 1] / math.sqrt(2.0)
 
 
+# the sliding friction applied with the mesh excitation on the coupled model (scene key runup.mesh_friction): "none",
+# "iso13989" = a mean coefficient per operating point from ISO/TR 13989-1 (housingfe.source.mesh_friction
+# .iso13989_run_friction; the formula quoted from memory, not verified against the standard), or a number = a fixed
+# mean coefficient in MESH_FRICTION_RANGE (exclusive).  Default "none": the ISO formula is not verified
+MESH_FRICTIONS = ("none", "iso13989")
+DEFAULT_MESH_FRICTION = "none"
+MESH_FRICTION_RANGE = (0.0, 0.3)
+
+
+def check_mesh_friction(value) -> str | float:
+    """The runup.mesh_friction setting as the chain takes it ("none", "iso13989" or a float), or InputError
+    "mesh_friction: ..." (a number outside MESH_FRICTION_RANGE, another word)."""
+    lo, hi = MESH_FRICTION_RANGE
+    if isinstance(value, str) and value in MESH_FRICTIONS:
+        return value
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        mu = float(value)
+        if math.isfinite(mu) and lo < mu < hi:
+            return mu
+        raise InputError(f"mesh_friction: a mean friction coefficient must lie between {lo:g} and {hi:g} "
+                         f"(exclusive), got {value!r}")
+    raise InputError(f"mesh_friction: {value!r} is not one of {', '.join(MESH_FRICTIONS)} or a mean friction "
+                     f"coefficient between {lo:g} and {hi:g}")
+
+
+def friction_lines(source, lines: Lines, mesh_friction) -> tuple[dict, np.ndarray]:
+    """({friction unit load name: complex rms amplitude per line}, mean friction coefficient per line [-]) of the
+    sliding friction at `lines`' torques, speeds and harmonics: mu = the fixed coefficient, or with "iso13989"
+    housingfe.source.mesh_friction.iso13989_run_friction at each line's torque and speed; the amplitude of
+    resultant r is harmonic n of SourceModel.friction_curve(torque, mu) / sqrt(2) (the load distributions of the
+    source's stiffness curve, S(t)'s time origin: coherent with the mesh excitation and the shuttling moment).
+    First order, like the shuttling moment: friction does not enter the source's harmonic balance."""
+    from housingfe.source.mesh_friction import iso13989_run_friction
+
+    mesh_friction = check_mesh_friction(mesh_friction)
+    out = {name: np.zeros(len(lines.frequency), complex) for name in FRICTION_LOADS.values()}
+    mu_line = np.zeros(len(lines.frequency))
+    H = int(lines.harmonic.max()) if lines.harmonic.size else 1
+    reference = {}          # per torque: (mu, {resultant: harmonics}) of its first point; linear in mu
+    for torque, speed, *_ in lines.points:
+        at = (lines.torque == torque) & (lines.speed == speed)
+        mu = (iso13989_run_friction(source.pair, torque, speed) if mesh_friction == "iso13989"
+              else float(mesh_friction))
+        if torque not in reference:
+            curve = source.friction_curve(torque, mu)
+            reference[torque] = (mu, {r: curve.harmonics(r, H) for r in FRICTION_LOADS})
+        mu_ref, harmonics = reference[torque]
+        n = lines.harmonic[at]
+        for resultant, name in FRICTION_LOADS.items():
+            out[name][at] = harmonics[resultant][n - 1] * (mu / mu_ref) / math.sqrt(2.0)
+        mu_line[at] = mu
+    return out, mu_line
+
+
 @single_thread
 def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float,
-                 mesh_moment: str = DEFAULT_MESH_MOMENT) -> tuple[Lines, float]:
+                 mesh_moment: str = DEFAULT_MESH_MOMENT, mesh_friction=DEFAULT_MESH_FRICTION) -> tuple[Lines, float]:
     """The source's lines up to f_lines_max (Hz) at every speed (rev/min) and torque (N m); also the time (s).
     mesh_moment (MESH_MOMENTS): "shuttling" adds the shuttling moment per line (Lines.shuttle_moment,
-    `shuttle_moments`) for the mesh_force route; the rigid-bore source's own L_omega does not contain it."""
+    `shuttle_moments`) for the mesh_force route; mesh_friction (`check_mesh_friction`): other than "none" adds the
+    sliding friction per line (Lines.friction, `friction_lines`); the rigid-bore source's own L_omega contains
+    neither."""
     _check_mesh_moment(mesh_moment)
+    mesh_friction = check_mesh_friction(mesh_friction)
     t0 = time.perf_counter()
     cols = {k: [] for k in ("torque", "speed", "harmonic", "frequency", "L_omega", "mesh_excitation", "point")}
     points = []
@@ -281,6 +360,8 @@ def source_lines(source, speeds_rpm, torques_nm, f_lines_max: float,
             at = lines.torque == float(torque)
             moment[at] = shuttle_moments(source, float(torque), lines.harmonic[at])
         lines.shuttle_moment = moment
+    if mesh_friction != "none":
+        lines.friction, lines.friction_mu = friction_lines(source, lines, mesh_friction)
     return lines, time.perf_counter() - t0
 
 
@@ -314,7 +395,8 @@ def mesh_receptance(model: GearboxModel, frequencies_hz) -> np.ndarray:
 @single_thread
 def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max: float, *,
                          first_order: bool = False, harmonics: int | None = None,
-                         mesh_moment: str = DEFAULT_MESH_MOMENT) -> tuple[Lines, float]:
+                         mesh_moment: str = DEFAULT_MESH_MOMENT,
+                         mesh_friction=DEFAULT_MESH_FRICTION) -> tuple[Lines, float]:
     """The source's lines (`source_lines`, the rigid-bore source's L_omega kept for the tf_omega route) with the
     mesh excitation from the harmonic balance of the time-varying mesh solved on the coupled gearbox instead of the
     rigid-bore lumped interior (housingfe.source.roosmalen.dynamics.mesh_harmonic_balance
@@ -324,15 +406,16 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
     the wheel's level on the coupled model (what the mesh_force route's L_omega_coupled then is, too).  model: the
     GearboxModel at the torque (one torque per model: another torque changes the bearings, `with_drivetrain`).  first_order: the mean-stiffness solve (quasi-static transmission
     error on the mean system).  harmonics: H of the balance (default: the source's).  mesh_moment (MESH_MOMENTS):
-    "shuttling" applies the shuttling moment (`shuttle_moments`) with the mesh excitation, in L_omega_flexible too.
-    Returns (Lines, seconds)."""
+    "shuttling" applies the shuttling moment (`shuttle_moments`) with the mesh excitation, in L_omega_flexible too;
+    mesh_friction (`check_mesh_friction`) the sliding friction likewise (`friction_lines`; the model must hold the
+    friction loads, `build_gearbox_model(friction=True)`).  Returns (Lines, seconds)."""
     from housingfe.source.roosmalen.dynamics import mesh_harmonic_balance
     from housingfe.source.stiffness import normal_force_from_torque
 
     t0 = time.perf_counter()
     H = int(harmonics or source.harmonics)
     k_ref = mesh_reference_stiffness(model)
-    rigid, _ = source_lines(source, speeds_rpm, torques_nm, f_lines_max, mesh_moment)
+    rigid, _ = source_lines(source, speeds_rpm, torques_nm, f_lines_max, mesh_moment, mesh_friction)
     cols = {k: [] for k in ("frequency", "mesh_excitation")}
     for torque in torques_nm:
         S, shock = source.mesh_stiffness(float(torque))
@@ -361,20 +444,25 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
 
 
 def run_source(model: GearboxModel, source, speeds_rpm, torques_nm, f_lines_max: float,
-               receptance: str = DEFAULT_SOURCE_RECEPTANCE, mesh_moment: str = DEFAULT_MESH_MOMENT
-               ) -> tuple[Lines, float]:
+               receptance: str = DEFAULT_SOURCE_RECEPTANCE, mesh_moment: str = DEFAULT_MESH_MOMENT,
+               mesh_friction=DEFAULT_MESH_FRICTION) -> tuple[Lines, float]:
     """The source's lines with the receptance of `receptance` (SOURCE_RECEPTANCES): `coupled_source_lines` or
-    `source_lines` (the rigid-bore lumped source); mesh_moment (MESH_MOMENTS) applied with the mesh excitation."""
+    `source_lines` (the rigid-bore lumped source); mesh_moment (MESH_MOMENTS) and mesh_friction
+    (`check_mesh_friction`) applied with the mesh excitation."""
+    if check_mesh_friction(mesh_friction) != "none" and not has_friction_loads(model):
+        raise InputError("mesh_friction: the gearbox model has no friction unit loads (build it with friction=True)")
     if receptance == "coupled":
-        return coupled_source_lines(model, source, speeds_rpm, torques_nm, f_lines_max, mesh_moment=mesh_moment)
+        return coupled_source_lines(model, source, speeds_rpm, torques_nm, f_lines_max, mesh_moment=mesh_moment,
+                                    mesh_friction=mesh_friction)
     if receptance == "rigid-bores":
-        return source_lines(source, speeds_rpm, torques_nm, f_lines_max, mesh_moment)
+        return source_lines(source, speeds_rpm, torques_nm, f_lines_max, mesh_moment, mesh_friction)
     raise InputError(f"source_receptance: {receptance!r} is not one of {', '.join(SOURCE_RECEPTANCES)}")
 
 
 def engagement_rerun(models: dict, source, engagement: str, speeds_rpm, f_lines_max: float,
                      receptance: str = DEFAULT_SOURCE_RECEPTANCE, routes=("tf_omega", "mesh_force"),
-                     mesh_moment: str = DEFAULT_MESH_MOMENT) -> tuple[dict, float]:
+                     mesh_moment: str = DEFAULT_MESH_MOMENT,
+                     mesh_friction=DEFAULT_MESH_FRICTION) -> tuple[dict, float]:
     """The run-up once more with another engagement shock (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS) on
     the SAME coupled models {torque N m: GearboxModel} (no new mesh, basis or reduction): the source's operating
     points keep their stiffness curves, load shares and matrices (SourceModel.with_engagement), so this costs the
@@ -383,7 +471,8 @@ def engagement_rerun(models: dict, source, engagement: str, speeds_rpm, f_lines_
     other = source.with_engagement(engagement)
     out = {}
     for torque, model in models.items():
-        lines, _ = run_source(model, other, speeds_rpm, [float(torque)], f_lines_max, receptance, mesh_moment)
+        lines, _ = run_source(model, other, speeds_rpm, [float(torque)], f_lines_max, receptance, mesh_moment,
+                              mesh_friction)
         out[torque] = runup(model, None, speeds_rpm, [float(torque)], routes=tuple(routes), lines=lines)
     return out, time.perf_counter() - t0
 
@@ -429,17 +518,21 @@ def tf_omega_route(model: GearboxModel, lines: Lines) -> RouteResult:
 @register_route("mesh_force")
 def mesh_force_route(model: GearboxModel, lines: Lines) -> RouteResult:
     """The mesh excitation F_n - k_m d_n (complex rms, N) on the coupled model's gear mesh, at every line, with the
-    shuttling moment (Lines.shuttle_moment, N m) where it is on.  The excitation level stays L_F of the force: with
-    the moment on, the transfer L_v - L_F holds the moment's share (the names say so)."""
+    shuttling moment (Lines.shuttle_moment, N m) and the sliding friction (Lines.friction) where they are on.  The
+    excitation level stays L_F of the force: with the moment or friction on, the transfer L_v - L_F holds their
+    share (the names say so)."""
     f = lines.frequency
     c = model.reduction.coefficients(f, lines.mesh_amplitudes())
     resp = model.reduction.response_of(f, c)
     L_F = levels.level(np.abs(lines.mesh_excitation) ** 2, levels.F0)
-    if lines.shuttle_moment is None:
+    extra = " and ".join(what for what, on in (("the shuttling moment", lines.shuttle_moment is not None),
+                                                ("the sliding friction", lines.friction is not None)) if on)
+    if not extra:
         names = ("L_F, mesh excitation F_n - k_m d_n (dB re 1 N)", "L_v - L_F (dB re 5e-8 m/s per N)")
     else:
-        names = ("L_F, mesh excitation F_n - k_m d_n (dB re 1 N; the shuttling moment applied with it is not in "
-                 "this level)", "L_v - L_F (dB re 5e-8 m/s per N; includes the response to the shuttling moment)")
+        verb = "are" if " and " in extra else "is"
+        names = (f"L_F, mesh excitation F_n - k_m d_n (dB re 1 N; {extra} applied with it {verb} not in "
+                 "this level)", f"L_v - L_F (dB re 5e-8 m/s per N; includes the response to {extra})")
     return RouteResult("mesh_force", resp.velocity_level_db, resp, c, _wheel_omega_level(model, resp, f),
                        excitation_db=L_F, excitation_name=names[0], transfer_name=names[1])
 

@@ -92,6 +92,7 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "scene": scene.scene.name, "description": scene.scene.description,
         "scene_settings": scene.model_dump(mode="json"),
         "mesh_moment": scene.runup.mesh_moment_model,     # in effect (the setting may leave it to the default)
+        "mesh_friction": friction_in_effect(scene, results),
         "timings_s": timings,
         "modal_basis": gm.summary(),
         "housing_resolution": _resolution(gm),
@@ -196,6 +197,36 @@ def _resolution(gm) -> dict | None:
     return res.as_dict() if res is not None else None
 
 
+def friction_in_effect(scene, results: dict) -> dict:
+    """The sliding friction of a run-up (runup.json "mesh_friction"): the setting (runup.mesh_friction), whether it
+    is applied (on the mesh_force route), and the mean coefficients per torque {"<torque>": [min, max]} [-]."""
+    setting = scene.runup.mesh_friction
+    applied = setting != "none" and "mesh_force" in scene.runup.routes
+    mu = {}
+    for torque, (_, res) in results.items():
+        if res.lines.friction_mu is not None:
+            mu[f"{torque:g}"] = [float(res.lines.friction_mu.min()), float(res.lines.friction_mu.max())]
+    return {"setting": setting, "applied": applied, "mu": mu}
+
+
+def friction_line(scene, results: dict) -> str | None:
+    """The summary's line on the sliding friction where it is on (None where it is off)."""
+    fr = friction_in_effect(scene, results)
+    if not fr["applied"]:
+        return None
+    lo = min(v[0] for v in fr["mu"].values())
+    hi = max(v[1] for v in fr["mu"].values())
+    if fr["setting"] == "iso13989":
+        from housingfe.source.mesh_friction import ISO13989_ROUGHNESS_RA, ISO13989_VISCOSITY
+
+        what = (f"mu {lo:.3f}-{hi:.3f} from ISO/TR 13989-1 at each speed and torque (formula from memory, not "
+                f"verified; oil {ISO13989_VISCOSITY:g} Pa s, Ra {ISO13989_ROUGHNESS_RA * 1e6:g} um assumed)")
+    else:
+        what = f"mu {lo:.3f} fixed"
+    return (f"mesh friction: the sliding friction (runup.mesh_friction), {what}, is applied with the mesh excitation "
+            "on mesh_force (docs/source.md, 'Sliding friction'); tf_omega does not contain it")
+
+
 def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, decompositions: list = (),
                  notes: list = ()) -> str:
     """The console summary: the model, the run-up maxima per route, the notes (one line each), the checks, which
@@ -215,6 +246,9 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
     if scene.runup.mesh_moment_model == "shuttling" and "mesh_force" in scene.runup.routes:
         lines.append("mesh moment: the shuttling moment (runup.mesh_moment) is applied with the mesh excitation on "
                      "mesh_force (docs/source.md, 'The shuttling moment'); tf_omega does not contain it")
+    friction = friction_line(scene, results)
+    if friction:
+        lines.append(friction)
     lines += list(notes)
     lines.append("checks (ours | measured | thesis calc. | pass):")
     for r in check_rows:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import time
 from pathlib import Path
-from typing import Literal, Optional
+from typing import Literal, Optional, Union
 
 import numpy as np
 from pydantic import Field, PositiveFloat, PositiveInt, field_validator, model_validator
@@ -129,6 +129,12 @@ class RunupSpec(_Strict):
     # force alone.  Default: housingfe.runup.chain.DEFAULT_MESH_MOMENT, and "none" with the thesis' replica
     # "thesis-2d"
     mesh_moment: Optional[Literal["shuttling", "none"]] = None
+    # the sliding friction at the flanks applied with the mesh excitation on the mesh_force route (and in the coupled
+    # source's L_omega; housingfe.runup.chain.MESH_FRICTIONS; docs/source.md "Sliding friction"): "none" (default);
+    # "iso13989" = the mean coefficient of ISO/TR 13989-1 at each speed and torque (oil 0.049 Pa s, Ra 0.4 um,
+    # assumed) -- that formula was written from memory and is NOT verified against the standard's text, hence off by
+    # default; or a number = a fixed mean coefficient, 0 < mu < 0.3
+    mesh_friction: Union[Literal["none", "iso13989"], float] = Field("none", json_schema_extra={"unit": "-"})
 
     @property
     def mesh_moment_model(self) -> str:
@@ -138,6 +144,16 @@ class RunupSpec(_Strict):
         if self.mesh_moment is not None:
             return self.mesh_moment
         return "none" if self.engagement == "thesis-2d" else DEFAULT_MESH_MOMENT
+
+    @field_validator("mesh_friction", mode="before")
+    @classmethod
+    def _mesh_friction(cls, value):
+        from housingfe.runup.chain import check_mesh_friction
+
+        try:
+            return check_mesh_friction(value)
+        except InputError as exc:        # "mesh_friction: ..." -> the key is put in front by the error's location
+            raise ValueError(str(exc).removeprefix("mesh_friction: ")) from None
 
     @property
     def misalignment_model(self) -> str:
@@ -293,7 +309,8 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
             print(f"bearing {row['bearing']} -> {row['surface']}: centre "
                   f"[{', '.join(f'{x + 0.0:.4g}' for x in row['centre_m'])}] m, radius {row['radius_m'] * 1e3:.4g} mm")
     gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
-                             basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
+                             basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface,
+                             friction=spec.mesh_friction != "none")
     gm.bores = bores
     timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
     progress.update(note="coupled model and modal basis")
@@ -319,7 +336,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         m = gm if torque == reference_torque else with_drivetrain(gm, drivetrains[torque])
         timings[f"reanalysis_{torque:g}Nm_s"] = time.perf_counter() - t1 if m is not gm else 0.0
         lines, t_src = run_source(m, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance,
-                                  spec.mesh_moment_model)
+                                  spec.mesh_moment_model, spec.mesh_friction)
         timings["source_s"] = timings.get("source_s", 0.0) + t_src
         res = runup(m, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
         for k, v in res.timings.items():
@@ -339,7 +356,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
 
         bound, timings["envelope_bound_s"] = engagement_rerun(
             {t: m for t, (m, _) in results.items()}, source, BOUND_ENGAGEMENT, spec.speeds, spec.f_max_hz,
-            spec.source_receptance, spec.routes, spec.mesh_moment_model)
+            spec.source_receptance, spec.routes, spec.mesh_moment_model, spec.mesh_friction)
         notes += report.bound_lines(results, bound, scene.radiation.models[0])
         # the same checks on the bound's curves (the validate rows 28.bound.*: reported beside the checks, not judged)
         t1 = time.perf_counter()

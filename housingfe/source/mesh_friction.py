@@ -25,6 +25,12 @@ from housingfe.errors import InputError
 from housingfe.source.mesh_moments import N_SAMPLES, one_sided_harmonics
 from housingfe.source.stiffness import FRICTION_RESULTANTS, MeshModel, StiffnessCurve, friction_resultants
 
+# the oil and flanks that `iso13989_run_friction` (the run-up's runup.mesh_friction = "iso13989") assumes: the thesis'
+# test gearbox states neither for its gears; Shell Omala 150 at the viscosity the thesis' fluid-film bearings take
+# (Sec. 3.5) and ground flanks of Ra 0.4 um (the central point of benchmarks/experiments/shuttling) -- assumed
+ISO13989_VISCOSITY = 0.049          # Pa s
+ISO13989_ROUGHNESS_RA = 0.4e-6      # m
+
 
 @dataclass
 class FrictionCurve:
@@ -139,3 +145,10 @@ def mesh_mean_friction(pair, pinion_torque: float, pinion_speed_rpm: float, visc
     k_b = iso13989_helical_load_factor(pair.transverse_contact_ratio + pair.overlap_ratio)
     return iso13989_mean_friction(2 * pinion_torque / d1 / pair.total_contact_width, 2 * v_t * math.sin(alpha_wt),
                                   rho, viscosity, roughness_ra, d1, k_b, lubricant_factor)
+
+
+def iso13989_run_friction(pair, pinion_torque: float, pinion_speed_rpm: float) -> float:
+    """`mesh_mean_friction` [-] at a pinion torque [N m] and speed [rpm] with the assumed oil and flanks
+    (ISO13989_VISCOSITY, ISO13989_ROUGHNESS_RA): the run-up's runup.mesh_friction = "iso13989".  The formula is
+    quoted from memory (`iso13989_mean_friction`), not verified against the standard's text."""
+    return mesh_mean_friction(pair, pinion_torque, pinion_speed_rpm, ISO13989_VISCOSITY, ISO13989_ROUGHNESS_RA)

@@ -145,14 +145,15 @@ class ChainSession:
 
         housing = self.housing()
         spec = self.spec
+        friction = spec.mesh_friction != "none"      # the friction unit loads join the reduction
         key = json.dumps([self._housing_key(), spec.basis_factor, spec.damping_ratio, spec.surface,
-                          self._layouts.get(id(drivetrain)) or layout_key(drivetrain)])
+                          self._layouts.get(id(drivetrain)) or layout_key(drivetrain)] + (["friction"] * friction))
         t0 = time.perf_counter()
         base = None if self.fresh_basis else self.pool.models.get(key)
         if base is None:
             model = build_gearbox_model(housing, drivetrain, spec.f_max_hz, damping_ratio=spec.damping_ratio,
                                         basis_factor=spec.basis_factor, radiators=self.radiators,
-                                        surface=spec.surface)
+                                        surface=spec.surface, friction=friction)
             self.pool.models.setdefault(key, model)
             how = "built"
         else:
@@ -193,7 +194,8 @@ class ChainSession:
 
         spec, drivetrain = self.spec, model.drivetrain
         misalignment = spec.misalignment_model
-        if spec.source_receptance == "rigid-bores" and misalignment == "none" and spec.mesh_moment_model == "none":
+        if (spec.source_receptance == "rigid-bores" and misalignment == "none" and spec.mesh_moment_model == "none"
+                and spec.mesh_friction == "none"):
             return self.lines(drivetrain, torque)
         if misalignment == "coupled":          # the static tilt of this drivetrain on the flexible housing
             from housingfe.drivetrain.misalignment import coupled_misalignment
@@ -209,7 +211,7 @@ class ChainSession:
         source = drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
                                          misalignment=misalignment)
         lines, seconds = run_source(model, source, spec.speeds, [float(torque)], spec.f_max_hz,
-                                    spec.source_receptance, spec.mesh_moment_model)
+                                    spec.source_receptance, spec.mesh_moment_model, spec.mesh_friction)
         self.timings["source_s"] = self.timings.get("source_s", 0.0) + seconds
         return lines
 

@@ -387,7 +387,7 @@ def _runs(base: _Base, values: dict, gear_set: str, bearings: str, torque: float
             source = dt.source_model(harmonics=spec.harmonics, engagement=engagement or spec.engagement,
                                      misalignment=misalignment)
             lines, _ = run_source(model, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance,
-                                  spec.mesh_moment_model)
+                                  spec.mesh_moment_model, spec.mesh_friction)
             results[engagement] = runup(model, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
     return model, results
 

@@ -207,3 +207,90 @@ def test_cli_mesh_moment_changes_mesh_force_only(tmp_path):
     tooth = [(float(ra["Lv_tooth_dB"]), float(rb["Lv_tooth_dB"])) for ra, rb in zip(out["none"], out["shuttling"])
              if ra["route"] == "mesh_force"]
     assert max(b - a for a, b in tooth) > 3.0          # set A: the moment is not a small correction
+    assert json.loads((tmp_path / "shuttling" / "runup.json").read_text())["mesh_friction"] == {
+        "setting": "none", "applied": False, "mu": {}}
+    # the sliding friction on top (runup.mesh_friction = 0.06): said and recorded; tf_omega moves only by the four
+    # static vectors the Ritz space gains; mesh_force's total moves by up to a few dB (set A: about +-1 dB)
+    proc = housingfe(*args, "--set", "runup.mesh_friction=0.06", "--out", str(tmp_path / "friction"))
+    assert proc.returncode == 0, proc.stderr
+    assert "mesh friction: the sliding friction (runup.mesh_friction), mu 0.060 fixed, is applied" in proc.stdout
+    record = json.loads((tmp_path / "friction" / "runup.json").read_text())["mesh_friction"]
+    assert record == {"setting": 0.06, "applied": True, "mu": {"2000": [0.06, 0.06]}}
+    rows = _rows(tmp_path / "friction" / "runup.csv")
+    moved = []
+    for ra, rb in zip(out["shuttling"], rows):
+        if ra["route"] == "tf_omega":
+            assert float(rb["Lv_dB"]) == pytest.approx(float(ra["Lv_dB"]), abs=0.01)
+        else:
+            moved.append(abs(float(rb["LwA_dB"]) - float(ra["LwA_dB"])))
+    assert 0.05 < max(moved) < 6.0
+
+
+def test_friction_lines_are_the_resultants_harmonics_of_fresh_load_distributions():
+    """Lines.friction (runup.mesh_friction): harmonic n of each sliding-friction resultant / sqrt 2 of load
+    distributions computed afresh (housingfe.source.mesh_friction.friction_curve) at the source's positions; the
+    mesh excitation itself is unchanged (first order); "iso13989" scales them by ISO/TR 13989-1's mu per speed,
+    which goes as v^-0.2 below the standard's 50 m/s cap; "none" leaves them out."""
+    from housingfe.drivetrain.description import FRICTION_LOADS
+    from housingfe.source.mesh_friction import friction_curve
+    from housingfe.source.stiffness import normal_force_from_torque
+
+    src = test_gearbox("A").source_model()
+    speeds = [250.0, 1300.0]
+    lines, _ = source_lines(src, speeds, [2000.0], 2000.0, mesh_moment="shuttling", mesh_friction=0.06)
+    plain, _ = source_lines(src, speeds, [2000.0], 2000.0, mesh_moment="shuttling")
+    assert plain.friction is None and plain.friction_mu is None
+    assert set(plain.mesh_amplitudes()) == {"mesh", "shuttle"}
+    assert set(lines.mesh_amplitudes()) == {"mesh", "shuttle", *FRICTION_LOADS.values()}
+    np.testing.assert_array_equal(plain.mesh_excitation, lines.mesh_excitation)
+    np.testing.assert_array_equal(plain.shuttle_moment, lines.shuttle_moment)
+    F = normal_force_from_torque(src.pair, 2000.0)
+    fresh = friction_curve(src.mesh_model, F, 0.06, src.stiffness_positions)
+    H = int(lines.harmonic.max())
+    for resultant, name in FRICTION_LOADS.items():
+        ref = fresh.harmonics(resultant, H)[lines.harmonic - 1] / math.sqrt(2.0)
+        np.testing.assert_allclose(lines.friction[name], ref, rtol=1e-9, atol=1e-9 * np.abs(ref).max())
+    np.testing.assert_array_equal(lines.friction_mu, 0.06)
+    # set A at 2000 N m, mu 0.06: the friction force's first harmonic is tens of N (0.06 of a ~30 kN force's split)
+    assert 10.0 < abs(lines.friction["friction_force"][0]) * math.sqrt(2.0) < 1000.0
+    iso, _ = source_lines(src, speeds, [2000.0], 2000.0, mesh_moment="shuttling", mesh_friction="iso13989")
+    mu = {s: iso.friction_mu[iso.speed == s] for s in speeds}
+    assert mu[250.0][0] / mu[1300.0][0] == pytest.approx((1300.0 / 250.0) ** 0.2, rel=1e-12)
+    assert 0.03 < mu[1300.0][0] < mu[250.0][0] < 0.15
+    for name in FRICTION_LOADS.values():
+        np.testing.assert_allclose(iso.friction[name], lines.friction[name] * iso.friction_mu / 0.06, rtol=1e-12)
+
+
+@pytest.mark.slow
+def test_friction_loads_through_the_mesh_force_route(coarse):
+    """runup.mesh_friction = 0.06 on the coarse gearbox: the model built with friction holds the four unit loads
+    (the default one does not), the mesh_force route's L_v is the superposition of the six unit responses with the
+    lines' amplitudes (1e-9 dB), that Ritz reduction agrees with a direct solve of the full model within 0.3 dB,
+    the re-analysis keeps the loads, and a model without them refuses friction."""
+    from housingfe.errors import InputError
+    from housingfe.runup.chain import has_friction_loads, run_source
+
+    gm0, src, _, _ = coarse
+    assert set(gm0.reduction.names) == {"wheel_torque", "mesh", "shuttle"} and not has_friction_loads(gm0)
+    gm = build_gearbox_model(gm0.housing_model, gm0.drivetrain, F_LINES, radiators=gm0.radiators, friction=True)
+    # their static vectors join (one of the four may already lie in the span of the others and the bearing pairs)
+    assert has_friction_loads(gm) and len(gm.reduction.vectors) >= len(gm0.reduction.vectors) + 3
+    lines, _ = run_source(gm, src, [1100.0], [2000.0], F_LINES, "rigid-bores", "shuttling", 0.06)
+    f = lines.frequency
+    res = runup(gm, None, [1100.0], [2000.0], routes=("mesh_force",), lines=lines)
+    amps = lines.mesh_amplitudes()
+    c = sum(gm.reduction.unit_coordinates(f, name) * np.asarray(a)[None, :] for name, a in amps.items())
+    np.testing.assert_allclose(res.routes["mesh_force"].L_v, gm.reduction.response_of(f, c).velocity_level_db,
+                               rtol=0, atol=1e-9)
+    loads, _, _ = unit_loads(gm.structure, gm.drivetrain, friction=True)
+    eta = 0.08
+    red = RitzReduction(gm.basis, loads, loss_factor(eta), nodes=(gm.wheel_node,))
+    ours = red.evaluate(f, amps).velocity_level_db
+    friction_only = red.evaluate(f, {k: v for k, v in amps.items() if k.startswith("friction_")}).velocity_level_db
+    ref = harmonic_response(gm.structure, [Load(k, loads[k], (f, a)) for k, a in amps.items()], loss_factor(eta), f,
+                            solver="direct")
+    np.testing.assert_allclose(ours, ref.velocity_level_db, atol=0.3)
+    assert np.max(friction_only) > np.max(ours) - 30.0        # not negligible at mu 0.06
+    assert has_friction_loads(with_drivetrain(gm, with_torque(gm.drivetrain, 1000.0)))
+    with pytest.raises(InputError, match="mesh_friction: the gearbox model has no friction unit loads"):
+        run_source(gm0, src, [1100.0], [2000.0], F_LINES, "rigid-bores", "shuttling", 0.06)

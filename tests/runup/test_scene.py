@@ -56,6 +56,16 @@ def test_mesh_moment_choices(overrides, moment):
     assert scene.runup.mesh_moment_model == moment
 
 
+@pytest.mark.parametrize("overrides, friction", [([], "none"), (["runup.mesh_friction=iso13989"], "iso13989"),
+                                                 (["runup.mesh_friction=0.06"], 0.06),
+                                                 (['runup.mesh_friction="none"'], "none")])
+def test_mesh_friction_choices(overrides, friction):
+    """runup.mesh_friction: off by default (the ISO/TR 13989-1 formula is unverified), the ISO coefficient per
+    operating point, or a fixed mean coefficient."""
+    scene, _ = load_runup_scene("test-gearbox-runup", overrides)
+    assert scene.runup.mesh_friction == friction
+
+
 def test_missing_drivetrain_is_named(tmp_path):
     text = (Path(__file__).parents[2] / "housingfe/scenes/test-gearbox-runup.toml").read_text()
     start = text.index("[drivetrain]")
@@ -74,6 +84,10 @@ def test_missing_drivetrain_is_named(tmp_path):
     (["--set", "drivetrain.bearings=cylindrical_roller"], "cannot carry it"),
     (["--set", "runup.engagement=envelope-bund"],
      "runup.engagement: Input should be 'face-width', 'thesis-2d' or 'envelope-bound'"),
+    # the sliding friction's mean coefficient: 0 < mu < 0.3, or one of the words
+    (["--set", "runup.mesh_friction=-0.1"], "runup.mesh_friction: a mean friction coefficient must lie between 0"),
+    (["--set", "runup.mesh_friction=0.5"], "runup.mesh_friction: a mean friction coefficient must lie between 0"),
+    (["--set", "runup.mesh_friction=foo"], "runup.mesh_friction: 'foo' is not one of none, iso13989"),
 ])
 def test_cli_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
     out = tmp_path / "out"

@@ -1,4 +1,8 @@
-"""What the sliding friction would do to the run-up (issue 28): a measurement, the chain untouched, nothing tuned.
+"""What the sliding friction does to the run-up (issue 28): a measurement beside the chain's runup.mesh_friction, nothing tuned.
+
+Since the friction is a run-up option (scene key runup.mesh_friction), the unit loads and amplitudes here are the
+chain's (housingfe.runup.chain.unit_loads with friction, friction_lines; Drivetrain.friction_node_loads): this script
+adds the comparison of coefficients and the split by resultant.
 
 The run-up of `housingfe run test-gearbox-runup` (sets A-D with ball bearings, and
 test-gearbox-runup-double-helical with cylindrical rollers; the largest torque, 2000 N m; the scenes' defaults:
@@ -15,65 +19,22 @@ radiator without and with friction, mesh_force route); the console output is fri
 
     PYTHONPATH=. OPENBLAS_NUM_THREADS=1 /work/main/.venv/bin/python benchmarks/experiments/shuttling/friction_runup.py [A B C D double_helical]
 """
-import math
 import sys
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
-from shuttling import MU_POINTS, VISCOSITY, friction_coefficients  # noqa: E402
+from shuttling import friction_coefficients  # noqa: E402
 
+from housingfe.drivetrain.description import FRICTION_LOADS  # noqa: E402
 from housingfe.outputs import format_table, write_csv  # noqa: E402
-from housingfe.response.reduced import RitzReduction  # noqa: E402
-from housingfe.runup.chain import Lines, bearing_pairs, run_source, runup, unit_loads  # noqa: E402
-from housingfe.source.mesh_friction import FrictionCurve  # noqa: E402
+from housingfe.runup.chain import friction_lines, run_source, runup  # noqa: E402
 
 HERE = Path(__file__).parent
 SCENE = "test-gearbox-runup"
-
-
-@dataclass
-class FrictionLines(Lines):
-    """The chain's lines with the friction amplitudes (complex rms per line, by unit load name) added."""
-
-    friction: dict = field(default_factory=dict)
-
-    def mesh_amplitudes(self) -> dict:
-        return {**super().mesh_amplitudes(), **self.friction}
-
-
-def friction_directions(drivetrain) -> dict:
-    """Housing-frame unit vectors: e_f (pinion centre -> T1), the pinion's rotation vector e_1 = e_f x d (see
-    housingfe.source.stiffness.friction_resultants: e_f = d x e_1), the wheel's e_2 = -e_1, and e_w x e_f."""
-    forces = drivetrain.gear_forces()
-    a = np.asarray(drivetrain.shaft("pinion").axis, float)
-    a /= np.linalg.norm(a)
-    n = forces.direction
-    d = n - (n @ a) * a
-    d /= np.linalg.norm(d)
-    c = np.asarray(drivetrain.shaft("wheel").centre, float) - np.asarray(drivetrain.shaft("pinion").centre, float)
-    c -= (c @ a) * a
-    e_f = c / np.linalg.norm(c) - (c @ d) / np.linalg.norm(c) * d      # perpendicular to d, towards the wheel side
-    e_f /= np.linalg.norm(e_f)
-    e_1 = np.cross(e_f, d)
-    return {"e_f": e_f, "e_1": e_1, "e_2": -e_1, "tilt": np.cross(drivetrain.mesh_face_direction(), e_f), "d": d}
-
-
-def friction_unit_loads(structure, drivetrain) -> dict:
-    dirs = friction_directions(drivetrain)
-    nodes = {g: f"{g}:{drivetrain.shaft_nodes(g)[1]['gear']}" for g in ("pinion", "wheel")}
-    z = np.zeros(3)
-
-    def load(pinion, wheel):
-        return structure.system.load(node_loads={nodes["pinion"]: pinion, nodes["wheel"]: wheel})
-
-    return {"friction_force": load(np.concatenate([dirs["e_f"], z]), np.concatenate([-dirs["e_f"], z])),
-            "friction_pinion_torque": load(np.concatenate([z, dirs["e_1"]]), np.zeros(6)),
-            "friction_wheel_torque": load(np.zeros(6), np.concatenate([z, dirs["e_2"]])),
-            "friction_tilt": load(np.concatenate([z, dirs["tilt"]]), np.concatenate([z, -dirs["tilt"]]))}
 
 
 CASES = {"A": (SCENE, []), "B": (SCENE, ["drivetrain.gear_set=B"]), "C": (SCENE, ["drivetrain.gear_set=C"]),
@@ -94,7 +55,6 @@ def run_case(case: str, scene_name: str, overrides: list, housings: dict) -> tup
         radiators_of,
     )
     from housingfe.scene import load_housing_scene
-    from housingfe.source.mesh_friction import mesh_mean_friction
 
     t0 = time.perf_counter()
     scene, path = load_runup_scene(scene_name, overrides)
@@ -107,44 +67,31 @@ def run_case(case: str, scene_name: str, overrides: list, housings: dict) -> tup
     radiators = radiators_of(scene.radiation, model)
     drivetrains, _ = matched_drivetrains(scene.housing, model, {torque: drivetrain_of(scene.drivetrain, torque)}, path)
     dt = drivetrains[torque]
+    # the chain's reduction with the friction loads among the unit loads (their static vectors join), as
+    # runup.mesh_friction builds it (housingfe.runup.chain.unit_loads, Drivetrain.friction_node_loads)
     gm = build_gearbox_model(model, dt, spec.f_max_hz, damping_ratio=spec.damping_ratio,
-                             basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface)
+                             basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface, friction=True)
     assert spec.misalignment_model == "rigid-bores", spec.misalignment_model
     source = dt.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
                              misalignment=lead_gap_law(dt, "rigid-bores"))
-    # the chain's reduction once more, with the friction loads among the unit loads (their static vectors join)
-    loads, wheel, _ = unit_loads(gm.structure, dt)
-    loads.update(friction_unit_loads(gm.structure, dt))
-    extra = {}
-    for radiator in radiators.values():
-        extra.update(radiator.extra_points(gm.structure))
-    red = RitzReduction(gm.basis, loads, gm.reduction.damping, surface=spec.surface, nodes=(wheel,),
-                        extra_points=extra, static_vectors=bearing_pairs(gm.structure))
-    gm = replace(gm, reduction=red)
     lines, _ = run_source(gm, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance,
                           spec.mesh_moment_model)
     print(f"{case}: {scene_name} {' '.join(overrides)} at {torque:g} N m ({scene.drivetrain.bearings} bearings):"
           f" model and source lines {time.perf_counter() - t0:.1f} s; mesh moment {spec.mesh_moment_model}, "
           f"receptance {spec.source_receptance}")
-    curve = source._point(float(torque)).curve
     mus = friction_coefficients(source.pair)
-    # "iso": ISO/TR 13989-1 at each line's own speed (Ra 0.4 um; mu ~ v^-0.2)
-    ra = MU_POINTS["central"][1]
-    mu_line = np.array([mesh_mean_friction(source.pair, torque, v, VISCOSITY, ra) for v in lines.speed])
-    mus["iso"] = mus["central"]
+    # "iso": ISO/TR 13989-1 at each line's own speed (Ra 0.4 um; mu ~ v^-0.2): runup.mesh_friction = "iso13989"
+    mus["iso"] = "iso13989"
     base = runup(gm, None, spec.speeds, [torque], routes=("mesh_force",), lines=lines)
-    n = lines.harmonic
-    H = int(n.max())
+    mu_line = friction_lines(source, lines, "iso13989")[1]
 
-    def with_friction(mu, names, scale=1.0):
-        fc = FrictionCurve.of_curve(curve, mu)
-        amp = {("friction_tilt" if k == "tilt_moment" else f"friction_{k}"):
-               scale * fc.harmonics(k, H)[n - 1] / math.sqrt(2.0) for k in names}
-        fl = FrictionLines(**{k: getattr(lines, k) for k in Lines.__dataclass_fields__}, friction=amp)
+    def with_friction(mu, names):
+        amp = friction_lines(source, lines, mu)[0]
+        fl = replace(lines, friction={FRICTION_LOADS[k]: amp[FRICTION_LOADS[k]] for k in names})
         return runup(gm, None, spec.speeds, [torque], routes=("mesh_force",), lines=fl)
 
-    everything = ("force", "pinion_torque", "wheel_torque", "tilt_moment")
-    out = {label: with_friction(mu, everything, mu_line / mu if label == "iso" else 1.0) for label, mu in mus.items()}
+    everything = tuple(FRICTION_LOADS)
+    out = {label: with_friction(mu, everything) for label, mu in mus.items()}
     # which resultant does it: each alone at the central mu
     parts = {"force pair": ("force",), "torques": ("pinion_torque", "wheel_torque"), "tilt": ("tilt_moment",)}
     part_rows = []

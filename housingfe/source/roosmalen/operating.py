@@ -203,6 +203,14 @@ class SourceModel:
 
         return CentreOfPressure.of_curve(self._point(float(torque_nm)).curve)
 
+    def friction_curve(self, torque_nm: float, mu: float):
+        """The sliding-friction resultants over one mesh period at a pinion torque [N m] and mean friction
+        coefficient mu [-] (housingfe.source.mesh_friction.FrictionCurve: from the load distributions of the
+        operating point's stiffness curve; its harmonics share S(t)'s time origin)."""
+        from housingfe.source.mesh_friction import FrictionCurve
+
+        return FrictionCurve.of_curve(self._point(float(torque_nm)).curve, mu)
+
     def mesh_stiffness(self, torque_nm: float) -> tuple[np.ndarray, np.ndarray]:
         """(S samples over one mesh period [N/m], F_e samples [N]) at a torque, uniformly spaced (the inputs of
         the harmonic balance)."""
