@@ -6,13 +6,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from housingfe.data import thesis
 from housingfe.source.gears import GearPair
 from housingfe.source.mesh_friction import FrictionCurve, friction_curve
-from housingfe.source.stiffness import MeshModel, ShaftBending, friction_resultants, stiffness_curve
+from housingfe.source.stiffness import MeshModel, friction_resultants, stiffness_curve
+from tests.source.thesis_gears import REF, SYMMETRIC_SHAFTS
 
-REF = thesis()["gears"]
-SYMMETRIC_SHAFTS = (ShaftBending(0.06, 0.06, 0.080), ShaftBending(0.06, 0.06, 0.095))
 MU = 0.05
 
 

@@ -6,19 +6,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from housingfe.data import thesis
 from housingfe.source.gears import GearPair
 from housingfe.source.mesh_moments import CentreOfPressure, centre_of_pressure_curve, one_sided_harmonics
 from housingfe.source.stiffness import (
     MeshModel,
-    ShaftBending,
     load_centre,
     normal_force_from_torque,
     stiffness_curve,
 )
-
-REF = thesis()["gears"]
-SYMMETRIC_SHAFTS = (ShaftBending(0.06, 0.06, 0.080), ShaftBending(0.06, 0.06, 0.095))
+from tests.source.thesis_gears import REF, SYMMETRIC_SHAFTS
 
 
 def exact_uniform_centroid(pair: GearPair, u: float) -> tuple[float, float]:

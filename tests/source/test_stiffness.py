@@ -6,7 +6,6 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_bvp
 
-from housingfe.data import thesis
 from housingfe.errors import InputError
 from housingfe.source.gears import GearPair
 from housingfe.source.stiffness import (
@@ -20,9 +19,8 @@ from housingfe.source.stiffness import (
     plate_green,
     stiffness_curve,
 )
-
-REF = thesis()["gears"]
-SHAFTS = (ShaftBending(0.06, 0.06, 0.080), ShaftBending(0.06, 0.06, 0.095))
+from tests.source.thesis_gears import REF
+from tests.source.thesis_gears import SYMMETRIC_SHAFTS as SHAFTS
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,11 @@
 """The thesis' test gears (housingfe/data/roosmalen1994.toml, Appendix F) as the source tests build them."""
 from housingfe.data import thesis
 from housingfe.source.gears import GearPair
+from housingfe.source.stiffness import ShaftBending
+
+REF = thesis()["gears"]
+# equal spans both sides of the gears (m, m) and the shaft diameters (m): a mesh without the thesis' overhang asymmetry
+SYMMETRIC_SHAFTS = (ShaftBending(0.06, 0.06, 0.080), ShaftBending(0.06, 0.06, 0.095))
 
 
 def spur_pair() -> GearPair:

@@ -76,6 +76,19 @@ def metrics(res, ref, route):
     return out
 
 
+def gear_set_b_args(doc: str, default_out: str, argv=None, extra=()) -> tuple[argparse.Namespace, list[str]]:
+    """The command line of the run-up experiments (--out, --coarse) and the scene overrides of test-gearbox-runup for
+    gear set B (`extra` added; --coarse: a 60 mm housing mesh and lines to 1.5 kHz, a quick look)."""
+    p = argparse.ArgumentParser(description=doc.splitlines()[0])
+    p.add_argument("--out", default=default_out)
+    p.add_argument("--coarse", action="store_true", help="60 mm housing mesh, lines to 1.5 kHz (a quick look)")
+    args = p.parse_args(argv)
+    overrides = ["drivetrain.gear_set=B", *extra]
+    if args.coarse:
+        overrides += ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500.0"]
+    return args, overrides
+
+
 def main(argv=None):
     from mpi4py import MPI
 
@@ -84,14 +97,8 @@ def main(argv=None):
     from housingfe.runup.scene import drivetrain_of, housing_model_for, load_runup_scene
     from housingfe.scene import load_housing_scene
 
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", default="/tmp/bearing_ranking_runup")
-    p.add_argument("--coarse", action="store_true", help="60 mm housing mesh, lines to 1.5 kHz (a quick look)")
-    args = p.parse_args(argv)
+    args, overrides = gear_set_b_args(__doc__, "/tmp/bearing_ranking_runup", argv)
     t0 = time.perf_counter()
-    overrides = ["drivetrain.gear_set=B"]
-    if args.coarse:
-        overrides += ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500.0"]
     scene, _ = load_runup_scene("test-gearbox-runup", overrides)
     spec = scene.runup
     hs, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))

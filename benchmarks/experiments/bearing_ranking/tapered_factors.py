@@ -24,7 +24,6 @@ harmonic to f_max) and the tooth-frequency line alone; the max L_WA.
 """
 from __future__ import annotations
 
-import argparse
 import csv
 import json
 import math
@@ -38,7 +37,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import common  # noqa: E402
-from runup_factors import Patched, metrics  # noqa: E402
+from runup_factors import Patched, gear_set_b_args, metrics  # noqa: E402
 
 TORQUE = 2000.0
 ROUTES = ("tf_omega", "mesh_force")
@@ -162,15 +161,9 @@ def mean_level(res, route: str) -> float:
 def main(argv=None):
     from housingfe.studies.chain_session import ChainSession
 
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", default="/tmp/bearing_ranking_tapered")
-    p.add_argument("--coarse", action="store_true", help="60 mm housing mesh, lines to 1.5 kHz (a quick look)")
-    args = p.parse_args(argv)
+    args, overrides = gear_set_b_args(__doc__, "/tmp/bearing_ranking_tapered", argv, ['radiation.models=["erp"]'])
     t0 = time.perf_counter()
     load0 = os.getloadavg()
-    overrides = ["drivetrain.gear_set=B", 'radiation.models=["erp"]']
-    if args.coarse:
-        overrides += ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500.0"]
     session = ChainSession.from_scene("test-gearbox-runup", overrides)
     spec = session.spec
     print(f"default chain: source_receptance={spec.source_receptance}, misalignment={spec.misalignment_model}, "
