@@ -21,7 +21,7 @@ bench: bootstrap
 
 # Builds docker/Dockerfile (docker, else podman; offline-capable) and checks box-free in it against this machine.
 container: bootstrap
-	bash docker/build.sh --check
+	bash docker/build.sh --check $(CONTAINER_ARGS)
 
 clean:
 	rm -rf results .pytest_cache

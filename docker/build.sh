@@ -3,6 +3,8 @@
 #   bash docker/build.sh           build the image ($HOUSINGFE_IMAGE, default housingfe:latest)
 #   bash docker/build.sh --check   build, run `housingfe run box-free` in the image without network and compare
 #                                  its frequencies with the same run on this machine (relative 1e-9)
+#   ... --clean                    remove the image again at the end (CI: an image is 3.3 GB, and images left by
+#                                  earlier runs once filled a CI machine's disk mid-build)
 # Engine: docker when a Docker daemon answers, else podman (installed with apt when missing) with runc, cgroupfs
 # and docker/containers.conf. The base image debian:bookworm-slim is pulled, or made with debootstrap from this
 # machine's Debian mirror when no registry is reachable. PyPI packages are downloaded here into ./wheelhouse and
@@ -18,11 +20,14 @@ venv="${HOUSINGFE_VENV:-$here/.venv}"
 wheelhouse="$here/wheelhouse"
 
 check=0
-case "${1:-}" in
-  --check) check=1 ;;
-  "") ;;
-  *) echo "usage: bash docker/build.sh [--check]" >&2; exit 2 ;;
-esac
+clean=0
+for arg in "$@"; do
+  case "$arg" in
+    --check) check=1 ;;
+    --clean) clean=1 ;;
+    *) echo "usage: bash docker/build.sh [--check] [--clean]" >&2; exit 2 ;;
+  esac
+done
 
 log() { echo "container: $*" >&2; }
 as_root() { if [ "$(id -u)" -eq 0 ]; then "$@"; else sudo "$@"; fi; }
@@ -124,19 +129,49 @@ EOF
   touch "$stamp"
 }
 
+# ---- disk ---------------------------------------------------------------------------------------------------
+# The image is 3.3 GB and committing its big layer needs about as much again; say so now rather than fail with
+# "no space left on device" after a quarter of an hour of building.
+need_gb=8
+check_disk() {
+  local root
+  if [ "$engine" = docker ]; then root=$(docker info --format '{{.DockerRootDir}}' 2>/dev/null || echo /var/lib/docker)
+  else root=$(ctr info --format '{{.Store.GraphRoot}}' 2>/dev/null || echo /var/lib/containers/storage); fi
+  local probe="$root"
+  while [ ! -d "$probe" ]; do probe=$(dirname "$probe"); done
+  local free_kb
+  free_kb=$(df -Pk "$probe" | awk 'NR==2 {print $4}')
+  if [ "$free_kb" -lt $((need_gb * 1024 * 1024)) ]; then
+    log "FAILED: $((free_kb / 1024)) MB free under $root; building the image needs about $need_gb GB" \
+        "(old images: '$engine image prune -a')"
+    exit 1
+  fi
+}
+
 # ---- build --------------------------------------------------------------------------------------------------
 t_start=$SECONDS
 log "engine: $engine"
+check_disk
 base_image
 make_wheelhouse
 t0=$SECONDS
+old_id=$(ctr image inspect --format '{{.Id}}' "$image" 2>/dev/null || true)
 if [ "$engine" = docker ]; then
-  docker build -f docker/Dockerfile -t "$image" .
+  docker build --force-rm -f docker/Dockerfile -t "$image" .
 else
-  ctr build --network host -f docker/Dockerfile -t "$image" .
+  # No layer cache: `COPY .` changes with every commit, so the cached layers were never reused, only left behind
+  # (about 3.3 GB per build).
+  ctr build --layers=false --force-rm --network host -f docker/Dockerfile -t "$image" .
 fi
 t_build=$((SECONDS - t0))
 log "image $image built in $t_build s ($(ctr image inspect --format '{{.Size}}' "$image" | awk '{printf "%.2f GB", $1/1e9}'))"
+# The image this tag named before is now untagged and would stay on disk.
+new_id=$(ctr image inspect --format '{{.Id}}' "$image")
+if [ -n "$old_id" ] && [ "$old_id" != "$new_id" ]; then
+  ctr rmi "$old_id" >/dev/null 2>&1 && log "removed the previous $image (${old_id:0:12})" || true
+fi
+# --clean: remove the image however the rest ends, a failed check included.
+[ "$clean" -eq 0 ] || trap 'ctr rmi "$image" >/dev/null 2>&1 && log "removed $image (--clean)"' EXIT
 [ "$check" -eq 1 ] || exit 0
 
 # ---- check: the same scene in the image and on this machine ------------------------------------------------
