@@ -3,6 +3,9 @@ coupled test gearbox:
 
 * the mesh receptance of the Ritz reduction tends to 1/k_ref at zero frequency (the gears turn freely apart from
   the mesh: only the mesh spring resists a static compression) — the static value the balance uses;
+* with the drive line (runup.drive_line = "quill-shafts") the static receptance is the mesh spring in parallel with
+  the quill shafts' torsional stiffness seen along the line of action (chain.static_mesh_receptance), within the
+  bearings' and housing's share;
 * the rank-one harmonic balance on that receptance equals the full Hill system assembled on every Ritz coordinate
   of the coupled model (housingfe.benchmarks.flexsource.full_hill_on_ritz, which the benchmark times too; mesh
   compression per harmonic, 1e-8 of its largest dynamic harmonic);
@@ -23,6 +26,7 @@ from housingfe.runup.chain import (
     mesh_reference_stiffness,
     runup,
     source_lines,
+    static_mesh_receptance,
 )
 from housingfe.source.roosmalen.dynamics import mesh_harmonic_balance
 from housingfe.source.stiffness import normal_force_from_torque
@@ -36,6 +40,37 @@ def test_static_mesh_receptance_is_one_over_the_mesh_stiffness(coarse):
     gm = coarse[0]
     k = mesh_reference_stiffness(gm)
     assert mesh_receptance(gm, [1e-3])[0] * k == pytest.approx(1.0, abs=1e-6)
+
+
+@pytest.mark.slow
+def test_static_mesh_receptance_with_the_drive_line(coarse):
+    """1/g(0) - k_ref = 1/s, s = a_p^2/k_p + a_w^2/k_w: the mesh pair turns each gear against its quill chain
+    (near quill in series with the FE shaft's torsion from gear to shaft end, far quill to ground), a = the mesh
+    normal's lever about each shaft axis (rotation-only model: g = s / (1 + k_ref s)).  The bearings and the
+    housing add translational compliance along the line of action: within 3 %.  Without the drive line g(0) is
+    1/k_ref exactly (above)."""
+    from dataclasses import replace
+
+    from housingfe.runup.chain import build_gearbox_model
+
+    gm0 = coarse[0]
+    dt = replace(gm0.drivetrain, drive_line="quill-shafts")
+    gm = build_gearbox_model(gm0.housing_model, dt, F_LINES)
+    k_ref = mesh_reference_stiffness(gm)
+    mesh = gm.structure.spec.gear_meshes[0]
+    pair = dt.gears.pair
+    G = pair.youngs_modulus / (2 * (1 + pair.poisson_ratio))
+    inverse = 0.0
+    for name in ("pinion", "wheel"):
+        line = dt.shaft(name)
+        axis = np.asarray(line.axis, float) / np.linalg.norm(line.axis)
+        lever = axis @ np.cross(np.asarray(mesh.point) - np.asarray(line.centre), np.asarray(mesh.direction))
+        near, _, far = dt.drive_line_parts()[name]
+        shaft = G * math.pi * line.diameter**4 / 32 / (0.0 - line.ends[0])
+        inverse += lever**2 * (1 / near + 1 / far + 1 / shaft)
+    g0 = static_mesh_receptance(gm)
+    assert 0.99 < g0 * k_ref < 1.0                     # the quills are ~1000x softer than the mesh
+    assert 1 / g0 - k_ref == pytest.approx(1 / inverse, rel=0.03)
 
 
 @pytest.mark.slow
