@@ -124,14 +124,20 @@ def unit_loads(structure, drivetrain, friction: bool = False) -> tuple[dict, str
 
 def bearing_pairs(structure) -> list:
     """Self-equilibrated unit force and moment pairs across every bearing (shaft node +, bore master -), six per
-    bearing, as coupled vectors: the static vectors that make a re-analysis with other bearing stiffnesses
-    (another torque, another configuration) accurate."""
+    bearing, and unit torques across each drive line's quills (about the shaft axis: shaft end +, coupling node -;
+    on the coupling node alone for the far quill to ground), as coupled vectors: the static vectors that make a
+    re-analysis with other bearing or quill stiffnesses (another torque, another configuration, the uncertainty's
+    quill samples) accurate."""
     out = []
     for b in structure.spec.bearings:
         for i in range(6):
             e = np.zeros(6)
             e[i] = 1.0
             out.append(structure.system.load(node_loads={b.shaft_node: e, b.bore: -e}))
+    for d in structure.spec.drive_lines:
+        e = np.r_[np.zeros(3), structure.shaft_axis(d.shaft_node)]
+        out.append(structure.system.load(node_loads={d.shaft_node: e, d.name: -e}))
+        out.append(structure.system.load(node_loads={d.name: e}))
     return out
 
 

@@ -42,20 +42,26 @@ def test_static_mesh_receptance_is_one_over_the_mesh_stiffness(coarse):
     assert mesh_receptance(gm, [1e-3])[0] * k == pytest.approx(1.0, abs=1e-6)
 
 
-@pytest.mark.slow
-def test_static_mesh_receptance_with_the_drive_line(coarse):
-    """1/g(0) - k_ref = 1/s, s = a_p^2/k_p + a_w^2/k_w: the mesh pair turns each gear against its quill chain
-    (near quill in series with the FE shaft's torsion from gear to shaft end, far quill to ground), a = the mesh
-    normal's lever about each shaft axis (rotation-only model: g = s / (1 + k_ref s)).  The bearings and the
-    housing add translational compliance along the line of action: within 3 %.  Without the drive line g(0) is
-    1/k_ref exactly (above)."""
+@pytest.fixture(scope="module")
+def coarse_drive_line(coarse):
+    """The coarse model's housing and drivetrain with the quill shafts (runup.drive_line = "quill-shafts")."""
     from dataclasses import replace
 
     from housingfe.runup.chain import build_gearbox_model
 
     gm0 = coarse[0]
-    dt = replace(gm0.drivetrain, drive_line="quill-shafts")
-    gm = build_gearbox_model(gm0.housing_model, dt, F_LINES)
+    return build_gearbox_model(gm0.housing_model, replace(gm0.drivetrain, drive_line="quill-shafts"), F_LINES)
+
+
+@pytest.mark.slow
+def test_static_mesh_receptance_with_the_drive_line(coarse_drive_line):
+    """1/g(0) - k_ref = 1/s, s = a_p^2/k_p + a_w^2/k_w: the mesh pair turns each gear against its quill chain
+    (near quill in series with the FE shaft's torsion from gear to shaft end, far quill to ground), a = the mesh
+    normal's lever about each shaft axis (rotation-only model: g = s / (1 + k_ref s)).  The bearings and the
+    housing add translational compliance along the line of action: within 3 %.  Without the drive line g(0) is
+    1/k_ref exactly (above)."""
+    gm = coarse_drive_line
+    dt = gm.drivetrain
     k_ref = mesh_reference_stiffness(gm)
     mesh = gm.structure.spec.gear_meshes[0]
     pair = dt.gears.pair
@@ -71,6 +77,25 @@ def test_static_mesh_receptance_with_the_drive_line(coarse):
     g0 = static_mesh_receptance(gm)
     assert 0.99 < g0 * k_ref < 1.0                     # the quills are ~1000x softer than the mesh
     assert 1 / g0 - k_ref == pytest.approx(1 / inverse, rel=0.03)
+
+
+@pytest.mark.slow
+def test_reanalysis_with_other_quill_shafts(coarse_drive_line):
+    """The uncertainty's quill samples re-use the basis (with_drivetrain): with every quill 20 % thinner (stiffness
+    x 0.41) the re-analysed rig mode is the spring chain's (tests/drivetrain/test_drive_line.py) within 0.5 %, as
+    the fresh model's is; the Ritz space holds the static torques across the quills (chain.bearing_pairs)."""
+    from dataclasses import replace
+
+    from housingfe.runup.chain import with_drivetrain
+    from tests.drivetrain.test_drive_line import _rig_chain_hz
+
+    gm = coarse_drive_line
+    thin = replace(gm.drivetrain, quill_shafts=tuple(replace(q, diameter=0.8 * q.diameter)
+                                                     for q in gm.drivetrain.quill_shafts))
+    before = gm.reduction.frequencies_hz[0]
+    after = with_drivetrain(gm, thin).reduction.frequencies_hz[0]
+    assert before == pytest.approx(_rig_chain_hz(gm.drivetrain), rel=5e-3)
+    assert after == pytest.approx(_rig_chain_hz(thin), rel=5e-3) and after < 0.75 * before
 
 
 @pytest.mark.slow
