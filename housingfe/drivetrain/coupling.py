@@ -296,7 +296,8 @@ class CoupledSystem:
         """Six q vectors: unit translations x, y, z and unit rotations about the global x, y, z axes through the
         origin of the whole coupled system (every FE node, every extra node: u = theta x r, rotation DOFs =
         theta).  With the rigid modes of (K, M): housingfe.solvers.modal.rigid_body_mass_properties(M, modes,
-        system.rigid_body_vectors(V)) gives the total mass and centre of gravity."""
+        system.rigid_body_vectors(V)) gives the total mass and centre of gravity.  A torsion node keeps only its
+        rotation about its axis (its constraints hold no rigid translation; it carries no translational mass)."""
         lo, n_loc_fe, _ = self._full_range()
         bs = V.dofmap.index_map_bs
         x = V.tabulate_dof_coordinates()[:n_loc_fe // bs]

@@ -500,7 +500,9 @@ class Drivetrain:
     def to_coupling_spec(self, forces: GearForces | None = None):
         """The FE interior on the housing's bores (housingfe.drivetrain.interior.CouplingSpec): bore masters of
         kind rbe2 at the bearing bores, the two shafts with their gears as rigid discs bored to the shaft, the
-        bearings (designation at the statics load, tilt held), the gear mesh (mean stiffness at `torque`)."""
+        bearings (designation at the statics load, tilt held), the gear mesh (mean stiffness at `torque`), and with
+        drive_line = "quill-shafts" the drive lines (`drive_line_parts` from each shaft's front end node to a
+        coupling node "coupling_<motor|brake>" and on to ground; housingfe.drivetrain.interior.DriveLineSpec)."""
         from housingfe.drivetrain.interior import CouplingSpec
 
         forces = forces or self.gear_forces()
