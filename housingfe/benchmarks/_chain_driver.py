@@ -78,7 +78,7 @@ def main(out_dir: str, result_json: str, overrides: list[str]) -> None:
         torque = float(change.get("torque", base_torque))
         dspec = scene.drivetrain.model_copy(update={k: v for k, v in change.items() if k != "torque"})
         t0, c0 = time.perf_counter(), _cpu_s()
-        dt = rs.drivetrain_of(dspec, torque)
+        dt = rs.drivetrain_of(dspec, torque, spec.drive_line_model)
         dt = rs.matched_drivetrains(scene.housing, gm.housing_model, {torque: dt}, path)[0][torque]
         model = chain.with_drivetrain(gm, dt)
         reanalysis_s = time.perf_counter() - t0

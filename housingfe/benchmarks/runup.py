@@ -58,7 +58,7 @@ def _setup(quick: bool):
     scene, _ = load_runup_scene(SCENE, overrides)
     housing_scene, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
     torque = max(scene.runup.torques_nm)
-    return scene, housing_scene, drivetrain_of(scene.drivetrain, torque), torque
+    return scene, housing_scene, drivetrain_of(scene.drivetrain, torque, scene.runup.drive_line_model), torque
 
 
 # ------------------------------------------------------------------------------------------------ sections
@@ -296,10 +296,10 @@ def main(out_dir: Path, quick: bool) -> None:
     alone = runup_alone(gm, e2e["source"], scene, torque, repetitions)
     num = numerical_sigma(gm, scene, torque, e2e["lines"])
     other_torque = 1000.0
-    reuses = [reuse(gm, scene, f"{other_torque:g} N m", drivetrain_of(scene.drivetrain, other_torque),
+    reuses = [reuse(gm, scene, f"{other_torque:g} N m", drivetrain_of(scene.drivetrain, other_torque, spec.drive_line_model),
                     e2e["source"], other_torque)]
     spec_b = scene.drivetrain.model_copy(update={"gear_set": "B"})
-    dt_b = drivetrain_of(spec_b, torque)
+    dt_b = drivetrain_of(spec_b, torque, spec.drive_line_model)
     t0 = time.perf_counter()
     source_b = dt_b.source_model(harmonics=spec.harmonics, engagement=spec.engagement)
     source_b_s = time.perf_counter() - t0

@@ -16,7 +16,12 @@ on its axis at the bearing centre, tied to the nodes of the bore surface in one 
   energy 1/2 k |u_s - (u_m + theta_m x r_s)|^2.  A penalty: it tends to rbe2 as k -> infinity
   (see tests/drivetrain/test_coupling.py and docs/coupling.md for how the answer depends on k).
 
-Extra nodes (masters, shaft nodes) carry 6 DOFs each and are appended after the FE DOFs.  The whole coupled
+Extra nodes (masters, shaft nodes) carry 6 DOFs each and are appended after the FE DOFs.  A torsion node (e.g.
+the coupling of a drive line: a polar inertia between two torsion springs) has ONE independent DOF, its rotation
+phi (rad) about a unit axis a: its six DOFs are u = 0, theta = a phi, constraints of the same u_full = P q kind
+(its translations are rows of P without entries, its rotations refer to the one kept rotation component, the one
+of largest |a_k|: theta_j = (a_j / a_k) theta_k).  So a node that only a torsion spring and a polar inertia
+touch gets no penalty springs and no arbitrary diagonal values for the DOFs nothing holds.  The whole coupled
 model is the transformation u_full = P q from the independent DOFs q, with K_c = P^T K_full P (likewise M, C):
 no constraint rows are kept, so there are no spurious eigenvalues from constrained DOFs (the usual trouble
 with MPC/penalty diagonals in eigenproblems) and the modal (SLEPc, inertia-counted) and harmonic solvers
@@ -291,7 +296,8 @@ class CoupledSystem:
         """Six q vectors: unit translations x, y, z and unit rotations about the global x, y, z axes through the
         origin of the whole coupled system (every FE node, every extra node: u = theta x r, rotation DOFs =
         theta).  With the rigid modes of (K, M): housingfe.solvers.modal.rigid_body_mass_properties(M, modes,
-        system.rigid_body_vectors(V)) gives the total mass and centre of gravity."""
+        system.rigid_body_vectors(V)) gives the total mass and centre of gravity.  A torsion node keeps only its
+        rotation about its axis (its constraints hold no rigid translation; it carries no translational mass)."""
         lo, n_loc_fe, _ = self._full_range()
         bs = V.dofmap.index_map_bs
         x = V.tabulate_dof_coordinates()[:n_loc_fe // bs]
@@ -315,20 +321,25 @@ class CoupledSystem:
 
 # ------------------------------------------------------------------------------------------------ coupling
 def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_rods=(),
-           extra_nodes=None) -> CoupledSystem:
+           extra_nodes=None, torsion_nodes=None) -> CoupledSystem:
     """Couple a HousingModel with bore masters, shafts and lumped elements (collective: call on every rank).
 
     connections: BoreConnection list (a master node per bore, named by the connection).
     shafts: {name: housingfe.drivetrain.shafts.Shaft}; node i of shaft `name` is called "name:i" (its discs and supports
     are included through Shaft.matrices()).
     extra_nodes: {name: position} free 6-DOF nodes without stiffness of their own (e.g. a ground-less hub).
+    torsion_nodes: {name: (position, axis)} nodes with one DOF, the rotation about `axis` (module docstring):
+    elements on them act through u = 0, theta = axis phi.
     elements: Element list (springs, bearings, point masses) among any named nodes; gear_meshes: GearMesh
     list; tie_rods: TieRod list (beams between named nodes).
     """
     t0 = time.perf_counter()
     release_petsc_garbage(model.K.getComm())
     n_fe = model.K.getSize()[0]
-    nodes = _register_nodes(n_fe, connections, shafts, extra_nodes)
+    torsion_nodes = {name: (position, _unit(axis, f"torsion node {name}"))
+                     for name, (position, axis) in (torsion_nodes or {}).items()}
+    nodes = _register_nodes(n_fe, connections, shafts, {**(extra_nodes or {}),
+                                                       **{n: x for n, (x, _) in torsion_nodes.items()}})
     lay = _Layout(model, 6 * len(nodes))
     # the lumped parts are small: every rank builds them (same checks, same symmetry flag), the last adds them
     Kx, Mx, Cx = _extra_matrices(nodes, shafts, list(elements) + [_gear_element(g, nodes) for g in gear_meshes]
@@ -345,7 +356,7 @@ def couple(model, connections=(), elements=(), shafts=None, gear_meshes=(), tie_
     C_full = _full_damping(lay, Cx) if lay.comm.allreduce(bool(Cx)) else None
     t2 = time.perf_counter()
 
-    P, independent = _transformation(lay, connections, bores, nodes)
+    P, independent = _transformation(lay, connections, bores, nodes, torsion_nodes)
     K, M = _triple_products(K_full, M_full, P)
     C = _ptap(C_full, P) if C_full is not None else None
     for A in (K_full, M_full, C_full):
@@ -463,9 +474,24 @@ def _bores(model, lay: _Layout, connections) -> list[_Bore]:
     return out
 
 
-def _transformation(lay: _Layout, connections, bores, nodes: dict) -> tuple[PETSc.Mat, np.ndarray]:
+def torsion_dof(axis) -> int:
+    """The rotation component (0, 1, 2 = theta_x, theta_y, theta_z) a torsion node keeps: that of the largest
+    |axis_k| (the others follow as theta_j = axis_j / axis_k theta_k)."""
+    return int(np.argmax(np.abs(np.asarray(axis, float))))
+
+
+def _unit(axis, what: str) -> np.ndarray:
+    a = np.asarray(axis, float)
+    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
+        raise InputError(f"{what}: axis must be a finite non-zero 3-vector")
+    return a / np.linalg.norm(a)
+
+
+def _transformation(lay: _Layout, connections, bores, nodes: dict,
+                    torsion_nodes: dict | None = None) -> tuple[PETSc.Mat, np.ndarray]:
     """P (u_full = P q, MPIAIJ) and the local full rows that are q entries (the independent DOFs)."""
     comm, last = lay.comm, lay.comm.size - 1
+    torsion_nodes = torsion_nodes or {}
     eliminated = np.zeros(lay.n_local, bool)            # local full rows
     extra_eliminated = np.zeros(lay.n_x, bool)          # every extra DOF, on every rank
     for c, b in zip(connections, bores):
@@ -473,6 +499,9 @@ def _transformation(lay: _Layout, connections, bores, nodes: dict) -> tuple[PETS
             eliminated[b.dofs.ravel()] = True
         elif c.kind == "rbe3":
             extra_eliminated[nodes[c.name][1] - lay.n_fe + np.arange(6)] = True
+    for name, (_, axis) in torsion_nodes.items():       # all but the kept rotation component
+        kept = np.arange(6) != 3 + torsion_dof(axis)
+        extra_eliminated[nodes[name][1] - lay.n_fe + np.flatnonzero(kept)] = True
     if lay.last:
         eliminated[lay.n_fe_local:] = extra_eliminated
     independent = np.flatnonzero(~eliminated)
@@ -516,6 +545,14 @@ def _transformation(lay: _Layout, connections, bores, nodes: dict) -> tuple[PETS
                 rows.append(block[0])
                 cols.append(block[1])
                 vals.append(block[2])
+    if lay.last:
+        for name, (_, axis) in torsion_nodes.items():   # theta_j = a_j / a_k theta_k; translations: no entries
+            k = torsion_dof(axis)
+            mx = nodes[name][1] - lay.n_fe + np.arange(6)
+            others = [j for j in range(3) if j != k]
+            rows.append(lay.n_fe_local + mx[[3 + j for j in others]])
+            cols.append(np.full(2, q_extra[mx[3 + k]]))
+            vals.append(np.array([axis[j] / axis[k] for j in others]))
     r_all, c_all, v_all = np.concatenate(rows), np.concatenate(cols), np.concatenate(vals)
     _collective_check(comm, np.any(c_all < 0), "coupling: a constraint refers to an eliminated DOF (chained "
                                                "constraints)")

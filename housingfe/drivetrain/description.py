@@ -23,8 +23,11 @@ Where the thesis' two models genuinely differ, the description keeps both as nam
 * bearing positions: `lumped_bearing_spans` (bearing to gear FACE, Fig. 2.6 of the source model: 60 mm assumed,
   i.e. 93 / 91 mm from the gear centre) vs `BearingSeat.position` (mid bearing plate of the reconstructed housing,
   107.5 mm, measured on the mesh) in the FE reduction;
-* quill shafts and couplings: in the lumped model only (torsion springs and inertias to the motor and brake); the
-  FE shafts end flush with the bearing plates (`ShaftLine.ends`) and have no drive line beyond them.
+* quill shafts and couplings: the same drive line in both (`drive_line_parts`: per shaft the near quill, the coupling's
+  polar inertia, the far quill to ground; torsion only), in the FE reduction from the shaft's front end node (the
+  shafts end flush with the bearing plates, `ShaftLine.ends`) when `drive_line` = "quill-shafts"; with "none" (the
+  description's default, what the housing-side studies and scenes were built with) the FE shafts end there without
+  it and the FE gear train has a free rigid rotation (one zero mode).
 
 The layer contract puts housingfe.source below housingfe.drivetrain: the interior takes its gears, tooth forces and
 mesh stiffness from the source, never the other way round.
@@ -51,6 +54,13 @@ from housingfe.source.stiffness import (
 
 Vector3 = tuple[float, float, float]
 SHAFTS = ("pinion", "wheel")
+# the FE reduction's drive line beyond the shaft ends (Drivetrain.drive_line): "quill-shafts" = the lumped model's
+# quill shafts and couplings (Appendix C shafts 1-4, DOFs 13, 14), "none" = shafts ending at the bearing plates
+DRIVE_LINES = ("quill-shafts", "none")
+# the FE shaft node the drive line leaves from: the front end (node 0).  Fig. 5.1: both quill shafts leave the test
+# gearbox on the side of the auxiliary gearbox; which plate that is was not recoverable (assumed).  Torsion only,
+# so the side changes only the 140 mm of shaft between gear and end (~2e6 N m/rad, 20x the quills)
+DRIVE_LINE_NODE = 0
 # the sliding-friction resultants (housingfe.source.stiffness.FRICTION_RESULTANTS) -> their unit loads on the coupled
 # model (Drivetrain.friction_node_loads; housingfe.runup.chain.unit_loads with friction on)
 FRICTION_LOADS = {"force": "friction_force", "pinion_torque": "friction_pinion_torque",
@@ -173,7 +183,8 @@ class Drivetrain:
     "self_aligning", "tapered_roller", "cylindrical_roller", "fluid_film") whose 6x6 K (and C) replace the seats'
     own bearings in the FE reduction, at the statics loads of `torque` and, for the speed-dependent fluid film, the
     pinion speed bearing_speed_rpm (rev/min; the wheel turns the other way at z1/z2 of it); None: the seats' own
-    designations / matrices."""
+    designations / matrices.  drive_line (DRIVE_LINES): the FE reduction's drive line beyond the shaft ends,
+    "quill-shafts" (`drive_line_parts`, the lumped model's) or "none"."""
 
     gears: GearSet
     shafts: tuple[ShaftLine, ShaftLine]
@@ -189,8 +200,11 @@ class Drivetrain:
     hold_tilt: bool = True
     bearing_configuration: str | None = None
     bearing_speed_rpm: float = 1500.0
+    drive_line: str = "none"
 
     def __post_init__(self):
+        if self.drive_line not in DRIVE_LINES:
+            raise InputError(f"drive_line: {self.drive_line!r} is not one of {', '.join(DRIVE_LINES)}")
         if [s.name for s in self.shafts] != list(SHAFTS):
             raise InputError("drivetrain: shafts: need (pinion, wheel)")
         if not (math.isfinite(self.torque) and self.torque > 0):
@@ -260,6 +274,18 @@ class Drivetrain:
         interior, geometry, model = self.to_lumped()
         return SourceModel(self.gears.pair, self.gears.corrections, interior, geometry, mesh_model=model,
                            misalignment=misalignment, **kwargs)
+
+    def drive_line_parts(self) -> dict:
+        """{"pinion" | "wheel": (near quill k [N m/rad], coupling polar inertia [kg m^2], far quill k [N m/rad])}:
+        the drive line of each shaft in the lumped model's topology (housingfe.source.roosmalen.dynamics.assemble:
+        pinion -shaft 2- coupling DOF 13 -shaft 1- held far end; wheel -shaft 3- coupling DOF 14 -shaft 4-
+        ground), k = pi G d^4 / (32 l) with the gear material's G = E / (2 (1 + nu)) as `derive_interior` takes it.
+        Both reductions take these numbers."""
+        p = self.gears.pair
+        G = p.youngs_modulus / (2 * (1 + p.poisson_ratio))
+        k = [q.stiffness(G) for q in self.quill_shafts]          # shafts 1, 2, 3, 4
+        return {"pinion": (k[1], self.couplings[0].inertia, k[0]),
+                "wheel": (k[2], self.couplings[1].inertia, k[3])}
 
     # ------------------------------------------------------------------------- lumped <-> housing frames
     def lumped_frame(self) -> np.ndarray:
@@ -474,7 +500,9 @@ class Drivetrain:
     def to_coupling_spec(self, forces: GearForces | None = None):
         """The FE interior on the housing's bores (housingfe.drivetrain.interior.CouplingSpec): bore masters of
         kind rbe2 at the bearing bores, the two shafts with their gears as rigid discs bored to the shaft, the
-        bearings (designation at the statics load, tilt held), the gear mesh (mean stiffness at `torque`)."""
+        bearings (designation at the statics load, tilt held), the gear mesh (mean stiffness at `torque`), and with
+        drive_line = "quill-shafts" the drive lines (`drive_line_parts` from each shaft's front end node to a
+        coupling node "coupling_<motor|brake>" and on to ground; housingfe.drivetrain.interior.DriveLineSpec)."""
         from housingfe.drivetrain.interior import CouplingSpec
 
         forces = forces or self.gear_forces()
@@ -511,8 +539,14 @@ class Drivetrain:
         mesh = {"a": f"pinion:{nodes['pinion']['gear']}", "b": f"wheel:{nodes['wheel']['gear']}",
                 "stiffness": forces.stiffness, "point": tuple(float(x) for x in forces.point),
                 "direction": tuple(float(x) for x in forces.direction)}
+        drive_lines = []
+        if self.drive_line == "quill-shafts":
+            for name, (near, inertia, far) in self.drive_line_parts().items():
+                coupling = self.couplings[SHAFTS.index(name)].name
+                drive_lines.append({"name": f"coupling_{coupling}", "shaft_node": f"{name}:{DRIVE_LINE_NODE}",
+                                    "near_stiffness": near, "inertia": inertia, "far_stiffness": far})
         return CouplingSpec.model_validate({"bores": bores, "shafts": shafts, "bearings": bearings,
-                                            "gear_meshes": [mesh]})
+                                            "gear_meshes": [mesh], "drive_lines": drive_lines})
 
 
 # ------------------------------------------------------------------------------------------ test gearbox

@@ -148,20 +148,36 @@ class TieRodSpec(_Strict):
     rigid_end_b: float = Field(0.0, ge=0.0, json_schema_extra={"unit": "m"})
 
 
+class DriveLineSpec(_Strict):
+    """The drive line beyond a shaft end (a test rig's quill shafts): from the shaft node `shaft_node` a torsion
+    spring `near_stiffness` (N m/rad, the quill between the shaft and the coupling) to a coupling node `name` of
+    polar inertia `inertia` (kg m^2), and from it a torsion spring `far_stiffness` (N m/rad, the quill to the
+    motor / brake) to ground.  Torsion only, about the shaft's axis: a flexible coupling transmits torque and no
+    lateral force or bending moment.  The coupling node is a torsion node (housingfe.drivetrain.coupling: one DOF,
+    its rotation about the axis; u = 0, theta = axis phi as constraints of u_full = P q, no penalty values)."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_]+$")
+    shaft_node: str
+    near_stiffness: PositiveFloat = Field(json_schema_extra={"unit": "N m/rad"})
+    inertia: PositiveFloat = Field(json_schema_extra={"unit": "kg m^2"})
+    far_stiffness: PositiveFloat = Field(json_schema_extra={"unit": "N m/rad"})
+
+
 class CouplingSpec(_Strict):
     bores: list[BoreMasterSpec] = []
     shafts: list[ShaftSpec] = []
     bearings: list[BearingSpec] = []
     gear_meshes: list[GearMeshSpec] = []
     tie_rods: list[TieRodSpec] = []
+    drive_lines: list[DriveLineSpec] = []
 
 
     @model_validator(mode="after")
     def _unique(self):
-        names = [b.name for b in self.bores] + [s.name for s in self.shafts]
+        names = [b.name for b in self.bores] + [s.name for s in self.shafts] + [d.name for d in self.drive_lines]
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
-            raise ValueError(f"bores: names must be unique among bores and shafts ({', '.join(dup)})")
+            raise ValueError(f"bores: names must be unique among bores, shafts and drive lines ({', '.join(dup)})")
         return self
 
 
@@ -177,10 +193,20 @@ class Parts:
     gear_meshes: list
     tie_rods: list          # Elements (beam K, M between the two nodes, rigid ends included)
     positions: dict         # node name (bores, shaft nodes) -> position (m)
+    drive_lines: list = field(default_factory=list)     # Elements: torsion springs and coupling inertias
+    torsion_nodes: dict = field(default_factory=dict)   # coupling node name -> (position m, unit axis)
 
     @property
     def elements(self) -> list:
-        return self.bearings + self.tie_rods
+        return self.bearings + self.tie_rods + self.drive_lines
+
+    def couple(self, model, extra_elements=(), gear_meshes=None):
+        """housingfe.drivetrain.coupling.couple() of these parts (plus `extra_elements`; gear_meshes: these
+        parts' own unless given)."""
+        from housingfe.drivetrain import coupling as cp
+
+        return cp.couple(model, self.connections, self.elements + list(extra_elements), self.shafts,
+                         self.gear_meshes if gear_meshes is None else gear_meshes, torsion_nodes=self.torsion_nodes)
 
 
 def _check(spec: CouplingSpec) -> CouplingSpec:
@@ -234,7 +260,35 @@ def parts(spec: CouplingSpec, bore_centres: dict) -> Parts:
                 **{f"{n}:{i}": x for n, sh in shafts.items() for i, x in enumerate(sh.nodes)}}
     rods = [tie_rod_element(t, position[t.a], position[t.b], f"coupling.tie_rods.{i}")
             for i, t in enumerate(spec.tie_rods)]
-    return Parts(connections, shafts, bearings, meshes, rods, position)
+    lines, torsion = [], {}
+    for i, d in enumerate(spec.drive_lines):
+        shaft = shafts.get(d.shaft_node.split(":")[0]) if ":" in d.shaft_node else None
+        if shaft is None or d.shaft_node not in position:
+            raise InputError(f"coupling.drive_lines.{i}.shaft_node: unknown shaft node {d.shaft_node!r} "
+                             "('<shaft>:<index>')")
+        axis = np.asarray(shaft.axis, float) / np.linalg.norm(shaft.axis)
+        torsion[d.name] = (position[d.shaft_node], axis)
+        lines += drive_line_elements(d, axis)
+    return Parts(connections, shafts, bearings, meshes, rods, position, lines, torsion)
+
+
+def torsion_block(value: float, axis) -> np.ndarray:
+    """6x6 with value a a^T in the rotation block (a unit axis): a torsion spring's K6 (N m/rad) or a polar
+    inertia's M6 (kg m^2) about the axis, nothing in the translations or the other rotations."""
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    out = np.zeros((6, 6))
+    out[3:, 3:] = value * np.outer(a, a)
+    return out
+
+
+def drive_line_elements(d: DriveLineSpec, axis) -> list:
+    """The Elements of a drive line (DriveLineSpec): the near torsion spring shaft node - coupling node, the
+    coupling's polar inertia, the far torsion spring coupling node - ground."""
+    from housingfe.drivetrain import coupling as cp
+
+    return [cp.spring(d.shaft_node, d.name, torsion_block(d.near_stiffness, axis)),
+            cp.point_mass(d.name, torsion_block(d.inertia, axis)),
+            cp.spring(d.name, None, torsion_block(d.far_stiffness, axis))]
 
 
 def tie_rod_element(t: TieRodSpec, pa: np.ndarray, pb: np.ndarray, key: str):
@@ -272,11 +326,8 @@ def bore_centres(model, spec: CouplingSpec) -> dict:
 
 def couple_from_spec(model, spec: CouplingSpec | dict):
     """housingfe.drivetrain.coupling.couple() from a scene's [coupling] section (a CouplingSpec or the raw dict)."""
-    from housingfe.drivetrain import coupling as cp
-
     spec = _check(spec)
-    p = parts(spec, bore_centres(model, spec))
-    return cp.couple(model, p.connections, p.elements, p.shafts, p.gear_meshes)
+    return parts(spec, bore_centres(model, spec)).couple(model)
 
 
 # -------------------------------------------------------------------------------- interior on rigid bores
@@ -294,23 +345,40 @@ class RigidBoreModes:
     dofs: int
 
 
-def interior_matrices(spec: CouplingSpec, centres: dict):
+def interior_matrices(spec: CouplingSpec, centres: dict, housing_body: bool = False):
     """Dense K, M (and the bearings' K alone) of the interior with the bore masters fixed (SI units).
-    Returns (K, M, K_bearings, node names in DOF order)."""
+    Returns (K, M, K_bearings, node names in DOF order).  Shaft nodes carry 6 DOFs each (global axes), then the
+    drive lines' coupling nodes one each (their rotation about the shaft axis, named like the node).
+    housing_body: the bore masters follow the rigid motion of one body instead (6 DOFs named "housing" first:
+    u, theta about the origin; no mass): the interior on a free rigid housing."""
     from housingfe.drivetrain import coupling as cp
 
     p = parts(spec, centres)
-    names = [f"{n}:{i}" for n, sh in p.shafts.items() for i in range(len(sh.nodes))]
+    names = [f"{n}:{i}" for n, sh in p.shafts.items() for i in range(len(sh.nodes))] + list(p.torsion_nodes)
+    if housing_body:
+        names = ["housing"] + names
     index = {n: 6 * i for i, n in enumerate(names)}
     size = 6 * len(names)
     K, M, Kb = np.zeros((size, size)), np.zeros((size, size)), np.zeros((size, size))
+    # a bore master's 6 DOFs as the housing body's: u_m = u + theta x c, theta_m = theta
+    follow = {}
+    if housing_body:
+        for c in p.connections:
+            T = np.eye(6)
+            T[:3, 3:] = -cp.skew(np.asarray(c.centre, float))
+            follow[c.name] = T
 
     def add(target, nodes, block):
-        # rows/columns of bore masters (fixed) and ground (None) are dropped
-        keep = [(j, index[n]) for j, n in enumerate(nodes) if n in index]
-        for a, ia in keep:
-            for b, ib in keep:
-                target[ia:ia + 6, ib:ib + 6] += block[6 * a:6 * a + 6, 6 * b:6 * b + 6]
+        # rows/columns of fixed bore masters and of ground (None) are dropped
+        maps = []
+        for j, n in enumerate(nodes):
+            if n in index:
+                maps.append((j, index[n], np.eye(6)))
+            elif n in follow:
+                maps.append((j, index["housing"], follow[n]))
+        for a, ia, Ta in maps:
+            for b, ib, Tb in maps:
+                target[ia:ia + 6, ib:ib + 6] += Ta.T @ block[6 * a:6 * a + 6, 6 * b:6 * b + 6] @ Tb
 
     for name, shaft in p.shafts.items():
         ks, ms = shaft.matrices()
@@ -320,12 +388,40 @@ def interior_matrices(spec: CouplingSpec, centres: dict):
     for e in p.bearings:
         add(K, list(e.nodes), e.K)
         add(Kb, list(e.nodes), e.K)
+    for e in p.drive_lines + p.tie_rods:
+        for target, block in ((K, e.K), (M, e.M)):
+            if block is not None:
+                add(target, list(e.nodes), block)
     for g in p.gear_meshes:
         add(K, [g.a, g.b], cp.gear_mesh_element(g, p.positions[g.a], p.positions[g.b]).K)
-    for e in p.tie_rods:
-        add(K, list(e.nodes), e.K)
-        add(M, list(e.nodes), e.M)
+    if p.torsion_nodes:     # a coupling node keeps its rotation about the axis: T maps it to the node's 6 DOFs
+        T = np.zeros((size, size - 5 * len(p.torsion_nodes)))
+        col = 0
+        for n in names:
+            i = index[n]
+            if n in p.torsion_nodes:
+                T[i + 3:i + 6, col] = p.torsion_nodes[n][1]
+                col += 1
+            else:
+                T[i:i + 6, col:col + 6] = np.eye(6)
+                col += 6
+        K, M, Kb = (T.T @ A @ T for A in (K, M, Kb))
     return K, M, Kb, names
+
+
+def free_housing_mechanisms(spec: CouplingSpec, centres: dict) -> int:
+    """Zero-stiffness modes of the interior on a FREE rigid housing (`interior_matrices(housing_body=True)`): the
+    zero modes a coupled model of a free housing has, since a zero-energy motion strains no part of the housing
+    (it moves as a rigid body, and the bore masters with it: rbe2 / rbe3 / star reproduce rigid motions exactly).
+    Without anything between the interior and ground this is 6 + the mechanisms on fixed bores; a grounded drive
+    line (or a bearing to ground) restrains some of the housing's six.  A dense rank count of the Jacobi-scaled K
+    (its symmetric part), a few hundred DOFs."""
+    K = interior_matrices(_check(spec), centres, housing_body=True)[0]
+    K = (K + K.T) / 2
+    d = np.sqrt(np.abs(np.diag(K)))
+    d[d == 0] = 1.0
+    lam = np.linalg.eigvalsh(K / d[:, None] / d[None, :])
+    return int(np.count_nonzero(lam < 1e-10 * lam.max()))
 
 
 def rigid_bore_modes(spec: CouplingSpec, centres: dict, f_max: float) -> RigidBoreModes:
@@ -436,20 +532,24 @@ class CoupledInterior:
         bearing matrix replaced by the nearest PSD matrix to its symmetric part (fluid films have a non-symmetric
         K whose symmetric part can be indefinite).  Same DOFs as K, built once."""
         if self._basis_K is None:
-            from housingfe.drivetrain import coupling as cp
-
             bearings = [b.model_copy(update={"designation": None, "load": None, "model": None, "fixed_tilt": None,
                                              "stiffness": None, "damping_matrix": None,
                                              "stiffness_matrix": nearest_psd(b.matrices()[0]).tolist()})
                         for b in self.spec.bearings]
-            p = parts(self.spec.model_copy(update={"bearings": bearings}), self.centres)
-            self._basis_K = cp.couple(self.model, p.connections, p.elements, p.shafts, p.gear_meshes).K
+            self._basis_K = parts(self.spec.model_copy(update={"bearings": bearings}), self.centres).couple(
+                self.model).K
         return self._basis_K
 
     def expected_mechanisms(self) -> int:
-        """Zero modes the coupled model must have: the housing's six rigid-body motions if it is free, plus the
-        interior's own mechanisms on fixed bores (each counted independently, by a dense rank count)."""
-        return self.model.rigid_modes_expected + self.rigid.mechanisms
+        """Zero modes the coupled model must have: on a held housing the interior's own mechanisms on fixed bores;
+        on a free one the zero modes of the interior on a free rigid housing (`free_housing_mechanisms`: the six
+        rigid-body motions plus the interior's mechanisms, fewer where a drive line ties the gears to ground).
+        Dense rank counts."""
+        if not self.model.rigid_modes_expected:
+            return self.rigid.mechanisms
+        if not self.spec.drive_lines and all(b.bore is not None for b in self.spec.bearings):
+            return self.model.rigid_modes_expected + self.rigid.mechanisms     # nothing to ground: independent
+        return free_housing_mechanisms(self.spec, self.centres)
 
     def fe_vector(self, q):
         """The housing displacement (PETSc Vec on model.V) of a coupled vector q."""
@@ -507,13 +607,11 @@ def build_interior(model, spec: CouplingSpec, f_max: float) -> CoupledInterior:
     """Couple a HousingModel with the interior of its scene; modes of the interior on rigid bores below f_max."""
     import time
 
-    from housingfe.drivetrain import coupling as cp
-
     t0 = time.perf_counter()
     spec = _check(spec)
     centres = bore_centres(model, spec)
     p = parts(spec, centres)
-    system = cp.couple(model, p.connections, p.elements, p.shafts, p.gear_meshes)
+    system = p.couple(model)
     rigid = rigid_bore_modes(spec, centres, f_max)
     model.timings["coupling_s"] = time.perf_counter() - t0
     return CoupledInterior(model, spec, p, system, rigid, centres)

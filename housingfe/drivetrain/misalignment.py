@@ -37,7 +37,8 @@ def static_gear_tilts(drivetrain, forces=None) -> tuple[np.ndarray, np.ndarray, 
 
     forces = forces or drivetrain.gear_forces()
     spec = drivetrain.to_coupling_spec(forces)
-    spec = spec.model_copy(update={"gear_meshes": []})
+    # the drive line beyond the shaft ends is torsion only, and the spin is held here: it changes no tilt
+    spec = spec.model_copy(update={"gear_meshes": [], "drive_lines": []})
     centres = {}
     for seat in drivetrain.bearings:
         centres[seat.name] = drivetrain.shaft(seat.shaft).point(seat.position)
@@ -91,7 +92,7 @@ def coupled_gear_tilts(housing_model, drivetrain, forces=None) -> tuple[np.ndarr
     from housingfe.drivetrain.interior import bore_centres, parts
 
     forces = forces or drivetrain.gear_forces()
-    spec = drivetrain.to_coupling_spec(forces).model_copy(update={"gear_meshes": []})
+    spec = drivetrain.to_coupling_spec(forces).model_copy(update={"gear_meshes": [], "drive_lines": []})
     centres = bore_centres(housing_model, spec)
     p = parts(spec, centres)
     loads, axes = _gear_loads(drivetrain, forces)

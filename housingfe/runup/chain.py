@@ -124,14 +124,20 @@ def unit_loads(structure, drivetrain, friction: bool = False) -> tuple[dict, str
 
 def bearing_pairs(structure) -> list:
     """Self-equilibrated unit force and moment pairs across every bearing (shaft node +, bore master -), six per
-    bearing, as coupled vectors: the static vectors that make a re-analysis with other bearing stiffnesses
-    (another torque, another configuration) accurate."""
+    bearing, and unit torques across each drive line's quills (about the shaft axis: shaft end +, coupling node -;
+    on the coupling node alone for the far quill to ground), as coupled vectors: the static vectors that make a
+    re-analysis with other bearing or quill stiffnesses (another torque, another configuration, the uncertainty's
+    quill samples) accurate."""
     out = []
     for b in structure.spec.bearings:
         for i in range(6):
             e = np.zeros(6)
             e[i] = 1.0
             out.append(structure.system.load(node_loads={b.shaft_node: e, b.bore: -e}))
+    for d in structure.spec.drive_lines:
+        e = np.r_[np.zeros(3), structure.shaft_axis(d.shaft_node)]
+        out.append(structure.system.load(node_loads={d.shaft_node: e, d.name: -e}))
+        out.append(structure.system.load(node_loads={d.name: e}))
     return out
 
 
@@ -175,6 +181,9 @@ def with_drivetrain(model: GearboxModel, drivetrain) -> GearboxModel:
     from housingfe.drivetrain.interior import build_interior
 
     t0 = time.perf_counter()
+    if drivetrain.drive_line != model.drivetrain.drive_line:
+        raise InputError(f"drivetrain: drive_line {drivetrain.drive_line!r} is not the model's "
+                         f"({model.drivetrain.drive_line!r}): another set of DOFs, build a new gearbox model")
     structure = build_interior(model.housing_model, drivetrain.to_coupling_spec(),
                                model.basis.f_max)
     loads, wheel, axis = unit_loads(structure, drivetrain, has_friction_loads(model))
@@ -384,12 +393,30 @@ def mesh_receptance(model: GearboxModel, frequencies_hz) -> np.ndarray:
     """g(f) = h^T H(f) h (m/N) of the coupled model (holding its mean mesh stiffness) at the gear mesh: the mesh
     compression per unit compressive mesh-force pair, from the Ritz reduction (the modal basis with its static
     correction; the reduction's damping), batched over the frequencies (Hz, > 0).  At f = 0 the value is
-    1 / k_ref exactly (`coupled_source_lines`): the gears turn freely apart from the mesh, so only the mesh spring
-    resists a static mesh compression."""
+    1 / k_ref exactly without a drive line (`coupled_source_lines`): the gears turn freely apart from the mesh, so
+    only the mesh spring resists a static mesh compression; with the drive line (runup.drive_line) the quill shafts
+    resist it too (`static_mesh_receptance`)."""
     red = model.reduction
     j = red.names.index("mesh")
     # the reduction remembers the solve: a re-run with another engagement shock reuses it (engagement_rerun)
     return red.system.Fr[:, j] @ red.unit_coordinates(frequencies_hz, "mesh")
+
+
+# g(0) of a model with a drive line: the Ritz solve at this frequency (Hz).  The reduction holds the static
+# vector of the mesh load, so this is the static receptance to (f / f_rig)^2 ~ 1e-10 (rig mode ~76 Hz), and a free
+# housing's rigid modes, on which the self-equilibrated mesh pair does no work, stay out of it
+STATIC_RECEPTANCE_HZ = 1e-3
+
+
+def static_mesh_receptance(model: GearboxModel) -> float:
+    """g(0) (m/N): the coupled model's static mesh compression per unit compressive mesh-force pair.  Without a
+    drive line exactly 1 / k_ref (the gears turn freely apart from the mesh); with one (the quill shafts to motor
+    and brake, housingfe.drivetrain.interior.DriveLineSpec) less: a static mesh-force pair also twists the loop
+    through the quills, as the lumped source's g(0) does (dynamics.lumped_receptance)."""
+    k_ref = mesh_reference_stiffness(model)
+    if not model.structure.spec.drive_lines:
+        return 1.0 / k_ref
+    return float(np.real(mesh_receptance(model, [STATIC_RECEPTANCE_HZ])[0]))
 
 
 @single_thread
@@ -401,8 +428,9 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
     mesh excitation from the harmonic balance of the time-varying mesh solved on the coupled gearbox instead of the
     rigid-bore lumped interior (housingfe.source.roosmalen.dynamics.mesh_harmonic_balance
     with the coupled model's mesh receptance, `mesh_receptance`): S(t) and F_e(t) of `source` at each torque, the
-    coupled model's mean mesh stiffness k_ref, its static state (the transmitted normal force F: b_0 = F / k_ref,
-    g(0) = 1 / k_ref).  mesh_excitation is W_n - k_ref d_n (what the mesh_force route applies); L_omega_flexible is
+    coupled model's mean mesh stiffness k_ref, its static state (the transmitted normal force F: b_0 = F / k_ref, the
+    mesh carries F whatever else the torque loop holds; g(0) = `static_mesh_receptance`, 1 / k_ref without a drive
+    line).  mesh_excitation is W_n - k_ref d_n (what the mesh_force route applies); L_omega_flexible is
     the wheel's level on the coupled model (what the mesh_force route's L_omega_coupled then is, too).  model: the
     GearboxModel at the torque (one torque per model: another torque changes the bearings, `with_drivetrain`).  first_order: the mean-stiffness solve (quasi-static transmission
     error on the mean system).  harmonics: H of the balance (default: the source's).  mesh_moment (MESH_MOMENTS):
@@ -415,6 +443,7 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
     t0 = time.perf_counter()
     H = int(harmonics or source.harmonics)
     k_ref = mesh_reference_stiffness(model)
+    g0 = static_mesh_receptance(model)
     rigid, _ = source_lines(source, speeds_rpm, torques_nm, f_lines_max, mesh_moment, mesh_friction)
     cols = {k: [] for k in ("frequency", "mesh_excitation")}
     for torque in torques_nm:
@@ -424,7 +453,7 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
         nn = np.arange(1, H + 1)
         g = mesh_receptance(model, (f_t[:, None] * nn[None, :]).ravel()).reshape(len(f_t), H)
         for i in range(len(f_t)):
-            rec = np.concatenate([[1.0 / k_ref], g[i]])
+            rec = np.concatenate([[g0], g[i]])
             st = mesh_harmonic_balance(rec, F / k_ref, S, shock, k_ref, f_t[i], first_order=first_order)
             f, exc = st.one_sided(st.excitation)
             keep = f <= f_lines_max * (1 + 1e-12)

@@ -93,6 +93,7 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "scene_settings": scene.model_dump(mode="json"),
         "mesh_moment": scene.runup.mesh_moment_model,     # in effect (the setting may leave it to the default)
         "mesh_friction": friction_in_effect(scene, results),
+        "drive_line": scene.runup.drive_line_model,       # in effect
         "timings_s": timings,
         "modal_basis": gm.summary(),
         "housing_resolution": _resolution(gm),
@@ -249,6 +250,10 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
     friction = friction_line(scene, results)
     if friction:
         lines.append(friction)
+    if scene.runup.drive_line_model == "quill-shafts":
+        lines.append("drive line: the quill shafts and couplings to motor and brake (runup.drive_line) are in the "
+                     "coupled model; its lowest elastic mode "
+                     + (f"{b.frequencies_hz[b.rigid_count]:.1f} Hz" if len(b.frequencies_hz) > b.rigid_count else "-"))
     lines += list(notes)
     lines.append("checks (ours | measured | thesis calc. | pass):")
     for r in check_rows:

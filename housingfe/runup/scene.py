@@ -135,6 +135,19 @@ class RunupSpec(_Strict):
     # assumed) -- that formula was written from memory and is NOT verified against the standard's text, hence off by
     # default; or a number = a fixed mean coefficient, 0 < mu < 0.3
     mesh_friction: Union[Literal["none", "iso13989"], float] = Field("none", json_schema_extra={"unit": "-"})
+    # the test rig's drive line in the coupled FE model (housingfe.drivetrain.description.DRIVE_LINES): "quill-shafts"
+    # = the quill shafts and couplings to the motor and the brake (torsion springs, coupling inertias: the lumped
+    # source's, Appendix C shafts 1-4) from the shafts' front ends to ground, which restrain the gear train's rigid
+    # rotation (a rig torsion mode near 76 Hz instead of a zero mode); "none" = the shafts end at the bearing
+    # plates.  Default: "quill-shafts", and "none" with the thesis' replica "thesis-2d" (docs/runup.md)
+    drive_line: Optional[Literal["quill-shafts", "none"]] = None
+
+    @property
+    def drive_line_model(self) -> str:
+        """The FE drive line in effect (see `drive_line`)."""
+        if self.drive_line is not None:
+            return self.drive_line
+        return "none" if self.engagement == "thesis-2d" else "quill-shafts"
 
     @property
     def mesh_moment_model(self) -> str:
@@ -260,12 +273,13 @@ def load_runup_scene(name_or_path: str, overrides: list[str] | None = None) -> t
     return scene, path
 
 
-def drivetrain_of(spec: DrivetrainSpec, torque: float):
-    """The Drivetrain of a scene's [drivetrain] at a pinion torque (N m)."""
+def drivetrain_of(spec: DrivetrainSpec, torque: float, drive_line: str = "none"):
+    """The Drivetrain of a scene's [drivetrain] at a pinion torque (N m), with the FE drive line `drive_line`
+    (a run-up's RunupSpec.drive_line_model; housingfe.drivetrain.description.DRIVE_LINES)."""
     from dataclasses import replace
 
     dt = _gearboxes()[spec.gearbox](spec.gear_set, spec.bearings, torque)
-    return replace(dt, bearing_speed_rpm=spec.bearing_speed_rpm)
+    return replace(dt, bearing_speed_rpm=spec.bearing_speed_rpm, drive_line=drive_line)
 
 
 @single_thread
@@ -287,7 +301,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     spec = scene.runup
     housing_scene, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
     try:
-        drivetrains = {t: drivetrain_of(scene.drivetrain, t) for t in spec.torques_nm}
+        drivetrains = {t: drivetrain_of(scene.drivetrain, t, spec.drive_line_model) for t in spec.torques_nm}
         for t, dt in drivetrains.items():     # a bearing that cannot carry its load stops here, before any FE
             dt.to_coupling_spec()
     except InputError as exc:

@@ -110,7 +110,7 @@ class ChainSession:
         if key not in self._drivetrains:
             spec = self.scene.drivetrain.model_copy(update={"gear_set": gear_set, "bearings": bearings})
             try:
-                dt = drivetrain_of(spec, float(torque))
+                dt = drivetrain_of(spec, float(torque), self.scene.runup.drive_line_model)
                 self._layouts[id(dt)] = layout_key(dt)      # builds the coupling spec: bearings at their loads
             except InputError as exc:
                 raise InputError(f"{self.scene_path}: {exc}") from None
@@ -235,6 +235,8 @@ def layout_key(drivetrain) -> str:
     spec = drivetrain.to_coupling_spec().model_dump(mode="json")
     bearing_keys = ("name", "shaft_node", "bore", "axis")
     spec["bearings"] = [{k: b.get(k) for k in bearing_keys} for b in spec["bearings"]]
+    # the drive line's springs and inertias change no DOF: a re-analysis takes other quill shafts (uncertainty)
+    spec["drive_lines"] = [{k: d[k] for k in ("name", "shaft_node")} for d in spec.get("drive_lines", [])]
     for mesh in spec["gear_meshes"]:
         mesh.pop("stiffness", None)
         mesh["point"] = [round(x, 9) for x in mesh["point"]]

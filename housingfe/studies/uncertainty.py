@@ -296,7 +296,7 @@ def perturbed_drivetrain(base: _Base, values: dict, gear_set: str, bearings: str
     from housingfe.runup.scene import drivetrain_of
 
     spec = base.session.scene.drivetrain.model_copy(update={"gear_set": gear_set, "bearings": bearings})
-    dt = drivetrain_of(spec, float(torque)).with_bores(base.surfaces)
+    dt = drivetrain_of(spec, float(torque), base.session.scene.runup.drive_line_model).with_bores(base.surfaces)
     changes = {}
     sd, sl = values["quill_diameter_scale"], values["quill_length_scale"]
     if (sd, sl) != (1.0, 1.0):

@@ -3,6 +3,9 @@ coupled test gearbox:
 
 * the mesh receptance of the Ritz reduction tends to 1/k_ref at zero frequency (the gears turn freely apart from
   the mesh: only the mesh spring resists a static compression) — the static value the balance uses;
+* with the drive line (runup.drive_line = "quill-shafts") the static receptance is the mesh spring in parallel with
+  the quill shafts' torsional stiffness seen along the line of action (chain.static_mesh_receptance), within the
+  bearings' and housing's share;
 * the rank-one harmonic balance on that receptance equals the full Hill system assembled on every Ritz coordinate
   of the coupled model (housingfe.benchmarks.flexsource.full_hill_on_ritz, which the benchmark times too; mesh
   compression per harmonic, 1e-8 of its largest dynamic harmonic);
@@ -23,6 +26,7 @@ from housingfe.runup.chain import (
     mesh_reference_stiffness,
     runup,
     source_lines,
+    static_mesh_receptance,
 )
 from housingfe.source.roosmalen.dynamics import mesh_harmonic_balance
 from housingfe.source.stiffness import normal_force_from_torque
@@ -36,6 +40,62 @@ def test_static_mesh_receptance_is_one_over_the_mesh_stiffness(coarse):
     gm = coarse[0]
     k = mesh_reference_stiffness(gm)
     assert mesh_receptance(gm, [1e-3])[0] * k == pytest.approx(1.0, abs=1e-6)
+
+
+@pytest.fixture(scope="module")
+def coarse_drive_line(coarse):
+    """The coarse model's housing and drivetrain with the quill shafts (runup.drive_line = "quill-shafts")."""
+    from dataclasses import replace
+
+    from housingfe.runup.chain import build_gearbox_model
+
+    gm0 = coarse[0]
+    return build_gearbox_model(gm0.housing_model, replace(gm0.drivetrain, drive_line="quill-shafts"), F_LINES)
+
+
+@pytest.mark.slow
+def test_static_mesh_receptance_with_the_drive_line(coarse_drive_line):
+    """1/g(0) - k_ref = 1/s, s = a_p^2/k_p + a_w^2/k_w: the mesh pair turns each gear against its quill chain
+    (near quill in series with the FE shaft's torsion from gear to shaft end, far quill to ground), a = the mesh
+    normal's lever about each shaft axis (rotation-only model: g = s / (1 + k_ref s)).  The bearings and the
+    housing add translational compliance along the line of action: within 3 %.  Without the drive line g(0) is
+    1/k_ref exactly (above)."""
+    gm = coarse_drive_line
+    dt = gm.drivetrain
+    k_ref = mesh_reference_stiffness(gm)
+    mesh = gm.structure.spec.gear_meshes[0]
+    pair = dt.gears.pair
+    G = pair.youngs_modulus / (2 * (1 + pair.poisson_ratio))
+    inverse = 0.0
+    for name in ("pinion", "wheel"):
+        line = dt.shaft(name)
+        axis = np.asarray(line.axis, float) / np.linalg.norm(line.axis)
+        lever = axis @ np.cross(np.asarray(mesh.point) - np.asarray(line.centre), np.asarray(mesh.direction))
+        near, _, far = dt.drive_line_parts()[name]
+        shaft = G * math.pi * line.diameter**4 / 32 / (0.0 - line.ends[0])
+        inverse += lever**2 * (1 / near + 1 / far + 1 / shaft)
+    g0 = static_mesh_receptance(gm)
+    assert 0.99 < g0 * k_ref < 1.0                     # the quills are ~1000x softer than the mesh
+    assert 1 / g0 - k_ref == pytest.approx(1 / inverse, rel=0.03)
+
+
+@pytest.mark.slow
+def test_reanalysis_with_other_quill_shafts(coarse_drive_line):
+    """The uncertainty's quill samples re-use the basis (with_drivetrain): with every quill 20 % thinner (stiffness
+    x 0.41) the re-analysed rig mode is the spring chain's (tests/drivetrain/test_drive_line.py) within 0.5 %, as
+    the fresh model's is; the Ritz space holds the static torques across the quills (chain.bearing_pairs)."""
+    from dataclasses import replace
+
+    from housingfe.runup.chain import with_drivetrain
+    from tests.drivetrain.test_drive_line import _rig_chain_hz
+
+    gm = coarse_drive_line
+    thin = replace(gm.drivetrain, quill_shafts=tuple(replace(q, diameter=0.8 * q.diameter)
+                                                     for q in gm.drivetrain.quill_shafts))
+    before = gm.reduction.frequencies_hz[0]
+    after = with_drivetrain(gm, thin).reduction.frequencies_hz[0]
+    assert before == pytest.approx(_rig_chain_hz(gm.drivetrain), rel=5e-3)
+    assert after == pytest.approx(_rig_chain_hz(thin), rel=5e-3) and after < 0.75 * before
 
 
 @pytest.mark.slow

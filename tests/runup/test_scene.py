@@ -31,6 +31,7 @@ def test_builtin_scenes_validate(name):
     ('runup.engagement="3-d"', "runup.engagement"),
     ('runup.engagement="envelope-bund"', "runup.engagement"),
     ('runup.mesh_moment="shutling"', "runup.mesh_moment"),
+    ('runup.drive_line="quills"', "runup.drive_line"),
 ])
 def test_bad_values_name_the_key(override, key):
     with pytest.raises(InputError) as err:
@@ -66,6 +67,21 @@ def test_mesh_friction_choices(overrides, friction):
     assert scene.runup.mesh_friction == friction
 
 
+@pytest.mark.parametrize("overrides, drive_line", [([], "quill-shafts"), (['runup.engagement="thesis-2d"'], "none"),
+                                                   (['runup.drive_line="none"'], "none"),
+                                                   (['runup.engagement="thesis-2d"', 'runup.drive_line="quill-shafts"'],
+                                                    "quill-shafts")])
+def test_drive_line_choices(overrides, drive_line):
+    """runup.drive_line: the quill shafts and couplings in the coupled model by default; the thesis' replica keeps
+    the shafts ending at the plates unless asked.  The run's drivetrains carry the choice to their FE reduction."""
+    from housingfe.runup.scene import drivetrain_of
+
+    scene, _ = load_runup_scene("test-gearbox-runup", overrides)
+    assert scene.runup.drive_line_model == drive_line
+    spec = drivetrain_of(scene.drivetrain, 2000.0, scene.runup.drive_line_model).to_coupling_spec()
+    assert len(spec.drive_lines) == (2 if drive_line == "quill-shafts" else 0)
+
+
 def test_missing_drivetrain_is_named(tmp_path):
     text = (Path(__file__).parents[2] / "housingfe/scenes/test-gearbox-runup.toml").read_text()
     start = text.index("[drivetrain]")
@@ -88,6 +104,7 @@ def test_missing_drivetrain_is_named(tmp_path):
     (["--set", "runup.mesh_friction=-0.1"], "runup.mesh_friction: a mean friction coefficient must lie between 0"),
     (["--set", "runup.mesh_friction=0.5"], "runup.mesh_friction: a mean friction coefficient must lie between 0"),
     (["--set", "runup.mesh_friction=foo"], "runup.mesh_friction: 'foo' is not one of none, iso13989"),
+    (["--set", "runup.drive_line=quills"], "runup.drive_line: Input should be 'quill-shafts' or 'none'"),
 ])
 def test_cli_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
     out = tmp_path / "out"
