@@ -18,6 +18,7 @@ import pytest
 from housingfe.drivetrain import coupling as cp
 from housingfe.drivetrain.description import test_gearbox
 from housingfe.drivetrain.interior import build_interior
+from housingfe.errors import SolverError
 from housingfe.scene import build_model_from_scene, load_housing_scene
 from housingfe.solvers import modal
 from tests.two_ranks import module_result
@@ -84,6 +85,17 @@ def test_free_test_gearbox_keeps_its_zero_modes(free_housing, drive_line, expect
     held = [4] if drive_line == "quill-shafts" else []      # rotation about y, the shafts' axis: the quills hold it
     free = [q for i, q in enumerate(r["rayleigh"]) if i not in held]
     assert max(abs(q) for q in free) < modal.RIGID_EIGENVALUE_RATIO * r["scale"]
+
+
+def test_a_rigid_motion_the_model_resists_is_named(free_housing, monkeypatch):
+    """The old zero-length bearings (no arm) put back: modal.modes still refuses the count (6 of 7), and the message
+    names the rigid motions the model resists, rotations about x and y (Rayleigh quotients 2.8 and 12.5 rad^2/s^2,
+    above the zero-mode limit 0.19), not the ones it leaves free."""
+    plain = cp.bearing
+    monkeypatch.setattr(cp, "bearing", lambda a, b, K, axis, C=None, offset=None: plain(a, b, K, axis, C))
+    structure = build_interior(free_housing, test_gearbox("A").to_coupling_spec(), F_MAX["none"])
+    with pytest.raises(SolverError, match=r"must have 7 .* found 6: .* exact rigid motions .*: rx 2\.8\d, ry 12\.5 \("):
+        modal.modes(structure, F_MAX["none"])
 
 
 def test_free_test_gearbox_on_two_ranks(free_housing):
