@@ -123,21 +123,30 @@ class TieRod:
     material: object = None
 
 
-def spring(a: str, b: str | None, K6, C6=None) -> Element:
+def spring(a: str, b: str | None, K6, C6=None, offset=None) -> Element:
     """A 6x6 spring (bearing) between nodes a and b (b None: ground), K6 in global axes; C6 optional damping.
-    Forces on a: -K6 (u_a - u_b)."""
+    Forces on a: -K6 (u_a - u_b).  offset: position of a minus position of b (m) when the two nodes are not at
+    one point (a shaft node on the nominal shaft line, a bore master at the centre measured on the mesh): b's
+    side then reaches a's point through a rigid arm, u_b + theta_b x offset, so that a rigid motion of the whole
+    model strains no spring (a zero-length spring between points 0.3-0.4 mm apart held the free test gearbox's
+    rotations at 0.04-0.19 Hz, found as a rigid-body mode that was not one: docs/stability.md)."""
     K6 = _check6(K6, f"spring {a}-{b}: K")
     C6 = None if C6 is None else _check6(C6, f"spring {a}-{b}: C")
     if b is None:
         return Element((a,), K6, None, C6)
-    rel = np.hstack([np.eye(6), -np.eye(6)])
+    arm = np.eye(6)
+    if offset is not None:
+        arm[:3] = rigid_arm(np.asarray(offset, float))
+    rel = np.hstack([np.eye(6), -arm])
     return Element((a, b), rel.T @ K6 @ rel, None, None if C6 is None else rel.T @ C6 @ rel)
 
 
-def bearing(shaft_node: str, master: str | None, K_local, axis, C_local=None) -> Element:
+def bearing(shaft_node: str, master: str | None, K_local, axis, C_local=None, offset=None) -> Element:
     """A bearing between a shaft node and a bore master (or ground): the 6x6 K (and fluid-film C) in the
     bearing frame (z = shaft axis, as housingfe.bearings returns them), rotated to global axes with
-    `axis_frame(axis)`.  Rotation about the shaft axis stays free: its local row and column are zeroed."""
+    `axis_frame(axis)`.  Rotation about the shaft axis stays free: its local row and column are zeroed.
+    offset: shaft node position minus master position (m); the bearing acts at the shaft node, the master
+    reaches it by a rigid arm (`spring`)."""
     from housingfe.bearings import transform_stiffness
 
     free_spin = np.ones(6)
@@ -148,7 +157,8 @@ def bearing(shaft_node: str, master: str | None, K_local, axis, C_local=None) ->
         a = _check6(a, f"bearing {shaft_node}-{master}") * np.outer(free_spin, free_spin)
         return transform_stiffness(a, frame)
 
-    return spring(shaft_node, master, glob(K_local), None if C_local is None else glob(C_local))
+    return spring(shaft_node, master, glob(K_local), None if C_local is None else glob(C_local),
+                  offset=None if master is None else offset)
 
 
 def point_mass(node: str, M6) -> Element:

@@ -238,6 +238,8 @@ def parts(spec: CouplingSpec, bore_centres: dict) -> Parts:
                 raise InputError(f"coupling.shafts.{i}.discs: node {d.node} out of range 0..{len(shaft.nodes) - 1}")
             shaft.add_disc(d.node, RigidDisc.cylinder(d.outer_diameter, d.width, d.inner_diameter))
         shafts[s.name] = shaft
+    position = {**{n: np.asarray(x, float) for n, x in bore_centres.items()},
+                **{f"{n}:{i}": x for n, sh in shafts.items() for i, x in enumerate(sh.nodes)}}
     known = set(bore_centres) | {f"{n}:{i}" for n, sh in shafts.items() for i in range(len(sh.nodes))}
     bearings = []
     for i, b in enumerate(spec.bearings):
@@ -249,15 +251,16 @@ def parts(spec: CouplingSpec, bore_centres: dict) -> Parts:
             K, C = b.matrices()
         except InputError as exc:
             raise InputError(f"coupling.bearings.{i} ({b.label}): {exc}") from None
-        bearings.append(cp.bearing(b.shaft_node, b.bore, K, b.axis, C))
+        # the bearing acts at the shaft node; the bore master (its centre measured on the mesh, off the nominal
+        # shaft line by a fraction of an element on coarse bores) reaches it by a rigid arm (cp.spring)
+        offset = None if b.bore is None else position[b.shaft_node] - position[b.bore]
+        bearings.append(cp.bearing(b.shaft_node, b.bore, K, b.axis, C, offset=offset))
     for kind, items in (("gear_meshes", spec.gear_meshes), ("tie_rods", spec.tie_rods)):
         for i, g in enumerate(items):
             for key in ("a", "b"):
                 if getattr(g, key) not in known:
                     raise InputError(f"coupling.{kind}.{i}.{key}: unknown node {getattr(g, key)!r}")
     meshes = [cp.GearMesh(g.a, g.b, g.stiffness, g.point, g.direction, g.damping) for g in spec.gear_meshes]
-    position = {**{n: np.asarray(x, float) for n, x in bore_centres.items()},
-                **{f"{n}:{i}": x for n, sh in shafts.items() for i, x in enumerate(sh.nodes)}}
     rods = [tie_rod_element(t, position[t.a], position[t.b], f"coupling.tie_rods.{i}")
             for i, t in enumerate(spec.tie_rods)]
     lines, torsion = [], {}

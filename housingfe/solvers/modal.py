@@ -585,7 +585,31 @@ class ModalBasis(ModalResult):
         if expected is not None and self.rigid_count != expected:
             raise SolverError(f"the model must have {expected} rigid-body / mechanism modes, found "
                               f"{self.rigid_count}: lowest frequencies "
-                              f"{np.round(self.frequencies_hz[:expected + 1], 4).tolist()} Hz")
+                              f"{np.round(self.frequencies_hz[:expected + 1], 4).tolist()} Hz"
+                              + self._rigid_motion_clause())
+
+    def _rigid_motion_clause(self) -> str:
+        """Why a zero mode may be missing: the Rayleigh quotients of the structure's six exact rigid motions, when
+        it has them.  Each one the model does not hold must be round-off (below RIGID_EIGENVALUE_RATIO of the
+        scale); one above it means the model itself resists a rigid motion (e.g. a spring between two points
+        that are not one), a modelling fault that no threshold should hide (docs/stability.md, "Hard case")."""
+        if self.eigenvalue_scale is None or not hasattr(self.structure, "rigid_body_vectors"):
+            return ""
+        K, M = self.structure.K, self.structure.M
+        quotients = []
+        for r in self.structure.rigid_body_vectors():
+            kr, mr = K.createVecLeft(), M.createVecLeft()
+            K.mult(r, kr)
+            M.mult(r, mr)
+            quotients.append(r.dot(kr) / r.dot(mr))
+        limit = RIGID_EIGENVALUE_RATIO * self.eigenvalue_scale
+        strained = [f"{name} {q:.3g}" for name, q in zip(("tx", "ty", "tz", "rx", "ry", "rz"), quotients)
+                    if abs(q) >= limit]
+        if not strained or len(strained) == len(quotients):      # none, or a held structure: nothing to say
+            return ""
+        return (f"; the model resists these exact rigid motions (Rayleigh quotients, rad^2/s^2, zero-mode limit "
+                f"{limit:.3g}): {', '.join(strained)} (held on purpose, e.g. by a grounded spring, or a fault of "
+                "the model such as a spring between two points that are not one)")
 
     def to_housing(self) -> ModalResult:
         """The same modes as housing FE fields (structure.to_housing of every vector), for the housing reports."""
