@@ -87,6 +87,27 @@ def assemble_loads(structure, loads) -> list:
     return [structure.load_case(load, f"loads.{i}") for i, load in enumerate(loads)]
 
 
+def modal_basis(structure, K, f_basis: float, *, keep_solver: bool) -> modal.ModalBasis:
+    """The modal basis of the modal / projected solver: every mode of (K, structure.M) below f_basis (Hz), with
+    the structure's known rigid motions deflated, checked as the modal path checks it (modal.structure_basis):
+    SolverError when the number of zero modes (|lambda| < RIGID_EIGENVALUE_RATIO x the matrix scale) is not
+    structure.expected_zero_modes, naming the exact rigid motions the model resists.  A zero mode counted as an
+    elastic one would otherwise enter the sweep silently (the free coupled test gearbox's spurious 0.185 Hz mode:
+    docs/stability.md, "Hard case").  Where the expected count is unknown (expected_zero_modes None: a supported
+    housing without an interior, imported or built, whose partial supports may leave mechanisms) nothing is
+    checked and the count found is used, as before.  K: structure.K, or its symmetric stand-in for "projected"."""
+    modes = modal.solve_modes(K, structure.M, f_basis, keep_solver=keep_solver,
+                              null_space=modal.known_null_space(structure))
+    return modal.structure_basis(modes, structure)
+
+
+def basis_facts(modes: modal.ModalBasis, f_basis: float) -> dict:
+    """harmonic.json's facts of a modal basis: elastic modes in it, zero modes found and expected (None: not
+    known, not checked), its f_max (Hz)."""
+    return {"modes_in_basis": len(modes.eigenvalues) - modes.rigid_count, "rigid_modes": modes.rigid_count,
+            "rigid_modes_expected": modes.expected_zero_modes, "basis_f_max_hz": f_basis}
+
+
 def run(structure, spec, loads, damping, *, extra_points: dict | None = None) -> ForcedResult:
     """Assemble the loads, run the chosen solver(s) on spec.frequencies and evaluate the responses.
 
@@ -94,7 +115,9 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
     spec: the harmonic spec (housingfe.scene.HarmonicSpec); loads: load specs (housingfe.scene.LoadSpec); damping:
     a housingfe.scene.DampingSpec; extra_points: named point sets whose complex displacements are kept per line
     (e.g. the radiating facets for the numerical radiation model: housingfe.radiation.housing.radiation_points).
-    The sound power is not computed here (housingfe.radiation)."""
+    The sound power is not computed here (housingfe.radiation).  The modal / projected solvers' basis must have
+    the structure's expected number of zero modes (modal_basis: SolverError otherwise); the direct solver uses
+    no basis and checks nothing."""
     from housingfe.response.harmonic import StructureObserver
 
     t0 = time.perf_counter()
@@ -127,11 +150,9 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
         if solver == "modal":
             f_basis = spec.modal_basis_factor * spec.f_max
             # the residual vectors reuse the eigensolve's factorisation of K - shift M
-            modes = modal.solve_modes(K, M, f_basis, keep_solver=spec.residual,
-                                      null_space=modal.known_null_space(structure))
+            modes = modal_basis(structure, K, f_basis, keep_solver=spec.residual)
             timings["modal_eigensolve_s"] = time.perf_counter() - t1
-            facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
-                         rigid_modes=modes.rigid_count, basis_f_max_hz=f_basis)
+            facts.update(basis_facts(modes, f_basis))
             result = harmonic.modal_superposition(K, M, modes, loads, freqs, damping,
                                                   observer.reduce, residual=spec.residual)
             modes.release_solver()
@@ -143,11 +164,9 @@ def run(structure, spec, loads, damping, *, extra_points: dict | None = None) ->
         elif solver == "projected":
             f_basis = spec.modal_basis_factor * spec.f_max
             K_sym = K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
-            modes = modal.solve_modes(K_sym, M, f_basis, keep_solver=True,
-                                      null_space=modal.known_null_space(structure))
+            modes = modal_basis(structure, K_sym, f_basis, keep_solver=True)
             timings["modal_eigensolve_s"] = time.perf_counter() - t1
-            facts.update(modes_in_basis=len(modes.eigenvalues) - modes.rigid_count,
-                         rigid_modes=modes.rigid_count, basis_f_max_hz=f_basis)
+            facts.update(basis_facts(modes, f_basis))
             result = harmonic.projected(K, M, modes, loads, freqs, damping, observer.reduce, C=C, K_sym=K_sym)
             modes.release_solver()
             name = "projected"

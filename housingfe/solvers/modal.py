@@ -678,14 +678,26 @@ def modes(structure, f_max: float, *, tol: float = 1e-10, check: bool = True) ->
     not the structure's expected_zero_modes (ModalBasis.check_zero_modes).  A structure with a non-symmetric
     stiffness (fluid-film bearings: structure.symmetric False) gets the modes of its symmetric positive
     semi-definite stand-in structure.basis_stiffness(), the basis of the projected solver."""
-    import dataclasses
-
     K = structure.K if getattr(structure, "symmetric", True) else structure.basis_stiffness()
     result = solve_modes(K, structure.M, f_max, tol=tol, null_space=known_null_space(structure))
     if getattr(structure, "V", None) is not None:     # a bare K, M stand-in has no coordinates to orient by
         orient_modes(result.vectors, structure.V, getattr(structure, "to_housing", lambda vec: vec))
+    return structure_basis(result, structure, check=check)
+
+
+def structure_basis(result: ModalResult, structure, *, check: bool = True) -> ModalBasis:
+    """The ModalBasis of a solve_modes result on `structure`'s matrices (the same eigenpairs, a kept factorisation
+    included).  check: SolverError when the number of zero modes is not the structure's expected_zero_modes
+    (ModalBasis.check_zero_modes; no check where that is None); a kept factorisation is freed before raising.
+    The one zero-mode check of the modal path (modes) and of the forced response's modal bases."""
+    import dataclasses
+
     basis = ModalBasis(**{f.name: getattr(result, f.name) for f in dataclasses.fields(ModalResult)},
                        structure=structure)
     if check:
-        basis.check_zero_modes()
+        try:
+            basis.check_zero_modes()
+        except SolverError:
+            basis.release_solver()
+            raise
     return basis

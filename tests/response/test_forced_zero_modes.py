@@ -1,0 +1,94 @@
+"""The forced response checks its modal basis' zero-mode count as the modal path does (modal.structure_basis).
+
+The case is the hard one of tests/drivetrain/test_free_housing_zero_modes.py as the forced path reaches it: the
+`test-gearbox-interior` scene (gear set B's interior) on the FREE test gearbox, 60 mm mesh.  It must have 7 zero
+modes: the housing's six rigid motions and the gear train's free rotation.  With the old zero-length bearings (bore
+masters 0.3-0.4 mm off the shaft lines, no rigid arm) the model resists the rotations about x and y, one of the
+seven comes out at 0.185 Hz, and the forced path used to count it as an elastic mode of its basis without a word.
+docs/stability.md, "Hard case"."""
+import json
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from housingfe.drivetrain import coupling as cp
+from housingfe.drivetrain.interior import build_interior
+from housingfe.errors import SolverError
+from housingfe.response.forced import run as run_forced
+from housingfe.scene import build_model_from_scene, load_housing_scene
+
+FREE = ["supports=[]", "mesh.size=0.06"]
+# the same message as the modal path's: 7 expected, 6 found, the resisted rotations' Rayleigh quotients (rad^2/s^2)
+RESISTED = r"must have 7 rigid-body / mechanism modes, found 6: .* exact rigid motions .*: rx 2\.8\d, ry 12\.5 \("
+# the old coupling: the bearing a zero-length spring between the shaft node and the off-line bore master
+OLD_BEARINGS = ("from housingfe.drivetrain import coupling as cp\n"
+                "plain = cp.bearing\n"
+                "cp.bearing = lambda a, b, K, axis, C=None, offset=None: plain(a, b, K, axis, C)\n")
+
+
+@pytest.fixture(scope="module")
+def free_scene(comm):
+    scene, _ = load_housing_scene("test-gearbox-interior", FREE)
+    return scene, build_model_from_scene(scene, comm)
+
+
+def _forced(scene, model, solver):
+    structure = build_interior(model, scene.coupling, scene.analysis.f_max)
+    spec = scene.analysis.harmonic.model_copy(update={"solver": solver})
+    return run_forced(structure, spec, scene.loads, scene.damping)
+
+
+def test_free_coupled_gearbox_basis_has_its_seven_zero_modes(free_scene):
+    """The fixed coupling: the forced path's basis (to 1.5 x 1000 Hz) counts exactly the 7 zero modes expected,
+    the rest are elastic, and the sweep runs (TF_omega finite at every line)."""
+    forced = _forced(*free_scene, "modal")
+    assert forced.facts["rigid_modes_expected"] == 7
+    assert forced.facts["rigid_modes"] == 7
+    assert forced.facts["modes_in_basis"] >= 1
+    [response] = forced.responses["modal+residual"]
+    assert np.all(np.isfinite(response.extras["TF_omega_dB"]))
+
+
+@pytest.mark.parametrize("solver", ["modal", "projected"])
+def test_a_rigid_motion_the_model_resists_stops_the_forced_response(free_scene, monkeypatch, solver):
+    """The old zero-length bearings put back: both basis solvers refuse the count (6 of 7) and name the rigid motions
+    the model resists (rx 2.83, ry 12.5 rad^2/s^2 above the zero-mode limit 0.194), instead of sweeping with a
+    0.185 Hz 'elastic' mode."""
+    plain = cp.bearing
+    monkeypatch.setattr(cp, "bearing", lambda a, b, K, axis, C=None, offset=None: plain(a, b, K, axis, C))
+    with pytest.raises(SolverError, match=RESISTED):
+        _forced(*free_scene, solver)
+
+
+def _cli(tmp_path, out, prelude=""):
+    """`housingfe run test-gearbox-interior` on the free 60 mm housing in a process of its own (4-5 s)."""
+    args = ["run", "test-gearbox-interior", "--out", str(out), *[a for s in FREE for a in ("--set", s)]]
+    code = prelude + "import sys\nfrom housingfe.cli import main\nsys.exit(main(sys.argv[1:]))\n"
+    return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, timeout=300,
+                          cwd=tmp_path)
+
+
+def test_cli_free_coupled_gearbox_reports_its_zero_modes(tmp_path):
+    """As a user runs it: exit 0, harmonic.json says 7 zero modes found of 7 expected."""
+    out = tmp_path / "free"
+    proc = _cli(tmp_path, out)
+    assert proc.returncode == 0, proc.stderr
+    facts = json.loads((out / "harmonic.json").read_text())
+    assert facts["rigid_modes"] == facts["rigid_modes_expected"] == 7
+
+
+def test_cli_a_wrong_zero_mode_count_is_one_line_exit_3_no_folder(tmp_path):
+    """The same command with the old bearings put back in the process (no scene can build that coupling any
+    more): one line `housingfe: solver error: ...` naming the resisted rotations besides the mesh-quality warning,
+    exit 3, no traceback, no result folder (not even a temporary one)."""
+    out = tmp_path / "free"
+    proc = _cli(tmp_path, out, prelude=OLD_BEARINGS)
+    assert proc.returncode == 3, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip() and not ln.startswith("housingfe: warning:")]
+    assert len(lines) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert lines[0].startswith("housingfe: solver error: ")
+    assert re.search(RESISTED, lines[0]), lines[0]
+    assert not out.exists() and not list(tmp_path.glob(".free*"))
