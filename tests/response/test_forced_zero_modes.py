@@ -8,6 +8,7 @@ seven comes out at 0.185 Hz, and the forced path used to count it as an elastic 
 docs/stability.md, "Hard case"."""
 import json
 import re
+import shutil
 import subprocess
 import sys
 
@@ -19,6 +20,7 @@ from housingfe.drivetrain.interior import build_interior
 from housingfe.errors import SolverError
 from housingfe.response.forced import run as run_forced
 from housingfe.scene import build_model_from_scene, load_housing_scene
+from tests.two_ranks import module_result
 
 FREE = ["supports=[]", "mesh.size=0.06"]
 # the same message as the modal path's: 7 expected, 6 found, the resisted rotations' Rayleigh quotients (rad^2/s^2)
@@ -92,3 +94,33 @@ def test_cli_a_wrong_zero_mode_count_is_one_line_exit_3_no_folder(tmp_path):
     assert lines[0].startswith("housingfe: solver error: ")
     assert re.search(RESISTED, lines[0]), lines[0]
     assert not out.exists() and not list(tmp_path.glob(".free*"))
+
+
+def forced_summary(comm) -> dict:
+    """The free coupled test gearbox's forced response (modal basis): zero-mode facts and TF_omega (dB) per line."""
+    scene, _ = load_housing_scene("test-gearbox-interior", FREE)
+    forced = _forced(scene, build_model_from_scene(scene, comm), "modal")
+    [response] = forced.responses["modal+residual"]
+    return {"ranks": comm.size, "rigid_modes": forced.facts["rigid_modes"],
+            "expected": forced.facts["rigid_modes_expected"], "modes": forced.facts["modes_in_basis"],
+            "tf_omega_dB": np.asarray(response.extras["TF_omega_dB"], float).ravel().tolist()}
+
+
+def test_forced_zero_mode_check_on_two_ranks(comm):
+    """1 and 2 MPI ranks: the forced path finds the same 7 of 7 zero modes, the same number of elastic modes in
+    its basis, and the same TF_omega at every line (to 1e-6 dB)."""
+    if comm.size > 1 or not shutil.which("mpirun"):
+        pytest.skip("runs from a one-rank session with mpirun installed")
+    one = forced_summary(comm)
+    two = module_result("tests.response.test_forced_zero_modes")
+    assert two["ranks"] == 2 and two["rigid_modes"] == two["expected"] == one["rigid_modes"] == 7
+    assert two["modes"] == one["modes"] and len(one["tf_omega_dB"]) > 10
+    assert np.allclose(two["tf_omega_dB"], one["tf_omega_dB"], rtol=0, atol=1e-6)
+
+
+if __name__ == "__main__":     # mpirun -n 2 python -m tests.response.test_forced_zero_modes
+    from mpi4py import MPI
+
+    result = forced_summary(MPI.COMM_WORLD)
+    if MPI.COMM_WORLD.rank == 0:
+        print(json.dumps(result))
