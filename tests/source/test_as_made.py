@@ -150,3 +150,17 @@ def test_draws_stay_within_the_tolerances():
             assert np.ptp(only_form.gap(np.zeros(xi.size, int), xi, 0 * xi)) <= tol["f_falpha"] * (1 + 1e-9)
     with pytest.raises(InputError, match="unknown"):
         am.draw_deviations(rng, 10, tol, ["runout"], 1.0, 1.0)
+
+
+def test_first_order_te_is_the_limit_of_the_full_load_distribution(spur):
+    """Deviations 1 % of grade 5 (~0.07 um against a ~30 um deflection): the full load distribution with the
+    deviations in the flank gaps changes the approach as the first-order sum k_i e_i / sum k_i, to 1 % of its range."""
+    pair, model, w = spur
+    z1, z2 = pair.teeth
+    rng = np.random.default_rng(11)
+    tol = {k: v * 0.01 for k, v in am.iso1328_tolerances(0.004, 0.096, 0.040).items()}
+    pin, whl = (am.draw_deviations(rng, z, tol, am.DEVIATION_KINDS, 0.9, 1.0) for z in (z1, z2))
+    first = am.first_order_te(pair, w, pin, whl, periods=4)
+    exact = am.exact_deviation_te(model, FORCE, pin, whl, w.n_positions, periods=4)
+    assert np.ptp(first) > 0.02e-6
+    assert np.max(np.abs(exact - first)) < 0.01 * np.ptp(first)
