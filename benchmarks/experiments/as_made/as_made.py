@@ -246,6 +246,11 @@ def main(draws: int, seed: int, positions: int, exact: bool, out_dir: Path = HER
                   f" | ({time.perf_counter() - t1:.0f} s)")
     keys = list(rows[1])
     write_csv(out_dir / "as_made.csv", keys, [[_fmt(r.get(k, "")) for k in keys] for r in rows + exact_rows])
+    upto = orders <= 2.6 * z2
+    write_csv(out_dir / "as_made_spectrum.csv", ["wheel_order", "aligned_um", "pitch_median_draw_um",
+                                                 "all_median_draw_um"],
+              [[f"{q:g}", f"{a0 * 1e6:.4g}", f"{a1 * 1e6:.4g}", f"{a2 * 1e6:.4g}"] for q, a0, a1, a2 in
+               zip(orders[upto], a_model[upto], keep["pitch"][2][upto], keep["all"][2][upto])])
     plot(orders, a_model, keep["all"][2], rows, bands, f_tooth, z2, {v: x * 1e6 for v, x in needed[route].items()},
          route, out_dir / "as_made.png")
     print(f"\n{draws} draws x {len(CASES)} cases, {positions} positions per mesh period"
