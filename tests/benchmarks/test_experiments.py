@@ -36,3 +36,23 @@ def test_lomega_budget_first_order_is_the_full_balance():
     for fo_fw, fo_2d, full_fw, full_2d in rows:
         assert abs(float(fo_fw) - float(full_fw)) <= 0.16
         assert abs(float(fo_2d) - float(full_2d)) <= 0.16
+
+
+def test_as_made_experiment_keeps_the_aligned_model_and_its_stiffness(tmp_path):
+    """benchmarks/experiments/as_made: the aligned pair's tooth line is the default's quasi-static TE (0.56 um,
+    docs/source.md), the point stiffnesses sum to the mesh stiffness k_m, and grade-5 deviations raise the tooth band
+    above the aligned model's 0.56 um but keep it under 5 um (docs/source.md, 'Gears as made': 1.0-1.8 um)."""
+    script = ROOT / "benchmarks" / "experiments" / "as_made" / "as_made.py"
+    proc = subprocess.run([sys.executable, str(script), "--draws", "8", "--no-exact", "--rigid-only", "--out",
+                           str(tmp_path)],
+                          cwd=ROOT, capture_output=True, text=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"),
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    line = re.search(r"aligned pair alone .*tooth line ([\d.]+) um", proc.stdout)
+    assert line and abs(float(line.group(1)) - 0.56) < 0.01, proc.stdout
+    k = re.search(r"sum k_i = ([\d.e+]+) N/m .*k_m = ([\d.e+]+) N/m", proc.stdout)
+    assert abs(float(k.group(1)) / float(k.group(2)) - 1) < 1e-3
+    band = re.search(r"^\| all \| [^|]+\| ([\d.]+) / ([\d.]+) / ([\d.]+) \[", proc.stdout, re.M)
+    assert band, proc.stdout
+    assert all(0.6 < float(x) < 5.0 for x in band.groups())
+    assert (tmp_path / "as_made.csv").is_file() and (tmp_path / "as_made.png").is_file()

@@ -1,0 +1,166 @@
+"""Gears as made (housingfe.source.as_made, issue 28): ISO 1328-1 grade-5 tolerances, the first-order loaded TE of
+tooth deviations over the hunting period, its spectrum in shaft orders."""
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from housingfe.errors import InputError
+from housingfe.source import as_made as am
+from housingfe.source.gears import GearPair
+from housingfe.source.stiffness import Corrections, MeshModel
+from tests.source.thesis_gears import SYMMETRIC_SHAFTS
+
+FORCE = 40e3
+
+
+@pytest.fixture(scope="module")
+def spur():
+    # set A's module and tooth numbers as a spur pair at its standard centre distance (eps_alpha 1.71, eps_beta 0)
+    pair = GearPair.from_table(dict(module_mm=4.0, teeth=[24, 72], pressure_angle_deg=20.0, helix_angle_deg=0.0,
+                                    addendum_modification=[0.0, 0.0], face_width_mm=[40.0, 40.0],
+                                    centre_distance_mm=192.0, kind="spur"))
+    model = MeshModel(pair, shafts=SYMMETRIC_SHAFTS, corrections=Corrections(), n_slices=6)
+    return pair, model, am.contact_weights(model, FORCE, n_positions=8)
+
+
+def test_iso1328_grade5_tolerances_of_set_a():
+    """ISO 1328-1:1995 formulas with the geometric means of the ranges (m 3.5-6 mm: 4.583; d 50-125 mm: 79.06,
+    280-560 mm: 396.0; b 40-80 mm: 56.57), rounded per Sec. 5.2.3. Pinion: f_pt = 0.3 (4.583 + 0.4 * 8.891) + 4 =
+    6.44 -> 6.5; F_p = 1.375 + 11.11 + 7 = 19.5 -> 19 (hand: 19.49); f_Halpha = 4.282 + 1.245 + 0.5 = 6.03 -> 6.0;
+    f_falpha = 5.352 + 1.511 + 0.5 = 7.36 -> 7.5; f_Hbeta = 0.622 + 3.385 + 3 = 7.01 -> 7.0.  Wheel: 7.76 -> 8.0,
+    33.25 -> 33, 7.57 -> 7.5, 9.24 -> 9.0, 7.78 -> 8.0."""
+    d1, d2 = 24 * 4.0 / math.cos(math.radians(12)), 72 * 4.0 / math.cos(math.radians(12))
+    pin = am.iso1328_tolerances(0.004, d1 * 1e-3, 0.066)
+    whl = am.iso1328_tolerances(0.004, d2 * 1e-3, 0.062)
+    um = lambda t: {k: round(v * 1e6, 6) for k, v in t.items()}       # noqa: E731
+    assert um(pin) == {"f_pt": 6.5, "F_p": 19.0, "f_falpha": 7.5, "f_Halpha": 6.0, "f_Hbeta": 7.0}
+    assert um(whl) == {"f_pt": 8.0, "F_p": 33.0, "f_falpha": 9.0, "f_Halpha": 7.5, "f_Hbeta": 8.0}
+    # one grade coarser: sqrt(2) before rounding (f_pt 6.44 * 1.414 = 9.11 -> 9.0)
+    assert am.iso1328_tolerances(0.004, d1 * 1e-3, 0.066, grade=6)["f_pt"] == pytest.approx(9.0e-6)
+    with pytest.raises(InputError, match="module"):
+        am.iso1328_tolerances(0.1, 0.1, 0.05)
+
+
+def test_weights_sum_to_the_mesh_stiffness_and_are_the_approachs_first_order_sensitivity(spur):
+    """sum k_i is dF/d delta of the load distribution, and a small gap on one tooth pair's points moves the
+    approach by its weight share (finite difference of the nonlinear load distribution)."""
+    pair, model, w = spur
+    pbt = pair.transverse_base_pitch
+    for p in (0, 5):
+        u = p / 8 * pbt
+        assert w.stiffness[p] == pytest.approx(model.stiffness_at(u, FORCE)["stiffness"], rel=2e-3)
+        _, _, d0 = model.load_distribution(u, FORCE)
+        k = int(w.pair[p][0])
+        e0 = 0.2e-6
+
+        class Perturbed(MeshModel):
+            def gaps(self, pts):
+                return super().gaps(pts) + np.where(pts["pair"] == k, e0, 0.0)
+
+        perturbed = Perturbed(**{f: getattr(model, f) for f in ("pair", "shafts", "corrections", "n_slices")})
+        _, _, d1 = perturbed.load_distribution(u, FORCE)
+        share = w.weight[p][w.pair[p] == k].sum()
+        assert 0.05 < share < 0.95
+        assert (d1 - d0) / e0 == pytest.approx(share, rel=5e-3)
+
+
+def test_spur_single_deviating_tooth_gives_its_deviation_times_its_load_share(spur):
+    """A spur pair (eps_beta = 0), one pinion tooth displaced by e0 (the same over its flank): the first-order TE at
+    every instant is e0 times that tooth's share of the mesh stiffness, which on uncorrected flanks is its share of
+    the load F_tooth / F (to the Hertz tangent/secant difference, < 3 %), and zero while the tooth is out of mesh."""
+    pair, model, w = spur
+    z1, z2 = pair.teeth
+    e0 = 1e-6
+    pin, whl = am.ToothDeviations.zeros(z1), am.ToothDeviations.zeros(z2)
+    pin.position[0] = e0
+    te = am.first_order_te(pair, w, pin, whl).reshape(-1, w.n_positions)
+    assert te.shape == (math.lcm(z1, z2), 8)
+    pbt = pair.transverse_base_pitch
+    compared = 0
+    for m in range(te.shape[0]):
+        for p in range(w.n_positions):
+            ks = w.pair[p]
+            on = ((m + ks) % z1) == 0
+            if not on.any():
+                assert te[m, p] == 0.0
+                continue
+            pts, F, _ = model.load_distribution(p / 8 * pbt, FORCE) if m < 3 else (None, None, None)
+            stiffness_share = w.weight[p][on].sum()
+            assert te[m, p] == pytest.approx(e0 * stiffness_share, rel=1e-12)
+            if pts is not None:
+                load_share = F[pts["pair"] == ks[on][0]].sum() / FORCE
+                assert stiffness_share == pytest.approx(load_share, rel=0.03)
+                compared += 1
+    assert compared >= 4 and np.count_nonzero(te) > 0
+
+
+def test_identical_teeth_give_only_tooth_harmonics_and_random_ones_spread_over_shaft_orders(spur):
+    """The same deviations on every tooth make the TE periodic in the mesh period: lines only at multiples of the
+    tooth order (z2 wheel orders).  Deviations on the pinion alone repeat every pinion revolution: lines only at
+    multiples of z2/z1 wheel orders.  Random ones on both spread energy over all shaft orders, and Parseval holds."""
+    pair, model, w = spur
+    z1, z2 = pair.teeth
+    rng = np.random.default_rng(3)
+    tol = {"f_pt": 6e-6, "F_p": 1.0, "f_falpha": 7e-6, "f_Halpha": 6e-6, "f_Hbeta": 7e-6}
+
+    same = [am.ToothDeviations.zeros(z) for z in (z1, z2)]
+    for d in same:
+        d.profile_slope[:] = 5e-6
+        d.helix_slope[:] = -3e-6
+        d.twist[:] = 4e-6
+        d.form[:] = [1e-6, -0.5e-6, 0.2e-6]
+    te = am.first_order_te(pair, w, *same)
+    orders, a = am.order_amplitudes(te)
+    assert np.max(a[1:]) > 1e-7
+    off_tooth = (np.arange(a.size) % z2) != 0
+    assert np.max(a[off_tooth]) < 1e-12 * np.max(a[1:])
+
+    pin = am.draw_deviations(rng, z1, tol, am.DEVIATION_KINDS, 0.9, 1.0)
+    te = am.first_order_te(pair, w, pin, am.ToothDeviations.zeros(z2))
+    _, a = am.order_amplitudes(te)
+    not_pinion = (np.arange(a.size) % (z2 // z1)) != 0
+    assert np.max(a[not_pinion]) < 1e-12 * np.max(a)
+
+    whl = am.draw_deviations(rng, z2, tol, am.DEVIATION_KINDS, 0.9, 1.0)
+    te = am.first_order_te(pair, w, pin, whl)
+    orders, a = am.order_amplitudes(te)
+    side = (orders > 0) & off_tooth
+    assert np.sum(a[side] ** 2) > 0.5 * np.sum(a[1:] ** 2)        # most of the energy off the tooth harmonics
+    assert np.count_nonzero(a[side] > 1e-3 * a.max()) > z2 // 2
+    n = te.size
+    parseval = a[0] ** 2 + np.sum(a[1:n // 2] ** 2) / 2 + a[n // 2] ** 2
+    assert parseval == pytest.approx(np.mean(te**2), rel=1e-12)
+
+
+def test_draws_stay_within_the_tolerances():
+    rng = np.random.default_rng(7)
+    tol = am.iso1328_tolerances(0.004, 0.2944, 0.062)
+    for _ in range(5):
+        d = am.draw_deviations(rng, 72, tol, am.DEVIATION_KINDS, 1.0, 1.0)
+        steps = np.diff(np.concatenate([d.position, d.position[:1]]))
+        assert np.abs(steps).max() <= tol["f_pt"] * (1 + 1e-12)
+        assert np.ptp(d.position) <= tol["F_p"] * (1 + 1e-12)
+        assert np.abs(d.profile_slope).max() <= tol["f_Halpha"]
+        assert np.abs(d.helix_slope).max() <= tol["f_Hbeta"]
+        xi = np.linspace(-0.5, 0.5, 401)
+        for t in range(72):
+            only_form = replace(am.ToothDeviations.zeros(1), form=d.form[t:t + 1])
+            assert np.ptp(only_form.gap(np.zeros(xi.size, int), xi, 0 * xi)) <= tol["f_falpha"] * (1 + 1e-9)
+    with pytest.raises(InputError, match="unknown"):
+        am.draw_deviations(rng, 10, tol, ["runout"], 1.0, 1.0)
+
+
+def test_first_order_te_is_the_limit_of_the_full_load_distribution(spur):
+    """Deviations 1 % of grade 5 (~0.07 um against a ~30 um deflection): the full load distribution with the
+    deviations in the flank gaps changes the approach as the first-order sum k_i e_i / sum k_i, to 1 % of its range."""
+    pair, model, w = spur
+    z1, z2 = pair.teeth
+    rng = np.random.default_rng(11)
+    tol = {k: v * 0.01 for k, v in am.iso1328_tolerances(0.004, 0.096, 0.040).items()}
+    pin, whl = (am.draw_deviations(rng, z, tol, am.DEVIATION_KINDS, 0.9, 1.0) for z in (z1, z2))
+    first = am.first_order_te(pair, w, pin, whl, periods=4)
+    exact = am.exact_deviation_te(model, FORCE, pin, whl, w.n_positions, periods=4)
+    assert np.ptp(first) > 0.02e-6
+    assert np.max(np.abs(exact - first)) < 0.01 * np.ptp(first)
