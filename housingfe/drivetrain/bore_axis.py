@@ -1,9 +1,10 @@
-"""A bore master on the bore's axis: the least-squares cylinder through the bore surface's FE nodes (SI units).
+"""A bore master on the bore's axis: the least-squares cylinder through the bore surface's mesh vertices (SI units).
 
 A bearing bore's master node (housingfe.drivetrain.coupling, `[coupling.bores]` without a `centre`) belongs on the
 bore's axis, mid-length.  The centre of the bounding box of the surface's nodes is there only for a complete,
 evenly meshed bore: the faceted bores of the test gearbox put it 0.29-0.42 mm off the shaft line at 60 mm elements,
-a half bore (split housing) puts it r/2 off, and a groove, an oil hole or an uneven mesh move it too.  The rule
+a half bore (split housing) puts it r/2 off, and any bore whose vertices do not reach its extremes evenly
+(an uneven mesh, a partial or notched bore) moves it.  The rule
 (`fit_bore`), on the surface's mesh vertices (which the mesher puts on the CAD surface; `surface_geometry`):
 
 * The vertices' P1 nodal normals m_i = int phi_i n dA give the normal tensor T = sum m_i m_i^T / |m_i| (trace 1,
@@ -36,11 +37,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from housingfe.drivetrain.bore_matching import ANGLE_TOLERANCE_DEG
 from housingfe.errors import InputError
 
 FLAT_NORMAL_SPREAD = 1e-3   # l2 / l3 of the normal tensor below which a surface is flat (normals within ~2 deg)
 MAX_RELATIVE_RMS = 0.05     # rms distance from the fitted cylinder / R above which a surface is not a bore
-MAX_TILT_DEG = 1.0          # a bore's fitted axis vs the axis of the bearing it carries (bore_matching's tolerance)
+MAX_TILT_DEG = ANGLE_TOLERANCE_DEG   # a bore's fitted axis vs its bearing's axis: the run-up's bore matching's 1 deg
 
 
 @dataclass(frozen=True)
