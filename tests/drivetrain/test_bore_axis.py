@@ -166,6 +166,8 @@ def test_a_flat_face_is_a_seat_at_its_centroid(half_tube):
     centroid = ORIGIN + np.array([(R_IN + R_OUT) / 2, 0.0, LENGTH / 2])     # the cut rectangle's centre
     assert np.linalg.norm(fit.centre - centroid) < 1e-12
     assert fit.tilt_deg((0.0, 1.0, 0.0)) < 1e-6 and fit.rms < 1e-12
+    _, w, _ = bore_axis.surface_geometry(half_tube, "seat")
+    assert w.sum() == pytest.approx((R_OUT - R_IN) * LENGTH, rel=1e-12)     # the weights: the rectangle's area
 
 
 def test_a_curved_surface_that_is_no_cylinder_is_refused_in_one_line(tube):
@@ -258,7 +260,17 @@ def mpi_case(comm) -> dict:
             value = [float(v) for v in (*fit.centre, *fit.axis, 0.0 if math.isnan(fit.radius) else fit.radius)]
             out[f"{name}_{surface}"] = value
             out[f"{name}_{surface}_same_on_all_ranks"] = all(v == value for v in comm.allgather(value))
+        out[f"{name}_owned_bore_vertices"] = comm.allgather(owned_vertices(model, "bore"))
     return out
+
+
+def owned_vertices(model, surface) -> int:
+    """The surface's mesh vertices this rank owns (the fit gathers them from every rank)."""
+    from dolfinx import fem
+
+    V1 = fem.FunctionSpace(model.housing.mesh, ("CG", 1))
+    nodes = fem.locate_dofs_topological(V1, 2, model.housing.facets(surface))
+    return int(np.sum(nodes < V1.dofmap.index_map.size_local))
 
 
 def test_two_ranks_fit_the_serial_bore(comm):
@@ -267,6 +279,9 @@ def test_two_ranks_fit_the_serial_bore(comm):
     one = mpi_case(comm)
     two = module_result("tests.drivetrain.test_bore_axis")
     assert two["ranks"] == 2
+    for name in ("half", "tilted"):     # each bore split between the ranks, every vertex owned once
+        assert min(two[f"{name}_owned_bore_vertices"]) > 0
+        assert sum(two[f"{name}_owned_bore_vertices"]) == sum(one[f"{name}_owned_bore_vertices"])
     for key in ("half_bore", "half_seat", "tilted_bore"):
         assert two[f"{key}_same_on_all_ranks"]
         assert np.max(np.abs(np.subtract(two[key], one[key]))) < 1e-12, key
