@@ -85,6 +85,8 @@ def _run(scene, out: Path, comm, t_start: float) -> Path:
     forced = None
     if harmonic_spec is not None:
         forced = forced_response(scene, model, structure)
+        if interior is not None:
+            forced.facts["bores"] = bore_records(interior)
     with outputs.atomic_output_dir(out, comm) as tmp:
         if modes is not None:
             housing_modes = modes.to_housing()
@@ -218,4 +220,11 @@ def interior_summary(interior, result) -> dict:
         "coupled_housing_modes": int(np.sum(share <= 0.5)),
         "coupled_dofs": interior.system.size,
         "coupling_s": interior.model.timings.get("coupling_s"),
+        "bores": bore_records(interior),
     }
+
+
+def bore_records(interior) -> dict:
+    """Where each bore master went (housingfe.drivetrain.bore_axis.BoreFit.summary; None: the scene gave the
+    centre), for summary.json and harmonic.json."""
+    return {name: None if fit is None else fit.summary() for name, fit in interior.bores.items()}

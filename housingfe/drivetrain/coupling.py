@@ -852,8 +852,8 @@ def surface_nodes(model, surface: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def surface_centre(model, surface: str) -> np.ndarray:
-    """Centre (m) of the bounding box of a surface's nodes (a bore: on the axis, mid-plate); the same on every
-    rank."""
+    """Centre (m) of the bounding box of a surface's nodes; the same on every rank.  On the axis of a complete,
+    evenly meshed bore only: bore masters go where housingfe.drivetrain.bore_axis.fit_bore puts them."""
     from mpi4py import MPI
 
     nodes, _ = surface_nodes(model, surface)

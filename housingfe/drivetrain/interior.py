@@ -32,8 +32,9 @@ class _Strict(BaseModel):
 
 
 class BoreMasterSpec(_Strict):
-    """A bore master: surface of the housing, centre (m; default: centre of the surface's bounding box),
-    axis, kind (rbe2 | rbe3 | star) and rod_stiffness (N/m per rod, star only)."""
+    """A bore master: surface of the housing, centre (m; default: on the axis of the cylinder fitted to the surface,
+    mid-length, or the centroid of a flat surface: housingfe.drivetrain.bore_axis), axis (checked against the
+    fitted one where given), kind (rbe2 | rbe3 | star) and rod_stiffness (N/m per rod, star only)."""
 
     name: str
     surface: str
@@ -314,17 +315,45 @@ def tie_rod_element(t: TieRodSpec, pa: np.ndarray, pb: np.ndarray, key: str):
     return cp.Element((t.a, t.b), T.T @ k @ T, T.T @ m @ T, None)
 
 
-def bore_centres(model, spec: CouplingSpec) -> dict:
-    """Bore name -> centre (m): the given one, or the centre of the bore surface's bounding box."""
-    from housingfe.drivetrain import coupling as cp
+def bore_fits(model, spec: CouplingSpec) -> dict:
+    """Bore name -> housingfe.drivetrain.bore_axis.BoreFit of its surface (None where the scene gives the centre):
+    the master on the fitted cylinder's axis mid-length, or at the centroid of a flat seat (the rule:
+    housingfe.drivetrain.bore_axis).  InputError naming the key for an unknown surface, a curved surface that is no
+    cylinder, and a bore axis more than bore_axis.MAX_TILT_DEG from the axis of a bearing it carries (or from the
+    bore's own `axis` where the scene gives one).  Collective."""
+    from housingfe.drivetrain import bore_axis
 
     out = {}
     for i, b in enumerate(spec.bores):
         if b.surface not in model.housing.facet_groups:
             raise InputError(f"coupling.bores.{i}.surface: no surface {b.surface!r} "
                              f"(known: {', '.join(sorted(model.housing.facet_groups))})")
-        out[b.name] = np.asarray(b.centre if b.centre is not None else cp.surface_centre(model, b.surface), float)
+        if b.centre is not None:
+            out[b.name] = None
+            continue
+        try:
+            fit = bore_axis.fit_bore(model, b.surface)
+        except InputError as exc:
+            raise InputError(f"coupling.bores.{i}.surface: {exc}") from None
+        if fit.kind == "cylinder":
+            given = [(f"its axis {bore_axis.format_vector(b.axis)}", b.axis)] if "axis" in b.model_fields_set else []
+            given += [(f"the axis {bore_axis.format_vector(c.axis)} of bearing {c.label!r}", c.axis)
+                      for c in spec.bearings if c.bore == b.name]
+            for what, axis in given:
+                tilt = fit.tilt_deg(axis)
+                if tilt > bore_axis.MAX_TILT_DEG:
+                    raise InputError(f"coupling.bores.{i} ({b.name}): the bore surface {b.surface!r} runs along "
+                                     f"{bore_axis.format_vector(fit.axis)}, {tilt:.3g} deg from {what} (at most "
+                                     f"{bore_axis.MAX_TILT_DEG:g} deg)")
+        out[b.name] = fit
     return out
+
+
+def bore_centres(model, spec: CouplingSpec, fits: dict | None = None) -> dict:
+    """Bore name -> centre (m): the given one, or that of the bore's fit (`bore_fits`; fits: its result, if
+    already computed)."""
+    fits = bore_fits(model, spec) if fits is None else fits
+    return {b.name: np.asarray(b.centre if b.centre is not None else fits[b.name].centre, float) for b in spec.bores}
 
 
 def couple_from_spec(model, spec: CouplingSpec | dict):
@@ -451,7 +480,8 @@ class CoupledInterior:
     """A housing model coupled with its interior: what the solvers (K, M, C) and the reports need.
 
     system: housingfe.drivetrain.coupling.CoupledSystem (independent DOFs q); parts: the built elements; rigid: the
-    interior's modes on rigid bores; centres: bore centres (m)."""
+    interior's modes on rigid bores; centres: bore centres (m); bores: bore name -> BoreFit (None: centre given;
+    housingfe.drivetrain.bore_axis)."""
 
     model: object
     spec: CouplingSpec
@@ -459,6 +489,7 @@ class CoupledInterior:
     system: object
     rigid: RigidBoreModes
     centres: dict
+    bores: dict = field(default_factory=dict)
     _basis_K: object = field(default=None, repr=False)   # built on first use (projected solver only)
 
     @property
@@ -612,9 +643,10 @@ def build_interior(model, spec: CouplingSpec, f_max: float) -> CoupledInterior:
 
     t0 = time.perf_counter()
     spec = _check(spec)
-    centres = bore_centres(model, spec)
+    fits = bore_fits(model, spec)
+    centres = bore_centres(model, spec, fits)
     p = parts(spec, centres)
     system = p.couple(model)
     rigid = rigid_bore_modes(spec, centres, f_max)
     model.timings["coupling_s"] = time.perf_counter() - t0
-    return CoupledInterior(model, spec, p, system, rigid, centres)
+    return CoupledInterior(model, spec, p, system, rigid, centres, fits)

@@ -5,7 +5,8 @@ model's, and the time of each).
 
 Masters (one per bore, rbe2): --master SURFACE (repeatable) or, by default, the scene's [coupling] bores, the
 bores of a "mesh" geometry ([[geometry.bores]]), the bore selectors of a "cad" geometry (bore_<name>), or each
-bearing seat of a "gearbox" geometry (bore_<name>_front / _back)."""
+bearing seat of a "gearbox" geometry (bore_<name>_front / _back).  A master sits on the axis of the cylinder fitted to
+its surface, mid-length, or at the centroid of a flat surface (housingfe.drivetrain.bore_axis)."""
 from __future__ import annotations
 
 import argparse
@@ -43,7 +44,6 @@ def _cmd(args: argparse.Namespace) -> int:
 def scene_masters(scene, model, surfaces: list[str] | None) -> list:
     """The masters (housingfe.drivetrain.reduction.Master) of a scene: the given surfaces, else the scene's bores
     (see the module docstring); InputError naming the key when a surface is unknown or none are found."""
-    from housingfe.drivetrain import coupling as cp
     from housingfe.drivetrain.interior import bore_centres
     from housingfe.drivetrain.reduction import Master
 
@@ -53,7 +53,7 @@ def scene_masters(scene, model, surfaces: list[str] | None) -> list:
         for s in surfaces:
             if s not in known:
                 raise InputError(f"--master: no surface {s!r} (known: {', '.join(sorted(known))})")
-            out.append(Master(s, s, cp.surface_centre(model, s)))
+            out.append(Master(s, s, _bore_centre(model, s, "--master")))
         return out
     if scene.coupling is not None and scene.coupling.bores:
         centres = bore_centres(model, scene.coupling)
@@ -69,7 +69,18 @@ def scene_masters(scene, model, surfaces: list[str] | None) -> list:
     if not names:
         raise InputError("--master: the scene has no bores ([coupling] bores, [[geometry.bores]]); give the "
                          "master surfaces with --master SURFACE")
-    return [Master(n, n, cp.surface_centre(model, n)) for n in names]
+    return [Master(n, n, _bore_centre(model, n, "geometry.bores")) for n in names]
+
+
+def _bore_centre(model, surface: str, key: str) -> np.ndarray:
+    """A master's position (m): on the axis of the surface's fitted cylinder, mid-length, or the centroid of a
+    flat surface (housingfe.drivetrain.bore_axis, as the coupling's bore masters); InputError naming `key`."""
+    from housingfe.drivetrain.bore_axis import fit_bore
+
+    try:
+        return fit_bore(model, surface).centre
+    except InputError as exc:
+        raise InputError(f"{key}: {exc}") from None
 
 
 def check_cutoff_resolved(scene, cutoff_hz: float) -> None:
