@@ -205,10 +205,7 @@ class RitzReduction:
         belongs to this reduction's system and damping: a re-analysis or another damping starts afresh."""
         f = np.asarray(frequencies, float)
         j = self.names.index(name)
-        memo = self.__dict__.get("_unit_memo")
-        if memo is None or memo[0] is not self.system or memo[1] is not self.damping:
-            memo = self._unit_memo = (self.system, self.damping, {})
-        solutions = memo[2]
+        solutions = self._unit_solutions()
         key = (name, f.shape, f.tobytes())
         if key not in solutions:
             s = self.system
@@ -220,6 +217,37 @@ class RitzReduction:
                 solutions.pop(next(iter(solutions)))          # the oldest
             solutions[key] = c
         return solutions[key]
+
+    def _unit_solutions(self) -> dict:
+        """The memo of `unit_coordinates` for this reduction's current system and damping."""
+        memo = self.__dict__.get("_unit_memo")
+        if memo is None or memo[0] is not self.system or memo[1] is not self.damping:
+            memo = self._unit_memo = (self.system, self.damping, {})
+        return memo[2]
+
+    def prefetch_unit_coordinates(self, frequencies, names) -> None:
+        """Solve the unit loads `names` at `frequencies` (Hz) in ONE batched solve (one factorisation per line for all
+        of them) into the memo of `unit_coordinates`, which then returns them without solving: for callers that
+        will ask for several loads at many new lines (e.g. housingfe.runup.as_made's sidebands through both
+        routes).  At most UNIT_SOLUTIONS names; the values equal separate solves to rounding."""
+        f = np.asarray(frequencies, float)
+        names = list(dict.fromkeys(names))[:UNIT_SOLUTIONS]
+        solutions = self._unit_solutions()
+        keys = {name: (name, f.shape, f.tobytes()) for name in names}
+        missing = [name for name in names if keys[name] not in solutions]
+        if not missing or not f.size:
+            return
+        s = self.system
+        eta = np.zeros(len(f)) if s.D is not None else self.damping.hysteretic(f)
+        C = s.Cr if s.D is None else s.Cr + s.D
+        c = harmonic.solve_reduced(s.Kr, s.Mr, C, 2 * math.pi * f, eta,
+                                   s.Fr[:, [self.names.index(name) for name in missing]])
+        for i, name in enumerate(missing):
+            while len(solutions) >= UNIT_SOLUTIONS:
+                solutions.pop(next(iter(solutions)))          # the oldest
+            ci = np.ascontiguousarray(c[i])
+            ci.setflags(write=False)
+            solutions[keys[name]] = ci
 
     def evaluate(self, frequencies, amplitudes: dict):
         """The summed response (housingfe.response.observers.LoadResponse with amplitude 1: the amplitudes are in
