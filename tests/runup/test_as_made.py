@@ -107,6 +107,23 @@ def test_sidebands_add_energy_in_the_tooth_band(coarse, spectra):
             assert r12[f"{key}_as_made_dB"] > r0[f"{key}_as_made_dB"]
 
 
+def test_prefetched_unit_coordinates_equal_the_direct_ones(coarse, spectra):
+    """RitzReduction.prefetch_unit_coordinates (the QZ form, both loads at once) gives the unit coordinates of the
+    batched direct solve at the sideband lines to 1e-8 relative."""
+    from housingfe.solvers import harmonic
+
+    gm, src, lines, _ = coarse
+    f = am.sideband_lines(src, gm, lines, 2000.0, spectra[5], 1500.0).frequency
+    red = gm.reduction
+    red.prefetch_unit_coordinates(f, ["wheel_torque", "mesh"])
+    s = red.system
+    for name in ("wheel_torque", "mesh"):
+        j = red.names.index(name)
+        ref = harmonic.solve_reduced(s.Kr, s.Mr, s.Cr + s.D, 2 * math.pi * f, np.zeros(f.size), s.Fr[:, j:j + 1])[0]
+        got = red.unit_coordinates(f, name)
+        assert np.abs(got - ref).max() <= 1e-8 * np.abs(ref).max()
+
+
 def _read(path):
     with open(path, newline="") as fh:
         return list(csv.DictReader(fh))
