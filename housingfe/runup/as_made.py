@@ -163,13 +163,25 @@ COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "tooth_frequency_hz",
            "L_omega_tooth_band_dB", "L_omega_tooth_band_as_made_dB", "L_omega_total_dB", "L_omega_total_as_made_dB",
            "Lv_tooth_band_dB", "Lv_tooth_band_as_made_dB", "Lv_dB", "Lv_as_made_dB",
            "Lw_tooth_band_dB", "Lw_tooth_band_as_made_dB", "Lw_dB", "Lw_as_made_dB",
-           "LwA_tooth_band_dB", "LwA_tooth_band_as_made_dB", "LwA_dB", "LwA_as_made_dB")
+           "LwA_tooth_band_dB", "LwA_tooth_band_as_made_dB", "LwA_dB", "LwA_as_made_dB",
+           "LwA_peak_band_hz", "LwA_peak_band_dB", "LwA_peak_band_as_made_hz", "LwA_peak_band_as_made_dB")
+
+
+def _peak_band(frequency: np.ndarray, lwa_db: np.ndarray) -> tuple[float, float]:
+    """(nominal centre Hz, level dB) of the 1/3-octave band holding the most A-weighted power of the lines."""
+    if frequency.size == 0:
+        return float("nan"), float("-inf")
+    bands = levels.third_octave_bands(frequency.min() / 1.3, frequency.max() * 1.3)
+    power = levels.band_sum(frequency, _power(lwa_db), bands)
+    i = int(np.argmax(power))
+    return float(bands.nominal[i]), _db(float(power[i]))
 
 
 def table_rows(periodic: RunupResult, sidebands: RunupResult, grade: int) -> list[dict]:
     """One row per route, radiator and operating point (COLUMNS): in the tooth band (the 1/3-octave band of
     f_tooth) and over all lines, L_omega (tf_omega: the rigid-bore source's; mesh_force: the wheel on the coupled
-    model), L_v, L_W and L_WA of the periodic lines alone and with the expected sidebands (energy sums)."""
+    model), L_v, L_W and L_WA of the periodic lines alone and with the expected sidebands (energy sums); and the
+    1/3-octave band (nominal Hz) with the most A-weighted power, with its level, without and with them."""
     rows = []
     P, S = periodic.lines, sidebands.lines
     a_P, a_S = levels.a_weighting_db(P.frequency), levels.a_weighting_db(S.frequency)
@@ -193,6 +205,10 @@ def table_rows(periodic: RunupResult, sidebands: RunupResult, grade: int) -> lis
                         base = float(np.sum(_power(vP[selP])))
                         row[f"{name}_dB"] = _db(base)
                         row[f"{name}_as_made_dB"] = _db(base + float(np.sum(_power(vS[selS]))))
+                lwaP, lwaS = periodic.L_W[route, rad][inP] + a_P[inP], sidebands.L_W[route, rad][inS] + a_S[inS]
+                row["LwA_peak_band_hz"], row["LwA_peak_band_dB"] = _peak_band(P.frequency[inP], lwaP)
+                row["LwA_peak_band_as_made_hz"], row["LwA_peak_band_as_made_dB"] = _peak_band(
+                    np.concatenate([P.frequency[inP], S.frequency[inS]]), np.concatenate([lwaP, lwaS]))
                 rows.append(row)
     return rows
 
@@ -239,8 +255,9 @@ def summary_lines(run: AsMadeRun, radiation: str) -> list[str]:
                    and r["torque_nm"] == float(torque)]
             i = int(np.argmax([r["LwA_as_made_dB"] for r in sel]))
             j = int(np.argmax([r["LwA_dB"] for r in sel]))
-            parts.append(f"{route} {sel[i]['LwA_as_made_dB']:.1f} dB(A) @ {sel[i]['speed_rpm']:g} rpm (periodic "
-                         f"{sel[j]['LwA_dB']:.1f})")
+            parts.append(f"{route} {sel[i]['LwA_as_made_dB']:.1f} dB(A) @ {sel[i]['speed_rpm']:g} rpm, most in the "
+                         f"{sel[i]['LwA_peak_band_as_made_hz']:g} Hz band (periodic {sel[j]['LwA_dB']:.1f} @ "
+                         f"{sel[j]['speed_rpm']:g} rpm, {sel[j]['LwA_peak_band_hz']:g} Hz band)")
         out.append(f"  {torque:g} N m as made (ISO 1328-1 grade {run.grade}, expected sidebands in the bands of "
                    f"harmonics 1-{run.n_max}, {run.lines} lines, {run.seconds:.1f} s): max L_WA " + "; ".join(parts)
                    + f"; sigma {radiation} ({CSV})")

@@ -147,4 +147,9 @@ def test_run_scene_with_as_made_keeps_the_periodic_outputs_byte_identical(tmp_pa
         assert float(r["Lv_dB"]) == pytest.approx(float(t["Lv_dB"]), abs=1e-4)
         assert float(r["Lv_tooth_band_dB"]) == pytest.approx(float(t["Lv_tooth_dB"]), abs=1e-4)
         assert float(r["LwA_as_made_dB"]) >= float(r["LwA_dB"]) and int(r["sideband_lines"]) > 50
+        # the loudest 1/3-octave band holds part of the total and at least its share among the bands it spans
+        for sfx in ("", "_as_made"):
+            peak, total = float(r[f"LwA_peak_band{sfx}_dB"]), float(r[f"LwA{sfx}_dB"])
+            assert total - 10 * math.log10(12) <= peak <= total + 1e-9
+            assert float(r[f"LwA_peak_band{sfx}_hz"]) in levels.NOMINAL_THIRD_OCTAVES
     assert "as made (ISO 1328-1 grade 5" in (on / "summary.txt").read_text()
