@@ -205,10 +205,7 @@ class RitzReduction:
         belongs to this reduction's system and damping: a re-analysis or another damping starts afresh."""
         f = np.asarray(frequencies, float)
         j = self.names.index(name)
-        memo = self.__dict__.get("_unit_memo")
-        if memo is None or memo[0] is not self.system or memo[1] is not self.damping:
-            memo = self._unit_memo = (self.system, self.damping, {})
-        solutions = memo[2]
+        solutions = self._unit_solutions()
         key = (name, f.shape, f.tobytes())
         if key not in solutions:
             s = self.system
@@ -220,6 +217,42 @@ class RitzReduction:
                 solutions.pop(next(iter(solutions)))          # the oldest
             solutions[key] = c
         return solutions[key]
+
+    def _unit_solutions(self) -> dict:
+        """The memo of `unit_coordinates` for this reduction's current system and damping."""
+        memo = self.__dict__.get("_unit_memo")
+        if memo is None or memo[0] is not self.system or memo[1] is not self.damping:
+            memo = self._unit_memo = (self.system, self.damping, {})
+        return memo[2]
+
+    def prefetch_unit_coordinates(self, frequencies, names) -> None:
+        """Solve the unit loads `names` at `frequencies` (Hz) for all of them at once into the memo of
+        `unit_coordinates`, which then returns them without solving: for callers that will ask for several loads at
+        many new lines (e.g. housingfe.runup.as_made's thousands of sideband lines through both routes).  At most
+        UNIT_SOLUTIONS names.  With modal (viscous) damping the system K + i w C - w^2 M does not depend on w
+        otherwise, so its linearisation is reduced ONCE to generalised Schur form (QZ, backward stable) and each
+        line costs a triangular solve, O(n^2) instead of a factorisation O(n^3) (`pencil_solve`; equal to the
+        direct solve to ~1e-9 relative, tests/response/test_reduced.py); with a loss factor (eta per line) the
+        batched direct solve."""
+        f = np.asarray(frequencies, float)
+        names = list(dict.fromkeys(names))[:UNIT_SOLUTIONS]
+        solutions = self._unit_solutions()
+        keys = {name: (name, f.shape, f.tobytes()) for name in names}
+        missing = [name for name in names if keys[name] not in solutions]
+        if not missing or not f.size:
+            return
+        s = self.system
+        Fr = s.Fr[:, [self.names.index(name) for name in missing]]
+        if s.D is not None:
+            c = pencil_solve(s.Kr, s.Mr, s.Cr + s.D, 2 * math.pi * f, Fr)
+        else:
+            c = harmonic.solve_reduced(s.Kr, s.Mr, s.Cr, 2 * math.pi * f, self.damping.hysteretic(f), Fr)
+        for i, name in enumerate(missing):
+            while len(solutions) >= UNIT_SOLUTIONS:
+                solutions.pop(next(iter(solutions)))          # the oldest
+            ci = np.ascontiguousarray(c[i])
+            ci.setflags(write=False)
+            solutions[keys[name]] = ci
 
     def evaluate(self, frequencies, amplitudes: dict):
         """The summed response (housingfe.response.observers.LoadResponse with amplitude 1: the amplitudes are in
@@ -270,3 +303,24 @@ def modal_basis_summary(basis, reduction: RitzReduction | None = None) -> dict:
 
 
 __all__ = ["ReducedSystem", "RitzReduction", "modal_basis_summary"]
+
+
+def pencil_solve(K, M, C, omega, F) -> np.ndarray:
+    """(loads, n, lines) solutions c of (K + i omega C - omega^2 M) c = F (n x n real or complex; F (n, loads)) at
+    many angular frequencies omega [rad/s]: the first-order form z = [c; s c / w0] (s = i omega; w0 =
+    sqrt(max |K_ii| / max |M_ii|) balances the two halves), A z - s B z = [0; -F] with A = [[0, w0 I], [-K, -w0 C]],
+    B = [[I, 0], [0, w0 M]], reduced once to complex generalised Schur form A = Q S Z^H, B = Q T Z^H
+    (scipy.linalg.qz); then c = Z_top (S - s T)^-1 Q^H [0; -F], an upper-triangular solve per line."""
+    K, M, C = (np.asarray(x) for x in (K, M, C))
+    n = K.shape[0]
+    w0 = math.sqrt(np.max(np.abs(np.diag(K))) / np.max(np.abs(np.diag(M))))
+    eye, zero = np.eye(n), np.zeros((n, n))
+    A = np.block([[zero, w0 * eye], [-K, -w0 * C]])
+    B = np.block([[eye, zero], [zero, w0 * M]])
+    S, T, Q, Z = scipy.linalg.qz(A, B, output="complex")
+    rhs = Q.conj().T @ np.vstack([np.zeros_like(F), -np.asarray(F)])
+    omega = np.asarray(omega, float)
+    Y = np.empty((omega.size, 2 * n, rhs.shape[1]), complex)
+    for k, w in enumerate(omega):
+        Y[k] = scipy.linalg.solve_triangular(S - 1j * w * T, rhs, check_finite=False)
+    return np.einsum("ij,kjl->lik", Z[:n], Y)

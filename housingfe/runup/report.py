@@ -6,7 +6,9 @@ contributions per peak, the slope decomposition); when the run-up also ran the e
 at an overlap ratio near an integer, housingfe.runup.scene), runup_envelope_bound.csv (its totals, the columns of
 runup.csv), runup_envelope_bound_harmonics.csv (its lines, the columns of runup_harmonics.csv) and runup.json's
 "envelope_bound" (its checks and peak contributions, housingfe.runup.checks.evaluate on the bound's curves: what
-`housingfe validate` reports as the rows 28.bound.*, beside the checks, not judged)."""
+`housingfe validate` reports as the rows 28.bound.*, beside the checks, not judged); with runup.as_made = <ISO grade>,
+runup_as_made.csv (the tooth band and the totals with and without the expected sidebands of gears as made,
+housingfe.runup.as_made) and runup.json's "as_made"."""
 from __future__ import annotations
 
 import platform
@@ -54,13 +56,14 @@ def _fmt(v):
 
 def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict,
           decompositions: list = (), notes: list = (), bound: dict | None = None,
-          bound_checks: tuple | None = None) -> None:
+          bound_checks: tuple | None = None, as_made=None) -> None:
     """Every output file of a run-up into `folder` (rank 0); decompositions: housingfe.runup.slopes
     SlopeDecomposition of every curve; notes: lines for the summary about the model's validity (e.g. the source's
     housingfe.source.roosmalen.overlap.cancellation_note); bound: {torque: RunupResult} of the envelope bound
     (engagement "envelope-bound" on the same models) -> runup_envelope_bound.csv and
     runup_envelope_bound_harmonics.csv; bound_checks: (check rows, peak contributions) of the bound's curves
-    (housingfe.runup.checks.evaluate) -> runup.json "envelope_bound"."""
+    (housingfe.runup.checks.evaluate) -> runup.json "envelope_bound"; as_made: housingfe.runup.as_made.AsMadeRun
+    (runup.as_made on) -> runup_as_made.csv and runup.json "as_made"."""
     totals = [r for _, res in results.values() for r in res.totals]
     outputs.write_csv(folder / "runup.csv", TOTAL_COLUMNS, ([_fmt(r[k]) for k in TOTAL_COLUMNS] for r in totals))
     if bound:
@@ -68,6 +71,10 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
                           ([_fmt(r[k]) for k in TOTAL_COLUMNS] for res in bound.values() for r in res.totals))
         outputs.write_csv(folder / BOUND_HARMONICS_CSV, HARMONIC_COLUMNS,
                           ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for res in bound.values() for r in res.harmonic_rows()))
+    if as_made is not None:
+        from housingfe.runup import as_made as am
+
+        outputs.write_csv(folder / am.CSV, am.COLUMNS, ([_fmt(r[k]) for k in am.COLUMNS] for r in as_made.rows))
     harm = [r for _, res in results.values() for r in res.harmonic_rows()]
     outputs.write_csv(folder / "runup_harmonics.csv", HARMONIC_COLUMNS,
                       ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for r in harm))
@@ -103,6 +110,9 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "envelope_bound": None if not bound_checks else {
             "engagement": "envelope-bound", "what": "a bound, not the model (docs/source.md)", "totals": BOUND_CSV,
             "harmonics": BOUND_HARMONICS_CSV, "checks": bound_checks[0], "peak_contributions": bound_checks[1]},
+        "as_made": None if as_made is None else {
+            "grade": as_made.grade, "totals": "runup_as_made.csv", "bands_of_harmonics": [1, as_made.n_max],
+            "sideband_lines": as_made.lines, "what": "expected sidebands of ISO 1328-1 deviations (docs/runup.md)"},
         "area_level_dB": next(iter(results.values()))[1].area_level_db,
         "provenance": {"python": platform.python_version(), "dolfinx": dolfinx.__version__,
                        "machine": platform.machine(), "mpi_ranks": gm.structure.V.mesh.comm.size},

@@ -141,6 +141,22 @@ class RunupSpec(_Strict):
     # rotation (a rig torsion mode near 76 Hz instead of a zero mode); "none" = the shafts end at the bearing
     # plates.  Default: "quill-shafts", and "none" with the thesis' replica "thesis-2d" (docs/runup.md)
     drive_line: Optional[Literal["quill-shafts", "none"]] = None
+    # gears as made (housingfe.runup.as_made; docs/runup.md "Gears as made in the run-up"): "none" = the periodic
+    # lines of identical teeth alone; an ISO 1328-1 accuracy grade 0..12 (e.g. 5, the thesis' DIN 5) = also the
+    # expected shaft-order sidebands of tooth-to-tooth deviations uniform within that grade's tolerances, through the
+    # same routes, in runup_as_made.csv beside the periodic outputs (runup.csv, runup_harmonics.csv and the checks
+    # stay the periodic model's)
+    as_made: Union[Literal["none"], int] = Field("none", json_schema_extra={"unit": "ISO 1328-1 grade"})
+
+    @field_validator("as_made", mode="before")
+    @classmethod
+    def _as_made(cls, value):
+        from housingfe.runup.as_made import check_as_made
+
+        try:
+            return check_as_made(value)
+        except InputError as exc:        # "as_made: ..." -> the key is put in front by the error's location
+            raise ValueError(str(exc).removeprefix("as_made: ")) from None
 
     @property
     def drive_line_model(self) -> str:
@@ -376,12 +392,19 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         t1 = time.perf_counter()
         bound_checks = checks.evaluate(scene, {t: (results[t][0], res) for t, res in bound.items()}, gm)
         timings["envelope_bound_checks_s"] = time.perf_counter() - t1
+    as_made = None
+    if spec.as_made != "none":     # the expected sidebands of gears as made, on the same models
+        from housingfe.runup.as_made import as_made_run, summary_lines
+
+        as_made = as_made_run(results, source, spec.as_made, spec.f_max_hz, spec.routes)
+        timings["as_made_s"] = as_made.seconds
+        notes += summary_lines(as_made, scene.radiation.models[0])
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
             report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes,
-                         bound, bound_checks)
+                         bound, bound_checks, as_made)
     if comm.rank == 0:
         print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")

@@ -254,3 +254,197 @@ def band_rms_amplitude(frequencies: np.ndarray, amplitudes: np.ndarray, lower: f
     """Amplitude [same unit] of the single line with the energy of all lines with lower <= f < upper."""
     sel = (frequencies >= lower) & (frequencies < upper)
     return float(np.sqrt(np.sum(amplitudes[sel] ** 2)))
+
+
+# ------------------------------------------------------------------------------------------------ expected spectrum
+# the per-tooth flank parameters drawn independently for every tooth (draw_deviations), in the order of the
+# covariance matrix of DeviationStatistics: profile slope, helix slope, twist, the form's Legendre P2, P3, P4
+FLANK_PARAMETERS = ("profile_slope", "helix_slope", "twist", "P2", "P3", "P4")
+
+
+def _flank_basis(xi: np.ndarray, eta: np.ndarray) -> np.ndarray:
+    """(..., 6): the gap per unit of each FLANK_PARAMETERS entry at profile position xi and face position eta."""
+    x = 2 * xi
+    return np.stack([xi, eta, xi * eta, (3 * x**2 - 1) / 2, (5 * x**3 - 3 * x) / 2,
+                     (35 * x**4 - 30 * x**2 + 3) / 8], axis=-1)
+
+
+def _form_shape_covariance(n_theta: int = 96, n_phi: int = 192) -> np.ndarray:
+    """E[c c^T / ptp(shape c)^2] (3x3) for c ~ N(0, I_3): the ratio does not depend on |c|, so it is the mean over
+    the unit sphere of u u^T / ptp(shape u)^2 (Gauss-Legendre in cos(theta) x uniform in phi; ptp on the 201-point
+    profile grid of draw_deviations)."""
+    mu, wmu = np.polynomial.legendre.leggauss(n_theta)
+    phi = (np.arange(n_phi) + 0.5) * 2 * math.pi / n_phi
+    st = np.sqrt(1 - mu**2)
+    u = np.stack([np.outer(st, np.cos(phi)), np.outer(st, np.sin(phi)), np.outer(mu, np.ones(n_phi))], -1).reshape(
+        -1, 3)
+    w = np.repeat(wmu, n_phi) / (2 * n_phi)               # sums to 1
+    xi = np.linspace(-0.5, 0.5, 201)
+    legendre = _flank_basis(xi, np.zeros_like(xi))[:, 3:]  # (201, 3)
+    ptp = np.ptp(u @ legendre.T, axis=1)
+    return np.einsum("n,ni,nj->ij", w / ptp**2, u, u)
+
+
+@dataclass
+class DeviationStatistics:
+    """Second moments of one gear's random deviations as `draw_deviations` draws them (all zero-mean: every draw
+    and its negative are equally likely).  pitch_spectrum (z,) [m^2]: E|P_j|^2 of the DFT P_j = sum_t x_t
+    exp(-2 pi i j t / z) of the tooth positions x_t (the covariance of the positions is circulant: a cyclic shift of
+    the steps shifts the positions and keeps both acceptance tests, so the P_j are uncorrelated); flank_covariance
+    (6, 6) [m^2]: covariance of one tooth's FLANK_PARAMETERS, independent from tooth to tooth and of the pitch."""
+
+    teeth: int
+    pitch_spectrum: np.ndarray
+    flank_covariance: np.ndarray
+
+
+def deviation_statistics(teeth: int, tolerances: dict, kinds, pitch_factor: float, flank_factor: float, *,
+                         pitch_samples: int = 20000, seed: int = 28, batch: int = 50000) -> DeviationStatistics:
+    """The second moments (DeviationStatistics) of `draw_deviations(rng, teeth, tolerances, kinds, pitch_factor,
+    flank_factor)`, without drawing flanks:
+
+    - profile slope, helix slope, twist: uniform in +-a, variance a^2 / 3 (a = f_Halpha, f_Hbeta, f_Halpha times
+      flank_factor);
+    - profile form: c / ptp(shape c) U f_falpha flank_factor with c ~ N(0, I_3), U ~ U(0, 1): covariance
+      E[U^2] f^2 E[c c^T / ptp^2] = f^2 / 3 x the sphere mean of `_form_shape_covariance` (a quadrature, no draws);
+    - pitch: the steps are uniform in +-f_pt, mean-removed, and accepted only when every step stays within f_pt and
+      the positions' range within F_p.  Without the acceptance the positions are a closed random walk with
+      E|P_j|^2 = z (f_pt^2 / 3) / (4 sin^2(pi j / z)) (j != 0; P_0 = 0); the acceptance on F_p (about 29 % of the
+      tries for set A's pinion, 5 % for its wheel) cuts the low orders and has no closed form, so the spectrum is the
+      mean of |P_j|^2 over `pitch_samples` accepted position draws (seeded; the positions alone, vectorised, about
+      1 s; relative sampling error about 1/sqrt(pitch_samples) per order, 0.7 % at 20000)."""
+    kinds = set(kinds)
+    unknown = kinds - set(DEVIATION_KINDS)
+    if unknown:
+        raise InputError(f"as_made: unknown deviation kinds {sorted(unknown)}; choose from {DEVIATION_KINDS}")
+    z = int(teeth)
+    spectrum = np.zeros(z)
+    if "pitch" in kinds and tolerances["f_pt"] > 0:
+        rng = np.random.default_rng(seed)
+        f_pt, F_p = tolerances["f_pt"], tolerances["F_p"]
+        accepted, total = 0, np.zeros(z)
+        for _ in range(10000):
+            steps = rng.uniform(-1, 1, (batch, z)) * f_pt
+            steps -= steps.mean(axis=1, keepdims=True)
+            pos = np.cumsum(steps, axis=1)
+            ok = (np.abs(steps).max(axis=1) <= f_pt) & (np.ptp(pos, axis=1) <= F_p)
+            pos = pos[ok][: pitch_samples - accepted]
+            pos -= pos.mean(axis=1, keepdims=True)
+            total += np.sum(np.abs(np.fft.fft(pos, axis=1)) ** 2, axis=0)
+            accepted += pos.shape[0]
+            if accepted >= pitch_samples:
+                break
+        else:
+            raise InputError("as_made: no pitch draw within f_pt and F_p")
+        spectrum = total / accepted * pitch_factor**2
+    cov = np.zeros((6, 6))
+    var = {"profile_slope": tolerances["f_Halpha"], "helix_slope": tolerances["f_Hbeta"],
+           "twist": tolerances["f_Halpha"]}
+    for i, name in enumerate(FLANK_PARAMETERS[:3]):
+        if name in kinds:
+            cov[i, i] = (var[name] * flank_factor) ** 2 / 3
+    if "profile_form" in kinds:
+        cov[3:, 3:] = (tolerances["f_falpha"] * flank_factor) ** 2 / 3 * _form_shape_covariance()
+    return DeviationStatistics(z, spectrum, cov)
+
+
+@dataclass
+class ExpectedOrderSpectrum:
+    """Expected one-sided power per order of the loaded TE over the hunting period (`expected_order_spectrum`):
+    orders [wheel orders], aligned [m^2]: a_q^2 of the aligned pair's periodic TE (its tooth harmonics, the mean's
+    line), deviations [m^2]: E a_q^2 of the deviations' first-order TE; total = aligned + deviations (order 0 the
+    mean: a_0 = |mean|, as order_amplitudes)."""
+
+    orders: np.ndarray
+    aligned: np.ndarray
+    deviations: np.ndarray
+
+    @property
+    def total(self) -> np.ndarray:
+        return self.aligned + self.deviations
+
+    def band(self, frequencies: np.ndarray, lower: float, upper: float, which: str = "total") -> float:
+        """sqrt(E sum a_q^2) [m] over the lines with lower <= f < upper (frequencies [Hz] per order): the amplitude
+        of the single line with the band's expected energy (band_rms_amplitude of the expectation)."""
+        sel = (np.asarray(frequencies) >= lower) & (np.asarray(frequencies) < upper)
+        return float(np.sqrt(np.sum(getattr(self, which)[sel])))
+
+
+def _order_transfer(pair: GearPair, weights: ContactWeights, gear: int, q: np.ndarray, periods: int) -> np.ndarray:
+    """T_b(q) (len(q), 7) of gear `gear` (0 pinion, 1 wheel) for the per-tooth parameters b = (position,
+    FLANK_PARAMETERS): sum_p exp(-2 pi i q p / N) sum_k c_b[p, k] exp(2 pi i j k / z), j = q / r mod z (see
+    `expected_order_spectrum`)."""
+    z = int(pair.teeth[gear])
+    A, E = pair.path_of_contact
+    b = pair.contact_width
+    P = weights.n_positions
+    N = periods * P
+    r = periods // z
+    j = (q // r) % z
+    T = np.zeros((q.size, 7), complex)
+    for p in range(P):
+        xi = (weights.s[p] - 0.5 * (A + E)) / (E - A)
+        xi = -xi if gear == 1 else xi            # the wheel's profile runs the other way (first_order_te)
+        eta = weights.w_local[p] / b - 0.5
+        basis = np.concatenate([np.ones((xi.size, 1)), _flank_basis(xi, eta)], axis=1)     # (points, 7)
+        c = weights.weight[p][:, None] * basis
+        phase = np.exp(2j * math.pi * np.outer(j, weights.pair[p]) / z)                    # (q, points)
+        T += np.exp(-2j * math.pi * q * p / N)[:, None] * (phase @ c)
+    return T
+
+
+def expected_order_spectrum(pair: GearPair, weights: ContactWeights, pinion: DeviationStatistics,
+                            wheel: DeviationStatistics, aligned_te: np.ndarray | None = None,
+                            periods: int | None = None) -> ExpectedOrderSpectrum:
+    """E a_q^2 at every order of the record of `first_order_te` (default: the hunting period, M = lcm(z1, z2) mesh
+    periods of P = weights.n_positions samples, N = M P), analytically: no draws of the TE.
+
+    Derivation.  The first-order TE is linear in the per-tooth parameters theta_{g,b,t} (gear g, parameter b =
+    position or FLANK_PARAMETERS, tooth t): x[m, p] = sum_g sum_b sum_k c_{g,b}[p, k] theta_{g,b,(m + k) mod z_g},
+    c_{g,b}[p, k] = sum over the contact points i of pair k at position p of w_{p,i} phi_b(+-xi_i, eta_i) (the
+    weights of `contact_weights`, phi_b the gap per unit parameter, xi negated on the wheel).  With
+    theta_t = (1/z) sum_j Theta_j exp(2 pi i j t / z) and r_g = M / z_g, the DFT X_q = (1/N) sum x[m, p]
+    exp(-2 pi i q (m P + p) / N) sums over m to M where q = r_g j (mod M), else 0:
+
+        X_q = 1/(P z_g) sum_b Theta_{g,b,j} T_{g,b}(q),   j = q / r_g mod z_g (q a multiple of r_g; else no share)
+        T_{g,b}(q) = sum_p exp(-2 pi i q p / N) sum_k c_{g,b}[p, k] exp(2 pi i j k / z_g)
+
+    (a gear's deviations reach only its own rotation orders).  The deviations are zero-mean and independent between
+    the gears, between the pitch and the flanks, and the flanks from tooth to tooth (E Theta_b Theta_b'^* =
+    z Sigma_bb', Sigma = DeviationStatistics.flank_covariance); the pitch positions have E|Theta_pos,j|^2 =
+    pitch_spectrum[j] and no correlation between orders.  Hence, summed over the gears that reach q,
+
+        E|X_q|^2 = 1/(P z)^2 [ pitch_spectrum[j] |T_pos(q)|^2 + z T_fl(q)^H Sigma T_fl(q) ],
+
+    and with the aligned pair's periodic TE D (aligned_te: one mesh period of P samples, lines at q = n M) the
+    expected total E|D_q + X_q|^2 = |D_q|^2 + E|X_q|^2 (the cross term has zero mean): the mean's line plus the
+    variance.  One-sided as order_amplitudes: E a_q^2 = 4 E|X_q|^2 for 0 < q < N/2, E|X_q|^2 at 0 and N/2.  Orders in
+    wheel orders q / (M / z2)."""
+    z1, z2 = (int(z) for z in pair.teeth)
+    periods = hunting_mesh_periods(pair) if periods is None else int(periods)
+    P = weights.n_positions
+    N = periods * P
+    q_all = np.arange(N // 2 + 1)
+    one_sided = np.where((q_all == 0) | (2 * q_all == N), 1.0, 4.0)
+    dev = np.zeros(q_all.size)
+    for g, stats in enumerate((pinion, wheel)):
+        z = (z1, z2)[g]
+        if stats.teeth != z:
+            raise InputError(f"as_made: statistics of {stats.teeth} teeth for a gear of {z}")
+        if periods % z:
+            raise InputError(f"as_made: {periods} mesh periods are not whole revolutions of a {z}-tooth gear")
+        r = periods // z
+        q = q_all[q_all % r == 0]
+        j = (q // r) % z
+        T = _order_transfer(pair, weights, g, q, periods)
+        power = stats.pitch_spectrum[j] * np.abs(T[:, 0]) ** 2
+        power += z * np.real(np.einsum("qa,ab,qb->q", T[:, 1:].conj(), stats.flank_covariance, T[:, 1:]))
+        dev[q] += power / (P * z) ** 2
+    aligned = np.zeros(q_all.size)
+    if aligned_te is not None:
+        d = np.asarray(aligned_te, float)
+        if d.size != P:
+            raise InputError(f"as_made: the aligned TE needs {P} samples per mesh period, got {d.size}")
+        _, a = order_amplitudes(np.tile(d, periods))
+        aligned = a**2
+    return ExpectedOrderSpectrum(q_all / (periods // z2), aligned, dev * one_sided)

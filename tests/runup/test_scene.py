@@ -32,6 +32,8 @@ def test_builtin_scenes_validate(name):
     ('runup.engagement="envelope-bund"', "runup.engagement"),
     ('runup.mesh_moment="shutling"', "runup.mesh_moment"),
     ('runup.drive_line="quills"', "runup.drive_line"),
+    ("runup.as_made=13", "runup.as_made"),
+    ('runup.as_made="5"', "runup.as_made"),
 ])
 def test_bad_values_name_the_key(override, key):
     with pytest.raises(InputError) as err:
@@ -82,6 +84,14 @@ def test_drive_line_choices(overrides, drive_line):
     assert len(spec.drive_lines) == (2 if drive_line == "quill-shafts" else 0)
 
 
+@pytest.mark.parametrize("overrides, as_made", [([], "none"), (["runup.as_made=5"], 5), (["runup.as_made=none"], "none"),
+                                                (["runup.as_made=0"], 0)])
+def test_as_made_choices(overrides, as_made):
+    """runup.as_made: off by default (the periodic lines of identical teeth), or an ISO 1328-1 grade 0..12."""
+    scene, _ = load_runup_scene("test-gearbox-runup", overrides)
+    assert scene.runup.as_made == as_made
+
+
 def test_missing_drivetrain_is_named(tmp_path):
     text = (Path(__file__).parents[2] / "housingfe/scenes/test-gearbox-runup.toml").read_text()
     start = text.index("[drivetrain]")
@@ -105,6 +115,7 @@ def test_missing_drivetrain_is_named(tmp_path):
     (["--set", "runup.mesh_friction=0.5"], "runup.mesh_friction: a mean friction coefficient must lie between 0"),
     (["--set", "runup.mesh_friction=foo"], "runup.mesh_friction: 'foo' is not one of none, iso13989"),
     (["--set", "runup.drive_line=quills"], "runup.drive_line: Input should be 'quill-shafts' or 'none'"),
+    (["--set", "runup.as_made=grade5"], "runup.as_made: 'grade5' is neither \"none\" nor an ISO 1328-1 accuracy grade"),
 ])
 def test_cli_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
     out = tmp_path / "out"

@@ -164,3 +164,85 @@ def test_first_order_te_is_the_limit_of_the_full_load_distribution(spur):
     exact = am.exact_deviation_te(model, FORCE, pin, whl, w.n_positions, periods=4)
     assert np.ptp(first) > 0.02e-6
     assert np.max(np.abs(exact - first)) < 0.01 * np.ptp(first)
+
+
+def test_expected_order_spectrum_is_the_mean_of_the_draws(spur):
+    """The analytic E a_q^2 (expected_order_spectrum, deviation_statistics) against the mean of 400 seeded draws'
+    a_q^2 (first_order_te, draw_deviations as the experiment draws them, all kinds, ISO grade 5) at every order of
+    the hunting period.  Per order the sample mean of 400 has the standard error s_q / sqrt(400) (s_q the draws' own
+    standard deviation at that order, ~ the mean for a sum of several independent terms): every order lies within
+    5 standard errors (at 577 orders a false alarm has probability ~ 3e-4; the pitch spectrum's own sampling error,
+    ~0.7 %, is far below the 400-draw tolerance of ~25 %), and the band energy around the tooth order (the many
+    orders together) within 4 %."""
+    pair, model, w = spur
+    z1, z2 = pair.teeth
+    tol = [am.iso1328_tolerances(0.004, d, 0.040) for d in pair.pitch_diameter]
+    stats = [am.deviation_statistics(z, t, am.DEVIATION_KINDS, 0.94, 1.0) for z, t in zip((z1, z2), tol)]
+    expected = am.expected_order_spectrum(pair, w, *stats)
+    rng = np.random.default_rng(2028)
+    draws = 400
+    power = np.array([am.order_amplitudes(am.first_order_te(pair, w, *(
+        am.draw_deviations(rng, z, t, am.DEVIATION_KINDS, 0.94, 1.0) for z, t in zip((z1, z2), tol))))[1] ** 2
+        for _ in range(draws)])
+    mean, err = power.mean(axis=0), power.std(axis=0) / math.sqrt(draws)
+    assert expected.deviations.shape == mean.shape
+    assert np.all(np.abs(mean - expected.deviations) <= 5 * err + 1e-30)
+    assert np.count_nonzero(expected.deviations > 1e-3 * expected.deviations.max()) > z2   # all shaft orders
+    band = (expected.orders >= 0.89 * z2) & (expected.orders < 1.12 * z2)
+    assert np.sum(mean[band]) == pytest.approx(np.sum(expected.deviations[band]), rel=0.04)
+
+
+def test_expected_order_spectrum_without_deviations_is_the_aligned_pairs_tooth_lines_and_keeps_parseval(spur):
+    """Zero tolerances: only the aligned pair's tooth harmonics (orders n z2), exactly its a_n^2.  Parseval on the
+    expectation: sum of the expected line powers = the expected mean square of the record, computed in time from
+    the positions' circulant covariance R(d) = 1/z^2 sum_j S_j exp(2 pi i j d / z) and the flank covariance."""
+    pair, model, w = spur
+    z1, z2 = pair.teeth
+    aligned = 0.3e-6 * np.cos(2 * math.pi * np.arange(8) / 8) + 0.1e-6 * np.sin(4 * math.pi * np.arange(8) / 8) + 1e-6
+    zero = {k: 0.0 for k in ("f_pt", "F_p", "f_falpha", "f_Halpha", "f_Hbeta")}
+    none = [am.deviation_statistics(z, zero, am.DEVIATION_KINDS, 0.94, 1.0) for z in (z1, z2)]
+    spec = am.expected_order_spectrum(pair, w, *none, aligned_te=aligned)
+    assert np.max(spec.deviations) == 0.0
+    _, a = am.order_amplitudes(np.tile(aligned, am.hunting_mesh_periods(pair)))
+    assert np.allclose(spec.total, a**2, rtol=0, atol=1e-30)
+    on = spec.orders % z2 == 0
+    assert np.max(spec.total[~on]) < 1e-12 * np.max(spec.total)
+    assert np.sqrt(spec.total[z2]) == pytest.approx(0.3e-6, rel=1e-12)
+
+    tol = [am.iso1328_tolerances(0.004, d, 0.040) for d in pair.pitch_diameter]
+    stats = [am.deviation_statistics(z, t, am.DEVIATION_KINDS, 0.94, 1.0) for z, t in zip((z1, z2), tol)]
+    spec = am.expected_order_spectrum(pair, w, *stats)
+    n = 2 * (spec.orders.size - 1)
+    parseval = spec.deviations[0] + np.sum(spec.deviations[1:-1]) / 2 + spec.deviations[-1]
+    A, E = pair.path_of_contact
+    mean_square = 0.0
+    for p in range(w.n_positions):
+        xi = (w.s[p] - 0.5 * (A + E)) / (E - A)
+        eta = w.pair[p] * 0.0 + w.w_local[p] / pair.contact_width - 0.5
+        for g, (z, st) in enumerate(zip((z1, z2), stats)):
+            d = np.arange(z)
+            R = np.real(np.exp(2j * math.pi * np.outer(d, d) / z) @ st.pitch_spectrum) / z**2
+            k = w.pair[p]
+            c = w.weight[p]
+            mean_square += c @ R[(k[:, None] - k[None, :]) % z] @ c
+            basis = am._flank_basis(-xi if g else xi, eta) * c[:, None]
+            same = (k[:, None] - k[None, :]) % z == 0
+            mean_square += np.sum(same * (basis @ st.flank_covariance @ basis.T))
+    assert parseval == pytest.approx(mean_square / w.n_positions, rel=1e-10)
+    assert n == am.hunting_mesh_periods(pair) * w.n_positions
+
+
+def test_pitch_spectrum_without_the_range_test_is_the_closed_random_walk():
+    """F_p out of reach: only the per-step test |step| <= f_pt (after removing the mean) is left, which a step
+    fails rarely for many teeth; the sampled spectrum then approaches z (f_pt^2 / 3) / (4 sin^2(pi j / z)) of the
+    closed random walk (j != 0; P_0 = 0).  The F_p test of set A's wheel cuts the lowest orders."""
+    z, f_pt = 200, 8e-6
+    st = am.deviation_statistics(z, {"f_pt": f_pt, "F_p": 1.0, "f_falpha": 0, "f_Halpha": 0, "f_Hbeta": 0},
+                                 ["pitch"], 1.0, 1.0, pitch_samples=4000)
+    j = np.arange(1, z)
+    closed = z * f_pt**2 / 3 / (4 * np.sin(math.pi * j / z) ** 2)
+    assert st.pitch_spectrum[0] == pytest.approx(0.0, abs=1e-30)
+    assert np.mean(st.pitch_spectrum[1:] / closed) == pytest.approx(1.0, abs=0.03)
+    wheel = am.deviation_statistics(72, am.iso1328_tolerances(0.004, 0.2944, 0.062), ["pitch"], 1.0, 1.0)
+    free = 72 * (8e-6) ** 2 / 3 / (4 * math.sin(math.pi / 72) ** 2)
+    assert wheel.pitch_spectrum[1] < 0.5 * free

@@ -1,0 +1,264 @@
+"""Gears as made in the run-up (issue 28; scene key runup.as_made; docs/runup.md "Gears as made in the run-up").
+
+The run-up's source computes the periodic lines n f_tooth of an aligned pair whose teeth are all alike.  Real
+gears ground to an ISO 1328-1 accuracy grade differ from tooth to tooth; over the hunting period their first-order
+loaded TE has lines at every shaft order (housingfe.source.as_made), and a measured 1/3-octave band level holds
+those sidebands beside the tooth line.  With runup.as_made = <grade> the run-up adds, at every operating point, the
+EXPECTED power of the deviations' lines (`as_made.expected_order_spectrum`: the mean over the random teeth, not one
+draw) at the wheel orders inside the 1/3-octave bands of the tooth harmonics n = 1..n_max, each an incoherent line
+(energies add) at f = order x f_wheel:
+
+* excitation: first order on the mean-stiffness system, the mesh force k e of the deviations' TE e (k_ref of the
+  coupled model's mesh element on the mesh_force route; the rigid-bore source's k_m for its L_omega), valid below
+  the mesh mode (docs/source.md "Where the tooth-band L_omega deficit sits": 0.1 dB at the tooth line);
+* mesh_force route: that force on the coupled model's gear mesh (the routes' own `mesh_force_route`), WITHOUT the
+  shuttling moment's or the friction's share: the deviations move the force's size, their moment arm is not
+  modelled;
+* tf_omega route: L_omega = the rigid-bore lumped source's wheel velocity per unit TE (its mean system loaded by
+  k_m e along the mesh normal) x e, then + TF_omega(f) (`tf_omega_route`).
+
+The expected line power at a tooth-harmonic order (the deviations' tooth-periodic part) is added too: E|D + X|^2 =
+|D|^2 + E|X|^2.  Bands: the run-up's harmonics n whose 1/3-octave band (IEC 61260, housingfe.levels) lies below
+the Nyquist order of the contact weights' sampling with a factor 2 margin, n <= positions / 4 (8 at the source's 32
+positions per mesh period), and f <= f_max; overlapping bands of neighbouring harmonics count each order once.
+Assumptions beside every result: the deviations are uniform within the grade's tolerances as
+`as_made.draw_deviations` draws them (pitch, profile slope and form, helix slope, twist), both gears the same grade,
+ISO 1328-1:1995 standing in for DIN 3962 (the thesis' "DIN 5" ~ ISO 5).
+
+Least invasive: runup.csv, runup_harmonics.csv and the checks stay the periodic model's; the sideband lines run
+through the routes as a second set of Lines on the SAME models, and runup_as_made.csv holds the tooth band and the
+total with and without them."""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from housingfe import levels
+from housingfe.errors import InputError
+from housingfe.runup.chain import Lines, RunupResult, mesh_reference_stiffness, runup
+
+AS_MADE_OFF = "none"
+# ISO 1328-1:1995 defines the accuracy grades 0 (finest) to 12
+ISO_GRADES = tuple(range(13))
+CSV = "runup_as_made.csv"
+# the unit load each route solves for (housingfe.runup.chain: tf_omega_route, mesh_force_route without the moment)
+ROUTE_LOADS = {"tf_omega": "wheel_torque", "mesh_force": "mesh"}
+
+
+def check_as_made(value) -> str | int:
+    """The runup.as_made setting as the chain takes it ("none" or an ISO grade 0..12), or InputError "as_made: ..."."""
+    if value == AS_MADE_OFF:
+        return AS_MADE_OFF
+    if isinstance(value, int) and not isinstance(value, bool) and value in ISO_GRADES:
+        return int(value)
+    raise InputError(f"as_made: {value!r} is neither \"none\" nor an ISO 1328-1 accuracy grade (an integer "
+                     f"{ISO_GRADES[0]}..{ISO_GRADES[-1]}, e.g. 5 for the thesis' DIN 5)")
+
+
+def te_receptance_rigid_bores(mats, frequencies_hz) -> np.ndarray:
+    """|Omega_wheel / e| [(rad/s)/m] of the rigid-bore lumped source's mean system (K0 + k_m h h^T, M, D: `mats`,
+    housingfe.source.roosmalen.dynamics.Matrices) loaded by k_m e along the mesh normal h, at each frequency [Hz]."""
+    from housingfe.source.roosmalen.dynamics import WHEEL_THETA_Z
+
+    km, h = mats.mean_mesh_stiffness, mats.h
+    K = mats.K0 + km * np.outer(h, h)
+    w = 2 * math.pi * np.asarray(frequencies_hz, float)
+    A = K[None] - (w**2)[:, None, None] * mats.M[None] + 1j * w[:, None, None] * mats.D[None]
+    q = np.linalg.solve(A, np.broadcast_to(km * h, (w.size, h.size))[..., None])[..., 0]
+    return np.abs(w * q[:, WHEEL_THETA_Z])
+
+
+@dataclass
+class Spectrum:
+    """The expected deviation spectrum of one torque: wheel orders, E a_q^2 [m^2] (one-sided peak amplitudes),
+    the harmonics whose bands are added (n_max), the seconds it took."""
+
+    orders: np.ndarray
+    power: np.ndarray
+    n_max: int
+    seconds: float
+
+
+def deviation_spectrum(source, torque_nm: float, grade: int, *, pitch_samples: int = 20000, seed: int = 28) -> Spectrum:
+    """E a_q^2 of the first-order TE of grade-`grade` deviations on both gears of `source` (SourceModel) at a pinion
+    torque [N m]: contact weights of the source's mesh model (with its misalignment) at its stiffness positions,
+    ISO 1328-1 tolerances per gear (module, reference diameter, face width), deviation_statistics of all kinds,
+    expected_order_spectrum.  Mesh normal factors as the experiment: pitch x cos(alpha_t) cos(beta_b), flanks x
+    cos(beta_b)."""
+    from housingfe.source import as_made as am
+
+    t0 = time.perf_counter()
+    op = source._point(float(torque_nm))
+    pair = source.pair
+    weights = am.contact_weights(op.mesh_model, op.normal_force, op.n_positions)
+    beta_b = pair.base_helix_angle
+    pitch_factor = math.cos(pair.transverse_pressure_angle) * math.cos(beta_b)
+    flank_factor = math.cos(beta_b)
+    stats = []
+    for g, z in enumerate(pair.teeth):
+        tol = am.iso1328_tolerances(pair.module, pair.pitch_diameter[g], pair.face_width[g], grade)
+        stats.append(am.deviation_statistics(int(z), tol, am.DEVIATION_KINDS, pitch_factor, flank_factor,
+                                             pitch_samples=pitch_samples, seed=seed + g))
+    spec = am.expected_order_spectrum(pair, weights, *stats)
+    return Spectrum(spec.orders, spec.deviations, max(1, op.n_positions // 4), time.perf_counter() - t0)
+
+
+def band_of(frequency: float) -> tuple[float, float]:
+    """(lower, upper) [Hz] of the 1/3-octave band (housingfe.levels) with lower <= frequency < upper."""
+    b = levels.third_octave_bands(frequency / 1.3, frequency * 1.3)
+    i = int(np.flatnonzero((b.lower <= frequency) & (frequency < b.upper))[0])
+    return float(b.lower[i]), float(b.upper[i])
+
+
+def sideband_lines(source, model, periodic: Lines, torque_nm: float, spectrum: Spectrum, f_lines_max: float) -> Lines:
+    """Lines of the expected deviation power at one torque (`Lines`; the periodic run's `points`, so totals group
+    per operating point): per operating point the wheel orders q > 0 inside the 1/3-octave band of harmonic n
+    (n = 1..spectrum.n_max and n f_tooth <= f_lines_max; `harmonic` = the lowest n whose band holds the line),
+    frequency q f_tooth / z2, mesh_excitation k_ref sqrt(E a_q^2 / 2) (real rms N: the phase of an incoherent line
+    is immaterial), L_omega the rigid-bore source's level of the same TE (te_receptance_rigid_bores)."""
+    z2 = int(source.pair.teeth[1])
+    k_ref = mesh_reference_stiffness(model)
+    mats = source._point(float(torque_nm)).mats
+    cols = {k: [] for k in ("torque", "speed", "harmonic", "frequency", "power", "point")}
+    for p, (torque, speed, f_t, *_) in enumerate(periodic.points):
+        if torque != float(torque_nm):
+            continue
+        f = spectrum.orders * f_t / z2
+        band = np.zeros(f.size, int)
+        for n in range(spectrum.n_max, 0, -1):          # the lowest harmonic's band wins where bands overlap
+            if n * f_t > f_lines_max * (1 + 1e-12):
+                continue
+            lo, hi = band_of(n * f_t)
+            band[(f >= lo) & (f < hi) & (f <= f_lines_max * (1 + 1e-12)) & (spectrum.orders > 0)] = n
+        keep = (band > 0) & (spectrum.power > 0)
+        m = int(keep.sum())
+        cols["torque"] += [torque] * m
+        cols["speed"] += [speed] * m
+        cols["harmonic"] += list(band[keep])
+        cols["frequency"] += list(f[keep])
+        cols["power"] += list(spectrum.power[keep])
+        cols["point"] += [p] * m
+    freq = np.array(cols["frequency"], float)
+    power = np.array(cols["power"], float)
+    omega_ms = te_receptance_rigid_bores(mats, freq) ** 2 * power / 2 if freq.size else np.zeros(0)
+    return Lines(torque=np.array(cols["torque"], float), speed=np.array(cols["speed"], float),
+                 harmonic=np.array(cols["harmonic"], int), frequency=freq,
+                 L_omega=levels.level(omega_ms, levels.OMEGA0),
+                 mesh_excitation=(k_ref * np.sqrt(power / 2)).astype(complex),
+                 point=np.array(cols["point"], int), points=periodic.points, receptance=periodic.receptance)
+
+
+def _power(db) -> np.ndarray:
+    return 10.0 ** (np.asarray(db, float) / 10.0)
+
+
+def _db(power) -> float:
+    return float(10.0 * np.log10(power)) if power > 0 else float("-inf")
+
+
+COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "tooth_frequency_hz", "grade", "sideband_lines",
+           "L_omega_tooth_band_dB", "L_omega_tooth_band_as_made_dB", "L_omega_total_dB", "L_omega_total_as_made_dB",
+           "Lv_tooth_band_dB", "Lv_tooth_band_as_made_dB", "Lv_dB", "Lv_as_made_dB",
+           "Lw_tooth_band_dB", "Lw_tooth_band_as_made_dB", "Lw_dB", "Lw_as_made_dB",
+           "LwA_tooth_band_dB", "LwA_tooth_band_as_made_dB", "LwA_dB", "LwA_as_made_dB",
+           "LwA_peak_band_hz", "LwA_peak_band_dB", "LwA_peak_band_as_made_hz", "LwA_peak_band_as_made_dB")
+
+
+def _peak_band(frequency: np.ndarray, lwa_db: np.ndarray) -> tuple[float, float]:
+    """(nominal centre Hz, level dB) of the 1/3-octave band holding the most A-weighted power of the lines."""
+    if frequency.size == 0:
+        return float("nan"), float("-inf")
+    bands = levels.third_octave_bands(frequency.min() / 1.3, frequency.max() * 1.3)
+    power = levels.band_sum(frequency, _power(lwa_db), bands)
+    i = int(np.argmax(power))
+    return float(bands.nominal[i]), _db(float(power[i]))
+
+
+def table_rows(periodic: RunupResult, sidebands: RunupResult, grade: int) -> list[dict]:
+    """One row per route, radiator and operating point (COLUMNS): in the tooth band (the 1/3-octave band of
+    f_tooth) and over all lines, L_omega (tf_omega: the rigid-bore source's; mesh_force: the wheel on the coupled
+    model), L_v, L_W and L_WA of the periodic lines alone and with the expected sidebands (energy sums); and the
+    1/3-octave band (nominal Hz) with the most A-weighted power, with its level, without and with them."""
+    rows = []
+    P, S = periodic.lines, sidebands.lines
+    a_P, a_S = levels.a_weighting_db(P.frequency), levels.a_weighting_db(S.frequency)
+    for route, rp in periodic.routes.items():
+        rs = sidebands.routes[route]
+        omega_P = P.L_omega if route == "tf_omega" else rp.L_omega_coupled
+        omega_S = S.L_omega if route == "tf_omega" else rs.L_omega_coupled
+        for rad in periodic.radiators:
+            for p, (torque, speed, f_t, *_) in enumerate(P.points):
+                lo, hi = band_of(f_t)
+                inP, inS = P.point == p, S.point == p
+                bandP = inP & (P.frequency >= lo) & (P.frequency < hi)
+                bandS = inS & (S.frequency >= lo) & (S.frequency < hi)
+                row = {"route": route, "radiation": rad, "torque_nm": torque, "speed_rpm": speed,
+                       "tooth_frequency_hz": f_t, "grade": grade, "sideband_lines": int(inS.sum())}
+                for key, vP, vS in (("L_omega", omega_P, omega_S), ("Lv", rp.L_v, rs.L_v),
+                                    ("Lw", periodic.L_W[route, rad], sidebands.L_W[route, rad]),
+                                    ("LwA", periodic.L_W[route, rad] + a_P, sidebands.L_W[route, rad] + a_S)):
+                    total = "L_omega_total" if key == "L_omega" else key
+                    for name, selP, selS in ((f"{key}_tooth_band", bandP, bandS), (total, inP, inS)):
+                        base = float(np.sum(_power(vP[selP])))
+                        row[f"{name}_dB"] = _db(base)
+                        row[f"{name}_as_made_dB"] = _db(base + float(np.sum(_power(vS[selS]))))
+                lwaP, lwaS = periodic.L_W[route, rad][inP] + a_P[inP], sidebands.L_W[route, rad][inS] + a_S[inS]
+                row["LwA_peak_band_hz"], row["LwA_peak_band_dB"] = _peak_band(P.frequency[inP], lwaP)
+                row["LwA_peak_band_as_made_hz"], row["LwA_peak_band_as_made_dB"] = _peak_band(
+                    np.concatenate([P.frequency[inP], S.frequency[inS]]), np.concatenate([lwaP, lwaS]))
+                rows.append(row)
+    return rows
+
+
+@dataclass
+class AsMadeRun:
+    """The as-made addition of a run-up: grade, rows (COLUMNS), the sideband RunupResult per torque, the bands'
+    harmonics 1..n_max, the number of sideband lines, seconds."""
+
+    grade: int
+    rows: list
+    sidebands: dict
+    n_max: int
+    lines: int
+    seconds: float
+
+
+def as_made_run(results: dict, source, grade: int, f_lines_max: float, routes) -> AsMadeRun:
+    """The expected sidebands of grade-`grade` gears through `routes` on the run-up's own models (results: {torque:
+    (GearboxModel, RunupResult)} of the periodic run-up)."""
+    t0 = time.perf_counter()
+    grade = check_as_made(grade)
+    rows, side, n_max, count = [], {}, 1, 0
+    for torque, (model, res) in results.items():
+        spectrum = deviation_spectrum(source, float(torque), grade)
+        n_max = spectrum.n_max
+        lines = sideband_lines(source, model, res.lines, float(torque), spectrum, f_lines_max)
+        speeds = sorted({s for t, s, *_ in res.lines.points if t == float(torque)})
+        # both routes' unit loads in one factorisation per line (the sideband lines are many: ~500 per speed)
+        model.reduction.prefetch_unit_coordinates(lines.frequency, [ROUTE_LOADS[r] for r in routes if r in ROUTE_LOADS])
+        side[torque] = runup(model, None, speeds, [float(torque)], routes=tuple(routes), lines=lines)
+        rows += table_rows(res, side[torque], grade)
+        count += len(lines.frequency)
+    return AsMadeRun(grade, rows, side, n_max, count, time.perf_counter() - t0)
+
+
+def summary_lines(run: AsMadeRun, radiation: str) -> list[str]:
+    """The summary's lines: per torque and route, max L_WA with the expected sidebands beside the periodic one."""
+    out = []
+    for torque in run.sidebands:
+        parts = []
+        for route in run.sidebands[torque].routes:
+            sel = [r for r in run.rows if r["route"] == route and r["radiation"] == radiation
+                   and r["torque_nm"] == float(torque)]
+            i = int(np.argmax([r["LwA_as_made_dB"] for r in sel]))
+            j = int(np.argmax([r["LwA_dB"] for r in sel]))
+            parts.append(f"{route} {sel[i]['LwA_as_made_dB']:.1f} dB(A) @ {sel[i]['speed_rpm']:g} rpm, most in the "
+                         f"{sel[i]['LwA_peak_band_as_made_hz']:g} Hz band (periodic {sel[j]['LwA_dB']:.1f} @ "
+                         f"{sel[j]['speed_rpm']:g} rpm, {sel[j]['LwA_peak_band_hz']:g} Hz band)")
+        out.append(f"  {torque:g} N m as made (ISO 1328-1 grade {run.grade}, expected sidebands in the bands of "
+                   f"harmonics 1-{run.n_max}, {run.lines} lines, {run.seconds:.1f} s): max L_WA " + "; ".join(parts)
+                   + f"; sigma {radiation} ({CSV})")
+    return out
