@@ -430,16 +430,17 @@ def _aligned(cells: list[list[str]], widths: list[int]) -> str:
 
 
 # ---------------------------------------------------------------------------------------- file jobs on two cores
-def run_split(jobs: Sequence[tuple[float, Callable[[], object]]]) -> None:
+def run_split(jobs: Sequence[tuple[float, Callable[[], object]]], parallel: bool = True) -> None:
     """Run independent jobs that write files (e.g. a report's pictures: matplotlib's layout is pure Python, ~0.2-0.5 s
     a figure) as two halves of about equal estimated cost: one in this process, the other in a forked child on
     another core, where this process may use two (os.sched_getaffinity) and the platform forks; otherwise all here.
     jobs: (estimated cost, callable with no arguments); results are discarded, each job's files are its output.
     The child only runs its jobs (no MPI, no atexit handlers: os._exit) and reports success by its exit status; if
     it fails or is killed, its jobs run again here, so an error is raised in this process with its traceback.  The
-    files are the same either way (each job writes its own)."""
+    files are the same either way (each job writes its own).  parallel=False: all here (e.g. under MPI with more
+    than one rank, whose other ranks already have the cores)."""
     jobs = list(jobs)
-    if len(jobs) < 2 or not hasattr(os, "fork") or len(os.sched_getaffinity(0)) < 2:
+    if not parallel or len(jobs) < 2 or not hasattr(os, "fork") or len(os.sched_getaffinity(0)) < 2:
         for _, job in jobs:
             job()
         return

@@ -100,7 +100,7 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         pictures.append((PICTURE_COST_S["slopes"], lambda: slope_terms.plot(folder / "slope_terms.png",
                                                                             decompositions)))
     _import_pyplot()                    # once, before the pictures are shared out (0.25 s)
-    outputs.run_split(pictures)
+    outputs.run_split(pictures, parallel=gm.structure.V.mesh.comm.size == 1)
     (folder / "summary.txt").write_text(summary_text(scene, results, gm, check_rows, timings, decompositions, notes)
                                         + "\n")
     import dolfinx
