@@ -59,22 +59,14 @@ class MassProducts:
         self.scalar = _scalar_factor(M) if self.bs > 1 else None
 
     def __call__(self, X: np.ndarray) -> np.ndarray:
-        from housingfe.solvers.blocks import aij_product
-
         k = X.shape[1]
         if self.scalar is not None:
             bs = self.bs
-            fast = aij_product(self.scalar, X.reshape(self.rows_local // bs, bs * k))
-            if fast is not None:
-                return fast.reshape(self.rows_local, k)
             D = _dense(np.ascontiguousarray(X).reshape(self.rows_local // bs, bs * k), self.rows // bs,
                        self.comm)
             Y = self.scalar.matMult(D)
             out = np.array(Y.getDenseArray()).reshape(self.rows_local, k)
         else:
-            fast = aij_product(self.M, X)
-            if fast is not None:
-                return np.asfortranarray(fast)      # PETSc's dense layout, as below: the same bits downstream
             D = _dense(X, self.rows, self.comm)
             Y = self.M.matMult(D)
             out = np.array(Y.getDenseArray())

@@ -14,30 +14,8 @@ def columns(vectors) -> np.ndarray:
     return np.column_stack([v.getArray(readonly=True) for v in vectors])
 
 
-def aij_product(A: PETSc.Mat, X: np.ndarray) -> np.ndarray | None:
-    """A X (C order) for a sequential AIJ matrix A (one rank) by scipy's CSR kernel on PETSc's own arrays (no copy
-    of A), else None.  Each entry is the same sum in the same order as PETSc's MatMatMult (row entries in column
-    order from zero, no fused multiply-add): the same bits (checked on the coupled test gearbox's M, 8 / 31 / 66
-    columns), in 27 instead of 33 ms for 8 columns on 65 k DOFs (4.7 M entries)."""
-    if A.getType() != "seqaij" or A.getComm().getSize() != 1:
-        return None
-    import scipy.sparse as sp
-
-    from housingfe.solvers.mumps import _local_blocks
-
-    X = np.ascontiguousarray(X, dtype=float)
-    with _local_blocks(A) as parts:
-        if len(parts) != 1 or parts[0][3] is not None:
-            return None
-        ia, ja, va, _, _ = parts[0]
-        return sp.csr_matrix((va, ja, ia), shape=A.getSize(), copy=False) @ X
-
-
 def mat_block(A: PETSc.Mat, X: np.ndarray) -> np.ndarray:
-    """A X (local rows of the result, Fortran order) for a dense block X of A's local column rows."""
-    fast = aij_product(A, X)
-    if fast is not None:
-        return np.asfortranarray(fast)          # PETSc's dense layout: the products downstream keep their bits
+    """A X (local rows of the result) for a dense block X of A's local column rows."""
     X = np.asfortranarray(X, dtype=float)
     comm = A.getComm()
     D = PETSc.Mat().createDense([(X.shape[0], A.getSize()[1]), (X.shape[1], X.shape[1])], array=X, comm=comm)

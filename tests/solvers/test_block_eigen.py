@@ -207,24 +207,3 @@ def _mult_array(M, x):
     v = M.createVecRight()
     v.getArray()[:] = x
     return modal._mult(M, v).getArray().copy()
-
-
-def test_aij_products_are_petscs_bits_and_other_types_are_left_to_petsc(coarse_box_model):
-    """blocks.aij_product (scipy's CSR kernel on PETSc's arrays) gives exactly PETSc's MatMatMult: the eigensolve's
-    mass products, the Ritz residuals and the energy shares keep their bits.  A non-AIJ matrix gets None."""
-    from housingfe.solvers import blocks
-
-    M = coarse_box_model.M
-    if M.getComm().getSize() > 1:
-        pytest.skip("one rank only: on more the products stay PETSc's")
-    K = coarse_box_model.K
-    for A, k in ((M, 8), (K, 31), (M, 3)):
-        X = np.random.default_rng(k).standard_normal((A.getLocalSize()[0], k))
-        D = PETSc.Mat().createDense([(X.shape[0], A.getSize()[1]), (k, k)], array=np.asfortranarray(X),
-                                    comm=A.getComm())
-        reference = np.array(A.matMult(D).getDenseArray())
-        fast = blocks.aij_product(A, X)
-        assert fast is not None and np.array_equal(fast, reference)
-        assert np.array_equal(blocks.mat_block(A, X), reference) and blocks.mat_block(A, X).flags.f_contiguous
-    dense = PETSc.Mat().createDense([4, 4], array=np.eye(4), comm=PETSc.COMM_SELF)
-    assert blocks.aij_product(dense, np.ones((4, 2))) is None
