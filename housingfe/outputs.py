@@ -430,6 +430,11 @@ def _aligned(cells: list[list[str]], widths: list[int]) -> str:
 
 
 # ---------------------------------------------------------------------------------------- file jobs on two cores
+def _spare_core() -> bool:
+    """Whether this process may fork a child onto a second core (Linux: its CPU affinity holds two or more)."""
+    return hasattr(os, "fork") and hasattr(os, "sched_getaffinity") and len(os.sched_getaffinity(0)) >= 2
+
+
 def run_split(jobs: Sequence[tuple[float, Callable[[], object]]], parallel: bool = True) -> None:
     """Run independent jobs that write files (e.g. a report's pictures: matplotlib's layout is pure Python, ~0.2-0.5 s
     a figure) as two halves of about equal estimated cost: one in this process, the other in a forked child on
@@ -440,7 +445,7 @@ def run_split(jobs: Sequence[tuple[float, Callable[[], object]]], parallel: bool
     files are the same either way (each job writes its own).  parallel=False: all here (e.g. under MPI with more
     than one rank, whose other ranks already have the cores)."""
     jobs = list(jobs)
-    if not parallel or len(jobs) < 2 or not hasattr(os, "fork") or len(os.sched_getaffinity(0)) < 2:
+    if not parallel or len(jobs) < 2 or not _spare_core():
         for _, job in jobs:
             job()
         return

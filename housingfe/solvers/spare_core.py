@@ -17,7 +17,8 @@ class Forked:
 
     def __init__(self, fn: Callable[[], object], parallel: bool = True):
         self.fn, self.pid, self.fd = fn, None, None
-        if not parallel or not hasattr(os, "fork") or len(os.sched_getaffinity(0)) < 2:
+        if not parallel or not (hasattr(os, "fork") and hasattr(os, "sched_getaffinity")
+                                and len(os.sched_getaffinity(0)) >= 2):
             return
         read, write = os.pipe()
         pid = os.fork()
