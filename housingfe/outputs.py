@@ -18,7 +18,7 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
-from typing import Iterable, Iterator, Sequence
+from typing import Callable, Iterable, Iterator, Sequence
 
 from housingfe.errors import InputError
 
@@ -427,3 +427,51 @@ def _aligned(cells: list[list[str]], widths: list[int]) -> str:
 
 
 # ------------------------------------------------------------------------------------------ modal results
+
+
+# ---------------------------------------------------------------------------------------- file jobs on two cores
+def _spare_core() -> bool:
+    """Whether this process may fork a child onto a second core (Linux: its CPU affinity holds two or more)."""
+    return hasattr(os, "fork") and hasattr(os, "sched_getaffinity") and len(os.sched_getaffinity(0)) >= 2
+
+
+def run_split(jobs: Sequence[tuple[float, Callable[[], object]]], parallel: bool = True) -> None:
+    """Run independent jobs that write files (e.g. a report's pictures: matplotlib's layout is pure Python, ~0.2-0.5 s
+    a figure) as two halves of about equal estimated cost: one in this process, the other in a forked child on
+    another core, where this process may use two (os.sched_getaffinity) and the platform forks; otherwise all here.
+    jobs: (estimated cost, callable with no arguments); results are discarded, each job's files are its output.
+    The child only runs its jobs (no MPI, no atexit handlers: os._exit) and reports success by its exit status; if
+    it fails or is killed, its jobs run again here, so an error is raised in this process with its traceback.  The
+    files are the same either way (each job writes its own).  parallel=False: all here (e.g. under MPI with more
+    than one rank, whose other ranks already have the cores)."""
+    jobs = list(jobs)
+    if not parallel or len(jobs) < 2 or not _spare_core():
+        for _, job in jobs:
+            job()
+        return
+    here, there, load = [], [], [0.0, 0.0]
+    for cost, job in sorted(jobs, key=lambda j: -j[0]):       # greedy: the costliest first, to the lighter half
+        side = 0 if load[0] <= load[1] else 1
+        (here if side == 0 else there).append(job)
+        load[side] += cost
+    sys.stdout.flush()
+    sys.stderr.flush()
+    pid = os.fork()
+    if pid == 0:                                                # the child: its jobs, then out without cleanup
+        status = 1
+        try:
+            for job in there:
+                job()
+            status = 0
+        except BaseException:                                   # noqa: BLE001 - the parent re-runs and reports
+            pass
+        finally:
+            os._exit(status)
+    try:
+        for job in here:
+            job()
+    finally:
+        _, status = os.waitpid(pid, 0)
+    if status != 0:
+        for job in there:
+            job()

@@ -48,6 +48,17 @@ def bound_lines(results: dict, bound: dict, radiation: str) -> list[str]:
             for torque, res in bound.items()]
 
 
+# seconds per picture on one idle core (test-gearbox-runup, 2026-11-26), to share the pictures out evenly
+PICTURE_COST_S = {"spectrum": 0.28, "runup": 0.2, "slopes": 0.43}
+
+
+def _import_pyplot() -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot  # noqa: F401
+
+
 def _fmt(v):
     if isinstance(v, float):
         return "" if not np.isfinite(v) else f"{v:.6g}"
@@ -79,18 +90,24 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
     outputs.write_csv(folder / "runup_harmonics.csv", HARMONIC_COLUMNS,
                       ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for r in harm))
     outputs.write_csv(folder / "checks.csv", CHECK_COLUMNS, ([_fmt(r[k]) for k in CHECK_COLUMNS] for r in check_rows))
+    # the pictures (PICTURE_COST_S: matplotlib's layout, ~1.8 s together on one core) are drawn on two cores
+    pictures = []
     for speed in scene.runup.spectrum_speeds_rpm:
         rows = [r for r in harm if abs(r["speed_rpm"] - speed) < 1e-9]
         if rows:
             outputs.write_csv(folder / f"spectra_{speed:g}rpm.csv", HARMONIC_COLUMNS,
                               ([_fmt(r[k]) for k in HARMONIC_COLUMNS] for r in rows))
-            spectrum_plot(folder / f"spectra_{speed:g}rpm.png", rows, speed, scene.radiation.models[0])
-    runup_plot(folder / "runup.png", scene, totals)
+            pictures.append((PICTURE_COST_S["spectrum"], lambda rows=rows, speed=speed: spectrum_plot(
+                folder / f"spectra_{speed:g}rpm.png", rows, speed, scene.radiation.models[0])))
+    pictures.append((PICTURE_COST_S["runup"], lambda: runup_plot(folder / "runup.png", scene, totals)))
     if decompositions:
         outputs.write_csv(folder / "slope_terms.csv", slope_terms.SLOPE_COLUMNS,
                           ([_fmt(r[k]) for k in slope_terms.SLOPE_COLUMNS]
                            for r in slope_terms.slope_rows(decompositions)))
-        slope_terms.plot(folder / "slope_terms.png", decompositions)
+        pictures.append((PICTURE_COST_S["slopes"], lambda: slope_terms.plot(folder / "slope_terms.png",
+                                                                            decompositions)))
+    _import_pyplot()                    # once, before the pictures are shared out (0.25 s)
+    outputs.run_split(pictures, parallel=gm.structure.V.mesh.comm.size == 1)
     (folder / "summary.txt").write_text(summary_text(scene, results, gm, check_rows, timings, decompositions, notes)
                                         + "\n")
     import dolfinx

@@ -338,6 +338,14 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         for row in bores:
             print(f"bearing {row['bearing']} -> {row['surface']}: centre "
                   f"[{', '.join(f'{x + 0.0:.4g}' for x in row['centre_m'])}] m, radius {row['radius_m'] * 1e3:.4g} mm")
+    source = prepared = None
+    if spec.misalignment_model != "coupled":
+        # the lumped source's operating points (stiffness curve, load share: ~0.4 s) need no FE here: computed on the
+        # spare core while the coupled model is built (the same code on the same inputs: the same numbers)
+        from housingfe.solvers.spare_core import Forked
+
+        source = _source(drivetrains[reference_torque], spec, spec.misalignment_model)
+        prepared = Forked(lambda: source.prepared(spec.torques_nm), parallel=comm.size == 1)
     gm = build_gearbox_model(model, drivetrains[reference_torque], spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators, surface=spec.surface,
                              friction=spec.mesh_friction != "none")
@@ -345,7 +353,11 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     timings.update({k: gm.timings[k] for k in ("coupling_s", "basis_s", "reduction_s")})
     progress.update(note="coupled model and modal basis")
     misalignment = spec.misalignment_model
-    if misalignment == "coupled":           # the static tilt on the flexible housing, per torque
+    if source is not None:
+        t1 = time.perf_counter()
+        source.adopt(prepared.result())
+        timings["source_wait_s"] = time.perf_counter() - t1
+    elif misalignment == "coupled":         # the static tilt on the flexible housing, per torque
         from housingfe.drivetrain.misalignment import coupled_misalignment
 
         t1 = time.perf_counter()
@@ -354,12 +366,8 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
 
         def misalignment(torque: float) -> float:
             return gaps[float(torque)]
-    elif misalignment == "rigid-bores":
-        from housingfe.drivetrain.misalignment import lead_gap_law
 
-        misalignment = lead_gap_law(drivetrains[reference_torque], "rigid-bores")
-    source = drivetrains[reference_torque].source_model(harmonics=spec.harmonics, engagement=spec.engagement,
-                                                        misalignment=misalignment)
+        source = _source(drivetrains[reference_torque], spec, misalignment)
     results = {}
     for torque in spec.torques_nm:
         t1 = time.perf_counter()
@@ -409,6 +417,16 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
+
+
+def _source(drivetrain, spec: RunupSpec, misalignment):
+    """The lumped source of a run-up's reference drivetrain: `misalignment` a lead-gap law [m/m] of the torque, or
+    "rigid-bores" (its law on the drivetrain's rigid bores), or "none"."""
+    if misalignment == "rigid-bores":
+        from housingfe.drivetrain.misalignment import lead_gap_law
+
+        misalignment = lead_gap_law(drivetrain, "rigid-bores")
+    return drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement, misalignment=misalignment)
 
 
 def matched_drivetrains(ref: HousingRef, model, drivetrains: dict, path) -> tuple[dict, list[dict]]:

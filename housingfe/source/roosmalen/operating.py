@@ -127,6 +127,17 @@ class SourceModel:
                                                   lead_gap=self.lead_gap(torque))
         return self._points[torque]
 
+    def prepared(self, torques_nm) -> dict:
+        """{torque [N m]: operating point} (stiffness curve, load share, matrices, shock: what every speed at a
+        torque reuses) at these pinion torques, computed now; `adopt` takes them into another copy of this model (a
+        run-up computes them in a forked process while its FE model is built)."""
+        return {float(t): self._point(float(t)) for t in torques_nm}
+
+    def adopt(self, points: dict) -> None:
+        """Take operating points of `prepared` (of a model with the same gears, interior, engagement and
+        misalignment) as this model's own."""
+        self._points.update(points)
+
     def lead_gap(self, torque_nm: float) -> float:
         """MeshModel.lead_gap [m/m] of the misalignment at a pinion torque [N m] (0 for "none")."""
         if callable(self.misalignment):
