@@ -14,9 +14,11 @@ import json
 import math
 import os
 import shutil
+import signal
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 from typing import Callable, Iterable, Iterator, Sequence
 
@@ -435,13 +437,35 @@ def _spare_core() -> bool:
     return hasattr(os, "fork") and hasattr(os, "sched_getaffinity") and len(os.sched_getaffinity(0)) >= 2
 
 
+# A forked child that has not finished by then is killed and its work redone here: a child that hangs (e.g. on a
+# library lock held by another thread at the fork) must cost a delay, never a hung run.
+CHILD_TIMEOUT_S = 120.0
+
+
+def wait_child(pid: int, timeout: float | None = None) -> int:
+    """The exit status of the forked child `pid`, or -1 after killing it (SIGKILL) when it has not ended within
+    `timeout` s (None: CHILD_TIMEOUT_S)."""
+    deadline, delay = time.monotonic() + (CHILD_TIMEOUT_S if timeout is None else timeout), 0.002
+    while True:
+        done, status = os.waitpid(pid, os.WNOHANG)
+        if done:
+            return status
+        if time.monotonic() > deadline:
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+            os.waitpid(pid, 0)
+            return -1
+        time.sleep(delay)
+        delay = min(2 * delay, 0.02)
+
+
 def run_split(jobs: Sequence[tuple[float, Callable[[], object]]], parallel: bool = True) -> None:
     """Run independent jobs that write files (e.g. a report's pictures: matplotlib's layout is pure Python, ~0.2-0.5 s
     a figure) as two halves of about equal estimated cost: one in this process, the other in a forked child on
     another core, where this process may use two (os.sched_getaffinity) and the platform forks; otherwise all here.
     jobs: (estimated cost, callable with no arguments); results are discarded, each job's files are its output.
     The child only runs its jobs (no MPI, no atexit handlers: os._exit) and reports success by its exit status; if
-    it fails or is killed, its jobs run again here, so an error is raised in this process with its traceback.  The
+    it fails, is killed or has not ended CHILD_TIMEOUT_S after this process' half, its jobs run again here, so an error is raised in this process with its traceback.  The
     files are the same either way (each job writes its own).  parallel=False: all here (e.g. under MPI with more
     than one rank, whose other ranks already have the cores)."""
     jobs = list(jobs)
@@ -471,7 +495,7 @@ def run_split(jobs: Sequence[tuple[float, Callable[[], object]]], parallel: bool
         for job in here:
             job()
     finally:
-        _, status = os.waitpid(pid, 0)
+        status = wait_child(pid)
     if status != 0:
         for job in there:
             job()

@@ -34,3 +34,24 @@ def test_a_job_that_fails_everywhere_raises_here(tmp_path):
     jobs = [(1.0, _job(tmp_path / "a.txt")), (2.0, _job(tmp_path / "b.txt", always_fail=True))]
     with pytest.raises(RuntimeError, match="job failed"):
         outputs.run_split(jobs)
+
+
+@pytest.mark.skipif(not hasattr(os, "fork") or len(os.sched_getaffinity(0)) < 2, reason="needs fork and 2 cores")
+def test_a_child_that_hangs_is_killed_and_its_jobs_run_here(tmp_path, monkeypatch):
+    """A child that never ends costs CHILD_TIMEOUT_S, not a hung run: it is killed and its files written here."""
+    import time
+
+    monkeypatch.setattr(outputs, "CHILD_TIMEOUT_S", 1.0)
+    parent = os.getpid()
+
+    def job(path):
+        def run():
+            while os.getpid() != parent:
+                time.sleep(0.05)
+            path.write_text(str(os.getpid()))
+        return run
+
+    paths = [tmp_path / f"f{i}.txt" for i in range(4)]
+    t0 = time.monotonic()
+    outputs.run_split([(1.0, job(p)) for p in paths])
+    assert all(int(p.read_text()) == parent for p in paths) and time.monotonic() - t0 < 10

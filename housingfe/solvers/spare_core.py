@@ -6,12 +6,17 @@ from __future__ import annotations
 
 import os
 import pickle
+import select
+import time
 from typing import Callable
+
+from housingfe import outputs
 
 
 class Forked:
     """fn() computed in a forked child (where this process may use two cores and the platform forks), its result
-    sent back pickled; `result()` returns it, or computes fn() here if the child failed or there was no child.  The
+    sent back pickled; `result()` returns it, or computes fn() here if the child failed, had not finished within
+    outputs.CHILD_TIMEOUT_S (it is then killed) or there was no child.  The
     child only computes and pickles (no MPI, no atexit handlers: os._exit).  The value is the same either way
     (pickle keeps every float's bits)."""
 
@@ -41,10 +46,24 @@ class Forked:
         """fn()'s value (from the child if it succeeded, else computed here)."""
         if self.pid is None:
             return self.fn()
-        with os.fdopen(self.fd, "rb") as pipe:
-            data = pipe.read()
-        _, status = os.waitpid(self.pid, 0)
+        data = _read_until(self.fd, time.monotonic() + outputs.CHILD_TIMEOUT_S)
+        os.close(self.fd)
+        status = outputs.wait_child(self.pid, timeout=0.0 if data is None else None)
         self.pid = None
         if status != 0 or not data:
             return self.fn()
         return pickle.loads(data)
+
+
+def _read_until(fd: int, deadline: float) -> bytes | None:
+    """Everything written to the pipe `fd` until its writer closes it, or None if that has not happened by
+    `deadline` (time.monotonic(), s)."""
+    chunks = []
+    while True:
+        left = deadline - time.monotonic()
+        if left <= 0 or not select.select([fd], [], [], left)[0]:
+            return None
+        chunk = os.read(fd, 1 << 20)
+        if not chunk:
+            return b"".join(chunks)
+        chunks.append(chunk)

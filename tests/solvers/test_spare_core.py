@@ -43,3 +43,26 @@ def test_an_error_everywhere_is_raised_here():
 
     with pytest.raises(ValueError, match="bad input"):
         Forked(fails).result()
+
+
+@forks
+def test_a_child_that_hangs_is_killed_and_the_value_computed_here(monkeypatch):
+    """A child that never ends (e.g. a lock held across the fork) costs CHILD_TIMEOUT_S, not a hung run."""
+    import time
+
+    from housingfe import outputs
+
+    monkeypatch.setattr(outputs, "CHILD_TIMEOUT_S", 1.0)
+    parent = os.getpid()
+
+    def hangs_in_the_child():
+        while os.getpid() != parent:
+            time.sleep(0.05)
+        return "here"
+
+    t0 = time.monotonic()
+    forked = Forked(hangs_in_the_child)
+    child = forked.pid
+    assert forked.result() == "here" and time.monotonic() - t0 < 10
+    with pytest.raises(ChildProcessError):
+        os.waitpid(child, os.WNOHANG)          # killed and reaped
