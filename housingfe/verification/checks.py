@@ -6,7 +6,9 @@ unit, source, note) with these fields added (`tag`):
 * check_id — stable name, "28.<group>.<what>[.<variant>][.<route>]", e.g. "28.default.max_lwa.mesh_force"; the
   groups, in the issue's order: replica, default, excitation, speed_law, l_omega, variants (CHECK_GROUPS), and
   bound: the envelope bound's rows "28.bound.<the check's id after 28.>" (`as_bound`), reported beside the checks,
-  never judged, without a band and counted apart;
+  never judged, without a band and counted apart; and as_made: the rows "28.as_made.<the check's id after 28.>" of
+  the default run-up with the expected sidebands of gears as made (`as_made_row`; runup.as_made, docs/runup.md),
+  reported, never judged, without a band and counted apart as well;
 * measured, thesis_calculated — the published numbers beside ours (either may be None);
 * tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
 * passed — "yes", "no" or "" (a report row: nothing to pass);
@@ -34,11 +36,17 @@ from pathlib import Path
 
 import numpy as np
 
-CHECK_GROUPS = ("replica", "default", "excitation", "speed_law", "l_omega", "variants", "bound")
+CHECK_GROUPS = ("replica", "default", "excitation", "speed_law", "l_omega", "variants", "bound", "as_made")
 # the rows of the envelope bound (engagement "envelope-bound", docs/source.md): a check's value with the bound in
 # place of the default's excitation, reported beside the checks (passed "", no band), never judged nor counted
 BOUND_GROUP = "bound"
 BOUND_WHY = "envelope bound (engagement envelope-bound): a bound, not the model; docs/source.md"
+# the rows of gears as made (runup.as_made = AS_MADE_GRADE, housingfe.runup.as_made): a check's quantity with the
+# expected sidebands of ISO 1328-1 deviations beside the periodic lines, reported like the bound's, never judged
+AS_MADE_GROUP = "as_made"
+AS_MADE_GRADE = 5
+AS_MADE_WHY = (f"gears as made (runup.as_made = {AS_MADE_GRADE}, ISO 1328-1 grade {AS_MADE_GRADE} standing in for the "
+               "thesis' DIN 5): reported, not a check; docs/runup.md")
 CHECK_COLUMNS = ("check_id", "quantity", "ours", "measured", "thesis_calculated", "tolerance", "passed", "band", "why",
                  "unit", "scene", "source")
 NO_BAND = "—"
@@ -106,6 +114,30 @@ def as_bound(row: dict) -> dict:
     return row
 
 
+def is_as_made(row: dict) -> bool:
+    """A row of gears as made (28.as_made.*): reported, not a check."""
+    return is_check(row) and row["check_id"].split(".")[1] == AS_MADE_GROUP
+
+
+def is_reported_beside(row: dict) -> bool:
+    """A row shown beside the checks but not one of them (the envelope bound's, gears as made)."""
+    return is_bound(row) or is_as_made(row)
+
+
+def as_made_row(check_id: str, scene: str, quantity: str, ours, unit: str, source: str, *, measured=None,
+                thesis_calculated=None, why: str = "") -> dict:
+    """A row of gears as made: check_id 28.as_made.<the check's id after "28.">, ours with the expected sidebands,
+    measured / thesis calculated as the check's, passed "" (reported), no tolerance, no band, `why` starting with
+    AS_MADE_WHY."""
+    if not check_id.startswith(f"28.{AS_MADE_GROUP}."):
+        raise ValueError(f"as_made_row: {check_id!r} is not 28.{AS_MADE_GROUP}.<...>")
+    why = f"{AS_MADE_WHY}; {why}" if why else AS_MADE_WHY
+    r = check_row(check_id, scene, quantity, ours, unit, source, measured=measured,
+                  thesis_calculated=thesis_calculated, why=why)
+    r["note"] = f"reported, not judged: {why}"
+    return r
+
+
 def check_rows(rows) -> list[dict]:
     """The check rows of `rows`, in the issue's order of groups (stable within a group)."""
     found = [r for r in rows if is_check(r)]
@@ -124,7 +156,7 @@ def attach_bands(rows, bands) -> int:
     without an entry show "—"."""
     n = 0
     for r in rows:
-        if not (is_check(r) and r["check_id"] in bands) or is_bound(r):      # the bound's rows have no band
+        if not (is_check(r) and r["check_id"] in bands) or is_reported_beside(r):    # bound, as made: no band
             continue
         entry = bands[r["check_id"]]
         if isinstance(entry, dict):
@@ -236,17 +268,20 @@ def _cells(r: dict) -> list[str]:
 
 def checks_markdown(rows) -> str:
     """The check rows of `rows` as a Markdown table (the columns of CHECK_COLUMNS) and a count line; the envelope
-    bound's rows (28.bound.*) are counted apart: they are not checks."""
+    bound's rows (28.bound.*) and those of gears as made (28.as_made.*) are counted apart: they are not checks."""
     found = check_rows(rows)
     lines = ["| " + " | ".join(CHECK_COLUMNS) + " |", "|" + "---|" * len(CHECK_COLUMNS)]
     lines += ["| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in _cells(r)) + " |" for r in found]
     bound = sum(is_bound(r) for r in found)
-    checks = len(found) - bound
+    made = sum(is_as_made(r) for r in found)
+    checks = len(found) - bound - made
     passed = sum(r.get("passed") == "yes" for r in found)
     failed = sum(r.get("passed") == "no" for r in found)
     lines += ["", f"{checks} checks: {passed} passed, {failed} failed, {checks - passed - failed} reported"
               + (f"; and {bound} rows of the envelope bound (28.bound.*), reported: a bound, not the model" if bound
-                 else "")]
+                 else "")
+              + (f"; and {made} rows of gears as made (28.as_made.*, ISO grade {AS_MADE_GRADE} sidebands), reported: "
+                 "not checks" if made else "")]
     return "\n".join(lines) + "\n"
 
 

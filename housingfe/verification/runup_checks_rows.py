@@ -24,9 +24,19 @@ runup_envelope_bound_harmonics.csv and runup.json "envelope_bound"), the rows of
 checks.as_bound: reported beside the checks, never judged, no band; a bound, not the model, docs/source.md):
 
 * 28.bound.default.max_lwa.<route>, .max_lwa_harmonic.<route>, .peaks.<route> and 28.bound.l_omega.flexible.<speed>rpm
-  — the same row functions as the checks' (validate.run_check_rows, max_harmonic_row, peak_rows) on the bound's data.
+  — the same row functions as the checks' (validate.run_check_rows, max_harmonic_row, peak_rows) on the bound's data;
 
-Nothing is computed here that validate does not compute anyway: with both caches valid these rows take well under
+and from the default run-up run once more with runup.as_made = 5 (<results>/test-gearbox-runup-5/: the same scene
+with the expected sidebands of ISO 1328-1 grade-5 gears on the same models, runup_as_made.csv; one more cached
+computation, ~20 s), the rows of gears as made (`as_made_rows`, checks.as_made_row: reported beside the checks, never
+judged, no band; docs/runup.md "Gears as made in the run-up"), ours with the sidebands, read as the check reads it:
+
+* 28.as_made.default.max_lwa.<route> — max L_WA over speed at the highest torque, sigma the scene's first radiation
+  model (LwA_as_made_dB); why: the loudest 1/3-octave band at that maximum and its speed, the periodic maximum;
+* 28.as_made.l_omega.flexible.<500,1000,1500>rpm — the mesh_force route's wheel L_omega in the tooth band on the
+  flexible housing (L_omega_tooth_band_as_made_dB); why: the periodic value and what the sidebands add.
+
+Besides the as-made run nothing is computed here that validate does not compute anyway: with the caches valid these rows take well under
 a second; with quick and a stale cache they are left out (a note on the console).  `only_rows` collects every check
 row of issue 28 (these and the ones tagged by the other providers) for `housingfe validate --only runup-checks`.
 """
@@ -45,9 +55,10 @@ SOURCE = "van Roosmalen 1994, Ch. 5 (Secs. 5.4-5.6, Figs. 5.6, 5.7, 5.10) [test_
 TOOTH_BAND_QUANTITIES = {"L_omega": "L_omega", "L_v": "Lv_dB", "L_W": "Lw_dB"}
 
 
-def published_rows(results: Path | None = None, quick: bool = False) -> list[dict]:
+def published_rows(results: Path | None = None, quick: bool = False, failures: list[str] | None = None
+                   ) -> list[dict]:
     """The rows of the module docstring from the cached default run-up and study results (computed first when stale,
-    not with quick)."""
+    not with quick).  A failed as-made run costs its rows alone (appended to failures, or printed)."""
     from housingfe.verification import study_rows, validate
 
     out = []
@@ -58,6 +69,17 @@ def published_rows(results: Path | None = None, quick: bool = False) -> list[dic
     folder = study_rows.study_folder(results, quick)
     if folder is not None:
         out += replica_rows(folder)
+    try:
+        made = validate.runup_folder(validate.DEFAULT_RUNUP, AS_MADE_OVERRIDES, results, quick)
+    except (validate.ComputationFailed, SolverError) as exc:
+        message = f"gears as made (28.as_made.* left out): {exc}"
+        if failures is None:
+            print(f"validate: {message}", flush=True)
+        else:
+            failures.append(message)
+        made = None
+    if made is not None:
+        out += as_made_rows(*made)
     return out
 
 
@@ -65,7 +87,7 @@ def only_rows(results: Path, quick: bool = False, failures: list[str] | None = N
     """The check rows of issue 28 alone (`housingfe validate --only runup-checks`): the default run-up's tagged rows,
     the design-variant study's (study_rows), the quasi-static excitation's (source_rows.excitation_rows) and the
     checks no other provider makes (runup_checks_rows), each from the same cached computation the full validate
-    uses, and after them the envelope bound's reported rows 28.bound.* (not checks: checks.as_bound).  A failed
+    uses, and after them the reported rows 28.bound.* and 28.as_made.* (not checks: checks.as_bound, as_made_row).  A failed
     computation is appended to failures (its rows are missing)."""
     from housingfe.verification import source_rows, study_rows, validate
     from housingfe.verification.checks import check_rows
@@ -74,7 +96,7 @@ def only_rows(results: Path, quick: bool = False, failures: list[str] | None = N
     rows: list[dict] = []
     # in the order of the full validate (its run-up rows, then the providers by name), so both give one table
     for what, make in ((validate.DEFAULT_RUNUP, lambda: validate.runup_rows(validate.DEFAULT_RUNUP, (), results, quick)),
-                       ("runup_checks_rows", lambda: published_rows(results, quick)),
+                       ("runup_checks_rows", lambda: published_rows(results, quick, failures)),
                        ("quasi-static excitation", source_rows.excitation_rows),
                        ("study rows", lambda: study_rows.published_rows(results, quick))):
         try:
@@ -125,6 +147,70 @@ def bound_chain_rows(label: str, folder: Path) -> list[dict]:
     kept = [r for r in ck.check_rows(rows) if r["check_id"][3:].startswith(BOUND_CHECKS)]
     kept.sort(key=lambda r: next(i for i, p in enumerate(BOUND_CHECKS) if r["check_id"][3:].startswith(p)))
     return [ck.as_bound(r) for r in kept]
+
+
+# the default run-up once more with the expected sidebands of gears as made (runup.as_made, docs/runup.md)
+AS_MADE_OVERRIDES = (f"runup.as_made={ck.AS_MADE_GRADE}",)
+AS_MADE_SPEEDS_RPM = (500, 1000, 1500)          # the measured L_omega's speeds (28.l_omega.flexible.<speed>rpm)
+
+
+def as_made_rows(label: str, folder: Path) -> list[dict]:
+    """The rows of gears as made (module docstring) from a run-up result folder run with runup.as_made; none when it
+    was not (no runup_as_made.csv or runup.json "as_made").  measured / thesis calculated are the corresponding
+    check's (runup.json "checks": LwA_max, L_omega_flexible)."""
+    from housingfe.runup.as_made import CSV
+
+    data = json.loads((folder / "runup.json").read_text())
+    made = data.get("as_made")
+    if not made or not (folder / CSV).is_file():
+        return []
+    return as_made_rows_of(label, data["scene_settings"]["radiation"]["models"][0], made["grade"],
+                           _read_csv(folder / CSV), data["checks"])
+
+
+def _check_of(run_checks: list[dict], kind: str, quantity_test) -> dict:
+    return next((c for c in run_checks if c["check"] == kind and quantity_test(c["quantity"])), {})
+
+
+def as_made_rows_of(label: str, rad: str, grade: int, table: list[dict], run_checks: list[dict]) -> list[dict]:
+    """28.as_made.default.max_lwa.<route> and 28.as_made.l_omega.flexible.<speed>rpm from runup_as_made.csv's rows
+    (`table`) of the radiation model `rad` at the highest torque; run_checks: the run's checks (runup.json)."""
+    table = [r for r in table if r["radiation"] == rad]
+    if not table:
+        return []
+    top = max(_num(r["torque_nm"]) for r in table)
+    scene = f"{label} (gears as made, ISO grade {grade})"
+    out = []
+    for route in dict.fromkeys(r["route"] for r in table):
+        sel = [r for r in table if r["route"] == route and _num(r["torque_nm"]) == top]
+        made = np.array([_num(r["LwA_as_made_dB"]) for r in sel])
+        periodic = np.array([_num(r["LwA_dB"]) for r in sel])
+        i, j = int(np.nanargmax(made)), int(np.nanargmax(periodic))
+        at, p_at = sel[i], sel[j]
+        c = _check_of(run_checks, "LwA_max", lambda q: q.startswith(f"{route}:"))
+        out.append(ck.as_made_row(
+            f"28.as_made.default.max_lwa.{route}", scene,
+            f"{route}: max L_WA dB(A) with the expected sidebands of ISO grade-{grade} gears "
+            f"({_num(at['speed_rpm']):g} rpm, {top:g} N m, sigma {rad})", round(float(made[i]), 1), "dB(A)", SOURCE,
+            measured=c.get("measured"), thesis_calculated=c.get("thesis_calculated"),
+            why=f"the loudest 1/3-octave band at the maximum ({_num(at['speed_rpm']):g} rpm) is "
+                f"{_num(at['LwA_peak_band_as_made_hz']):g} Hz ({_num(at['LwA_peak_band_as_made_dB']):.1f} dB(A)); "
+                f"periodic alone {periodic[j]:.1f} dB(A) at {_num(p_at['speed_rpm']):g} rpm, loudest band "
+                f"{_num(p_at['LwA_peak_band_hz']):g} Hz: the sidebands add {made[i] - periodic[j]:+.1f} dB(A)"))
+    wheel = {_num(r["speed_rpm"]): r for r in table if r["route"] == "mesh_force" and _num(r["torque_nm"]) == top}
+    for speed in AS_MADE_SPEEDS_RPM:
+        r = wheel.get(float(speed))
+        if r is None:
+            continue
+        ours, periodic = _num(r["L_omega_tooth_band_as_made_dB"]), _num(r["L_omega_tooth_band_dB"])
+        c = _check_of(run_checks, "L_omega_flexible", lambda q: q.endswith(f" at {speed} rpm"))
+        out.append(ck.as_made_row(
+            f"28.as_made.l_omega.flexible.{speed}rpm", scene,
+            f"mesh_force wheel on the flexible housing: L_omega tooth band dB at {speed} rpm with the expected "
+            f"sidebands of ISO grade-{grade} gears ({top:g} N m)", round(ours, 1), "dB", SOURCE,
+            measured=c.get("measured"), thesis_calculated=c.get("thesis_calculated"),
+            why=f"periodic {periodic:.1f} dB; the sidebands add {ours - periodic:+.1f} dB"))
+    return out
 
 
 def chain_rows(label: str, rad: str, totals: list[dict], harm: list[dict], peak_contributions: list[dict]

@@ -546,7 +546,8 @@ def geometry_rows(names: list[str]) -> list[dict]:
 def provider_rows(failures: list[str] | None = None, progress=None, *, results: Path | None = None,
                   quick: bool = False) -> list[dict]:
     """published_rows() of every module in ROW_PROVIDERS; a provider whose published_rows takes `results` (the FE
-    result cache) and `quick` (validate --quick: compute nothing heavy) gets them.  A provider that fails is
+    result cache) and `quick` (validate --quick: compute nothing heavy) gets them, and one that takes `failures` the
+    list, to report a part of its rows lost without losing the rest.  A provider that fails is
     reported on one line (appended to `failures`, or raised as SolverError when no list is given); the others
     still count.  progress: a housingfe.progress.Progress counting one step per provider."""
     import inspect
@@ -557,7 +558,8 @@ def provider_rows(failures: list[str] | None = None, progress=None, *, results: 
             t0 = time.perf_counter()
             provide = importlib.import_module(module_name).published_rows
             accepted = inspect.signature(provide).parameters
-            options = {k: v for k, v in (("results", results), ("quick", quick)) if k in accepted}
+            options = {k: v for k, v in (("results", results), ("quick", quick), ("failures", failures))
+                       if k in accepted}
             rows = provide(**options)
             print(f"validate: {module_name}: {len(rows)} rows in {time.perf_counter() - t0:.1f} s", flush=True)
             out += rows

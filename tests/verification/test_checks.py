@@ -410,3 +410,99 @@ def test_the_bound_study_rows_are_reported_and_only_the_bound_s_jobs_give_them()
     bound_jobs = [(f, o) for f, o, _ in study_rows.JOBS if "runup.engagement=envelope-bound" in o]
     assert bound_jobs == [("profile-corrections", ("runup.engagement=envelope-bound",)),
                           ("bearings", ("runup.engagement=envelope-bound",))]
+
+
+# ----------------------------------------------------------------------- gears as made (28.as_made.*)
+def _write_as_made(folder, checks):
+    """A run-up run with runup.as_made = 5 (runup.json "as_made", runup_as_made.csv as housingfe.runup.report writes
+    them): routes tf_omega and mesh_force, sigma erp (checked) and foller (louder: must be ignored), 1000 N m
+    (louder: must be ignored) and 2000 N m, speeds 500/1000/1500 rpm.  At 2000 N m, erp, mesh_force: L_WA with the
+    sidebands 90 / 95.04 / 93 dB(A), periodic 85 / 80 / 82; the loudest band with the sidebands at 1000 rpm 2500 Hz
+    (93.2 dB(A)), periodic at 500 rpm 630 Hz; the wheel's L_omega tooth band 96.4 -> 98.9, 94.2 -> 107.6,
+    90.1 -> 104.2 dB.  tf_omega: with the sidebands 70 / 81 / 80.9, periodic 66 / 65.9 / 60, loudest band 2500 Hz
+    at 1000 rpm, periodic 400 Hz at 500 rpm."""
+    from housingfe.runup.as_made import COLUMNS, CSV
+
+    made = {"mesh_force": ((90.0, 95.04, 93.0), (85.0, 80.0, 82.0)), "tf_omega": ((70.0, 81.0, 80.9), (66.0, 65.9, 60.0))}
+    omega = ((96.4, 98.9), (94.2, 107.6), (90.1, 104.2))
+    periodic_band = {"mesh_force": 630.0, "tf_omega": 400.0}
+    rows = []
+    for route in ("tf_omega", "mesh_force"):
+        for rad in ("erp", "foller"):
+            for torque in (1000.0, 2000.0):
+                for k, speed in enumerate((500.0, 1000.0, 1500.0)):
+                    louder = 20.0 if rad == "foller" or torque == 1000.0 else 0.0
+                    r = dict.fromkeys(COLUMNS, 0.0)
+                    r.update(route=route, radiation=rad, torque_nm=torque, speed_rpm=speed,
+                             tooth_frequency_hz=0.4 * speed, grade=5, sideband_lines=500,
+                             L_omega_tooth_band_dB=omega[k][0] + louder,
+                             L_omega_tooth_band_as_made_dB=omega[k][1] + louder,
+                             LwA_as_made_dB=made[route][0][k] + louder, LwA_dB=made[route][1][k] + louder,
+                             LwA_peak_band_hz=periodic_band[route], LwA_peak_band_dB=made[route][1][k] - 1.0,
+                             LwA_peak_band_as_made_hz=2500.0, LwA_peak_band_as_made_dB=made[route][0][k] - 1.84)
+                    rows.append(r)
+    with open(folder / CSV, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(COLUMNS))
+        w.writeheader()
+        w.writerows(rows)
+    (folder / "runup.json").write_text(json.dumps({
+        "scene_settings": {"radiation": {"models": ["erp", "foller"]}}, "peak_contributions": [], "checks": checks,
+        "as_made": {"grade": 5, "totals": CSV, "bands_of_harmonics": [1, 8], "sideband_lines": 3000}}))
+
+
+def test_the_as_made_rows_are_reported_with_the_sidebands_and_leave_the_checks_alone(tmp_path):
+    default_checks = [{"check": "LwA_max", "quantity": f"{route}: max L_WA dB(A) (900 rpm, 2000 N m, sigma erp)",
+                       "ours": ours, "measured": 100.5, "thesis_calculated": 89.4, "goal": "within 3 dB of measured",
+                       "passed": "no", "note": ""} for route, ours in (("tf_omega", 65.9), ("mesh_force", 85.0))]
+    default_checks += [{"check": "L_omega_flexible", "quantity": f"flexible housing: L_omega tooth band dB at {s} rpm",
+                        "ours": ours, "measured": m, "thesis_calculated": None, "goal": "within 6 dB of measured",
+                        "passed": "no", "note": "how"} for s, ours, m in ((500, 96.4, 109.9), (1000, 94.2, 111.2),
+                                                                        (1500, 90.1, 120.8))]
+    _write_runup(tmp_path, default_checks)
+    made_folder = tmp_path / "made"
+    made_folder.mkdir()
+    assert runup_checks_rows.as_made_rows("test-gearbox-runup", tmp_path) == []     # run without runup.as_made
+    _write_as_made(made_folder, default_checks)
+
+    checks = validate.run_check_rows("test-gearbox-runup", default_checks)
+    checks += runup_checks_rows.default_chain_rows("test-gearbox-runup", tmp_path)
+    made = runup_checks_rows.as_made_rows("test-gearbox-runup-5", made_folder)
+    both = ck.check_rows(checks + made)
+    assert [r for r in both if not ck.is_as_made(r)] == ck.check_rows(checks)   # the checks' rows as they were
+    rows = {r["check_id"]: r for r in made}
+    assert list(rows) == ["28.as_made.default.max_lwa.tf_omega", "28.as_made.default.max_lwa.mesh_force",
+                          "28.as_made.l_omega.flexible.500rpm", "28.as_made.l_omega.flexible.1000rpm",
+                          "28.as_made.l_omega.flexible.1500rpm"]
+    prefix = ("gears as made (runup.as_made = 5, ISO 1328-1 grade 5 standing in for the thesis' DIN 5): reported, "
+              "not a check; docs/runup.md; ")
+    for r in rows.values():
+        assert (r["passed"], r["tolerance"], r["band"]) == ("", "", None) and r["why"].startswith(prefix)
+        assert r["scene"] == "test-gearbox-runup-5 (gears as made, ISO grade 5)"
+    top = rows["28.as_made.default.max_lwa.mesh_force"]
+    # the loudest of erp at 2000 N m (foller and 1000 N m are 20 dB louder and ignored)
+    assert (top["ours"], top["measured"], top["thesis_calculated"]) == (95.0, 100.5, 89.4)
+    assert "(1000 rpm, 2000 N m, sigma erp)" in top["quantity"]
+    assert top["why"] == prefix + ("the loudest 1/3-octave band at the maximum (1000 rpm) is 2500 Hz (93.2 dB(A)); "
+                                   "periodic alone 85.0 dB(A) at 500 rpm, loudest band 630 Hz: the sidebands add "
+                                   "+10.0 dB(A)")
+    tf = rows["28.as_made.default.max_lwa.tf_omega"]
+    assert tf["ours"] == 81.0 and "(1000 rpm) is 2500 Hz" in tf["why"] and "periodic alone 66.0 dB(A) at 500 rpm, " \
+        "loudest band 400 Hz: the sidebands add +15.0 dB(A)" in tf["why"]
+    for speed, ours, measured, why in ((500, 98.9, 109.9, "periodic 96.4 dB; the sidebands add +2.5 dB"),
+                                       (1000, 107.6, 111.2, "periodic 94.2 dB; the sidebands add +13.4 dB"),
+                                       (1500, 104.2, 120.8, "periodic 90.1 dB; the sidebands add +14.1 dB")):
+        r = rows[f"28.as_made.l_omega.flexible.{speed}rpm"]
+        assert (r["ours"], r["measured"], r["why"]) == (ours, measured, prefix + why)
+    # counted apart from the checks, after the bound's; no band attaches
+    assert ck.checks_markdown(both).splitlines()[-1] == ck.checks_markdown(checks).splitlines()[-1] + \
+        "; and 5 rows of gears as made (28.as_made.*, ISO grade 5 sidebands), reported: not checks"
+    assert ck.attach_bands(both, {"28.as_made.default.max_lwa.mesh_force": (90.0, 110.0)}) == 0
+    validate.write_outputs(both, tmp_path / "out", None)
+    with open(tmp_path / "out" / "checks.csv") as fh:
+        written = list(csv.DictReader(fh))
+    assert [r["check_id"] for r in written][-5:] == list(rows)          # the as-made rows last
+    assert {(r["passed"], r["band"]) for r in written[-5:]} == {("report", "")}
+    with pytest.raises(ValueError):
+        ck.as_made_row("28.default.max_lwa.tf_omega", "s", "q", 1.0, "dB", "src")
+    # validate computes them on the default run-up with runup.as_made = 5
+    assert runup_checks_rows.AS_MADE_OVERRIDES == ("runup.as_made=5",)
