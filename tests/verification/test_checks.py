@@ -506,3 +506,22 @@ def test_the_as_made_rows_are_reported_with_the_sidebands_and_leave_the_checks_a
         ck.as_made_row("28.default.max_lwa.tf_omega", "s", "q", 1.0, "dB", "src")
     # validate computes them on the default run-up with runup.as_made = 5
     assert runup_checks_rows.AS_MADE_OVERRIDES == ("runup.as_made=5",)
+
+
+def test_a_failed_as_made_run_loses_its_rows_alone(tmp_path, monkeypatch):
+    """validate's as-made run failing: the default chain's check rows stay, the failure is reported on one line."""
+    _write_runup(tmp_path)
+
+    def folder(name, overrides=(), results=None, quick=False):
+        if overrides:
+            raise validate.ComputationFailed("housingfe run test-gearbox-runup --set runup.as_made=5: exit 1: boom")
+        return "test-gearbox-runup", tmp_path
+
+    monkeypatch.setattr(validate, "runup_folder", folder)
+    monkeypatch.setattr(study_rows, "study_folder", lambda results, quick: None)
+    failures = []
+    rows = runup_checks_rows.published_rows(tmp_path, failures=failures)
+    assert [r["check_id"] for r in rows] == [r["check_id"] for r in
+                                             runup_checks_rows.default_chain_rows("test-gearbox-runup", tmp_path)]
+    assert failures == ["gears as made (28.as_made.* left out): housingfe run test-gearbox-runup --set "
+                        "runup.as_made=5: exit 1: boom"]
