@@ -40,6 +40,15 @@ def _gearboxes() -> dict:
     return {"test_gearbox": test_gearbox}
 
 
+def _checked(key: str, check, value):
+    """check(value) for a field validator: its InputError "<key>: ..." becomes a ValueError without the key, which
+    the error's location puts in front again."""
+    try:
+        return check(value)
+    except InputError as exc:
+        raise ValueError(str(exc).removeprefix(f"{key}: ")) from None
+
+
 class HousingRef(_Strict):
     """The housing: a housing scene (built-in name or path) with optional --set style overrides, and how the
     drivetrain's bearings find its bores (housingfe.drivetrain.bore_matching): match = "name" (each bearing's own
@@ -153,10 +162,7 @@ class RunupSpec(_Strict):
     def _as_made(cls, value):
         from housingfe.runup.as_made import check_as_made
 
-        try:
-            return check_as_made(value)
-        except InputError as exc:        # "as_made: ..." -> the key is put in front by the error's location
-            raise ValueError(str(exc).removeprefix("as_made: ")) from None
+        return _checked("as_made", check_as_made, value)
 
     @property
     def drive_line_model(self) -> str:
@@ -179,10 +185,7 @@ class RunupSpec(_Strict):
     def _mesh_friction(cls, value):
         from housingfe.runup.chain import check_mesh_friction
 
-        try:
-            return check_mesh_friction(value)
-        except InputError as exc:        # "mesh_friction: ..." -> the key is put in front by the error's location
-            raise ValueError(str(exc).removeprefix("mesh_friction: ")) from None
+        return _checked("mesh_friction", check_mesh_friction, value)
 
     @property
     def misalignment_model(self) -> str:
