@@ -37,12 +37,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from housingfe.drivetrain.bore_matching import ANGLE_TOLERANCE_DEG
 from housingfe.errors import InputError
 
 FLAT_NORMAL_SPREAD = 1e-3   # l2 / l3 of the normal tensor below which a surface is flat (normals within ~2 deg)
 MAX_RELATIVE_RMS = 0.05     # rms distance from the fitted cylinder / R above which a surface is not a bore
-MAX_TILT_DEG = ANGLE_TOLERANCE_DEG   # a bore's fitted axis vs its bearing's axis: the run-up's bore matching's 1 deg
+MAX_TILT_DEG = 1.0          # a bore's fitted axis vs its bearing's axis (deg); also the run-up's bore matching's
 
 
 @dataclass(frozen=True)

@@ -10,12 +10,14 @@ selected them (surface groups `bore_<name>`), so the run-up scene says which bor
 * by position (`housing.match = "position"`): the one housing bore whose axis runs along the bearing's shaft and
   whose extent along that axis holds the bearing.
 
-Either way every matched bore is checked against its shaft on the FE mesh: the bore's cylinder is fitted to the
-mesh vertices of its surface (axis, a point on it, radius, extent along the axis), and its axis must be parallel to
-the shaft's (within ANGLE_TOLERANCE_DEG), its centre within `tolerance` (m) of the shaft's axis, and the bearing's
-point on the shaft within the bore's extent along the axis (+- tolerance).  A bore that does not line up is one
-line naming it and the distance: "housing.bores: bore 'A_front' (centre (...) m) lies 12.3 mm off the pinion
-shaft's axis (tolerance 1 mm)".
+Either way every matched bore is checked against its shaft on the FE mesh: the bore's cylinder (axis, centre on it
+mid-extent, radius, extent along the axis) is the one the coupling puts its bore master on, fitted by area-weighted
+least squares to the mesh vertices of its surface (`bore_shape`: housingfe.drivetrain.bore_axis.fit_points, the one
+cylinder fit of the package; a flat seat is its plane, a curved surface that is no cylinder is refused), and its
+axis must be parallel to the shaft's (within ANGLE_TOLERANCE_DEG), its centre within `tolerance` (m) of the shaft's
+axis, and the bearing's point on the shaft within the bore's extent along the axis (+- tolerance).  A bore that
+does not line up is one line naming it and the distance: "housing.bores: bore 'A_front' (centre (...) m) lies
+12.3 mm off the pinion shaft's axis (tolerance 1 mm)".
 """
 from __future__ import annotations
 
@@ -24,10 +26,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from housingfe.drivetrain.bore_axis import MAX_TILT_DEG, fit_points, surface_geometry
 from housingfe.errors import InputError
 
 BORE_PREFIX = "bore_"
-ANGLE_TOLERANCE_DEG = 1.0
+ANGLE_TOLERANCE_DEG = MAX_TILT_DEG      # a bore's axis vs its shaft's: the coupling's bound on the same tilt
 DEFAULT_TOLERANCE_M = 1e-3
 MATCH_MODES = ("name", "position")
 
@@ -35,8 +38,9 @@ MATCH_MODES = ("name", "position")
 @dataclass(frozen=True)
 class BoreShape:
     """A bore surface of the housing mesh as a cylinder (m): its name (the surface group without "bore_"),
-    surface, unit axis, centre (on the axis, mid-extent), radius, extent along the axis (s_lo, s_hi from the
-    centre) and the rms deviation of its vertices from the cylinder (m)."""
+    surface, unit axis (largest component positive), centre (on the axis, mid-extent), radius, extent along the
+    axis (s_lo, s_hi from the centre) and the area-weighted rms deviation of its vertices from the cylinder (m).
+    A flat surface: axis its normal, centre its centroid, radius nan, s_lo = s_hi = 0 (bore_axis.BoreFit)."""
 
     name: str
     surface: str
@@ -62,80 +66,18 @@ def bore_surfaces(model) -> dict[str, str]:
     return dict(sorted(out.items()))
 
 
-def surface_triangles(model, surface: str) -> np.ndarray:
-    """The facets (m; (n, 3, 3) corner points of the linear geometry) of a surface group, the same array on every
-    rank (collective)."""
-    mesh = model.housing.mesh
-    tdim = mesh.topology.dim
-    facets = np.asarray(model.housing.facets(surface), dtype=np.int32)
-    mesh.topology.create_connectivity(tdim - 1, 0)
-    mesh.topology.create_connectivity(tdim - 1, tdim)
-    mesh.topology.create_connectivity(tdim, 0)
-    f2v, f2c = mesh.topology.connectivity(tdim - 1, 0), mesh.topology.connectivity(tdim - 1, tdim)
-    c2v, x = mesh.topology.connectivity(tdim, 0), mesh.geometry.x
-    out = np.zeros((len(facets), 3, 3))
-    for i, f in enumerate(facets):
-        # a cell's vertices and its first geometry nodes are in the same order (the corners)
-        c = f2c.links(f)[0]
-        corner = dict(zip(c2v.links(c), mesh.geometry.dofmap.links(c)))
-        out[i] = x[[corner[v] for v in f2v.links(f)]]
-    return np.concatenate(mesh.comm.allgather(out))
-
-
-def fit_cylinder(triangles: np.ndarray) -> tuple[np.ndarray, np.ndarray, float, float]:
-    """(unit axis, point on the axis, radius, rms deviation of the corners) of the circular cylinder through the
-    facets `triangles` (m, (n, 3, 3)): the axis is the direction the facet normals are most nearly perpendicular
-    to (the smallest principal direction of the area-weighted sum of n n^T), the circle an algebraic
-    least-squares fit (Kasa) of the corners projected across it; both refined by least squares on the corners'
-    distances to the axis."""
-    n = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])   # length: 2 x area
-    area = np.linalg.norm(n, axis=1)
-    n = n / np.maximum(area, 1e-300)[:, None]
-    _, vectors = np.linalg.eigh((area[:, None, None] * n[:, :, None] * n[:, None, :]).sum(axis=0))
-    axis, e1 = vectors[:, 0], vectors[:, 1]
-    e2 = np.cross(axis, e1)
-    points = np.unique(np.round(triangles.reshape(-1, 3), 12), axis=0)
-    c = points.mean(axis=0)
-    u, v = (points - c) @ e1, (points - c) @ e2
-    # u^2 + v^2 = 2 a u + 2 b v + d, R^2 = d + a^2 + b^2
-    A = np.column_stack([2 * u, 2 * v, np.ones_like(u)])
-    (a, b, d), *_ = np.linalg.lstsq(A, u**2 + v**2, rcond=None)
-    radius = math.sqrt(max(d + a * a + b * b, 0.0))
-    # refined by least squares on the distances to the axis (the facet normals of a coarse mesh tilt a little
-    # off the cylinder's; the corners lie on it): axis a0 + p e1 + q e2, point c0 + r e1 + t e2, radius
-    from scipy.optimize import least_squares
-
-    c0 = c + a * e1 + b * e2
-
-    def residuals(z):
-        ax = axis + z[0] * e1 + z[1] * e2
-        ax = ax / np.linalg.norm(ax)
-        d = points - (c0 + z[2] * e1 + z[3] * e2)
-        return np.linalg.norm(d - np.outer(d @ ax, ax), axis=1) - z[4]
-
-    fit = least_squares(residuals, np.array([0.0, 0.0, 0.0, 0.0, radius]), x_scale=[1.0, 1.0, radius, radius, radius])
-    z = fit.x
-    ax = axis + z[0] * e1 + z[1] * e2
-    ax = ax / np.linalg.norm(ax)
-    # the axis' sign is arbitrary (eigh of facets whose order depends on the MPI partition): its largest component
-    # positive, so 1 and 2 ranks report the same axis
-    ax = ax if ax[np.argmax(np.abs(ax))] > 0 else -ax
-    dev = float(np.sqrt(np.mean(fit.fun ** 2)))
-    return ax, c0 + z[2] * e1 + z[3] * e2, float(z[4]), dev
-
-
 def bore_shape(model, name: str, surface: str) -> BoreShape:
-    """The fitted cylinder of one bore surface (collective)."""
-    tris = surface_triangles(model, surface)
-    if len(tris) < 3:
-        raise InputError(f"housing.bores: bore {name!r} (surface {surface}) has {len(tris)} mesh facets, too few "
-                         f"for a cylinder")
-    axis, point, radius, dev = fit_cylinder(tris)
-    x = tris.reshape(-1, 3)
-    s = (x - point) @ axis
-    centre = point + 0.5 * (s.min() + s.max()) * axis
-    half = 0.5 * float(s.max() - s.min())
-    return BoreShape(name, surface, axis, centre, radius, -half, half, dev)
+    """The fitted cylinder of one bore surface (collective; the same on every rank): the coupling's bore fit
+    (housingfe.drivetrain.bore_axis: `surface_geometry` + `fit_points`, area-weighted on the surface's mesh
+    vertices).  A flat surface (a flat bearing seat) is its plane: axis the face normal, centre the centroid,
+    radius nan, no extent.  InputError "housing.bores: bore <name>: ..." for fewer than three vertices and for a
+    curved surface that is no cylinder (rms deviation above bore_axis.MAX_RELATIVE_RMS of the radius)."""
+    try:
+        fit = fit_points(*surface_geometry(model, surface), surface)
+    except InputError as err:
+        raise InputError(f"housing.bores: bore {name!r}: {err}") from None
+    half = fit.length / 2
+    return BoreShape(name, surface, fit.axis, fit.centre, fit.radius, -half, half, fit.rms)
 
 
 def _fmt(v) -> str:
@@ -230,12 +172,13 @@ def match_bores(model, drivetrain, mapping: dict | None = None, match: str = "na
 
 
 def matched_bores_summary(model, matched: dict[str, str]) -> list[dict]:
-    """JSON-able rows for a report: bearing, surface, fitted centre (m), axis, radius (m), rms deviation (m)
-    (collective)."""
+    """JSON-able rows for a report: bearing, surface, fitted centre (m), axis, radius (m; None for a flat seat),
+    length (m), rms deviation (m) (collective)."""
     rows = []
     for bearing, surface in matched.items():
         b = bore_shape(model, surface, surface)
         rows.append({"bearing": bearing, "surface": surface, "centre_m": [float(x) for x in b.centre],
-                     "axis": [float(x) for x in b.axis], "radius_m": b.radius, "length_m": 2 * b.s_hi,
+                     "axis": [float(x) for x in b.axis],
+                     "radius_m": None if math.isnan(b.radius) else b.radius, "length_m": 2 * b.s_hi,
                      "rms_deviation_m": b.deviation})
     return rows
