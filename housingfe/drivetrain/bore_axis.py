@@ -23,6 +23,8 @@ a half bore (split housing) puts it r/2 off, and any bore whose vertices do not 
 * The coupling (housingfe.drivetrain.interior.bore_fits) compares the fitted axis with the axis of every bearing
   the bore carries (and with the bore's own `axis` where the scene gives one): more than MAX_TILT_DEG apart is
   an InputError naming the bore, both axes and the angle.
+* The run-up's bore matching (housingfe.drivetrain.bore_matching.bore_shape: which bore carries which bearing)
+  reads the same fit (`surface_geometry` + `fit_points`): the package's one cylinder fit of a bore surface.
 
 MPI: the vertices of the surface (each owned by one rank), their weights and normals are gathered on every rank
 and sorted by coordinate, so every rank fits the same numbers in the same order and 1 and 2 ranks give the same

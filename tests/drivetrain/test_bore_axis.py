@@ -2,7 +2,7 @@
 bore has the tube's axis, radius and mid-length to round-off where the bounding box of the nodes is off; a tilted
 tube; a half bore (split housing) whose bounding-box centre lies ~r/2 off the axis; a flat face is a flat seat
 (centroid); a bore with its shoulder face is refused in one line; a bore tilted from its bearing's axis is refused;
-1 and 2 MPI ranks fit the same bore."""
+the run-up's bore matching reads the same fit; 1 and 2 MPI ranks fit the same bore."""
 from __future__ import annotations
 
 import json
@@ -179,6 +179,25 @@ def test_a_curved_surface_that_is_no_cylinder_is_refused_in_one_line(tube):
     assert "\n" not in str(err.value)
 
 
+def test_bore_matching_sees_the_coupling_s_cylinder(tilted_tube, tube, half_tube):
+    """The run-up's bore matching (bore_matching.bore_shape) reads the same fit as the coupling: the tilted tube's
+    axis, radius, mid-length centre and length to round-off, equal to fit_bore's; a flat seat is its plane (no
+    radius, no extent); a bore with its end face is refused in one line under housing.bores."""
+    from housingfe.drivetrain.bore_matching import bore_shape
+
+    b, fit = bore_shape(tilted_tube, "t", "bore"), bore_axis.fit_bore(tilted_tube, "bore")
+    assert np.array_equal(b.axis, fit.axis) and np.array_equal(b.centre, fit.centre) and b.radius == fit.radius
+    assert abs(float(b.axis @ TILTED) - 1.0) < 1e-12 and abs(b.radius - R_IN) < 1e-9
+    assert np.linalg.norm(b.centre - (ORIGIN + LENGTH / 2 * TILTED)) < 1e-9
+    assert b.s_hi == -b.s_lo and abs(2 * b.s_hi - LENGTH) < 1e-9 and b.deviation < 1e-9
+    seat = bore_shape(half_tube, "seat", "seat")
+    assert math.isnan(seat.radius) and seat.s_lo == seat.s_hi == 0.0 and abs(seat.axis[1] - 1.0) < 1e-9
+    with pytest.raises(InputError, match=r"^housing.bores: bore 'A': surface 'bore_and_end' is not a cylindrical "
+                                         r"bore: the best cylinder") as err:
+        bore_shape(tube, "A", "bore_and_end")
+    assert "\n" not in str(err.value)
+
+
 def test_the_coupling_refuses_a_bore_tilted_from_its_bearing(tube):
     """interior.bore_fits: the fitted axis against the axis of the bearing the bore carries (and the bore's own
     axis where the scene gives one); 0.5 deg passes, 2 deg is an error naming the bore, the axes and the angle."""
@@ -253,6 +272,8 @@ def test_the_test_gearbox_masters_sit_on_its_shaft_lines(tmp_path):
 
 def mpi_case(comm) -> dict:
     """The fits of the half and the tilted tube's surfaces (what 1 and 2 ranks must agree on)."""
+    from housingfe.drivetrain.bore_matching import bore_shape
+
     out = {"ranks": comm.size}
     for name, model in (("half", tube_model(comm, half=True)), ("tilted", tube_model(comm, TILTED, spin_deg=20.0))):
         for surface in ("bore", "seat") if name == "half" else ("bore",):
@@ -260,6 +281,8 @@ def mpi_case(comm) -> dict:
             value = [float(v) for v in (*fit.centre, *fit.axis, 0.0 if math.isnan(fit.radius) else fit.radius)]
             out[f"{name}_{surface}"] = value
             out[f"{name}_{surface}_same_on_all_ranks"] = all(v == value for v in comm.allgather(value))
+        shape = bore_shape(model, "b", "bore")           # the run-up's bore matching: the same fit
+        out[f"{name}_shape"] = [float(v) for v in (*shape.centre, *shape.axis, shape.radius, shape.s_hi)]
         out[f"{name}_owned_bore_vertices"] = comm.allgather(owned_vertices(model, "bore"))
     return out
 
@@ -284,6 +307,8 @@ def test_two_ranks_fit_the_serial_bore(comm):
         assert sum(two[f"{name}_owned_bore_vertices"]) == sum(one[f"{name}_owned_bore_vertices"])
     for key in ("half_bore", "half_seat", "tilted_bore"):
         assert two[f"{key}_same_on_all_ranks"]
+        assert np.max(np.abs(np.subtract(two[key], one[key]))) < 1e-12, key
+    for key in ("half_shape", "tilted_shape"):
         assert np.max(np.abs(np.subtract(two[key], one[key]))) < 1e-12, key
 
 
