@@ -19,6 +19,13 @@ values and the thesis' calculated ones (housingfe/data/roosmalen1994.toml), and 
 (e.g. `--set runup.engagement=thesis-2d`, the thesis' two-dimensional engagement shock); the keys a family sets
 itself (gear set, bearings, torques) are refused.
 
+With `--set runup.as_made=<ISO 1328-1 grade>` every variant's run-up also computes the expected sidebands of
+tooth-to-tooth deviations of gears of that grade on the same model and source (housingfe.runup.as_made, as
+`housingfe run` does), and the same comparison (differences, maxima, rankings, torque law) on that L_WA is written
+BESIDE the periodic one, labelled "as made, ISO grade g": extra columns *_as_made_* in <family>.csv and
+<family>_runup.csv, sections after the periodic ones in <family>.md, "as_made" in study.json, lines in the summary.
+The periodic tables stay as with the option off ("none", the default: nothing changes).
+
 Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route) and
 study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
 (default results/study-<family>-<engagement>); several families in one command share the housing model and the
@@ -426,7 +433,8 @@ def markdown(result: StudyResult, wall_s: float | None = None) -> str:
     per = result.timings.get("per_variant", {})
     lines += ["## Cost", "",
               f"{result.basis_builds} modal basis computed for {len(result.runs)} variants; per variant (s): "
-              + ", ".join(f"{k} {p['basis']} {p['model_s']:.1f} + run-up {p['runup_s']:.1f}" for k, p in per.items())
+              + ", ".join(f"{k} {p['basis']} {p['model_s']:.1f} + run-up {p['runup_s']:.1f}"
+                          + (f" + as made {p['as_made_s']:.1f}" if "as_made_s" in p else "") for k, p in per.items())
               + f"; housing mesh {result.timings.get('mesh_s', 0.0):.1f} s"
               + (f"; wall time {wall_s:.0f} s (this family; a command of one family: end to end)." if wall_s is not None else "."), "",
               "## Notes", ""] + [f"* {n}" for n in result.family.notes] + [""]
@@ -709,8 +717,10 @@ def register_cli(subparsers) -> None:
     p.add_argument("--out", default=None, help="result folder (default results/study-<family>-<engagement>, for "
                                                "several families results/study-<engagement>)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
-                   help="override a value of the families' run-up scenes, e.g. runup.engagement=thesis-2d "
-                        "(repeatable; not the gear set, bearings or torques, which the family sets)")
+                   help="override a value of the families' run-up scenes, e.g. runup.engagement=thesis-2d, or "
+                        "runup.as_made=5 (the comparison also with the expected sidebands of ISO grade-5 gears, "
+                        "beside the periodic one) (repeatable; not the gear set, bearings or torques, which the "
+                        "family sets)")
     p.add_argument("--fresh-basis", action="store_true",
                    help="compute a modal basis for every variant instead of re-analysing the layout's (slower; "
                         "measures what the reuse costs)")
