@@ -12,6 +12,7 @@ import pytest
 
 from housingfe.runup import as_made as am
 from housingfe.studies import design_variants as dv
+from tests.studies.runup_cli import cli_lwa_curves
 
 SPEEDS = np.array([500.0, 800.0, 1150.0, 1500.0])
 ROUTES = ("tf_omega", "mesh_force")
@@ -140,3 +141,32 @@ def test_as_made_speed_law_is_the_speed_law_fit():
         assert laws["2000"][route]["as_made"] == pytest.approx(6.0)
         assert laws["2000"][route]["periodic"] == pytest.approx(3.0)
     assert math.isnan(am.speed_laws(run, "sigma1")["2000"]["tf_omega"]["as_made"])     # no rows: no law
+
+
+@pytest.mark.slow
+def test_a_study_as_made_run_up_is_that_of_housingfe_run(tmp_path):
+    """A variant's as-made L_WA in a study (ChainSession.runup_as_made) is `housingfe run --set runup.as_made=5`'s
+    (runup_as_made.csv, LwA_as_made_dB) on the same scene, to 2e-3 dB at every speed and route: the same source,
+    mesh model and coupled model, not a simplified chain."""
+    from housingfe.studies.chain_session import ChainSession
+    from tests.studies.test_design_variants import COARSE
+
+    settings = COARSE + ["runup.as_made=5"]
+    session = ChainSession.from_scene("test-gearbox-runup", settings)
+    model = session.model(session.drivetrain("A", "ball", 2000.0))
+    made = session.runup_as_made(model, 2000.0, session.runup(model, 2000.0))
+    assert made.grade == 5 and made.lines > 100
+    cli_lwa_curves("test-gearbox-runup", settings, tmp_path / "run")
+    rows = _read_dicts(tmp_path / "run" / am.CSV)
+    for route in ROUTES:
+        s, lwa = am.lwa_curve(made, route, "erp", 2000.0)
+        cli = [r for r in rows if r["route"] == route and r["radiation"] == "erp"]
+        np.testing.assert_array_equal(s, [float(r["speed_rpm"]) for r in cli])
+        np.testing.assert_allclose(lwa, [float(r["LwA_as_made_dB"]) for r in cli], rtol=0, atol=2e-3, err_msg=route)
+    off = ChainSession.from_scene("test-gearbox-runup", COARSE)
+    assert off.runup_as_made(model, 2000.0, None) is None         # "none": nothing computed
+
+
+def _read_dicts(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
