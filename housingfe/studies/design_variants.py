@@ -556,8 +556,8 @@ def plot(path: Path, result: StudyResult) -> None:
             if run.variant.measured_max is not None:
                 ax.plot([s[-1] + 25], [run.variant.measured_max], marker="<", color=ax.lines[-1].get_color(), ms=7)
         ax.axvspan(*MEAN_RANGE_RPM, color="0.93", zorder=0)
-        ax.set_title(f"{route}: L_WA over speed (◁ measured maxima"
-                     + (f"; dashed: {result.as_made_label})" if result.as_made else ")"), fontsize=10)
+        ax.set_title(f"{route}: L_WA over speed (◁ measured maxima)"
+                     + (f"\ndashed: {result.as_made_label}" if result.as_made else ""), fontsize=10)
         ax.set_xlabel("pinion speed [rev/min]")
         ax.set_ylabel("L_WA [dB(A)]")
         ax.legend(fontsize=7, ncol=2)
