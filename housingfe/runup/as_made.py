@@ -245,9 +245,35 @@ def as_made_run(results: dict, source, grade: int, f_lines_max: float, routes) -
     return AsMadeRun(grade, rows, side, n_max, count, time.perf_counter() - t0)
 
 
+def lwa_curve(run: AsMadeRun, route: str, radiation: str, torque: float,
+              column: str = "LwA_as_made_dB") -> tuple[np.ndarray, np.ndarray]:
+    """(speeds rev/min, L_WA dB(A)) over the run-up of one route, radiator and torque (N m) from the rows: the total
+    with the expected sidebands (column "LwA_as_made_dB") or the periodic one ("LwA_dB")."""
+    sel = sorted((r for r in run.rows if r["route"] == route and r["radiation"] == radiation
+                  and r["torque_nm"] == float(torque)), key=lambda r: r["speed_rpm"])
+    return (np.array([r["speed_rpm"] for r in sel], float), np.array([r[column] for r in sel], float))
+
+
+def speed_laws(run: AsMadeRun, radiation: str) -> dict:
+    """{torque (N m, text): {route: {"as_made": slope, "periodic": slope}}}: the speed law of L_WA with and
+    without the expected sidebands, dB(A) per doubling of speed over slopes.SPEED_LAW_RANGE_RPM (the least-squares
+    fit of the speed-law check, housingfe.runup.slopes.slope_per_doubling; NaN where the speeds span less than a
+    doubling there)."""
+    from housingfe.runup.slopes import slope_per_doubling
+
+    out = {}
+    for torque, side in run.sidebands.items():
+        out[f"{float(torque):g}"] = {route: {kind: slope_per_doubling(*lwa_curve(run, route, radiation, torque, col))
+                                             for kind, col in (("as_made", "LwA_as_made_dB"), ("periodic", "LwA_dB"))}
+                                     for route in side.routes}
+    return out
+
+
 def summary_lines(run: AsMadeRun, radiation: str) -> list[str]:
-    """The summary's lines: per torque and route, max L_WA with the expected sidebands beside the periodic one."""
+    """The summary's lines: per torque and route, max L_WA with the expected sidebands beside the periodic one, and
+    the speed law (dB(A) per doubling, 250-1500 rev/min) of both."""
     out = []
+    laws = speed_laws(run, radiation)
     for torque in run.sidebands:
         parts = []
         for route in run.sidebands[torque].routes:
@@ -255,9 +281,11 @@ def summary_lines(run: AsMadeRun, radiation: str) -> list[str]:
                    and r["torque_nm"] == float(torque)]
             i = int(np.argmax([r["LwA_as_made_dB"] for r in sel]))
             j = int(np.argmax([r["LwA_dB"] for r in sel]))
+            law = laws[f"{float(torque):g}"][route]
             parts.append(f"{route} {sel[i]['LwA_as_made_dB']:.1f} dB(A) @ {sel[i]['speed_rpm']:g} rpm, most in the "
                          f"{sel[i]['LwA_peak_band_as_made_hz']:g} Hz band (periodic {sel[j]['LwA_dB']:.1f} @ "
-                         f"{sel[j]['speed_rpm']:g} rpm, {sel[j]['LwA_peak_band_hz']:g} Hz band)")
+                         f"{sel[j]['speed_rpm']:g} rpm, {sel[j]['LwA_peak_band_hz']:g} Hz band), speed law "
+                         f"{law['as_made']:.1f} dB(A)/doubling (periodic {law['periodic']:.1f})")
         out.append(f"  {torque:g} N m as made (ISO 1328-1 grade {run.grade}, expected sidebands in the bands of "
                    f"harmonics 1-{run.n_max}, {run.lines} lines, {run.seconds:.1f} s): max L_WA " + "; ".join(parts)
                    + f"; sigma {radiation} ({CSV})")

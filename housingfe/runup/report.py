@@ -11,6 +11,7 @@ runup_as_made.csv (the tooth band and the totals with and without the expected s
 housingfe.runup.as_made) and runup.json's "as_made"."""
 from __future__ import annotations
 
+import math
 import platform
 from pathlib import Path
 
@@ -129,11 +130,22 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
             "harmonics": BOUND_HARMONICS_CSV, "checks": bound_checks[0], "peak_contributions": bound_checks[1]},
         "as_made": None if as_made is None else {
             "grade": as_made.grade, "totals": "runup_as_made.csv", "bands_of_harmonics": [1, as_made.n_max],
-            "sideband_lines": as_made.lines, "what": "expected sidebands of ISO 1328-1 deviations (docs/runup.md)"},
+            "sideband_lines": as_made.lines, "what": "expected sidebands of ISO 1328-1 deviations (docs/runup.md)",
+            "speed_law_dBA_per_doubling": _as_made_laws(as_made, scene.radiation.models[0]),
+            "speed_law_range_rpm": list(slope_terms.SPEED_LAW_RANGE_RPM)},
         "area_level_dB": next(iter(results.values()))[1].area_level_db,
         "provenance": {"python": platform.python_version(), "dolfinx": dolfinx.__version__,
                        "machine": platform.machine(), "mpi_ranks": gm.structure.V.mesh.comm.size},
     })
+
+
+def _as_made_laws(as_made, radiation: str) -> dict:
+    """runup.json "as_made" "speed_law_dBA_per_doubling": per torque and route the speed law of L_WA with and
+    without the expected sidebands (housingfe.runup.as_made.speed_laws; NaN -> null)."""
+    from housingfe.runup.as_made import speed_laws
+
+    return {t: {route: {k: (round(v, 3) if math.isfinite(v) else None) for k, v in law.items()}
+                for route, law in per.items()} for t, per in speed_laws(as_made, radiation).items()}
 
 
 def spectrum_plot(path: Path, rows: list, speed: float, radiation: str) -> None:

@@ -75,6 +75,7 @@ class ChainSession:
     _lines: dict = field(default_factory=dict)
     _drivetrains: dict = field(default_factory=dict)
     _layouts: dict = field(default_factory=dict)
+    _scene_sources: dict = field(default_factory=dict)
 
     @classmethod
     def from_scene(cls, name_or_path: str, overrides=(), comm=None, fresh_basis: bool = False,
@@ -196,6 +197,7 @@ class ChainSession:
         misalignment = spec.misalignment_model
         if (spec.source_receptance == "rigid-bores" and misalignment == "none" and spec.mesh_moment_model == "none"
                 and spec.mesh_friction == "none"):
+            self._scene_sources[id(model)] = (model, self.source(drivetrain))
             return self.lines(drivetrain, torque)
         if misalignment == "coupled":          # the static tilt of this drivetrain on the flexible housing
             from housingfe.drivetrain.misalignment import coupled_misalignment
@@ -210,6 +212,7 @@ class ChainSession:
             misalignment = lead_gap_law(drivetrain, "rigid-bores")
         source = drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
                                          misalignment=misalignment)
+        self._scene_sources[id(model)] = (model, source)       # runup_as_made takes the same source's mesh
         lines, seconds = run_source(model, source, spec.speeds, [float(torque)], spec.f_max_hz,
                                     spec.source_receptance, spec.mesh_moment_model, spec.mesh_friction)
         self.timings["source_s"] = self.timings.get("source_s", 0.0) + seconds
@@ -222,6 +225,24 @@ class ChainSession:
 
         lines = self.scene_lines(model, torque) if lines is None else lines
         return runup(model, None, self.spec.speeds, [float(torque)], routes=tuple(self.spec.routes), lines=lines)
+
+    def runup_as_made(self, model, torque: float, result):
+        """The expected sidebands of gears as made (housingfe.runup.as_made.AsMadeRun) of one run-up `result` of
+        `model` at a pinion torque (N m), as `housingfe run` computes them with runup.as_made = <ISO grade>: the
+        source of the run-up's lines (`scene_lines`: the same mesh model, misalignment and operating point) and the
+        same coupled model and routes; None when runup.as_made is "none"."""
+        if self.spec.as_made == "none":
+            return None
+        from housingfe.runup.as_made import as_made_run
+
+        held = self._scene_sources.get(id(model))
+        if held is None or held[0] is not model:
+            self.scene_lines(model, torque)            # a run-up on lines given from outside: the scene's source
+            held = self._scene_sources[id(model)]
+        run = as_made_run({float(torque): (model, result)}, held[1], self.spec.as_made, self.spec.f_max_hz,
+                          tuple(self.spec.routes))
+        self.timings["as_made_s"] = self.timings.get("as_made_s", 0.0) + run.seconds
+        return run
 
     @property
     def basis_builds(self) -> int:

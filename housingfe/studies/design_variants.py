@@ -19,6 +19,13 @@ values and the thesis' calculated ones (housingfe/data/roosmalen1994.toml), and 
 (e.g. `--set runup.engagement=thesis-2d`, the thesis' two-dimensional engagement shock); the keys a family sets
 itself (gear set, bearings, torques) are refused.
 
+With `--set runup.as_made=<ISO 1328-1 grade>` every variant's run-up also computes the expected sidebands of
+tooth-to-tooth deviations of gears of that grade on the same model and source (housingfe.runup.as_made, as
+`housingfe run` does), and the same comparison (differences, maxima, rankings, torque law) on that L_WA is written
+BESIDE the periodic one, labelled "as made, ISO grade g": extra columns *_as_made_* in <family>.csv and
+<family>_runup.csv, sections after the periodic ones in <family>.md, "as_made" in study.json, lines in the summary.
+The periodic tables stay as with the option off ("none", the default: nothing changes).
+
 Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route) and
 study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
 (default results/study-<family>-<engagement>); several families in one command share the housing model and the
@@ -136,6 +143,7 @@ def families() -> dict[str, Family]:
 
 
 DOUBLE_HELICAL_TORQUES_NM = (500.0, 1000.0, 1500.0, 2000.0)
+PERIODIC, AS_MADE = "periodic", "as_made"         # which L_WA is compared (VariantRun.curves_of)
 TORQUE_LAW_NM = (1000.0, 2000.0)                 # the measured torque step (Sec. 5.9)
 TORQUE_LAW_MEASURED = {"cylindrical_roller": "roller", "fluid_film": "fluid_film"}
 
@@ -144,18 +152,28 @@ TORQUE_LAW_MEASURED = {"cylindrical_roller": "roller", "fluid_film": "fluid_film
 @dataclass
 class VariantRun:
     """A variant's run-up: per route the speeds (rev/min) and L_WA (dB(A)) of the total; how its basis was
-    obtained ("built" / "re-analysed"); wall times (s): the coupled model, the run-up (source lines + routes)."""
+    obtained ("built" / "re-analysed"); wall times (s): the coupled model, the run-up (source lines + routes); with
+    runup.as_made on, per route (speeds, L_WA dB(A)) with the expected sidebands of gears as made and the seconds
+    they took (housingfe.runup.as_made)."""
 
     variant: Variant
     curves: dict
     basis: str
     model_s: float
     runup_s: float
+    curves_as_made: dict = field(default_factory=dict)
+    as_made_s: float = 0.0
+
+    def curves_of(self, kind: str) -> dict:
+        """The curves per route of the periodic model (PERIODIC) or of gears as made (AS_MADE)."""
+        return self.curves if kind == PERIODIC else self.curves_as_made
 
 
 @dataclass
 class StudyResult:
-    """A family's runs and what is compared (rows per route and variant, rankings, torque law), with timings."""
+    """A family's runs and what is compared (rows per route and variant, rankings, torque law), with timings; with
+    runup.as_made = <ISO grade> (as_made_grade) the same comparison on the L_WA of gears as made in `as_made`
+    ({"rows", "rankings", "torque_law"}, the rows with the periodic rows' keys)."""
 
     family: Family
     engagement: str
@@ -167,6 +185,13 @@ class StudyResult:
     torque_law: list = field(default_factory=list)
     timings: dict = field(default_factory=dict)
     basis_builds: int = 0
+    as_made_grade: object = "none"
+    as_made: dict = field(default_factory=dict)
+
+    @property
+    def as_made_label(self) -> str:
+        """How the as-made comparison is labelled in every output: "as made, ISO grade g"."""
+        return f"as made, ISO grade {self.as_made_grade}"
 
 
 def check_overrides(family: Family, overrides) -> None:
@@ -201,32 +226,57 @@ def run_family(family: Family, session: ChainSession, progress=print) -> StudyRe
         t1 = time.perf_counter()
         res = session.runup(model, v.torque)
         t2 = time.perf_counter()
-        runs[v.key] = VariantRun(v, {r: lwa_curve(res, r, rad, v.torque) for r in routes}, session.log[-1].how,
-                                 t1 - t0, t2 - t1)
-        progress(f"{family.name}: {v.key:22s} basis {session.log[-1].how:11s} model {t1 - t0:5.1f} s, "
-                 f"run-up {t2 - t1:5.1f} s")
-    out = StudyResult(family, session.spec.engagement, rad, routes, {v.key: runs[v.key] for v in family.variants})
-    out.rows = compare(out)
-    out.rankings = rankings(out)
-    if family.name == "double-helical":
-        out.torque_law = torque_law(out)
+        how = session.log[-1].how
+        runs[v.key] = VariantRun(v, {r: lwa_curve(res, r, rad, v.torque) for r in routes}, how, t1 - t0, t2 - t1)
+        made = session.runup_as_made(model, v.torque, res)      # None with runup.as_made = "none"
+        if made is not None:
+            from housingfe.runup.as_made import lwa_curve as as_made_curve
+
+            runs[v.key].curves_as_made = {r: as_made_curve(made, r, rad, v.torque) for r in routes}
+            runs[v.key].as_made_s = made.seconds
+        progress(f"{family.name}: {v.key:22s} basis {how:11s} model {t1 - t0:5.1f} s, "
+                 f"run-up {t2 - t1:5.1f} s" + (f", as made {made.seconds:5.1f} s" if made is not None else ""))
+    out = analyse(StudyResult(family, session.spec.engagement, rad, routes,
+                              {v.key: runs[v.key] for v in family.variants}, as_made_grade=session.spec.as_made))
     out.basis_builds = session.basis_builds
     out.timings = {**session.timings, "variants_s": time.perf_counter() - t_start,
                    "per_variant": {k: {"basis": r.basis, "model_s": r.model_s, "runup_s": r.runup_s}
+                                   | ({"as_made_s": r.as_made_s} if r.curves_as_made else {})
                                    for k, r in runs.items()}}
     return out
 
 
-def compare(result: StudyResult) -> list[dict]:
-    """One row per route and variant: ours beside measured and the thesis' calculation."""
+def analyse(result: StudyResult) -> StudyResult:
+    """Fill a StudyResult's comparison from its runs: rows, rankings, (double helical) torque law, and with
+    as_made_grade != "none" the same on the L_WA of gears as made (`compare_as_made`)."""
+    result.rows = compare(result)
+    result.rankings = rankings(result)
+    if result.family.name == "double-helical":
+        result.torque_law = torque_law(result)
+    if result.as_made_grade != "none":
+        result.as_made = compare_as_made(result)
+    return result
+
+
+def compare_as_made(result: StudyResult) -> dict:
+    """The comparison of `compare`, `rankings` and `torque_law` on the L_WA of gears as made (runs' curves_as_made):
+    {"rows", "rankings", "torque_law"}."""
+    rows = compare(result, AS_MADE)
+    return {"rows": rows, "rankings": rankings(result, rows),
+            "torque_law": torque_law(result, AS_MADE) if result.family.name == "double-helical" else []}
+
+
+def compare(result: StudyResult, kind: str = "periodic") -> list[dict]:
+    """One row per route and variant: ours beside measured and the thesis' calculation; kind PERIODIC (the run-up's
+    L_WA) or AS_MADE (with the expected sidebands of gears as made)."""
     fam = result.family
     ref = result.runs[fam.reference]
     rows = []
     for route in result.routes:
-        s_ref, l_ref = ref.curves[route]
+        s_ref, l_ref = ref.curves_of(kind)[route]
         for key, run in result.runs.items():
             v = run.variant
-            s, lwa = run.curves[route]
+            s, lwa = run.curves_of(kind)[route]
             mean, sd, n = difference_stats(s, lwa, l_ref)
             top, at = maximum(s, lwa)
             rows.append({"family": fam.name, "engagement": result.engagement, "route": route,
@@ -246,16 +296,18 @@ def _order(values: dict) -> list[str]:
     return [k for k, _ in sorted(values.items(), key=lambda kv: kv[1])]
 
 
-def rankings(result: StudyResult) -> list[dict]:
+def rankings(result: StudyResult, rows: list | None = None) -> list[dict]:
     """Per route and measure (mean difference, maximum): the variants that were measured, quietest first, ours
-    against measured; `matches` when the orders are equal, `quietest`/`loudest` when those agree."""
+    against measured; `matches` when the orders are equal, `quietest`/`loudest` when those agree.  rows: the
+    comparison's rows (default result.rows; the as-made rows for gears as made)."""
+    rows_all = result.rows if rows is None else rows
     fam = result.family
     measured_mean = {v.key: (0.0 if v.key == fam.reference else v.measured_mean) for v in fam.variants
                      if v.key == fam.reference or v.measured_mean is not None}
     measured_max = {v.key: v.measured_max for v in fam.variants if v.measured_max is not None}
     out = []
     for route in result.routes:
-        rows = {r["variant"]: r for r in result.rows if r["route"] == route}
+        rows = {r["variant"]: r for r in rows_all if r["route"] == route}
         for measure, measured, column in (("mean difference 800-1500 rpm", measured_mean, "mean_diff_dB"),
                                           ("maximum L_WA", measured_max, "LwA_max_dBA")):
             if len(measured) < 2:
@@ -268,11 +320,11 @@ def rankings(result: StudyResult) -> list[dict]:
     return out
 
 
-def torque_law(result: StudyResult) -> list[dict]:
+def torque_law(result: StudyResult, kind: str = "periodic") -> list[dict]:
     """Double helical: per bearing configuration and route, L_WA(2000 N m) - L_WA(1000 N m) speed by speed over
     800-1500 rev/min (mean, s.d.) and at 1500 rev/min, and the least-squares slope of the energy mean
     (800-1500 rev/min) against log2 of the torque over every torque run (dB(A) per doubling), beside the measured
-    step (Fig. 5.21)."""
+    step (Fig. 5.21); kind PERIODIC or AS_MADE (the L_WA of gears as made)."""
     from housingfe.data import thesis
 
     measured = thesis()["test_gearbox"]["double_helical"]["torque_doubling_1000_to_2000Nm_dBA"]
@@ -283,12 +335,12 @@ def torque_law(result: StudyResult) -> list[dict]:
         if lo not in runs or hi not in runs:
             continue
         for route in result.routes:
-            s, high = runs[hi].curves[route]
-            _, low = runs[lo].curves[route]
+            s, high = runs[hi].curves_of(kind)[route]
+            _, low = runs[lo].curves_of(kind)[route]
             mean, sd, _ = difference_stats(s, high, low)
             at = float(high[np.argmin(np.abs(s - 1500.0))] - low[np.argmin(np.abs(s - 1500.0))])
             torques = sorted(runs)
-            means = [energy_mean_db(*runs[t].curves[route]) for t in torques]
+            means = [energy_mean_db(*runs[t].curves_of(kind)[route]) for t in torques]
             slope = float(np.polyfit(np.log2(torques), means, 1)[0]) if len(torques) > 2 else float("nan")
             out.append({"bearings": bearings, "route": route, "step_mean_dB": round(mean, 2),
                         "step_sd_dB": round(sd, 2), "step_at_1500rpm_dB": round(at, 2),
@@ -304,6 +356,25 @@ COLUMNS = ("family", "engagement", "route", "radiation", "variant", "gear_set", 
            "mean_diff_dB", "sd_diff_dB", "speeds_in_mean", "measured_mean_dB", "measured_sd_dB", "thesis_calc_mean_dB",
            "thesis_calc_sd_dB", "LwA_max_dBA", "at_rpm", "measured_max_dBA", "thesis_calc_max_dBA",
            "LwA_energy_mean_800_1500_dBA", "basis", "model_s", "runup_s")
+
+
+# with runup.as_made on: the as-made comparison as columns beside each row's periodic ones (<family>.csv)
+AS_MADE_COLUMNS = {"as_made_iso_grade": None, "mean_diff_as_made_dB": "mean_diff_dB",
+                   "sd_diff_as_made_dB": "sd_diff_dB", "LwA_max_as_made_dBA": "LwA_max_dBA",
+                   "at_rpm_as_made": "at_rpm", "LwA_energy_mean_800_1500_as_made_dBA": "LwA_energy_mean_800_1500_dBA"}
+AS_MADE_WHAT = ("the expected power of the shaft-order sideband lines that tooth-to-tooth deviations of gears of "
+                "this ISO 1328-1 grade make (housingfe.runup.as_made, docs/runup.md \"Gears as made in the run-up\"), "
+                "energy-added to the periodic lines, through both routes on the same models")
+AS_MADE_ASSUMPTIONS = ("ISO 1328-1:1995 grade standing in for the thesis' DIN 3962 grade (DIN 5 ~ ISO 5)",
+                       "deviations uniform within the grade's tolerances (pitch, profile slope and form, helix slope, "
+                       "twist), both gears the same grade",
+                       "the EXPECTED power over random teeth (not one drawn gear pair); first order on the "
+                       "mean-stiffness system")
+
+
+def _as_made_row(result: StudyResult, row: dict) -> dict:
+    """The as-made row of the same route and variant as a periodic row."""
+    return next(r for r in result.as_made["rows"] if r["route"] == row["route"] and r["variant"] == row["variant"])
 
 
 def _pm(mean, sd) -> str:
@@ -357,14 +428,68 @@ def markdown(result: StudyResult, wall_s: float | None = None) -> str:
                          f"{_num(t['slope_dB_per_doubling'], '{:+.1f}')} | {t['energy_means_dBA']} "
                          f"(at {t['torques_nm']} N m) |")
         lines.append("")
+    if result.as_made:
+        lines += markdown_as_made(result)
     per = result.timings.get("per_variant", {})
     lines += ["## Cost", "",
               f"{result.basis_builds} modal basis computed for {len(result.runs)} variants; per variant (s): "
-              + ", ".join(f"{k} {p['basis']} {p['model_s']:.1f} + run-up {p['runup_s']:.1f}" for k, p in per.items())
+              + ", ".join(f"{k} {p['basis']} {p['model_s']:.1f} + run-up {p['runup_s']:.1f}"
+                          + (f" + as made {p['as_made_s']:.1f}" if "as_made_s" in p else "") for k, p in per.items())
               + f"; housing mesh {result.timings.get('mesh_s', 0.0):.1f} s"
               + (f"; wall time {wall_s:.0f} s (this family; a command of one family: end to end)." if wall_s is not None else "."), "",
               "## Notes", ""] + [f"* {n}" for n in result.family.notes] + [""]
     return "\n".join(lines)
+
+
+def markdown_as_made(result: StudyResult) -> list[str]:
+    """The Markdown sections of gears as made (runup.as_made on): per route the differences and maxima as made
+    beside the periodic ones and the measured, the rankings and (double helical) the torque law."""
+    fam, label = result.family, result.as_made_label
+    lo, hi = MEAN_RANGE_RPM
+    made = result.as_made
+    lines = [f"# Gears {label} (`runup.as_made = {result.as_made_grade}`)", "",
+             f"The same comparison on L_WA with {AS_MADE_WHAT}. Assumptions: " + "; ".join(AS_MADE_ASSUMPTIONS)
+             + f". Differences to {fam.reference}, mean ± s.d. over {lo:g}–{hi:g} rev/min. The tables above are the "
+               "periodic model's (identical teeth), unchanged.", ""]
+    for route in result.routes:
+        lines += [f"## Route `{route}`, {label}", "",
+                  f"| variant | Δ mean ± s.d., {label}, dB | periodic | measured | max L_WA {label}, dB(A) (rpm) "
+                  "| periodic | measured |",
+                  "|---|---|---|---|---|---|---|"]
+        for p in (r for r in result.rows if r["route"] == route):
+            r = _as_made_row(result, p)
+            ref = r["variant"] == fam.reference
+            lines.append(f"| {r['variant']}{' (reference)' if ref else ''} | "
+                         f"{'0' if ref else _pm(r['mean_diff_dB'], r['sd_diff_dB'])} | "
+                         f"{'0' if ref else _pm(p['mean_diff_dB'], p['sd_diff_dB'])} | "
+                         f"{'0' if ref else _pm(r['measured_mean_dB'], r['measured_sd_dB'])} | "
+                         f"{r['LwA_max_dBA']:.1f} ({r['at_rpm']:g}) | {p['LwA_max_dBA']:.1f} ({p['at_rpm']:g}) | "
+                         f"{_num(r['measured_max_dBA'])} |")
+        lines.append("")
+    if made["rankings"]:
+        yn = {True: "yes", False: "no"}
+        lines += [f"## Ranking, {label} (quietest first, the measured variants)", "",
+                  "| route | by | ours | measured | same order | quietest | loudest |", "|---|---|---|---|---|---|---|"]
+        for k in made["rankings"]:
+            lines.append(f"| {k['route']} | {k['measure']} | {k['ours']} | {k['measured']} | {yn[k['matches']]} | "
+                         f"{yn[k['quietest']]} | {yn[k['loudest']]} |")
+        lines.append("")
+    if made["torque_law"]:
+        periodic = {(t["bearings"], t["route"]): t for t in result.torque_law}
+        lines += [f"## Torque law, {label} (Sec. 5.9, Fig. 5.21)", "",
+                  f"| bearings | route | L_WA(2000) − L_WA(1000 N m), {label}, mean ± s.d. 800–1500 rpm | periodic "
+                  "| measured | at 1500 rpm | slope over torques, dB(A) per doubling | energy means 800–1500 rpm, "
+                  "dB(A) |",
+                  "|---|---|---|---|---|---|---|---|"]
+        for t in made["torque_law"]:
+            p = periodic.get((t["bearings"], t["route"]))
+            lines.append(f"| {t['bearings']} | {t['route']} | {_pm(t['step_mean_dB'], t['step_sd_dB'])} | "
+                         f"{_pm(p['step_mean_dB'], p['step_sd_dB']) if p else '-'} | "
+                         f"{t['measured_step_dBA']:+.1f} | {t['step_at_1500rpm_dB']:+.1f} | "
+                         f"{_num(t['slope_dB_per_doubling'], '{:+.1f}')} | {t['energy_means_dBA']} "
+                         f"(at {t['torques_nm']} N m) |")
+        lines.append("")
+    return lines
 
 
 def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> None:
@@ -372,20 +497,41 @@ def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> Non
     from housingfe.outputs import write_csv, write_json
 
     name = result.family.name
-    write_csv(folder / f"{name}.csv", COLUMNS, ([r[c] for c in COLUMNS] for r in result.rows))
+    made = bool(result.as_made)
+    # gears as made: their columns after the periodic ones, which stay as without runup.as_made
+    extra = list(AS_MADE_COLUMNS) if made else []
+
+    def as_made_cells(row):
+        m = _as_made_row(result, row)
+        return [result.as_made_grade] + [m[c] for c in list(AS_MADE_COLUMNS.values())[1:]]
+
+    write_csv(folder / f"{name}.csv", list(COLUMNS) + extra,
+              ([r[c] for c in COLUMNS] + (as_made_cells(r) if made else []) for r in result.rows))
     keys = list(result.runs)
     first = result.runs[keys[0]].curves[result.routes[0]][0]
-    header = ["speed_rpm"] + [f"LwA_{route}_{k}_dBA" for route in result.routes for k in keys]
+    kinds = (PERIODIC, AS_MADE) if made else (PERIODIC,)
+    if made:
+        for k in keys:
+            for route in result.routes:
+                if not np.array_equal(result.runs[k].curves_as_made[route][0], first):
+                    raise ValueError(f"study {name}: {k} {route}: the as-made speeds are not the run-up's")
+    header = ["speed_rpm"] + [f"LwA_{'as_made_' if kind == AS_MADE else ''}{route}_{k}_dBA"
+                              for kind in kinds for route in result.routes for k in keys]
     write_csv(folder / f"{name}_runup.csv", header,
-              ([s] + [round(float(result.runs[k].curves[route][1][i]), 3) for route in result.routes for k in keys]
+              ([s] + [round(float(result.runs[k].curves_of(kind)[route][1][i]), 3)
+                      for kind in kinds for route in result.routes for k in keys]
                for i, s in enumerate(first)))
     (folder / f"{name}.md").write_text(markdown(result, wall_s))
-    write_json(folder / "study.json", {
+    data = {
         "family": name, "scene": result.family.scene, "engagement": result.engagement,
         "radiation": result.radiation, "reference": result.family.reference, "source": result.family.source,
         "notes": list(result.family.notes), "rows": result.rows, "rankings": result.rankings,
         "torque_law": result.torque_law, "basis_builds": result.basis_builds, "timings_s": result.timings,
-        "wall_s": wall_s})
+        "wall_s": wall_s}
+    if made:
+        data["as_made"] = {"grade": result.as_made_grade, "label": result.as_made_label, "what": AS_MADE_WHAT,
+                           "assumptions": list(AS_MADE_ASSUMPTIONS), **result.as_made}
+    write_json(folder / "study.json", data)
     plot(folder / f"{name}.png", result)
 
 
@@ -404,10 +550,14 @@ def plot(path: Path, result: StudyResult) -> None:
         for k, run in result.runs.items():
             s, lwa = run.curves[route]
             ax.plot(s, lwa, lw=1.8 if k == fam.reference else 1.0, label=k)
+            if run.curves_as_made:
+                ax.plot(*run.curves_as_made[route], lw=1.8 if k == fam.reference else 1.0, ls="--",
+                        color=ax.lines[-1].get_color())
             if run.variant.measured_max is not None:
                 ax.plot([s[-1] + 25], [run.variant.measured_max], marker="<", color=ax.lines[-1].get_color(), ms=7)
         ax.axvspan(*MEAN_RANGE_RPM, color="0.93", zorder=0)
-        ax.set_title(f"{route}: L_WA over speed (◁ measured maxima)", fontsize=10)
+        ax.set_title(f"{route}: L_WA over speed (◁ measured maxima)"
+                     + (f"\ndashed: {result.as_made_label}" if result.as_made else ""), fontsize=10)
         ax.set_xlabel("pinion speed [rev/min]")
         ax.set_ylabel("L_WA [dB(A)]")
         ax.legend(fontsize=7, ncol=2)
@@ -473,6 +623,27 @@ def summary_text(result: StudyResult, wall_s: float | None = None) -> str:
     for t in result.torque_law:
         out.append(f"torque law {t['bearings']}, {t['route']}: 1000 -> 2000 N m {t['step_mean_dB']:+.1f} ± "
                    f"{t['step_sd_dB']:.1f} dB(A) (measured {t['measured_step_dBA']:+.1f})")
+    if result.as_made:
+        label = result.as_made_label
+        out.append(f"{label} (runup.as_made = {result.as_made_grade}: expected sidebands of tooth-to-tooth "
+                   "deviations added to the periodic lines)")
+        out.append(format_table(["route", "variant", f"diff {label}", "diff periodic", "measured",
+                                 f"max {label} (rpm)", "max periodic", "measured max"],
+                                [[r["route"], r["variant"], _pm(m["mean_diff_dB"], m["sd_diff_dB"]),
+                                  _pm(r["mean_diff_dB"], r["sd_diff_dB"]),
+                                  _pm(r["measured_mean_dB"], r["measured_sd_dB"]),
+                                  f"{m['LwA_max_dBA']:.1f} ({m['at_rpm']:g})", f"{r['LwA_max_dBA']:.1f}",
+                                  _num(r["measured_max_dBA"])]
+                                 for r, m in ((r, _as_made_row(result, r)) for r in result.rows)]))
+        for k in result.as_made["rankings"]:
+            out.append(f"ranking {label}, {k['route']}, {k['measure']}: ours {k['ours']}; measured {k['measured']}; "
+                       f"{'same order' if k['matches'] else 'different order'}")
+        periodic = {(t["bearings"], t["route"]): t for t in result.torque_law}
+        for t in result.as_made["torque_law"]:
+            p = periodic.get((t["bearings"], t["route"]))
+            out.append(f"torque law {label}, {t['bearings']}, {t['route']}: 1000 -> 2000 N m "
+                       f"{t['step_mean_dB']:+.1f} ± {t['step_sd_dB']:.1f} dB(A) (periodic "
+                       f"{_pm(p['step_mean_dB'], None) if p else '-'}, measured {t['measured_step_dBA']:+.1f})")
     out.append(f"{result.basis_builds} basis for {len(result.runs)} variants"
                + (f"; wall time {wall_s:.1f} s" if wall_s is not None else ""))
     return "\n".join(out)
@@ -546,8 +717,10 @@ def register_cli(subparsers) -> None:
     p.add_argument("--out", default=None, help="result folder (default results/study-<family>-<engagement>, for "
                                                "several families results/study-<engagement>)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
-                   help="override a value of the families' run-up scenes, e.g. runup.engagement=thesis-2d "
-                        "(repeatable; not the gear set, bearings or torques, which the family sets)")
+                   help="override a value of the families' run-up scenes, e.g. runup.engagement=thesis-2d, or "
+                        "runup.as_made=5 (the comparison also with the expected sidebands of ISO grade-5 gears, "
+                        "beside the periodic one) (repeatable; not the gear set, bearings or torques, which the "
+                        "family sets)")
     p.add_argument("--fresh-basis", action="store_true",
                    help="compute a modal basis for every variant instead of re-analysing the layout's (slower; "
                         "measures what the reuse costs)")

@@ -2,6 +2,7 @@
 deviations as incoherent lines through the same routes, beside the periodic outputs (which stay byte-identical)."""
 import csv
 import importlib.util
+import json
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -153,3 +154,12 @@ def test_run_scene_with_as_made_keeps_the_periodic_outputs_byte_identical(tmp_pa
             assert total - 10 * math.log10(12) <= peak <= total + 1e-9
             assert float(r[f"LwA_peak_band{sfx}_hz"]) in levels.NOMINAL_THIRD_OCTAVES
     assert "as made (ISO 1328-1 grade 5" in (on / "summary.txt").read_text()
+    # the speed law of each route's L_WA with and without the sidebands: the fit of L_WA over log2(speed), 250-1500 rpm
+    laws = json.loads((on / "runup.json").read_text())["as_made"]["speed_law_dBA_per_doubling"]["2000"]
+    for route in ("tf_omega", "mesh_force"):
+        sel = [r for r in rows if r["route"] == route]
+        x = np.log2([float(r["speed_rpm"]) for r in sel])
+        for kind, col in (("as_made", "LwA_as_made_dB"), ("periodic", "LwA_dB")):
+            fit = np.polyfit(x, [float(r[col]) for r in sel], 1)[0]
+            assert laws[route][kind] == pytest.approx(fit, abs=2e-3), (route, kind)
+    assert "speed law" in (on / "summary.txt").read_text()

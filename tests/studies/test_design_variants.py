@@ -199,6 +199,7 @@ def test_result_files_hold_every_variant_and_route(bearings_coarse):
     (["study", "bearings", "--set", "drivetrain.bearings=ball"], "--set drivetrain.bearings: the study bearings sets it"),
     (["study", "double-helical", "--set", "runup.torques_nm=[1000.0]"], "--set runup.torques_nm"),
     (["study", "bearings", "--set", "runup.speed_max_rpm=700"], "no speed inside 800-1500"),
+    (["study", "double-helical", "--set", "runup.as_made=13"], "runup.as_made: 13 is neither \"none\" nor an ISO"),
 ])
 def test_bad_input_is_one_line_exit_2_and_no_folder(tmp_path, args, message):
     out = tmp_path / "out"
