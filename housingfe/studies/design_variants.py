@@ -187,11 +187,13 @@ def family_of(name: str) -> Family:
     """A built-in family by name, or a family file (a .toml path: housingfe.studies.family_file)."""
     known = families()
     if name not in known and (name.endswith(".toml") or Path(name).is_file()):
-        from housingfe.studies.family_file import load_family_file
+        from housingfe.studies.family_file import read_family_file
 
-        return load_family_file(name)
+        fields = read_family_file(name, Family.controlled)
+        return Family(**{**fields, "variants": tuple(Variant(**v) for v in fields["variants"])})
     if name not in known:
-        raise InputError(f"study: family {name!r}: unknown (known: {', '.join(known)}; or a family file .toml)")
+        raise InputError(f"study: family {name!r}: unknown (known: {', '.join(known)}) and not a "
+                         "family file (give a FILE.toml: docs/design-variants.md, 'Your own family')")
     return known[name]
 
 

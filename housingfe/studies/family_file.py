@@ -17,8 +17,9 @@
     measured_sd_db = 6.0                #   L_WA difference to the reference over 800-1500 rev/min, dB
     measured_max_dba = 92.3             # optional: the measured largest L_WA over the run-up, dB(A)
 
-The file becomes the same `Family` of `Variant`s as the built-in families (housingfe.studies.design_variants), run by
-the same machinery: every variant of the same layout re-uses one modal basis.  Everything a user can get wrong is
+`read_family_file` gives the fields of the `Family` and its `Variant`s that housingfe.studies.design_variants.family_of
+makes of it (this module does not import that one: no import cycle), so a file family is run by the same machinery
+as the built-in ones: every variant of the same layout re-uses one modal basis.  Everything a user can get wrong is
 found here, before any folder or FE model is made, as an InputError "<file>: <key>: <what>": the gear sets and
 bearing configurations are checked by the run-up scene's own validators (housingfe.runup.scene.DrivetrainSpec), the
 torques by the gear pair's strength, each drivetrain's bearings by their loads.
@@ -31,8 +32,15 @@ from typing import Optional
 from pydantic import Field, NonNegativeFloat, PositiveFloat, field_validator
 
 from housingfe.errors import InputError
-from housingfe.scenefile import FolderName, _Strict, builtin_scenes, load_toml_file, parse_table, scene_name_problem
-from housingfe.studies.design_variants import Family, Variant
+from housingfe.scenefile import (
+    SCENE_DIR,
+    FolderName,
+    _Strict,
+    builtin_scenes,
+    load_toml_file,
+    parse_table,
+    scene_name_problem,
+)
 
 
 class VariantEntry(_Strict):
@@ -104,14 +112,14 @@ def _scene_ref(value: str, path: Path) -> str:
     """The scene as the run-up machinery takes it: a file beside the family file (or absolute), else a built-in
     run-up scene name; InputError if it is neither or not a run-up scene."""
     builtin = builtin_scenes()
-    runups = [n for n in builtin if _kind(Path(__file__).parents[1] / "scenes" / f"{n}.toml") == "runup"]
+    runups = [n for n in builtin if _kind(SCENE_DIR / f"{n}.toml") == "runup"]
     candidate = Path(value).expanduser()
     if not candidate.is_absolute():
         candidate = path.parent / candidate
     if candidate.is_file():
         kind, ref = _kind(candidate), str(candidate)
     elif value in builtin:
-        kind, ref = _kind(Path(__file__).parents[1] / "scenes" / f"{value}.toml"), value
+        kind, ref = _kind(SCENE_DIR / f"{value}.toml"), value
     else:
         raise InputError(f"{path}: scene: {value!r}: no such file ({candidate}) nor built-in scene (built-in run-up "
                          f"scenes: {', '.join(runups)})")
@@ -127,8 +135,11 @@ def _kind(scene_path: Path):
     return info.get("kind") if isinstance(info, dict) else None
 
 
-def load_family_file(file: str | Path) -> Family:
-    """Read a family file (module docstring) into a Family; InputError "<file>: <key>: <what>" on any problem."""
+def read_family_file(file: str | Path, controlled: tuple) -> dict:
+    """Read a family file (module docstring): the keyword arguments of design_variants.Family, with "variants" a
+    list of the keyword arguments of design_variants.Variant (torque in N m, levels in dB / dB(A)).  controlled:
+    the scene keys a variant sets (refused in the file's `set`).  InputError "<file>: <key>: <what>" on any
+    problem."""
     from housingfe.runup.scene import DrivetrainSpec, drivetrain_of, load_runup_scene
 
     path = Path(file)
@@ -144,7 +155,6 @@ def load_family_file(file: str | Path) -> Family:
                              "variant needs a key of its own")
     if spec.reference not in keys:
         raise InputError(f"{path}: reference: {spec.reference!r} is not a variant key (variants: {', '.join(keys)})")
-    controlled = Family.__dataclass_fields__["controlled"].default
     for item in spec.set:
         key = item.split("=", 1)[0].strip()
         if any(key == c or key.startswith(c + ".") for c in controlled):
@@ -177,13 +187,15 @@ def load_family_file(file: str | Path) -> Family:
             dt.to_coupling_spec()            # the bearings at their loads: one that cannot carry its load stops here
         except InputError as exc:
             raise InputError(f"{path}: {where.rstrip('.')} ({v.key}): {exc}") from None
-        variants.append(Variant(v.key, drive.gear_set, drive.bearings, torque, v.measured_mean_db, v.measured_sd_db,
-                                v.measured_max_dba))
+        variants.append({"key": v.key, "gear_set": drive.gear_set, "bearings": drive.bearings, "torque": torque,
+                         "measured_mean": v.measured_mean_db, "measured_sd": v.measured_sd_db,
+                         "measured_max": v.measured_max_dba})
     name = spec.name or path.stem
     problem = scene_name_problem(name)
     if problem is not None:             # a stem such as ".fam" names no result file
         raise InputError(f"{path}: name: the file's stem {problem}; give name = \"...\"")
-    return Family(name, scene_ref, spec.title or f"{name}: {len(variants)} variants on {spec.scene}",
-                  tuple(variants), spec.reference,
-                  spec.source or f"the family file {path.name} (measured values as given there)",
-                  tuple(spec.notes), overrides=tuple(spec.set), path=path)
+    return {"name": name, "scene": scene_ref,
+            "title": spec.title or f"{name}: {len(variants)} variants on {spec.scene}", "variants": variants,
+            "reference": spec.reference,
+            "source": spec.source or f"the family file {path.name} (measured values as given there)",
+            "notes": tuple(spec.notes), "controlled": tuple(controlled), "overrides": tuple(spec.set), "path": path}
