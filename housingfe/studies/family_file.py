@@ -176,8 +176,8 @@ def read_family_file(file: str | Path, controlled: tuple) -> dict:
         if v.key == spec.reference and (v.measured_mean_db is not None or v.measured_sd_db is not None):
             raise InputError(f"{path}: {where}measured_mean_db: the reference's difference to itself is 0 (give "
                              "measured means and s.d. on the other variants)")
-        drive = parse_table(DrivetrainSpec, {**base, **({"gear_set": v.gear_set} if v.gear_set else {}),
-                                             **({"bearings": v.bearings} if v.bearings else {})}, path, where)
+        drive = parse_table(DrivetrainSpec, {**base, **({"gear_set": v.gear_set} if v.gear_set is not None else {}),
+                                             **({"bearings": v.bearings} if v.bearings is not None else {})}, path, where)
         torque = float(v.torque_nm if v.torque_nm is not None else scene.runup.torques_nm[0])
         dt = drivetrain_of(drive, torque, scene.runup.drive_line_model)
         problem = dt.gears.pair.torque_problem(torque)

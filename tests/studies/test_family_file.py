@@ -57,6 +57,8 @@ BAD = {
                       "variants.1.key: 'ball' is also variants.0.key"),
     "unknown_gear_set": (GOOD.replace('gear_set = "B"\nbearings = "self', 'gear_set = "E"\nbearings = "self'),
                          f"variants.1.gear_set: 'E' is not a gear set (known: {', '.join(GEAR_SETS)})"),
+    "empty_gear_set": (GOOD.replace('gear_set = "B"\nbearings = "self', 'gear_set = ""\nbearings = "self'),
+                       "variants.1.gear_set: '' is not a gear set"),
     "unknown_bearings": (GOOD.replace('bearings = "self_aligning"', 'bearings = "needle"'),
                          f"variants.1.bearings: 'needle' is not a bearing configuration (known: "
                          f"{', '.join(configurations())})"),
