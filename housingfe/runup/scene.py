@@ -92,7 +92,7 @@ class DrivetrainSpec(_Strict):
     def _bearings(cls, name):
         from housingfe.bearings.configurations import configurations
 
-        known = ["ball", *configurations()]
+        known = list(configurations())          # "ball" is one of them
         if name not in known:
             raise ValueError(f"{name!r} is not a bearing configuration (known: {', '.join(known)})")
         return name

@@ -10,6 +10,8 @@ re-analyses).
   bearings, 2000 N m;
 * `double-helical` (Sec. 5.9): the double helical set with cylindrical roller (reference at 2000 N m) and
   fluid-film bearings at 500, 1000, 1500 and 2000 N m; its torque law is the only measured one.
+* a family file of the user's own (`housingfe study my_family.toml`, housingfe.studies.family_file): any variants
+  of a run-up scene, with the user's measured numbers beside ours.
 
 Per variant and route (housingfe.runup.chain.ROUTES) on the scene's first radiation model (sigma = 1 for the
 built-in scenes): the mean and standard deviation over 800-1500 rev/min of L_WA(variant) - L_WA(reference), speed
@@ -83,6 +85,8 @@ class Family:
     source: str
     notes: tuple = ()
     controlled: tuple = ("drivetrain.gear_set", "drivetrain.bearings", "runup.torques_nm")
+    overrides: tuple = ()        # a family file's own `set` entries, applied to the scene before any --set
+    path: Path | None = None     # the family file (None: built in)
 
     def variant(self, key: str) -> Variant:
         return next(v for v in self.variants if v.key == key)
@@ -205,9 +209,16 @@ def check_overrides(family: Family, overrides) -> None:
 
 
 def family_of(name: str) -> Family:
+    """A built-in family by name, or a family file (a .toml path: housingfe.studies.family_file)."""
     known = families()
+    if name not in known and (name.endswith(".toml") or Path(name).is_file()):
+        from housingfe.studies.family_file import read_family_file
+
+        fields = read_family_file(name, Family.controlled)
+        return Family(**{**fields, "variants": tuple(Variant(**v) for v in fields["variants"])})
     if name not in known:
-        raise InputError(f"study: family {name!r}: unknown (known: {', '.join(known)})")
+        raise InputError(f"study: family {name!r}: unknown (known: {', '.join(known)}) and not a "
+                         "family file (give a FILE.toml: docs/design-variants.md, 'Your own family')")
     return known[name]
 
 
@@ -666,7 +677,8 @@ def run_studies(jobs, out_dir: str | None = None, fresh_basis: bool = False) -> 
     for family, overrides, sub in jobs:
         fam = family_of(family)
         check_overrides(fam, overrides)
-        session = ChainSession.from_scene(fam.scene, overrides, fresh_basis=fresh_basis, pool=pool)
+        session = ChainSession.from_scene(fam.scene, [*fam.overrides, *overrides], fresh_basis=fresh_basis,
+                                          pool=pool)
         speeds = session.spec.speeds
         if not np.any((speeds >= MEAN_RANGE_RPM[0]) & (speeds <= MEAN_RANGE_RPM[1])):
             raise InputError(f"{session.scene_path}: runup.speed_min_rpm/speed_max_rpm: no speed inside "
@@ -678,7 +690,8 @@ def run_studies(jobs, out_dir: str | None = None, fresh_basis: bool = False) -> 
     fam0, session0, _ = planned[0]
     comm = session0.comm
     out = Path(out_dir or f"results/study-{fam0.name}-{session0.spec.engagement}")
-    outputs.reserve_output(out, comm, inputs=[s.scene_path for _, s, _ in planned])     # before any model is built
+    outputs.reserve_output(out, comm, inputs=[s.scene_path for _, s, _ in planned]        # before any model is built
+                           + [f.path for f, _, _ in planned if f.path is not None])
     for fam, session, _ in planned:          # a bearing that cannot carry its load stops here, before any FE
         for v in fam.variants:
             session.drivetrain(v.gear_set, v.bearings, v.torque)
@@ -710,10 +723,11 @@ def run_study(family: str, out_dir: str | None = None, overrides=(), fresh_basis
 def register_cli(subparsers) -> None:
     """Add `housingfe study <family> [<family> ...] [--out DIR] [--set KEY=VALUE] [--fresh-basis]`."""
     p = subparsers.add_parser("study", help="design variants through the chain beside the thesis' measurements "
-                                            "(profile-corrections, bearings, double-helical)")
+                                            "(profile-corrections, bearings, double-helical) or your own family file")
     p.add_argument("families", nargs="+", metavar="family",
-                   help="profile-corrections | bearings | double-helical (several: they share the housing model and "
-                        "the bases that fit, each written to <out>/<family>/)")
+                   help="profile-corrections | bearings | double-helical | a family file FILE.toml "
+                        "(docs/design-variants.md, 'Your own family'; several: they share the housing model and "
+                        "the bases that fit, each written to <out>/<family name>/)")
     p.add_argument("--out", default=None, help="result folder (default results/study-<family>-<engagement>, for "
                                                "several families results/study-<engagement>)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
@@ -732,9 +746,10 @@ def _cmd(args: argparse.Namespace) -> int:
     if len(args.families) == 1:
         run_study(args.families[0], args.out, overrides, args.fresh_basis)
         return 0
+    fams = [family_of(f) for f in args.families]
     out = args.out
     if out is None:
-        engagement = ChainSession.from_scene(family_of(args.families[0]).scene, overrides).spec.engagement
+        engagement = ChainSession.from_scene(fams[0].scene, [*fams[0].overrides, *overrides]).spec.engagement
         out = f"results/study-{engagement}"
-    run_studies([(f, overrides, f) for f in args.families], out, args.fresh_basis)
+    run_studies([(f, overrides, fam.name) for f, fam in zip(args.families, fams)], out, args.fresh_basis)
     return 0
