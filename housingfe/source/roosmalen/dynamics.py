@@ -256,7 +256,8 @@ def engagement_force(pair: GearPair, corrections: Corrections, stiffness: np.nda
 def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffness: np.ndarray,
                                 normal_force: float, load_share: np.ndarray | None = None,
                                 n_slices: int = 256, n_samples: int | None = None,
-                                origin: float = 0.0, helix_stagger: bool = True) -> np.ndarray:
+                                origin: float = 0.0, helix_stagger: bool = True,
+                                exact_edges: bool = True) -> np.ndarray:
     """Engagement/disengagement shock force F_e [N] over one mesh period, distributed over the face width:
     Eq. 2.62 applied per face-width slice of the contact lines, sampled like `engagement_force`.
 
@@ -278,7 +279,14 @@ def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffn
 
     helix_stagger = False drops the o_j tan(beta_b) term: every slice of a contact line at the same roll position
     (the pair's transverse, spur-equivalent shock with the same load share and flank gaps; the reference of the
-    envelope bound in housingfe.source.roosmalen.overlap and `engagement_force_envelope_bound`)."""
+    envelope bound in housingfe.source.roosmalen.overlap and `engagement_force_envelope_bound`).
+
+    exact_edges = True (default): a staggered slice covers the roll positions s +- (b / n_slices) tan(beta_b) / 2, and
+    where the start A or the end E of the path of contact cuts it, it counts with the fraction inside and its gap is
+    taken at the middle of that part: the contact edges move continuously with t instead of jumping from slice to
+    slice.  Near an integer eps_beta the helix cancels the edges' steps to a residual ~|sinc(n eps_beta)| of them, a
+    window of (eps_beta - 1) p_bt only a few slices wide, which midpoint slices (exact_edges = False, before) resolve
+    badly (benchmarks/experiments/excitation_convergence)."""
     S = np.asarray(stiffness, dtype=float)
     n = S.size if n_samples is None else n_samples
     t = np.arange(n) / n
@@ -304,17 +312,29 @@ def engagement_force_face_width(pair: GearPair, corrections: Corrections, stiffn
     delta = (normal_force / S)[:, None]
     k_lo = math.floor((A - origin - b * tb) / p) - 1
     k_hi = math.ceil((E_ - origin) / p) + 1
+    # half a slice's extent along s (0: no stagger, a line's slices share one s and its edges are sharp anyway)
+    half = 0.5 * b / n_slices * tb if (exact_edges and helix_stagger and tb > 0) else 0.0
     total = np.zeros(n)
     for hx in range(helices):
         w_local = offset if hx == 0 else b - offset           # helix 1 has the opposite hand
         w = w_local + hx * (b + pair.helix_gap)
         for k in range(k_lo, k_hi + 1):
             s = origin + (t[:, None] + k) * p + (offset[None, :] * tb if helix_stagger else 0.0 * offset[None, :])
-            inside = (s >= A) & (s < E_)
-            if not inside.any():
-                continue
-            e = flank_gaps(pair, corrections, s, w_local[None, :], w[None, :], hx)
-            total += (np.where(inside, np.maximum(delta - e, 0.0), 0.0) * share[hx][None, :]).sum(axis=1)
+            if half > 0:
+                lo, hi = np.maximum(s - half, A), np.minimum(s + half, E_)
+                inside = np.clip((hi - lo) / (2 * half), 0.0, 1.0)
+                if not inside.any():
+                    continue
+                s_mid = np.where(inside > 0, 0.5 * (lo + hi), s)          # the middle of the part in contact
+                wl = offset[None, :] + (s_mid - s) / tb
+                wl = wl if hx == 0 else b - wl
+                e = flank_gaps(pair, corrections, s_mid, wl, wl + hx * (b + pair.helix_gap), hx)
+            else:
+                inside = ((s >= A) & (s < E_)).astype(float)
+                if not inside.any():
+                    continue
+                e = flank_gaps(pair, corrections, s, w_local[None, :], w[None, :], hx)
+            total += (inside * np.maximum(delta - e, 0.0) * share[hx][None, :]).sum(axis=1)
     total /= pair.transverse_contact_ratio * n_slices * helices
     return S * (total - total.mean())
 

@@ -226,6 +226,48 @@ def test_uniform_face_width_shock_is_the_transverse_shock_times_sinc(face_mm):
     assert np.max(amp(transverse) - expected) > 50 * 2e-3 * amp(transverse)[0]
 
 
+def _excitation_amplitudes(S, shock, force, harmonics=15):
+    x = np.mean(S) * dyn.quasi_static_compression(S, shock, force)
+    return 2 * np.abs(np.fft.rfft(x - x.mean())[1:harmonics + 1]) / x.size
+
+
+def test_face_width_excitation_near_an_integer_overlap_ratio_is_the_analytic_edge_residual():
+    """Set A's geometry (eps_beta = 1.026, eps_alpha = 1.441), no corrections, uniform load, constant S: the
+    quasi-static excitation is what the helix leaves of the two contact-edge steps (entry at A, exit at E),
+    k_m (d - mean d)_n = 2 F |sin(pi n eps_alpha)| |sinc(n eps_beta)| / (pi n eps_alpha): 1/n times the edges'
+    interference (near-zeros at n = 7, 9).  The scene default 256 slices x 256 samples gives it within 1e-3 of the
+    tooth line with the contact edges cut exactly; with the edges at the slice midpoints (before) the residual window
+    (eps_beta - 1) p_bt is only ~7 slices wide and harmonic 7 came out 2.4 times too large (the plateau of the
+    check 28.excitation.envelope)."""
+    S = np.full(256, K_MEAN)
+    force = 41.5e3
+    n = np.arange(1, 16)
+    ea, eb = PAIR.transverse_contact_ratio, PAIR.overlap_ratio
+    analytic = 2 * force * np.abs(np.sin(math.pi * n * ea)) * np.abs(np.sinc(n * eb)) / (math.pi * n * ea)
+    exact = _excitation_amplitudes(S, dyn.engagement_force_face_width(PAIR, Corrections(), S, force), force)
+    np.testing.assert_allclose(exact, analytic, rtol=0, atol=1e-3 * analytic[0])
+    midpoint = _excitation_amplitudes(S, dyn.engagement_force_face_width(PAIR, Corrections(), S, force,
+                                                                         exact_edges=False), force)
+    assert np.max(np.abs(midpoint - analytic)[4:12]) > 20 * 1e-3 * analytic[0]      # the test can tell
+
+
+@pytest.mark.parametrize("corrections", [Corrections(), SET_A])
+def test_face_width_excitation_is_converged_in_slices_and_samples_at_the_default(corrections):
+    """A time-varying S and a skewed load across the face: the quasi-static excitation's harmonics 1-15 at the
+    default 256 slices x 256 samples lie within 2e-3 of the tooth line of 2048 slices x 1024 samples (the converged
+    reference, benchmarks/experiments/excitation_convergence; errors 1e-4 / 2e-4 of it, midpoint edges 3e-2 / 1e-2)."""
+    force = 41.5e3
+    share = np.linspace(0.9, 1.15, 24)[None, :]
+    coarse_S = _stiffness_wave(n=32, rel_amp=0.02)
+    amps = []
+    for samples, slices in ((256, 256), (1024, 2048)):
+        S = np.interp(np.arange(samples) / samples, np.arange(32) / 32, coarse_S, period=1.0)
+        shock = dyn.engagement_force_face_width(PAIR, corrections, S, force, load_share=share, n_slices=slices)
+        amps.append(_excitation_amplitudes(S, shock, force))
+    default, reference = amps
+    np.testing.assert_allclose(default, reference, rtol=0, atol=2e-3 * reference[0])
+
+
 def test_face_width_is_the_default_engagement_and_thesis_2d_the_replica():
     force = 40e3
     S = np.full(256, K_MEAN)
