@@ -23,8 +23,9 @@ The six studies run as one cached computation (`housingfe.studies.design_variant
 the single helical families and both engagements share one modal basis and the double helical family has its
 own) in <results>/study-validate/, reused while its key holds (housingfe.verification.validate: the resolved scenes
 and the content of every file the run imported).  From an empty cache it takes a few minutes (two bases, 17
-re-analyses, the bound's two families about 20 s of it), so `housingfe validate --quick` computes nothing here: it takes the rows from a valid cached result
-or leaves them out with a note.
+re-analyses, the bound's two families about 20 s of it, the sidebands of the twelve variants as made about 100 s),
+so `housingfe validate --quick` computes nothing here: it takes the rows from a valid cached result or leaves them
+out with a note.
 """
 from __future__ import annotations
 
@@ -148,8 +149,8 @@ def study_folder(results: Path | None = None, quick: bool = False) -> Path | Non
                   "`housingfe validate` computes it)", flush=True)
             return None
         validate.compute({"kind": "study", "jobs": [[f, list(o), sub] for f, o, sub in JOBS]}, scene, folder, results,
-                         "housingfe study (profile-corrections, bearings, double-helical; thesis-2d profile "
-                         "corrections; envelope-bound profile corrections and bearings)", extra, reason)
+                         "housingfe study (profile-corrections, bearings, double-helical, the last two also as "
+                         "made; thesis-2d profile corrections; envelope-bound profile corrections and bearings)", extra, reason)
     return folder
 
 
