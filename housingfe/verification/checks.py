@@ -7,8 +7,9 @@ unit, source, note) with these fields added (`tag`):
   groups, in the issue's order: replica, default, excitation, speed_law, l_omega, variants (CHECK_GROUPS), and
   bound: the envelope bound's rows "28.bound.<the check's id after 28.>" (`as_bound`), reported beside the checks,
   never judged, without a band and counted apart; and as_made: the rows "28.as_made.<the check's id after 28.>" of
-  the default run-up with the expected sidebands of gears as made (`as_made_row`; runup.as_made, docs/runup.md),
-  reported, never judged, without a band and counted apart as well;
+  the default run-up and of the design-variant studies (28.as_made.variants.*) with the expected sidebands of gears
+  as made (`as_made_row`; runup.as_made, docs/runup.md), reported, never judged, without a band and counted apart
+  as well;
 * measured, thesis_calculated — the published numbers beside ours (either may be None);
 * tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
 * passed — "yes", "no" or "" (a report row: nothing to pass);
@@ -45,6 +46,8 @@ BOUND_WHY = "envelope bound (engagement envelope-bound): a bound, not the model;
 # expected sidebands of ISO 1328-1 deviations beside the periodic lines, reported like the bound's, never judged
 AS_MADE_GROUP = "as_made"
 AS_MADE_GRADE = 5
+AS_MADE_OVERRIDE = f"runup.as_made={AS_MADE_GRADE}"     # validate's runs of gears as made (run-up, studies)
+AS_MADE_VARIANTS = f"28.{AS_MADE_GROUP}.variants."      # the design variants' rows as made (study_rows.as_made_rows)
 AS_MADE_WHY = (f"gears as made (runup.as_made = {AS_MADE_GRADE}, ISO 1328-1 grade {AS_MADE_GRADE} standing in for the "
                "thesis' DIN 5): reported, not a check; docs/runup.md")
 CHECK_COLUMNS = ("check_id", "quantity", "ours", "measured", "thesis_calculated", "tolerance", "passed", "band", "why",
@@ -268,20 +271,23 @@ def _cells(r: dict) -> list[str]:
 
 def checks_markdown(rows) -> str:
     """The check rows of `rows` as a Markdown table (the columns of CHECK_COLUMNS) and a count line; the envelope
-    bound's rows (28.bound.*) and those of gears as made (28.as_made.*) are counted apart: they are not checks."""
+    bound's rows (28.bound.*) and those of gears as made (28.as_made.*; those of the design variants,
+    28.as_made.variants.*, named apart) are counted apart: they are not checks."""
     found = check_rows(rows)
     lines = ["| " + " | ".join(CHECK_COLUMNS) + " |", "|" + "---|" * len(CHECK_COLUMNS)]
     lines += ["| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in _cells(r)) + " |" for r in found]
     bound = sum(is_bound(r) for r in found)
     made = sum(is_as_made(r) for r in found)
+    variants = sum(is_as_made(r) and r["check_id"].startswith(AS_MADE_VARIANTS) for r in found)
     checks = len(found) - bound - made
     passed = sum(r.get("passed") == "yes" for r in found)
     failed = sum(r.get("passed") == "no" for r in found)
     lines += ["", f"{checks} checks: {passed} passed, {failed} failed, {checks - passed - failed} reported"
               + (f"; and {bound} rows of the envelope bound (28.bound.*), reported: a bound, not the model" if bound
                  else "")
-              + (f"; and {made} rows of gears as made (28.as_made.*, ISO grade {AS_MADE_GRADE} sidebands), reported: "
-                 "not checks" if made else "")]
+              + (f"; and {made} rows of gears as made (28.as_made.*, ISO grade {AS_MADE_GRADE} sidebands"
+                 + (f": {made - variants} of the default run-up, {variants} of the design variants "
+                    f"{AS_MADE_VARIANTS}*" if variants else "") + "), reported: not checks" if made else "")]
     return "\n".join(lines) + "\n"
 
 

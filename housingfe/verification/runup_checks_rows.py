@@ -150,7 +150,7 @@ def bound_chain_rows(label: str, folder: Path) -> list[dict]:
 
 
 # the default run-up once more with the expected sidebands of gears as made (runup.as_made, docs/runup.md)
-AS_MADE_OVERRIDES = (f"runup.as_made={ck.AS_MADE_GRADE}",)
+AS_MADE_OVERRIDES = (ck.AS_MADE_OVERRIDE,)
 AS_MADE_SPEEDS_RPM = (500, 1000, 1500)          # the measured L_omega's speeds (28.l_omega.flexible.<speed>rpm)
 
 

@@ -13,28 +13,37 @@ calculated differences -0.4/+2.9/-5.1 dB within 1.5 dB.  With the envelope bound
 A's overlap ratio 1.026 sits at the face-width engagement's cancellation; docs/source.md) the profile corrections and
 the bearings run once more, and their check rows come out as the envelope bound's rows 28.bound.variants.* (the same
 row functions, checks.as_bound: reported beside the checks, never judged, no band; a bound, not the model).  The
-double helical set (overlap ratio 1.139) has no such note and no bound rows.
+double helical set (overlap ratio 1.139) has no such note and no bound rows.  The bearings and the double helical
+set run with runup.as_made = 5 (the expected sidebands of ISO grade-5 gears; docs/design-variants.md "Gears as made
+in the variants"): the same run gives the periodic comparison, unchanged, and beside it the same comparison on the
+L_WA as made, whose rows come out as 28.as_made.variants.* (`as_made_rows`, checks.as_made_row: reported, never
+judged, no band) for the bearings' mean differences and rankings and the double helical set's torque law.
 
 The six studies run as one cached computation (`housingfe.studies.design_variants.run_studies`: one process, so
 the single helical families and both engagements share one modal basis and the double helical family has its
 own) in <results>/study-validate/, reused while its key holds (housingfe.verification.validate: the resolved scenes
 and the content of every file the run imported).  From an empty cache it takes a few minutes (two bases, 17
-re-analyses, the bound's two families about 20 s of it), so `housingfe validate --quick` computes nothing here: it takes the rows from a valid cached result
-or leaves them out with a note.
+re-analyses, the bound's two families about 20 s of it, the sidebands of the twelve variants as made about 100 s),
+so `housingfe validate --quick` computes nothing here: it takes the rows from a valid cached result or leaves them
+out with a note.
 """
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
+from housingfe.verification.checks import AS_MADE_OVERRIDE
+
 FOLDER = "study-validate"
 # (family, --set overrides, subfolder): the default engagement for every family, the thesis replica's shock for
 # the profile corrections (its calculated differences are the replica check), and the envelope bound for the single
-# helical families (set A's overlap note; reported rows 28.bound.*, not checks)
+# helical families (set A's overlap note; reported rows 28.bound.*, not checks); the bearings and the double helical
+# set also with gears as made (runup.as_made = 5: the same run gives the periodic comparison, unchanged, and the
+# as-made one beside it, study.json "as_made"; reported rows 28.as_made.variants.*, not checks)
 BOUND_ENGAGEMENT = "envelope-bound"
 JOBS = (("profile-corrections", (), "profile-corrections-face-width"),
-        ("bearings", (), "bearings-face-width"),
-        ("double-helical", (), "double-helical-face-width"),
+        ("bearings", (AS_MADE_OVERRIDE,), "bearings-face-width"),
+        ("double-helical", (AS_MADE_OVERRIDE,), "double-helical-face-width"),
         ("profile-corrections", ("runup.engagement=thesis-2d",), "profile-corrections-thesis-2d"),
         ("profile-corrections", (f"runup.engagement={BOUND_ENGAGEMENT}",), f"profile-corrections-{BOUND_ENGAGEMENT}"),
         ("bearings", (f"runup.engagement={BOUND_ENGAGEMENT}",), f"bearings-{BOUND_ENGAGEMENT}"))
@@ -61,8 +70,41 @@ def published_rows(results: Path | None = None, quick: bool = False) -> list[dic
     rows = []
     for family, overrides, sub in JOBS:
         data = json.loads((folder / sub / "study.json").read_text())
-        rows += bound_rows(data) if data["engagement"] == BOUND_ENGAGEMENT else study_rows(data)
+        rows += bound_rows(data) if data["engagement"] == BOUND_ENGAGEMENT else study_rows(data) + as_made_rows(data)
     return rows
+
+
+# the check rows of a family whose counterparts with gears as made are reported (28.as_made.<the check's id after
+# 28.>): the bearings' mean differences and rankings, the double helical set's torque law
+AS_MADE_CHECKS = {"bearings": ("variants.mean.bearings.", "variants.ranking.bearings."),
+                  "double-helical": ("variants.torque_law.",)}
+
+
+def as_made_rows(data: dict) -> list[dict]:
+    """The rows of gears as made of one study result run with runup.as_made (study.json "as_made": the comparison on
+    the L_WA with the expected sidebands of gears of that ISO grade): the check rows of `study_rows` on the as-made
+    comparison that AS_MADE_CHECKS names for the family, as 28.as_made.<the check's id after 28.>
+    (checks.as_made_row: reported, never judged, no tolerance, no band), ours as made beside the check's measured
+    and thesis calculated, the periodic value (the check's ours) first in `why`.  None for a study without
+    "as_made" (run without runup.as_made) or of another family: not an error."""
+    from housingfe.verification.checks import AS_MADE_GROUP, as_made_row, is_check
+
+    made, keep = data.get("as_made"), AS_MADE_CHECKS.get(data["family"], ())
+    if not made or not keep:
+        return []
+    periodic = {r["check_id"]: r for r in study_rows(data) if is_check(r)}
+    scene = f"study {data['family']} ({data['engagement']}, gears {made['label']})"
+    out = []
+    for r in study_rows({**data, **{k: made[k] for k in ("rows", "rankings", "torque_law")}}, causes=False):
+        if not (is_check(r) and r["check_id"][3:].startswith(keep)):
+            continue
+        p = periodic[r["check_id"]]["ours"]
+        p = p if isinstance(p, str) else f"{p:+g} {r['unit']}"
+        out.append(as_made_row(f"28.{AS_MADE_GROUP}.{r['check_id'][3:]}", scene,
+                               f"{made['label']}: {r['quantity']}",
+                               r["ours"], r["unit"], r["source"], measured=r["measured"],
+                               thesis_calculated=r["thesis_calculated"], why=f"periodic {p}; as made: {r['why']}"))
+    return out
 
 
 def bound_rows(data: dict) -> list[dict]:
@@ -107,8 +149,8 @@ def study_folder(results: Path | None = None, quick: bool = False) -> Path | Non
                   "`housingfe validate` computes it)", flush=True)
             return None
         validate.compute({"kind": "study", "jobs": [[f, list(o), sub] for f, o, sub in JOBS]}, scene, folder, results,
-                         "housingfe study (profile-corrections, bearings, double-helical; thesis-2d profile "
-                         "corrections; envelope-bound profile corrections and bearings)", extra, reason)
+                         "housingfe study (profile-corrections, bearings, double-helical, the last two also as "
+                         "made; thesis-2d profile corrections; envelope-bound profile corrections and bearings)", extra, reason)
     return folder
 
 
@@ -141,9 +183,10 @@ def _id(variant: str) -> str:
 RANKING_CHECKS = {"bearings": "bearings", "double-helical": "rollers_vs_fluid_films"}
 
 
-def study_rows(data: dict) -> list[dict]:
+def study_rows(data: dict, causes: bool = True) -> list[dict]:
     """Validate rows of one study result (study.json of housingfe.studies.design_variants); the rows that are checks
-    of issue 28 carry their check_id (housingfe.verification.checks)."""
+    of issue 28 carry their check_id (housingfe.verification.checks).  causes: the measured causes of the failing
+    checks in their `why` (they were measured on the periodic comparison: `as_made_rows` leaves them out)."""
     from housingfe.verification.checks import ranking_ends, tag
     from housingfe.verification.published import row
 
@@ -164,7 +207,7 @@ def study_rows(data: dict) -> list[dict]:
                                f"28.replica.correction.{_id(v)}", measured=r["measured_mean_dB"],
                                thesis_calculated=r["thesis_calc_mean_dB"], tolerance=f"{REPLICA_GOAL_DB:g} dB of the "
                                "thesis' calculation", passed=ok, why=f"ours s.d. {r['sd_diff_dB']} dB over speed"
-                               + (REPLICA_D_CAUSE if v == "D" else "")))
+                               + (REPLICA_D_CAUSE if v == "D" and causes else "")))
             continue
         if r["measured_mean_dB"] is not None:
             ok = abs(r["mean_diff_dB"] - r["measured_mean_dB"]) <= MEAN_GOAL_DB
@@ -223,5 +266,5 @@ def study_rows(data: dict) -> list[dict]:
                        f"28.variants.torque_law.{t['bearings']}.{t['route']}", measured=t["measured_step_dBA"],
                        tolerance=f"{TORQUE_LAW_GOAL_DB:g} dB", passed=ok,
                        why=f"slope over {t['torques_nm']} N m {t['slope_dB_per_doubling']:+.2f} dB(A) per doubling "
-                           f"(measured law: +3 per doubling){TORQUE_LAW_CAUSE}"))
+                           f"(measured law: +3 per doubling){TORQUE_LAW_CAUSE if causes else ''}"))
     return out

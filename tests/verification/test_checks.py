@@ -525,3 +525,111 @@ def test_a_failed_as_made_run_loses_its_rows_alone(tmp_path, monkeypatch):
                                              runup_checks_rows.default_chain_rows("test-gearbox-runup", tmp_path)]
     assert failures == ["gears as made (28.as_made.* left out): housingfe run test-gearbox-runup --set "
                         "runup.as_made=5: exit 1: boom"]
+
+
+# ----------------------------------------------------------- the design variants as made (28.as_made.variants.*)
+def _variant(variant, mean, measured=None, sd=None, route="mesh_force"):
+    return {"route": route, "variant": variant, "mean_diff_dB": mean, "sd_diff_dB": 0.8, "measured_mean_dB": measured,
+            "measured_sd_dB": sd, "thesis_calc_mean_dB": None, "thesis_calc_sd_dB": None, "LwA_max_dBA": 90.0,
+            "at_rpm": 1400.0, "measured_max_dBA": None, "thesis_calc_max_dBA": None}
+
+
+def _ranking(ours, measure="mean difference 800-1500 rpm", route="mesh_force"):
+    measured = "self_aligning < angular_contact < ball"
+    return {"route": route, "measure": measure, "ours": ours, "measured": measured, "matches": ours == measured,
+            "quietest": ours.split(" < ")[0] == "self_aligning", "loudest": ours.split(" < ")[-1] == "ball"}
+
+
+def _torque_law(step, slope, bearings="fluid_film", route="tf_omega"):
+    return {"route": route, "bearings": bearings, "step_mean_dB": step, "measured_step_dBA": 2.7, "step_sd_dB": 0.8,
+            "step_at_1500rpm_dB": step, "torques_nm": "500 1000 1500 2000", "slope_dB_per_doubling": slope}
+
+
+def _as_made_study(family, rows, rankings=(), torque_law=(), made=None):
+    """study.json of `housingfe study <family> --set runup.as_made=5` (made: the as-made comparison, or None for a
+    run without the option)."""
+    data = {**_study(family, rows, rankings, torque_law), "radiation": "erp"}
+    if made is not None:
+        data["as_made"] = {"grade": 5, "label": "as made, ISO grade 5", "what": "w", "assumptions": [], **made}
+    return data
+
+
+def test_the_variants_as_made_are_reported_beside_their_checks_and_leave_them_alone():
+    # bearings, mesh_force: self-aligning - ball periodic +8.7, as made +3.4 (measured -5.1 +- 6.0: 8.5 dB off,
+    # outside); angular contact - ball periodic -1.3, as made -0.4 (measured -4.2 +- 4.5: 3.8 dB off, inside)
+    bearings = _as_made_study(
+        "bearings", [_variant("ball", 0.0), _variant("self_aligning", 8.7, -5.1, 6.0),
+                     _variant("angular_contact", -1.3, -4.2, 4.5)],
+        [_ranking("angular_contact < ball < self_aligning")],
+        made={"rows": [_variant("ball", 0.0), _variant("self_aligning", 3.4, -5.1, 6.0),
+                       _variant("angular_contact", -0.4, -4.2, 4.5)],
+              "rankings": [_ranking("self_aligning < ball < angular_contact")], "torque_law": []})
+    # double helical: fluid films' torque law periodic +9.7, as made +1.24 (measured +2.7); its mean difference is a
+    # check too, but not one whose counterpart as made is reported
+    helical = _as_made_study(
+        "double-helical", [_variant("fluid_film", -0.5, -1.9, 3.0, "tf_omega")],
+        torque_law=[_torque_law(9.7, 8.4)],
+        made={"rows": [_variant("fluid_film", -1.2, -1.9, 3.0, "tf_omega")], "rankings": [],
+              "torque_law": [_torque_law(1.24, 1.01)]})
+    prefix = ck.AS_MADE_WHY + "; "
+    rows = {r["check_id"]: r for r in study_rows.as_made_rows(bearings) + study_rows.as_made_rows(helical)}
+    assert list(rows) == ["28.as_made.variants.mean.bearings.self_aligning.mesh_force",
+                          "28.as_made.variants.mean.bearings.angular_contact.mesh_force",
+                          "28.as_made.variants.ranking.bearings.mean.mesh_force",
+                          "28.as_made.variants.torque_law.fluid_film.tf_omega"]
+    for r in rows.values():
+        assert (r["passed"], r["tolerance"], r["band"]) == ("", "", None) and r["why"].startswith(prefix)
+        assert ck.is_as_made(r) and r["quantity"].startswith("as made, ISO grade 5: ")
+    sa = rows["28.as_made.variants.mean.bearings.self_aligning.mesh_force"]
+    assert (sa["ours"], sa["measured"], sa["scene"]) == (3.4, -5.1, "study bearings (face-width, gears as made, "
+                                                                      "ISO grade 5)")
+    assert sa["why"] == prefix + ("periodic +8.7 dB; as made: s.d. over speed: ours 0.8, measured 6.0 dB; ours outside "
+                                  "the measured s.d.")
+    ac = rows["28.as_made.variants.mean.bearings.angular_contact.mesh_force"]
+    assert (ac["ours"], ac["measured"]) == (-0.4, -4.2) and ac["why"].endswith("periodic -1.3 dB; as made: s.d. over "
+                                                                               "speed: ours 0.8, measured 4.5 dB; ours "
+                                                                               "inside the measured s.d.")
+    rank = rows["28.as_made.variants.ranking.bearings.mean.mesh_force"]
+    assert (rank["ours"], rank["measured"]) == ("self_aligning < ball < angular_contact",
+                                                "self_aligning < angular_contact < ball")
+    assert rank["why"] == prefix + ("periodic angular_contact < ball < self_aligning; as made: quietest yes, loudest "
+                                    "no, whole order no")
+    law = rows["28.as_made.variants.torque_law.fluid_film.tf_omega"]
+    assert (law["ours"], law["measured"], law["unit"]) == (1.24, 2.7, "dB(A)")
+    # the causes measured on the periodic torque law are not said of the one as made
+    assert law["why"] == prefix + ("periodic +9.7 dB(A); as made: slope over 500 1000 1500 2000 N m +1.01 dB(A) per "
+                                   "doubling (measured law: +3 per doubling)")
+    # the checks' rows as without the option; counted apart, named apart, no band attaches
+    periodic = study_rows.study_rows(bearings) + study_rows.study_rows(helical)
+    assert periodic == study_rows.study_rows({k: v for k, v in bearings.items() if k != "as_made"}) + \
+        study_rows.study_rows({k: v for k, v in helical.items() if k != "as_made"})
+    both = ck.check_rows(periodic + list(rows.values()))
+    assert [r for r in both if not ck.is_as_made(r)] == ck.check_rows(periodic)
+    assert ck.checks_markdown(both).splitlines()[-1] == ck.checks_markdown(periodic).splitlines()[-1] + \
+        ("; and 4 rows of gears as made (28.as_made.*, ISO grade 5 sidebands: 0 of the default run-up, 4 of the "
+         "design variants 28.as_made.variants.*), reported: not checks")
+    assert ck.attach_bands(both, {"28.as_made.variants.torque_law.fluid_film.tf_omega": (0.0, 3.0)}) == 0
+    # a study run without runup.as_made, or of a family without such rows: none, not an error
+    assert study_rows.as_made_rows({k: v for k, v in bearings.items() if k != "as_made"}) == []
+    assert study_rows.as_made_rows({**bearings, "family": "profile-corrections", "reference": "A"}) == []
+
+
+def test_validate_s_study_runs_the_bearings_and_the_double_helical_set_as_made(tmp_path, monkeypatch):
+    """The provider takes the rows as made from the jobs run with runup.as_made = 5 (the bearings and the double
+    helical set, default engagement) and no others; a cached study without "as_made" gives none."""
+    made_jobs = [(f, o) for f, o, _ in study_rows.JOBS if "runup.as_made=5" in o]
+    assert made_jobs == [("bearings", ("runup.as_made=5",)), ("double-helical", ("runup.as_made=5",))]
+    law = {"rows": [], "rankings": [], "torque_law": [_torque_law(1.24, 1.01)]}
+    for family, overrides, sub in study_rows.JOBS:
+        engagement = next((o.split("=")[1] for o in overrides if o.startswith("runup.engagement=")), "face-width")
+        data = {**_as_made_study(family, [], torque_law=[_torque_law(9.7, 8.4)] if family == "double-helical" else [],
+                                 made=law), "engagement": engagement}
+        (tmp_path / sub).mkdir()
+        (tmp_path / sub / "study.json").write_text(json.dumps(data))
+    monkeypatch.setattr(study_rows, "study_folder", lambda results=None, quick=False: tmp_path)
+    made = [r["check_id"] for r in study_rows.published_rows(tmp_path) if ck.is_as_made(r)]
+    assert made == ["28.as_made.variants.torque_law.fluid_film.tf_omega"]
+    data = json.loads((tmp_path / "double-helical-face-width" / "study.json").read_text())
+    del data["as_made"]
+    (tmp_path / "double-helical-face-width" / "study.json").write_text(json.dumps(data))
+    assert not any(ck.is_as_made(r) for r in study_rows.published_rows(tmp_path))
