@@ -33,9 +33,14 @@ DEVIATION_KINDS = ("pitch", "profile_slope", "profile_form", "helix_slope", "twi
 
 # the shape of the pitch deviations' order spectrum (draw_deviations, deviation_statistics): "independent" = single
 # pitch deviations drawn independently per tooth (a nearly white spectrum: sidebands at every shaft order, the upper
-# bound of the high-order sideband energy); "runout" = one order-1 sinusoid per gear (eccentricity: sidebands only at
-# the tooth orders +- 1 shaft order of that gear, the other end).  The flank deviations stay independent per tooth.
-PITCH_MODELS = ("independent", "runout")
+# bound of the high-order sideband energy); "runout" = the tooth positions one order-1 sinusoid per gear, each tooth
+# carrying its displacement unchanged through the mesh (sidebands only at the tooth orders +- 1 shaft order of that
+# gear); "none" = no pitch deviations, which is also the first-order limit of a pure eccentricity: the contact
+# normals of an involute pair are all parallel (the plane of action), so a translated gear opens every contact
+# point by the same gap, and the first-order TE sum k_i e_i / sum k_i is that gap, one order-1 line below every
+# tooth band (its sidebands come only from the stiffness ripple k(t) e(t), a second-order term this module drops).
+# The flank deviations stay independent per tooth in all three.
+PITCH_MODELS = ("independent", "runout", "none")
 DEFAULT_PITCH_MODEL = "independent"
 
 
@@ -44,7 +49,7 @@ def check_pitch_model(value) -> str:
     if isinstance(value, str) and value in PITCH_MODELS:
         return value
     raise InputError(f"as_made_pitch: {value!r} is not a pitch-deviation model; choose from "
-                     + " or ".join(f'"{m}"' for m in PITCH_MODELS))
+                     + ", ".join(f'"{m}"' for m in PITCH_MODELS))
 
 
 def runout_amplitude(teeth: int, tolerances: dict) -> float:
@@ -231,7 +236,7 @@ def draw_deviations(rng: np.random.Generator, teeth: int, tolerances: dict, kind
     - pitch, pitch_model "independent" (PITCH_MODELS): single pitch deviations uniform in +-f_pt, closed around
       the gear (sum zero), redrawn until the total cumulative pitch deviation (range of the tooth positions) is
       within F_p; "runout": the positions A cos(2 pi t / z + phi), phi uniform in [0, 2 pi), A uniform in
-      [0, runout_amplitude] (F_p / 2);
+      [0, runout_amplitude] (F_p / 2); "none": none (PITCH_MODELS);
     - profile_slope: uniform in +-f_Halpha per tooth; helix_slope: uniform in +-f_Hbeta per tooth;
     - profile_form: P2-P4 with normal random weights, scaled to a range over the profile of U(0, 1) f_falpha;
     - twist: uniform in +-f_Halpha per tooth (the profile slope at either face +-half of it from the middle's)."""
@@ -245,7 +250,7 @@ def draw_deviations(rng: np.random.Generator, teeth: int, tolerances: dict, kind
         amplitude = rng.uniform(0, 1) * runout_amplitude(teeth, tolerances)
         phase = rng.uniform(0, 2 * math.pi)
         dev.position = amplitude * np.cos(2 * math.pi * np.arange(teeth) / teeth + phase) * pitch_factor
-    elif "pitch" in kinds:
+    elif "pitch" in kinds and pitch_model == "independent":
         for _ in range(max_tries):
             steps = rng.uniform(-1, 1, teeth) * tolerances["f_pt"]
             steps -= steps.mean()
@@ -354,7 +359,7 @@ def deviation_statistics(teeth: int, tolerances: dict, kinds, pitch_factor: floa
     - pitch, pitch_model "runout": x_t = A cos(2 pi t / z + phi) has P_1 = conj(P_{z-1}) = (z / 2) A exp(i phi) and
       no other order, so E|P_1|^2 = E|P_{z-1}|^2 = z^2 E[A^2] / 4 = z^2 A_max^2 / 12 (A uniform in [0, A_max],
       A_max = runout_amplitude), closed form, no draws; the covariance R(d) = E[A^2] / 2 cos(2 pi d / z) is
-      circulant as the one above, so the same spectrum machinery takes it."""
+      circulant as the one above, so the same spectrum machinery takes it; "none": zero."""
     kinds = set(kinds)
     unknown = kinds - set(DEVIATION_KINDS)
     if unknown:
@@ -367,7 +372,7 @@ def deviation_statistics(teeth: int, tolerances: dict, kinds, pitch_factor: floa
             mean_square = runout_amplitude(z, tolerances) ** 2 / 3 * pitch_factor**2
             spectrum[1] += z**2 * mean_square / 4
             spectrum[z - 1] += z**2 * mean_square / 4
-    elif "pitch" in kinds and tolerances["f_pt"] > 0:
+    elif "pitch" in kinds and pitch_model == "independent" and tolerances["f_pt"] > 0:
         rng = np.random.default_rng(seed)
         f_pt, F_p = tolerances["f_pt"], tolerances["F_p"]
         accepted, total = 0, np.zeros(z)

@@ -308,7 +308,11 @@ def test_pitch_model_is_checked_and_independent_stays_the_default():
     d1 = am.draw_deviations(np.random.default_rng(5), 72, tol, am.DEVIATION_KINDS, 1.0, 1.0, pitch_model="independent")
     assert np.array_equal(d0.position, d1.position) and np.array_equal(d0.form, d1.form)
     for bad in ("eccentric", 1, None):
-        with pytest.raises(InputError, match="as_made_pitch: .* choose from \"independent\" or \"runout\""):
+        with pytest.raises(InputError, match="as_made_pitch: .* choose from \"independent\", \"runout\", \"none\""):
             am.deviation_statistics(72, tol, ["pitch"], 1.0, 1.0, pitch_model=bad)
     # few teeth: the single pitch step 2 A sin(pi / z) would exceed f_pt at A = F_p / 2, so A is capped
     assert am.runout_amplitude(6, {"f_pt": 5e-6, "F_p": 20e-6}) == pytest.approx(5e-6 / (2 * math.sin(math.pi / 6)))
+    # "none": no pitch deviations drawn or counted, the flanks as with the other models
+    assert not np.any(am.deviation_statistics(72, tol, am.DEVIATION_KINDS, 1.0, 1.0, pitch_model="none").pitch_spectrum)
+    d2 = am.draw_deviations(np.random.default_rng(5), 72, tol, am.DEVIATION_KINDS, 1.0, 1.0, pitch_model="none")
+    assert not np.any(d2.position) and np.any(d2.profile_slope)
