@@ -155,6 +155,8 @@ def test_run_scene_with_as_made_keeps_the_periodic_outputs_byte_identical(tmp_pa
             assert float(r[f"LwA_peak_band{sfx}_hz"]) in levels.NOMINAL_THIRD_OCTAVES
     assert "as made (ISO 1328-1 grade 5" in (on / "summary.txt").read_text()
     # the speed law of each route's L_WA with and without the sidebands: the fit of L_WA over log2(speed), 250-1500 rpm
+    assert json.loads((on / "runup.json").read_text())["as_made"]["pitch_model"] == "independent"     # the default
+    assert {r["pitch_model"] for r in rows} == {"independent"}
     laws = json.loads((on / "runup.json").read_text())["as_made"]["speed_law_dBA_per_doubling"]["2000"]
     for route in ("tf_omega", "mesh_force"):
         sel = [r for r in rows if r["route"] == route]
