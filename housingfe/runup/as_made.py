@@ -23,7 +23,11 @@ the Nyquist order of the contact weights' sampling with a factor 2 margin, n <= 
 positions per mesh period), and f <= f_max; overlapping bands of neighbouring harmonics count each order once.
 Assumptions beside every result: the deviations are uniform within the grade's tolerances as
 `as_made.draw_deviations` draws them (pitch, profile slope and form, helix slope, twist), both gears the same grade,
-ISO 1328-1:1995 standing in for DIN 3962 (the thesis' "DIN 5" ~ ISO 5).
+ISO 1328-1:1995 standing in for DIN 3962 (the thesis' "DIN 5" ~ ISO 5).  The pitch deviations' spectrum shape
+(runup.as_made_pitch, `as_made.PITCH_MODELS`): "independent" per tooth (default: sidebands at every shaft order, the
+upper bound of the high-order sideband energy), "runout" (the tooth positions one order-1 sinusoid per gear within
+F_p / 2: sidebands only at tooth orders +- 1 shaft order) or "none" (no pitch deviations: the first-order limit of a
+pure eccentricity); the flank deviations stay independent per tooth in all three.
 
 Least invasive: runup.csv, runup_harmonics.csv and the checks stay the periodic model's; the sideband lines run
 through the routes as a second set of Lines on the SAME models, and runup_as_made.csv holds the tooth band and the
@@ -82,12 +86,13 @@ class Spectrum:
     seconds: float
 
 
-def deviation_spectrum(source, torque_nm: float, grade: int, *, pitch_samples: int = 20000, seed: int = 28) -> Spectrum:
+def deviation_spectrum(source, torque_nm: float, grade: int, *, pitch_samples: int = 20000, seed: int = 28,
+                       pitch_model: str = "independent") -> Spectrum:
     """E a_q^2 of the first-order TE of grade-`grade` deviations on both gears of `source` (SourceModel) at a pinion
     torque [N m]: contact weights of the source's mesh model (with its misalignment) at its stiffness positions,
     ISO 1328-1 tolerances per gear (module, reference diameter, face width), deviation_statistics of all kinds,
-    expected_order_spectrum.  Mesh normal factors as the experiment: pitch x cos(alpha_t) cos(beta_b), flanks x
-    cos(beta_b)."""
+    expected_order_spectrum; pitch_model: the pitch deviations' spectrum shape (as_made.PITCH_MODELS).  Mesh normal
+    factors as the experiment: pitch x cos(alpha_t) cos(beta_b), flanks x cos(beta_b)."""
     from housingfe.source import as_made as am
 
     t0 = time.perf_counter()
@@ -101,7 +106,7 @@ def deviation_spectrum(source, torque_nm: float, grade: int, *, pitch_samples: i
     for g, z in enumerate(pair.teeth):
         tol = am.iso1328_tolerances(pair.module, pair.pitch_diameter[g], pair.face_width[g], grade)
         stats.append(am.deviation_statistics(int(z), tol, am.DEVIATION_KINDS, pitch_factor, flank_factor,
-                                             pitch_samples=pitch_samples, seed=seed + g))
+                                             pitch_samples=pitch_samples, seed=seed + g, pitch_model=pitch_model))
     spec = am.expected_order_spectrum(pair, weights, *stats)
     return Spectrum(spec.orders, spec.deviations, max(1, op.n_positions // 4), time.perf_counter() - t0)
 
@@ -159,7 +164,8 @@ def _db(power) -> float:
     return float(10.0 * np.log10(power)) if power > 0 else float("-inf")
 
 
-COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "tooth_frequency_hz", "grade", "sideband_lines",
+COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "tooth_frequency_hz", "grade", "pitch_model",
+           "sideband_lines",
            "L_omega_tooth_band_dB", "L_omega_tooth_band_as_made_dB", "L_omega_total_dB", "L_omega_total_as_made_dB",
            "Lv_tooth_band_dB", "Lv_tooth_band_as_made_dB", "Lv_dB", "Lv_as_made_dB",
            "Lw_tooth_band_dB", "Lw_tooth_band_as_made_dB", "Lw_dB", "Lw_as_made_dB",
@@ -177,7 +183,8 @@ def _peak_band(frequency: np.ndarray, lwa_db: np.ndarray) -> tuple[float, float]
     return float(bands.nominal[i]), _db(float(power[i]))
 
 
-def table_rows(periodic: RunupResult, sidebands: RunupResult, grade: int) -> list[dict]:
+def table_rows(periodic: RunupResult, sidebands: RunupResult, grade: int, pitch_model: str = "independent") -> \
+        list[dict]:
     """One row per route, radiator and operating point (COLUMNS): in the tooth band (the 1/3-octave band of
     f_tooth) and over all lines, L_omega (tf_omega: the rigid-bore source's; mesh_force: the wheel on the coupled
     model), L_v, L_W and L_WA of the periodic lines alone and with the expected sidebands (energy sums); and the
@@ -196,7 +203,8 @@ def table_rows(periodic: RunupResult, sidebands: RunupResult, grade: int) -> lis
                 bandP = inP & (P.frequency >= lo) & (P.frequency < hi)
                 bandS = inS & (S.frequency >= lo) & (S.frequency < hi)
                 row = {"route": route, "radiation": rad, "torque_nm": torque, "speed_rpm": speed,
-                       "tooth_frequency_hz": f_t, "grade": grade, "sideband_lines": int(inS.sum())}
+                       "tooth_frequency_hz": f_t, "grade": grade, "pitch_model": pitch_model,
+                       "sideband_lines": int(inS.sum())}
                 for key, vP, vS in (("L_omega", omega_P, omega_S), ("Lv", rp.L_v, rs.L_v),
                                     ("Lw", periodic.L_W[route, rad], sidebands.L_W[route, rad]),
                                     ("LwA", periodic.L_W[route, rad] + a_P, sidebands.L_W[route, rad] + a_S)):
@@ -216,7 +224,7 @@ def table_rows(periodic: RunupResult, sidebands: RunupResult, grade: int) -> lis
 @dataclass
 class AsMadeRun:
     """The as-made addition of a run-up: grade, rows (COLUMNS), the sideband RunupResult per torque, the bands'
-    harmonics 1..n_max, the number of sideband lines, seconds."""
+    harmonics 1..n_max, the number of sideband lines, seconds, the pitch deviations' spectrum model."""
 
     grade: int
     rows: list
@@ -224,25 +232,31 @@ class AsMadeRun:
     n_max: int
     lines: int
     seconds: float
+    pitch_model: str = "independent"
 
 
-def as_made_run(results: dict, source, grade: int, f_lines_max: float, routes) -> AsMadeRun:
+def as_made_run(results: dict, source, grade: int, f_lines_max: float, routes,
+                pitch_model: str = "independent") -> AsMadeRun:
     """The expected sidebands of grade-`grade` gears through `routes` on the run-up's own models (results: {torque:
-    (GearboxModel, RunupResult)} of the periodic run-up)."""
+    (GearboxModel, RunupResult)} of the periodic run-up); pitch_model: the pitch deviations' spectrum shape
+    (runup.as_made_pitch, housingfe.source.as_made.PITCH_MODELS)."""
+    from housingfe.source.as_made import check_pitch_model
+
     t0 = time.perf_counter()
     grade = check_as_made(grade)
+    pitch_model = check_pitch_model(pitch_model)
     rows, side, n_max, count = [], {}, 1, 0
     for torque, (model, res) in results.items():
-        spectrum = deviation_spectrum(source, float(torque), grade)
+        spectrum = deviation_spectrum(source, float(torque), grade, pitch_model=pitch_model)
         n_max = spectrum.n_max
         lines = sideband_lines(source, model, res.lines, float(torque), spectrum, f_lines_max)
         speeds = sorted({s for t, s, *_ in res.lines.points if t == float(torque)})
         # both routes' unit loads in one factorisation per line (the sideband lines are many: ~500 per speed)
         model.reduction.prefetch_unit_coordinates(lines.frequency, [ROUTE_LOADS[r] for r in routes if r in ROUTE_LOADS])
         side[torque] = runup(model, None, speeds, [float(torque)], routes=tuple(routes), lines=lines)
-        rows += table_rows(res, side[torque], grade)
+        rows += table_rows(res, side[torque], grade, pitch_model)
         count += len(lines.frequency)
-    return AsMadeRun(grade, rows, side, n_max, count, time.perf_counter() - t0)
+    return AsMadeRun(grade, rows, side, n_max, count, time.perf_counter() - t0, pitch_model)
 
 
 def lwa_curve(run: AsMadeRun, route: str, radiation: str, torque: float,
@@ -286,7 +300,8 @@ def summary_lines(run: AsMadeRun, radiation: str) -> list[str]:
                          f"{sel[i]['LwA_peak_band_as_made_hz']:g} Hz band (periodic {sel[j]['LwA_dB']:.1f} @ "
                          f"{sel[j]['speed_rpm']:g} rpm, {sel[j]['LwA_peak_band_hz']:g} Hz band), speed law "
                          f"{law['as_made']:.1f} dB(A)/doubling (periodic {law['periodic']:.1f})")
-        out.append(f"  {torque:g} N m as made (ISO 1328-1 grade {run.grade}, expected sidebands in the bands of "
+        out.append(f"  {torque:g} N m as made (ISO 1328-1 grade {run.grade}, pitch {run.pitch_model}, expected "
+                   f"sidebands in the bands of "
                    f"harmonics 1-{run.n_max}, {run.lines} lines, {run.seconds:.1f} s): max L_WA " + "; ".join(parts)
                    + f"; sigma {radiation} ({CSV})")
     return out

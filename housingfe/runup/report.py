@@ -129,7 +129,8 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
             "engagement": "envelope-bound", "what": "a bound, not the model (docs/source.md)", "totals": BOUND_CSV,
             "harmonics": BOUND_HARMONICS_CSV, "checks": bound_checks[0], "peak_contributions": bound_checks[1]},
         "as_made": None if as_made is None else {
-            "grade": as_made.grade, "totals": "runup_as_made.csv", "bands_of_harmonics": [1, as_made.n_max],
+            "grade": as_made.grade, "pitch_model": as_made.pitch_model, "totals": "runup_as_made.csv",
+            "bands_of_harmonics": [1, as_made.n_max],
             "sideband_lines": as_made.lines, "what": "expected sidebands of ISO 1328-1 deviations (docs/runup.md)",
             "speed_law_dBA_per_doubling": _as_made_laws(as_made, scene.radiation.models[0]),
             "speed_law_range_rpm": list(slope_terms.SPEED_LAW_RANGE_RPM)},

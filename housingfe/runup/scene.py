@@ -156,6 +156,13 @@ class RunupSpec(_Strict):
     # same routes, in runup_as_made.csv beside the periodic outputs (runup.csv, runup_harmonics.csv and the checks
     # stay the periodic model's)
     as_made: Union[Literal["none"], int] = Field("none", json_schema_extra={"unit": "ISO 1328-1 grade"})
+    # the shape of the as-made pitch deviations' order spectrum (housingfe.source.as_made.PITCH_MODELS; docs/source.md
+    # "Pitch deviations: independent per tooth or runout"): "independent" = single pitch deviations independent per
+    # tooth within f_pt and F_p (sidebands at every shaft order: the upper bound of the high-order sideband energy);
+    # "runout" = the tooth positions one order-1 sinusoid per gear, amplitude uniform within F_p / 2 (sidebands only
+    # at tooth orders +- 1 shaft order); "none" = no pitch deviations (the first-order limit of a pure eccentricity:
+    # no tooth-band sidebands).  The flank deviations stay independent per tooth; used only with runup.as_made on
+    as_made_pitch: Literal["independent", "runout", "none"] = "independent"
 
     @field_validator("as_made", mode="before")
     @classmethod
@@ -163,6 +170,13 @@ class RunupSpec(_Strict):
         from housingfe.runup.as_made import check_as_made
 
         return _checked("as_made", check_as_made, value)
+
+    @field_validator("as_made_pitch", mode="before")
+    @classmethod
+    def _as_made_pitch(cls, value):
+        from housingfe.source.as_made import check_pitch_model
+
+        return _checked("as_made_pitch", check_pitch_model, value)
 
     @property
     def drive_line_model(self) -> str:
@@ -407,7 +421,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     if spec.as_made != "none":     # the expected sidebands of gears as made, on the same models
         from housingfe.runup.as_made import as_made_run, summary_lines
 
-        as_made = as_made_run(results, source, spec.as_made, spec.f_max_hz, spec.routes)
+        as_made = as_made_run(results, source, spec.as_made, spec.f_max_hz, spec.routes, spec.as_made_pitch)
         timings["as_made_s"] = as_made.seconds
         notes += summary_lines(as_made, scene.radiation.models[0])
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]

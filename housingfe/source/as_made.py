@@ -31,6 +31,40 @@ _WIDTH_RANGES_MM = (4.0, 10.0, 20.0, 40.0, 80.0, 160.0, 250.0, 400.0, 650.0, 100
 
 DEVIATION_KINDS = ("pitch", "profile_slope", "profile_form", "helix_slope", "twist")
 
+# the shape of the pitch deviations' order spectrum (draw_deviations, deviation_statistics): "independent" = single
+# pitch deviations drawn independently per tooth (a nearly white spectrum: sidebands at every shaft order, the upper
+# bound of the high-order sideband energy); "runout" = the tooth positions one order-1 sinusoid per gear, each tooth
+# carrying its displacement unchanged through the mesh (sidebands only at the tooth orders +- 1 shaft order of that
+# gear); "none" = no pitch deviations, which is also the first-order limit of a pure eccentricity: the contact
+# normals of an involute pair are all parallel (the plane of action), so a translated gear opens every contact
+# point by the same gap, and the first-order TE sum k_i e_i / sum k_i is that gap, one order-1 line below every
+# tooth band (its sidebands come only from the stiffness ripple k(t) e(t), a second-order term this module drops).
+# The flank deviations stay independent per tooth in all three.
+PITCH_MODELS = ("independent", "runout", "none")
+DEFAULT_PITCH_MODEL = "independent"
+
+
+def check_pitch_model(value) -> str:
+    """The pitch model (PITCH_MODELS) or InputError "as_made_pitch: ..."."""
+    if isinstance(value, str) and value in PITCH_MODELS:
+        return value
+    raise InputError(f"as_made_pitch: {value!r} is not a pitch-deviation model; choose from "
+                     + ", ".join(f'"{m}"' for m in PITCH_MODELS))
+
+
+def runout_amplitude(teeth: int, tolerances: dict) -> float:
+    """Largest amplitude [m, along the reference circle in the transverse plane] of the "runout" pitch model's
+    order-1 sinusoid of the tooth positions, x_t = A cos(2 pi t / z + phi): F_p / 2, so that its cumulative pitch
+    deviation (range of the positions, <= 2 A) stays within ISO 1328-1 F_p (Sec. 6.3), capped where few teeth
+    would take a single pitch step 2 A sin(pi / z) beyond f_pt (z < ~10 at grade 5; never on set A).  A pure
+    eccentricity e shifts the flanks by e / cos(alpha) along the reference circle, so this is e <= F_p cos(alpha) / 2;
+    ISO 1328-2's radial runout tolerance F_r (2 e with a ball probe) is quoted as about 0.8 F_p for the same
+    grade (not read from the standard's text here), i.e. about 0.85 of this amplitude (-1.4 dB)."""
+    amplitude = tolerances["F_p"] / 2
+    if tolerances["f_pt"] > 0 and teeth > 1:
+        amplitude = min(amplitude, tolerances["f_pt"] / (2 * math.sin(math.pi / teeth)))
+    return amplitude
+
 
 def _range_mean(value: float, limits: tuple[float, ...], name: str) -> float:
     for lo, hi in zip(limits[:-1], limits[1:]):
@@ -191,15 +225,18 @@ def exact_deviation_te(model: MeshModel, total_force: float, pinion: ToothDeviat
 
 
 def draw_deviations(rng: np.random.Generator, teeth: int, tolerances: dict, kinds, pitch_factor: float,
-                    flank_factor: float, max_tries: int = 200000) -> ToothDeviations:
+                    flank_factor: float, max_tries: int = 200000,
+                    pitch_model: str = DEFAULT_PITCH_MODEL) -> ToothDeviations:
     """Random deviations of every tooth of one gear within the tolerances (iso1328_tolerances, [m]) for the
     deviation kinds asked (DEVIATION_KINDS), converted to the mesh normal: pitch_factor (cos alpha_t cos beta_b)
     for the pitch, measured along the reference circle in the transverse plane; flank_factor (cos beta_b) for the
     profile and helix deviations, measured in the transverse plane along the base tangent (the transverse line of
     action):
 
-    - pitch: single pitch deviations uniform in +-f_pt, closed around the gear (sum zero), redrawn until the total
-      cumulative pitch deviation (range of the tooth positions) is within F_p;
+    - pitch, pitch_model "independent" (PITCH_MODELS): single pitch deviations uniform in +-f_pt, closed around
+      the gear (sum zero), redrawn until the total cumulative pitch deviation (range of the tooth positions) is
+      within F_p; "runout": the positions A cos(2 pi t / z + phi), phi uniform in [0, 2 pi), A uniform in
+      [0, runout_amplitude] (F_p / 2); "none": none (PITCH_MODELS);
     - profile_slope: uniform in +-f_Halpha per tooth; helix_slope: uniform in +-f_Hbeta per tooth;
     - profile_form: P2-P4 with normal random weights, scaled to a range over the profile of U(0, 1) f_falpha;
     - twist: uniform in +-f_Halpha per tooth (the profile slope at either face +-half of it from the middle's)."""
@@ -208,7 +245,12 @@ def draw_deviations(rng: np.random.Generator, teeth: int, tolerances: dict, kind
     unknown = kinds - set(DEVIATION_KINDS)
     if unknown:
         raise InputError(f"as_made: unknown deviation kinds {sorted(unknown)}; choose from {DEVIATION_KINDS}")
-    if "pitch" in kinds:
+    check_pitch_model(pitch_model)
+    if "pitch" in kinds and pitch_model == "runout":
+        amplitude = rng.uniform(0, 1) * runout_amplitude(teeth, tolerances)
+        phase = rng.uniform(0, 2 * math.pi)
+        dev.position = amplitude * np.cos(2 * math.pi * np.arange(teeth) / teeth + phase) * pitch_factor
+    elif "pitch" in kinds and pitch_model == "independent":
         for _ in range(max_tries):
             steps = rng.uniform(-1, 1, teeth) * tolerances["f_pt"]
             steps -= steps.mean()
@@ -299,7 +341,8 @@ class DeviationStatistics:
 
 
 def deviation_statistics(teeth: int, tolerances: dict, kinds, pitch_factor: float, flank_factor: float, *,
-                         pitch_samples: int = 20000, seed: int = 28, batch: int = 50000) -> DeviationStatistics:
+                         pitch_samples: int = 20000, seed: int = 28, batch: int = 50000,
+                         pitch_model: str = DEFAULT_PITCH_MODEL) -> DeviationStatistics:
     """The second moments (DeviationStatistics) of `draw_deviations(rng, teeth, tolerances, kinds, pitch_factor,
     flank_factor)`, without drawing flanks:
 
@@ -312,14 +355,24 @@ def deviation_statistics(teeth: int, tolerances: dict, kinds, pitch_factor: floa
       E|P_j|^2 = z (f_pt^2 / 3) / (4 sin^2(pi j / z)) (j != 0; P_0 = 0); the acceptance on F_p (about 29 % of the
       tries for set A's pinion, 5 % for its wheel) cuts the low orders and has no closed form, so the spectrum is the
       mean of |P_j|^2 over `pitch_samples` accepted position draws (seeded; the positions alone, vectorised, about
-      1 s; relative sampling error about 1/sqrt(pitch_samples) per order, 0.7 % at 20000)."""
+      1 s; relative sampling error about 1/sqrt(pitch_samples) per order, 0.7 % at 20000);
+    - pitch, pitch_model "runout": x_t = A cos(2 pi t / z + phi) has P_1 = conj(P_{z-1}) = (z / 2) A exp(i phi) and
+      no other order, so E|P_1|^2 = E|P_{z-1}|^2 = z^2 E[A^2] / 4 = z^2 A_max^2 / 12 (A uniform in [0, A_max],
+      A_max = runout_amplitude), closed form, no draws; the covariance R(d) = E[A^2] / 2 cos(2 pi d / z) is
+      circulant as the one above, so the same spectrum machinery takes it; "none": zero."""
     kinds = set(kinds)
     unknown = kinds - set(DEVIATION_KINDS)
     if unknown:
         raise InputError(f"as_made: unknown deviation kinds {sorted(unknown)}; choose from {DEVIATION_KINDS}")
+    check_pitch_model(pitch_model)
     z = int(teeth)
     spectrum = np.zeros(z)
-    if "pitch" in kinds and tolerances["f_pt"] > 0:
+    if "pitch" in kinds and pitch_model == "runout":
+        if z > 1:                           # E[A^2] = A_max^2 / 3; at z = 2 orders 1 and z - 1 coincide and add
+            mean_square = runout_amplitude(z, tolerances) ** 2 / 3 * pitch_factor**2
+            spectrum[1] += z**2 * mean_square / 4
+            spectrum[z - 1] += z**2 * mean_square / 4
+    elif "pitch" in kinds and pitch_model == "independent" and tolerances["f_pt"] > 0:
         rng = np.random.default_rng(seed)
         f_pt, F_p = tolerances["f_pt"], tolerances["F_p"]
         accepted, total = 0, np.zeros(z)

@@ -240,7 +240,7 @@ class ChainSession:
             self.scene_lines(model, torque)            # a run-up on lines given from outside: the scene's source
             held = self._scene_sources[id(model)]
         run = as_made_run({float(torque): (model, result)}, held[1], self.spec.as_made, self.spec.f_max_hz,
-                          tuple(self.spec.routes))
+                          tuple(self.spec.routes), self.spec.as_made_pitch)
         self.timings["as_made_s"] = self.timings.get("as_made_s", 0.0) + run.seconds
         return run
 

@@ -155,6 +155,8 @@ def test_run_scene_with_as_made_keeps_the_periodic_outputs_byte_identical(tmp_pa
             assert float(r[f"LwA_peak_band{sfx}_hz"]) in levels.NOMINAL_THIRD_OCTAVES
     assert "as made (ISO 1328-1 grade 5" in (on / "summary.txt").read_text()
     # the speed law of each route's L_WA with and without the sidebands: the fit of L_WA over log2(speed), 250-1500 rpm
+    assert json.loads((on / "runup.json").read_text())["as_made"]["pitch_model"] == "independent"     # the default
+    assert {r["pitch_model"] for r in rows} == {"independent"}
     laws = json.loads((on / "runup.json").read_text())["as_made"]["speed_law_dBA_per_doubling"]["2000"]
     for route in ("tf_omega", "mesh_force"):
         sel = [r for r in rows if r["route"] == route]
@@ -163,3 +165,36 @@ def test_run_scene_with_as_made_keeps_the_periodic_outputs_byte_identical(tmp_pa
             fit = np.polyfit(x, [float(r[col]) for r in sel], 1)[0]
             assert laws[route][kind] == pytest.approx(fit, abs=2e-3), (route, kind)
     assert "speed law" in (on / "summary.txt").read_text()
+
+
+def test_pitch_models_through_the_run_up_spectrum(coarse):
+    """runup.as_made_pitch: "runout" differs from "none" (the flanks alone) only at wheel orders 72 n +- 1 (the
+    wheel's order-1 sinusoid) and 72 n +- 3 (the pinion's), and there it adds power; "independent" puts more power
+    than "runout" into the bands of harmonics 4-5 (wheel orders 256-403), where the helix averages the tooth-periodic
+    terms."""
+    _, src, _, _ = coarse
+    spec = {m: am.deviation_spectrum(src, 2000.0, 5, pitch_samples=2000, pitch_model=m)
+            for m in ("independent", "runout", "none")}
+    z2 = int(src.pair.teeth[1])
+    q = np.rint(spec["none"].orders).astype(int)
+    assert np.allclose(spec["none"].orders, q)
+    near = np.isin(np.minimum(q % z2, (-q) % z2), (1, 3))
+    extra = spec["runout"].power - spec["none"].power
+    assert np.all(np.abs(extra[~near]) <= 1e-12 * spec["none"].power.max())
+    assert np.all(extra[near & (q < 9 * z2)] > 0)
+    high = (q >= 256) & (q <= 403)
+    assert np.sum(spec["independent"].power[high]) > 2 * np.sum(spec["runout"].power[high])
+
+
+def test_bad_pitch_model_is_one_line_exit_2_no_folder(tmp_path):
+    import subprocess
+    import sys
+
+    out = tmp_path / "bad"
+    proc = subprocess.run([sys.executable, "-m", "housingfe", "run", "test-gearbox-runup", "--set",
+                           "runup.as_made_pitch=eccentric", "--out", str(out)], capture_output=True, text=True,
+                          cwd=ROOT)
+    assert proc.returncode == 2 and not out.exists()
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("housingfe: error: ")
+    assert "runup.as_made_pitch: 'eccentric' is not a pitch-deviation model" in lines[0]

@@ -246,3 +246,73 @@ def test_pitch_spectrum_without_the_range_test_is_the_closed_random_walk():
     wheel = am.deviation_statistics(72, am.iso1328_tolerances(0.004, 0.2944, 0.062), ["pitch"], 1.0, 1.0)
     free = 72 * (8e-6) ** 2 / 3 / (4 * math.sin(math.pi / 72) ** 2)
     assert wheel.pitch_spectrum[1] < 0.5 * free
+
+
+def test_runout_pitch_gives_lines_only_at_tooth_orders_plus_minus_one_shaft_order(spur):
+    """pitch_model "runout": each gear's tooth positions are one order-1 sinusoid A cos(2 pi t / z + phi), A within
+    F_p / 2.  Its first-order TE is the mesh-periodic weights modulated once per revolution of that gear, so its
+    lines lie only at n z_g +- 1 orders of that gear (n >= 0): wheel orders 72 n +- 1 for the wheel's, 72 n +- 3
+    (pinion orders 24 n +- 1) for the pinion's.  Each line's power is |Theta_1|^2 |T_pos(q)|^2 / (P z)^2 with
+    |Theta_1|^2 = z^2 A^2 / 4 whatever the phase: a draw's spectrum is the expectation times A^2 / E[A^2]
+    (E[A^2] = A_max^2 / 3) to rounding, and the mean of seeded draws is the expectation within 5 standard errors."""
+    pair, model, w = spur
+    z1, z2 = pair.teeth
+    r1 = z2 // z1
+    tol = [am.iso1328_tolerances(0.004, d, 0.040) for d in pair.pitch_diameter]
+    stats = [am.deviation_statistics(z, t, ["pitch"], 0.94, 1.0, pitch_model="runout") for z, t in zip((z1, z2), tol)]
+    for z, t, st in zip((z1, z2), tol, stats):
+        a_max = am.runout_amplitude(z, t)
+        assert a_max == pytest.approx(t["F_p"] / 2, rel=1e-12)               # F_p / 2, not capped by f_pt here
+        assert np.count_nonzero(st.pitch_spectrum) == 2
+        assert st.pitch_spectrum[1] == pytest.approx(z**2 * (0.94 * a_max) ** 2 / 12, rel=1e-12)
+    expected = am.expected_order_spectrum(pair, w, *stats).deviations
+    zero = am.ToothDeviations.zeros
+    q = np.arange(expected.size)
+    at_wheel = np.minimum(q % z2, (-q) % z2) == 1
+    at_pinion = np.minimum(q % z2, (-q) % z2) == r1
+    assert np.max(expected[~(at_wheel | at_pinion)]) == 0.0
+    assert np.min(expected[at_wheel | at_pinion][: 2 * 4]) > 0.0            # n = 0..3 of both gears carry power
+
+    rng = np.random.default_rng(1328)
+    silent = [replace(st, pitch_spectrum=0 * st.pitch_spectrum) for st in stats]
+    only = {0: am.expected_order_spectrum(pair, w, stats[0], silent[1]),
+            1: am.expected_order_spectrum(pair, w, silent[0], stats[1])}
+    for g, lines in ((0, at_pinion), (1, at_wheel)):
+        z = (z1, z2)[g]
+        dev = am.draw_deviations(rng, z, tol[g], ["pitch"], 0.94, 1.0, pitch_model="runout")
+        steps = np.diff(np.concatenate([dev.position, dev.position[:1]]))
+        assert np.ptp(dev.position) <= 0.94 * tol[g]["F_p"] and np.abs(steps).max() <= 0.94 * tol[g]["f_pt"]
+        te = am.first_order_te(pair, w, *((dev, zero(z2)) if g == 0 else (zero(z1), dev)))
+        _, a = am.order_amplitudes(te)
+        assert np.max(a[~lines] ** 2) < 1e-24 * np.max(a**2)
+        amplitude_sq = 2 * np.mean(dev.position**2) / 0.94**2          # A^2 of this draw
+        scale = amplitude_sq / (am.runout_amplitude(z, tol[g]) ** 2 / 3)
+        assert np.allclose(a**2, only[g].deviations * scale, rtol=1e-9, atol=1e-12 * np.max(a**2))
+
+    draws = 300
+    power = np.array([am.order_amplitudes(am.first_order_te(pair, w, *(
+        am.draw_deviations(rng, z, t, ["pitch"], 0.94, 1.0, pitch_model="runout") for z, t in zip((z1, z2), tol))))[1]
+        ** 2 for _ in range(draws)])
+    mean, err = power.mean(axis=0), power.std(axis=0) / math.sqrt(draws)
+    assert np.all(np.abs(mean - expected) <= 5 * err + 1e-30)
+    band = (q >= 0.89 * z2) & (q < 1.12 * z2)
+    assert np.sum(mean[band]) == pytest.approx(np.sum(expected[band]), rel=0.15)
+
+
+def test_pitch_model_is_checked_and_independent_stays_the_default():
+    tol = am.iso1328_tolerances(0.004, 0.2944, 0.062)
+    default = am.deviation_statistics(72, tol, ["pitch"], 1.0, 1.0, pitch_samples=500)
+    named = am.deviation_statistics(72, tol, ["pitch"], 1.0, 1.0, pitch_samples=500, pitch_model="independent")
+    assert np.array_equal(default.pitch_spectrum, named.pitch_spectrum)
+    d0 = am.draw_deviations(np.random.default_rng(5), 72, tol, am.DEVIATION_KINDS, 1.0, 1.0)
+    d1 = am.draw_deviations(np.random.default_rng(5), 72, tol, am.DEVIATION_KINDS, 1.0, 1.0, pitch_model="independent")
+    assert np.array_equal(d0.position, d1.position) and np.array_equal(d0.form, d1.form)
+    for bad in ("eccentric", 1, None):
+        with pytest.raises(InputError, match="as_made_pitch: .* choose from \"independent\", \"runout\", \"none\""):
+            am.deviation_statistics(72, tol, ["pitch"], 1.0, 1.0, pitch_model=bad)
+    # few teeth: the single pitch step 2 A sin(pi / z) would exceed f_pt at A = F_p / 2, so A is capped
+    assert am.runout_amplitude(6, {"f_pt": 5e-6, "F_p": 20e-6}) == pytest.approx(5e-6 / (2 * math.sin(math.pi / 6)))
+    # "none": no pitch deviations drawn or counted, the flanks as with the other models
+    assert not np.any(am.deviation_statistics(72, tol, am.DEVIATION_KINDS, 1.0, 1.0, pitch_model="none").pitch_spectrum)
+    d2 = am.draw_deviations(np.random.default_rng(5), 72, tol, am.DEVIATION_KINDS, 1.0, 1.0, pitch_model="none")
+    assert not np.any(d2.position) and np.any(d2.profile_slope)
