@@ -191,11 +191,19 @@ class StudyResult:
     basis_builds: int = 0
     as_made_grade: object = "none"
     as_made: dict = field(default_factory=dict)
+    as_made_pitch: str = "independent"
 
     @property
     def as_made_label(self) -> str:
-        """How the as-made comparison is labelled in every output: "as made, ISO grade g"."""
-        return f"as made, ISO grade {self.as_made_grade}"
+        """How the as-made comparison is labelled in every output: "as made, ISO grade g", with ", pitch <model>"
+        when the pitch deviations are not the default independent ones (runup.as_made_pitch)."""
+        pitch = "" if self.as_made_pitch == "independent" else f", pitch {self.as_made_pitch}"
+        return f"as made, ISO grade {self.as_made_grade}{pitch}"
+
+    @property
+    def as_made_assumptions(self) -> tuple:
+        """AS_MADE_ASSUMPTIONS with the pitch model's own line (runup.as_made_pitch)."""
+        return AS_MADE_ASSUMPTIONS[:1] + (AS_MADE_PITCH[self.as_made_pitch],) + AS_MADE_ASSUMPTIONS[2:]
 
 
 def check_overrides(family: Family, overrides) -> None:
@@ -248,7 +256,8 @@ def run_family(family: Family, session: ChainSession, progress=print) -> StudyRe
         progress(f"{family.name}: {v.key:22s} basis {how:11s} model {t1 - t0:5.1f} s, "
                  f"run-up {t2 - t1:5.1f} s" + (f", as made {made.seconds:5.1f} s" if made is not None else ""))
     out = analyse(StudyResult(family, session.spec.engagement, rad, routes,
-                              {v.key: runs[v.key] for v in family.variants}, as_made_grade=session.spec.as_made))
+                              {v.key: runs[v.key] for v in family.variants}, as_made_grade=session.spec.as_made,
+                              as_made_pitch=session.spec.as_made_pitch))
     out.basis_builds = session.basis_builds
     out.timings = {**session.timings, "variants_s": time.perf_counter() - t_start,
                    "per_variant": {k: {"basis": r.basis, "model_s": r.model_s, "runup_s": r.runup_s}
@@ -381,6 +390,14 @@ AS_MADE_ASSUMPTIONS = ("ISO 1328-1:1995 grade standing in for the thesis' DIN 39
                        "twist), both gears the same grade",
                        "the EXPECTED power over random teeth (not one drawn gear pair); first order on the "
                        "mean-stiffness system")
+# the second assumption per pitch model (runup.as_made_pitch; housingfe.source.as_made.PITCH_MODELS)
+AS_MADE_PITCH = {
+    "independent": AS_MADE_ASSUMPTIONS[1],
+    "runout": "pitch deviations one order-1 sinusoid per gear (runout), amplitude uniform in [0, F_p / 2], random "
+              "phase; profile slope and form, helix slope, twist uniform within the grade's tolerances; both gears "
+              "the same grade",
+    "none": "no pitch deviations; profile slope and form, helix slope, twist uniform within the grade's tolerances; "
+            "both gears the same grade"}
 
 
 def _as_made_row(result: StudyResult, row: dict) -> dict:
@@ -459,7 +476,7 @@ def markdown_as_made(result: StudyResult) -> list[str]:
     lo, hi = MEAN_RANGE_RPM
     made = result.as_made
     lines = [f"# Gears {label} (`runup.as_made = {result.as_made_grade}`)", "",
-             f"The same comparison on L_WA with {AS_MADE_WHAT}. Assumptions: " + "; ".join(AS_MADE_ASSUMPTIONS)
+             f"The same comparison on L_WA with {AS_MADE_WHAT}. Assumptions: " + "; ".join(result.as_made_assumptions)
              + f". Differences to {fam.reference}, mean ± s.d. over {lo:g}–{hi:g} rev/min. The tables above are the "
                "periodic model's (identical teeth), unchanged.", ""]
     for route in result.routes:
@@ -541,7 +558,8 @@ def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> Non
         "wall_s": wall_s}
     if made:
         data["as_made"] = {"grade": result.as_made_grade, "label": result.as_made_label, "what": AS_MADE_WHAT,
-                           "assumptions": list(AS_MADE_ASSUMPTIONS), **result.as_made}
+                           "pitch_model": result.as_made_pitch,
+                           "assumptions": list(result.as_made_assumptions), **result.as_made}
     write_json(folder / "study.json", data)
     plot(folder / f"{name}.png", result)
 

@@ -127,6 +127,21 @@ def test_periodic_tables_unchanged_and_as_made_labelled(tmp_path):
     assert s_on.startswith(s_off.rsplit("\n", 1)[0]) and "ranking as made, ISO grade 5, mesh_force" in s_on
 
 
+def test_the_pitch_model_names_itself_in_the_label_and_the_assumptions(tmp_path):
+    """runup.as_made_pitch other than the default "independent" is named in the label and in the assumptions the
+    outputs state (a runout study must not claim independent per-tooth pitch deviations); the default keeps the
+    label "as made, ISO grade g"."""
+    on, _ = _bearings(5)
+    assert on.as_made_label == "as made, ISO grade 5" and on.as_made_assumptions == dv.AS_MADE_ASSUMPTIONS
+    on.as_made_pitch = "runout"
+    assert on.as_made_label == "as made, ISO grade 5, pitch runout"
+    assert "order-1 sinusoid" in on.as_made_assumptions[1] and "uniform within" not in on.as_made_assumptions[0]
+    dv.write(tmp_path, on, 1.0)
+    made = json.loads((tmp_path / "study.json").read_text())["as_made"]
+    assert made["pitch_model"] == "runout" and made["label"].endswith("pitch runout")
+    assert "order-1 sinusoid" in (tmp_path / "bearings.md").read_text()
+
+
 def test_as_made_speed_law_is_the_speed_law_fit():
     """runup.json "as_made" speed law: the least-squares slope of L_WA against log2(speed) over 250-1500 rev/min
     of the rows' as-made and periodic totals: 6 and 3 dB(A) per doubling for levels built with those laws (the
