@@ -22,7 +22,8 @@ test-gearbox-runup scene (ball bearings, its misalignment, engagement, shuttling
     PYTHONPATH=. OPENBLAS_NUM_THREADS=1 /work/main/.venv/bin/python \
         benchmarks/experiments/stiffness_positions/stiffness_positions.py [--out DIR]
 
-Writes stiffness_positions_spectra.csv, stiffness_positions_lines.csv, stiffness_positions_totals.csv,
+Writes stiffness_positions_spectra.csv, stiffness_positions_lines.csv (the lines at 250/500/1000/1500 rpm),
+stiffness_positions_totals.csv (L_WA at every speed),
 stiffness_positions.png and prints the README's tables.
 """
 import argparse
@@ -166,7 +167,9 @@ def write(spec_rows, line_rows, total_rows, out: Path) -> None:
                 r["t_share"], r["t_prepared"]] for r in spec_rows for n in range(N_SPECTRUM)])
     cols = ["gear_set", "positions", "route", "speed_rpm", "harmonic", "frequency_hz", "L_F_dB", "L_M_dB", "L_omega_dB",
             "LwA_dB", "dL_F_dB", "dL_M_dB", "dL_omega_dB", "dLwA_dB", "reaches"]
-    write_csv(out / "stiffness_positions_lines.csv", cols, [[r[c] for c in cols] for r in line_rows])
+    # the lines at the reported speeds only (every speed's total: stiffness_positions_totals.csv)
+    write_csv(out / "stiffness_positions_lines.csv", cols,
+              [[r[c] for c in cols] for r in line_rows if r["speed_rpm"] in SPEEDS_REPORTED])
     cols = ["gear_set", "positions", "route", "speed_rpm", "LwA_dB", "dLwA_dB"]
     write_csv(out / "stiffness_positions_totals.csv", cols, [[r[c] for c in cols] for r in total_rows])
 
