@@ -7,14 +7,14 @@ instants (dynamics._fourier_coefficients: zero only beyond THEIR Nyquist limit, 
 lines n = 1..H (runup.harmonics = 30) below runup.f_max_hz = 4 kHz.  With P positions a harmonic n >= P / 2 of
 S(t) is no harmonic of the stiffness but an image of the linear interpolation, and the harmonics below P / 2 are
 aliased by those above.  This experiment measures, for gear set A and the uncorrected set at 2000 N m on the
-test-gearbox-runup scene (ball bearings, its misalignment, engagement, shuttling moment, coupled source)
-
-(and the double helical set with cylindrical roller bearings at 1000 and 2000 N m, the torque-law check's case):
+test-gearbox-runup scene (ball bearings, its misalignment, engagement, shuttling moment, coupled source), and the
+double helical set with cylindrical roller bearings at 1000 and 2000 N m (the torque-law check's case; own basis):
 
 1. |S_n| / k_m, n = 1..60, of S(t) as the balance takes it, at P = 16 / 32 / 64 / 128 / 256 / 512 (and the mesh
    model's points per contact line 24 -> 48 at 128 and 512 positions: does it interact?);
-2. the run-up's source lines and totals at every P against P = 512 (the reference; 256 says how converged it is):
-   the mesh excitation F_n - k_m d_n per line (dB re 1 N, mesh_force route), the rigid-bore L_omega per line, and
+2. the run-up's source lines and totals at every P against P = 512 (the reference; 256 gives the same S(t) at the
+   256 instants and differs in the load share only): the mesh excitation F_n - k_m d_n (dB re 1 N) and the
+   shuttling moment (dB re 1 N m) per line (mesh_force route), the rigid-bore L_omega per line, and
    L_WA per line and in total over speed (both routes, sigma = 1), computed with the scene's own coupled models
    (housingfe.studies.chain_session.ChainSession: one basis, the uncorrected set a re-analysis);
 3. the cost of one operating point (stiffness curve, load share, whole SourceModel.prepared) per P.
