@@ -19,7 +19,7 @@ draw) at the wheel orders inside the 1/3-octave bands of the tooth harmonics n =
 
 The expected line power at a tooth-harmonic order (the deviations' tooth-periodic part) is added too: E|D + X|^2 =
 |D|^2 + E|X|^2.  Bands: the run-up's harmonics n whose 1/3-octave band (IEC 61260, housingfe.levels) lies below
-the Nyquist order of the contact weights' sampling with a factor 2 margin, n <= positions / 4 (8 at the source's 32
+the Nyquist order of the contact weights' sampling with a factor 2 margin, n <= positions / 4 (32 at the source's default 128
 positions per mesh period), and f <= f_max; overlapping bands of neighbouring harmonics count each order once.
 Assumptions beside every result: the deviations are uniform within the grade's tolerances as
 `as_made.draw_deviations` draws them (pitch, profile slope and form, helix slope, twist), both gears the same grade,

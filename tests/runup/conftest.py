@@ -7,7 +7,8 @@ SPEEDS = [500.0, 1000.0, 1100.0]
 
 @pytest.fixture(scope="session")
 def coarse(comm):
-    """(GearboxModel, source, lines, RunupResult): test gearbox on a 60 mm mesh, set A, 2000 N m, lines to 1.5 kHz."""
+    """(GearboxModel, source, lines, RunupResult): test gearbox on a 60 mm mesh, set A, 2000 N m, lines to 1.5 kHz,
+    the source's stiffness at 32 positions per base pitch."""
     from housingfe.drivetrain.description import test_gearbox
     from housingfe.radiation.radiators import RADIATORS
     from housingfe.runup.chain import build_gearbox_model, runup, source_lines
@@ -18,6 +19,6 @@ def coarse(comm):
     hm = housing_model_for(hs, F_LINES, comm)
     dt = test_gearbox("A")
     gm = build_gearbox_model(hm, dt, F_LINES, radiators={"erp": RADIATORS["erp"]()})
-    src = dt.source_model()
+    src = dt.source_model(stiffness_positions=32)     # coarse too (the run-up's default is 128): test speed
     lines, _ = source_lines(src, SPEEDS, [2000.0], F_LINES)
     return gm, src, lines, runup(gm, None, SPEEDS, [2000.0], lines=lines)

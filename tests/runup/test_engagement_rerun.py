@@ -38,7 +38,7 @@ def test_rerun_equals_a_fresh_source_with_the_engagement(coarse, receptance):
 
     # fresh: a new source with the engagement, on a reduction with nothing remembered (the same projection)
     fresh_model = replace(gm, reduction=gm.reduction.with_damping(gm.reduction.damping))
-    fresh_src = gm.drivetrain.source_model(engagement="envelope-bound")
+    fresh_src = gm.drivetrain.source_model(engagement="envelope-bound", stiffness_positions=src.stiffness_positions)
     fresh_lines, _ = run_source(fresh_model, fresh_src, SPEEDS, [TORQUE], F_LINES, receptance)
     fresh = runup(fresh_model, None, SPEEDS, [TORQUE], lines=fresh_lines)
 

@@ -39,6 +39,14 @@ from housingfe.source.stiffness import Corrections, flank_gaps
 ENGAGEMENT_MODELS = ("face-width", "thesis-2d", "envelope-bound")
 DEFAULT_ENGAGEMENT = "face-width"
 
+# positions per base pitch at which the source samples the mesh stiffness (stiffness_curve; linearly interpolated
+# onto the 256 instants of S(t)): the harmonic balance and the run-up take S's harmonics, and the shuttling moment's
+# arm, up to the run-up's H = 30 lines; a harmonic n of the linear interpolant is the true one times sinc^2(n / P)
+# plus images of n' = P +- n.  Chosen for <= 0.5 dB error of the run-up's total L_WA at every speed >= 250 rev/min
+# against 512 positions (32: 3.3 dB at 250 rpm, 64: 0.9 dB, 128: 0.3 dB; sets A and uncorrected at 2000 N m:
+# benchmarks/experiments/stiffness_positions)
+DEFAULT_STIFFNESS_POSITIONS = 128
+
 N_DOF = 14       # after eliminating the prescribed far-end angle (DOF 15 of the thesis)
 WHEEL_THETA_Z = 11
 BEARING_DOFS = {"pinion": [0, 1, 2, 3, 4], "wheel": [6, 7, 8, 9, 10]}

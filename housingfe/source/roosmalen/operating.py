@@ -84,7 +84,7 @@ class SourceModel:
 
     def __init__(self, pair: GearPair, corrections: Corrections, interior: dyn.LumpedInterior,
                  geometry: dyn.ShaftGeometry, *, mesh_model: MeshModel | None = None, n_slices: int = 24,
-                 torque_configuration: int = 2, stiffness_positions: int = 32, harmonics: int = 30,
+                 torque_configuration: int = 2, stiffness_positions: int = dyn.DEFAULT_STIFFNESS_POSITIONS, harmonics: int = 30,
                  speed_range_rpm: tuple[float, float] = SPEED_RANGE_RPM, engagement: str = dyn.DEFAULT_ENGAGEMENT,
                  misalignment="none"):
         self.pair, self.corrections, self.interior, self.geometry = pair, corrections, interior, geometry

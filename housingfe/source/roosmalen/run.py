@@ -116,7 +116,7 @@ class SourceTable(_Strict):
     torque_run_Nm: list[PositiveFloat] = [400.0, 800.0, 1200.0, 1600.0, 2000.0]
     torque_run_speed_rpm: PositiveFloat = 1500.0
     harmonics: int = Field(30, ge=2, le=400)
-    stiffness_positions: int = Field(32, ge=4, le=512)
+    stiffness_positions: int = Field(dyn.DEFAULT_STIFFNESS_POSITIONS, ge=4, le=512)
     slices: int = Field(16, ge=2, le=200)
     torque_configuration: Literal[1, 2] = 2
     engagement: Literal[dyn.ENGAGEMENT_MODELS] = dyn.DEFAULT_ENGAGEMENT
