@@ -291,3 +291,52 @@ def test_load_distribution_converges_up_to_the_torque_limit(scene):
     assert curve.deflection.max() < pair.module
     with pytest.raises(InputError, match="875 N/mm"):
         stiffness_curve(model, normal_force_from_torque(pair, 1.01 * highest), 4)
+
+
+# ---------------------------------------------------------------- contact lines that vanish at the path's ends
+def test_hertz_approach_grows_with_the_load_and_its_compliance_as_one_over_the_width(test_gear):
+    """Weber's approach (eq. 2.40) F (ln(arg) - nu/(1-nu)) with arg ~ L/F peaks and falls at line loads far beyond
+    the tooth's (Hertzian half-width ~ the tooth thickness).  An approach must grow with the load, and a segment's
+    compliance must grow as 1/L as its width L -> 0 (a line load of finite approach): at least 2 (1 - nu^2) /
+    (pi E L), the Weber bracket's value at its peak."""
+    p = test_gear.pair
+    pts = {k: v[:1] for k, v in test_gear.contact_points(0.3 * p.transverse_base_pitch).items()}
+    E, nu = p.youngs_modulus, p.poisson_ratio
+    forces = np.logspace(-3, 7, 400)
+    for width in (1e-3, 1e-5, 1e-7):
+        pts["width"] = np.array([width])
+        approach = np.array([test_gear.hertz(pts, np.array([f]))[0] for f in forces])
+        assert np.all(np.diff(approach) > 0)
+        floor = 2 * (1 - nu**2) / (math.pi * E * width / math.cos(p.base_helix_angle))
+        assert np.all(approach / forces >= floor * (1 - 1e-12))
+    # at tooth-like line loads (1e5 N/m .. 1e6 N/m) the bracket is Weber's: ln(arg) - nu/(1-nu) >= 3
+    width = 1e-3
+    pts["width"] = np.array([width])
+    floor = 2 * (1 - nu**2) / (math.pi * E * width / math.cos(p.base_helix_angle))
+    for q in (1e5, 1e6):
+        assert test_gear.hertz(pts, np.array([q * width]))[0] / (q * width) >= 3 * floor
+
+
+def test_a_vanishing_contact_line_carries_a_vanishing_load(test_gear):
+    """The contact line that enters the path of contact at its end E is eps long (axially) at the mesh position
+    where it starts; at a given approach its load must go to zero with eps (no tip relief here).  Before Weber's
+    approach was held at its peak value a line of 30 um .. 0.1 um carried ~9.6 % of the 1000 N m mesh force (one
+    of its 24 points took it with zero Hertz compliance)."""
+    p = test_gear.pair
+    _, E_ = p.path_of_contact
+    tb, pbt = math.tan(p.base_helix_angle), p.transverse_base_pitch
+    force = normal_force_from_torque(p, 1000.0)
+    shares, deltas = [], []
+    for eps in (1e-4, 3e-5, 1e-6, 1e-7):
+        u = (E_ - eps * tb) % pbt
+        pts, F, delta = test_gear.load_distribution(u, force)
+        line = pts["pair"] == round((E_ - eps * tb - u) / pbt)
+        assert pts["width"][line].sum() == pytest.approx(eps, rel=1e-6)
+        shares.append(F[line].sum() / force)
+        deltas.append(delta)
+    assert shares[-2] < 1e-3 and shares[-1] < 1e-4
+    # the line load (force per length) tends to a finite limit: load proportional to eps
+    assert shares[-1] / 1e-7 == pytest.approx(shares[-2] / 1e-6, rel=0.02)
+    assert shares[1] / 3e-5 == pytest.approx(shares[-1] / 1e-7, rel=0.1)
+    # the mean approach tends to that without the line
+    assert np.ptp(deltas[2:]) < 1e-4 * deltas[-1]
