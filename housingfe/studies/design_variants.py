@@ -73,6 +73,21 @@ class Variant:
 
 
 @dataclass(frozen=True)
+class MeasuredTorqueLaw:
+    """A measured torque law of the variants of one gear set and bearing configuration: the step of L_WA from
+    from_nm to to_nm (pinion torques, N m; measured_step dB(A), the mean over 800-1500 rev/min as the thesis states
+    it) and/or the slope (measured_slope, dB(A) per doubling of torque).  Our step of that group is taken between
+    the same two torques."""
+
+    gear_set: str
+    bearings: str
+    from_nm: float
+    to_nm: float
+    measured_step: float | None = None
+    measured_slope: float | None = None
+
+
+@dataclass(frozen=True)
 class Family:
     """A family of variants on a run-up scene; `reference` is the key of the variant the differences are taken to;
     `source` names where in the thesis the published numbers are; `notes` what the comparison rests on."""
@@ -87,6 +102,8 @@ class Family:
     controlled: tuple = ("drivetrain.gear_set", "drivetrain.bearings", "runup.torques_nm")
     overrides: tuple = ()        # a family file's own `set` entries, applied to the scene before any --set
     path: Path | None = None     # the family file (None: built in)
+    torque_laws: tuple = ()      # MeasuredTorqueLaw per (gear set, bearings) group that has one
+    torque_law_source: str = ""  # where the measured torque laws come from (heads the torque-law table)
 
     def variant(self, key: str) -> Variant:
         return next(v for v in self.variants if v.key == key)
@@ -142,7 +159,11 @@ def families() -> dict[str, Family]:
             ("measured: Fig. 5.19 (2000 N m, fluid film - roller -1.9 dB mean, s.d. 3.0, over 800-1500 rev/min; "
              "maxima 91.0 / 87.7 dB(A)) and Fig. 5.21 (torque law: 1000 -> 2000 N m +3.4 / +2.7 dB(A))",
              "thesis calculated: none (its TF_omega differences of Fig. 5.20 were 'not satisfactory at all')",
-             "fluid films at the pinion speed drivetrain.bearing_speed_rpm for the whole run-up (docs/runup.md)")),
+             "fluid films at the pinion speed drivetrain.bearing_speed_rpm for the whole run-up (docs/runup.md)"),
+            torque_laws=tuple(MeasuredTorqueLaw("double_helical", b, *TORQUE_LAW_NM,
+                                                measured_step=dh["torque_doubling_1000_to_2000Nm_dBA"][key])
+                              for b, key in TORQUE_LAW_MEASURED.items()),
+            torque_law_source="Sec. 5.9, Fig. 5.21"),
     }
 
 
@@ -223,7 +244,8 @@ def family_of(name: str) -> Family:
         from housingfe.studies.family_file import read_family_file
 
         fields = read_family_file(name, Family.controlled)
-        return Family(**{**fields, "variants": tuple(Variant(**v) for v in fields["variants"])})
+        return Family(**{**fields, "variants": tuple(Variant(**v) for v in fields["variants"]),
+                         "torque_laws": tuple(MeasuredTorqueLaw(**t) for t in fields["torque_laws"])})
     if name not in known:
         raise InputError(f"study: family {name!r}: unknown (known: {', '.join(known)}) and not a "
                          "family file (give a FILE.toml: docs/design-variants.md, 'Your own family')")
@@ -267,12 +289,12 @@ def run_family(family: Family, session: ChainSession, progress=print) -> StudyRe
 
 
 def analyse(result: StudyResult) -> StudyResult:
-    """Fill a StudyResult's comparison from its runs: rows, rankings, (double helical) torque law, and with
-    as_made_grade != "none" the same on the L_WA of gears as made (`compare_as_made`)."""
+    """Fill a StudyResult's comparison from its runs: rows, rankings, torque law (of every gear set and bearing
+    configuration run at two or more torques), and with as_made_grade != "none" the same on the L_WA of gears as
+    made (`compare_as_made`)."""
     result.rows = compare(result)
     result.rankings = rankings(result)
-    if result.family.name == "double-helical":
-        result.torque_law = torque_law(result)
+    result.torque_law = torque_law(result)
     if result.as_made_grade != "none":
         result.as_made = compare_as_made(result)
     return result
@@ -282,8 +304,7 @@ def compare_as_made(result: StudyResult) -> dict:
     """The comparison of `compare`, `rankings` and `torque_law` on the L_WA of gears as made (runs' curves_as_made):
     {"rows", "rankings", "torque_law"}."""
     rows = compare(result, AS_MADE)
-    return {"rows": rows, "rankings": rankings(result, rows),
-            "torque_law": torque_law(result, AS_MADE) if result.family.name == "double-helical" else []}
+    return {"rows": rows, "rankings": rankings(result, rows), "torque_law": torque_law(result, AS_MADE)}
 
 
 def compare(result: StudyResult, kind: str = "periodic") -> list[dict]:
@@ -340,34 +361,54 @@ def rankings(result: StudyResult, rows: list | None = None) -> list[dict]:
     return out
 
 
-def torque_law(result: StudyResult, kind: str = "periodic") -> list[dict]:
-    """Double helical: per bearing configuration and route, L_WA(2000 N m) - L_WA(1000 N m) speed by speed over
-    800-1500 rev/min (mean, s.d.) and at 1500 rev/min, and the least-squares slope of the energy mean
-    (800-1500 rev/min) against log2 of the torque over every torque run (dB(A) per doubling), beside the measured
-    step (Fig. 5.21); kind PERIODIC or AS_MADE (the L_WA of gears as made)."""
-    from housingfe.data import thesis
+def torque_groups(result: StudyResult) -> list[tuple[str, str, dict]]:
+    """The variants that differ only in torque: per (gear set, bearing configuration), in the order the family
+    first names them, {torque N m: VariantRun}, for the groups run at two or more torques (of two variants at one
+    torque, the first)."""
+    groups: dict = {}
+    for run in result.runs.values():
+        v = run.variant
+        groups.setdefault((v.gear_set, v.bearings), {}).setdefault(v.torque, run)
+    return [(g, b, runs) for (g, b), runs in groups.items() if len(runs) >= 2]
 
-    measured = thesis()["test_gearbox"]["double_helical"]["torque_doubling_1000_to_2000Nm_dBA"]
-    lo, hi = TORQUE_LAW_NM
+
+def torque_law(result: StudyResult, kind: str = "periodic") -> list[dict]:
+    """The torque law of every group of variants that differ only in torque (`torque_groups`), per group and route:
+
+    * the slope of the energy mean of L_WA over 800-1500 rev/min against log2 of the torque, least squares over
+      every torque of the group (dB(A) per doubling; of two torques the energy means' step / log2(T2 / T1));
+    * the step L_WA(to_nm) - L_WA(from_nm) speed by speed over 800-1500 rev/min (mean, s.d.) and at 1500 rev/min,
+      between the torques of the family's measured torque law of that group (MeasuredTorqueLaw; the double helical
+      family: 1000 -> 2000 N m, Fig. 5.21), else between the group's lowest and highest torque;
+    * beside them the measured step and slope (None where not measured).
+
+    kind PERIODIC or AS_MADE (the L_WA of gears as made).  Keys: bearings, route, step_mean_dB, step_sd_dB,
+    step_at_1500rpm_dB, slope_dB_per_doubling, torques_nm, energy_means_dBA, measured_step_dBA, gear_set, from_nm,
+    to_nm, measured_slope_dBA_per_doubling."""
+    measured = {(t.gear_set, t.bearings): t for t in result.family.torque_laws}
     out = []
-    for bearings in TORQUE_LAW_MEASURED:
-        runs = {r.variant.torque: r for r in result.runs.values() if r.variant.bearings == bearings}
+    for gear_set, bearings, runs in torque_groups(result):
+        law = measured.get((gear_set, bearings))
+        torques = sorted(runs)
+        lo, hi = (law.from_nm, law.to_nm) if law is not None else (torques[0], torques[-1])
         if lo not in runs or hi not in runs:
-            continue
+            raise ValueError(f"study {result.family.name}: torque law {gear_set}/{bearings} {lo:g} -> {hi:g} N m: "
+                             f"no run at that torque (run: {', '.join(f'{t:g}' for t in torques)} N m)")
         for route in result.routes:
             s, high = runs[hi].curves_of(kind)[route]
             _, low = runs[lo].curves_of(kind)[route]
             mean, sd, _ = difference_stats(s, high, low)
             at = float(high[np.argmin(np.abs(s - 1500.0))] - low[np.argmin(np.abs(s - 1500.0))])
-            torques = sorted(runs)
             means = [energy_mean_db(*runs[t].curves_of(kind)[route]) for t in torques]
-            slope = float(np.polyfit(np.log2(torques), means, 1)[0]) if len(torques) > 2 else float("nan")
+            slope = float(np.polyfit(np.log2(torques), means, 1)[0])
             out.append({"bearings": bearings, "route": route, "step_mean_dB": round(mean, 2),
                         "step_sd_dB": round(sd, 2), "step_at_1500rpm_dB": round(at, 2),
                         "slope_dB_per_doubling": round(slope, 2),
                         "torques_nm": " ".join(f"{t:g}" for t in torques),
                         "energy_means_dBA": " ".join(f"{m:.1f}" for m in means),
-                        "measured_step_dBA": measured[TORQUE_LAW_MEASURED[bearings]]})
+                        "measured_step_dBA": None if law is None else law.measured_step,
+                        "gear_set": gear_set, "from_nm": lo, "to_nm": hi,
+                        "measured_slope_dBA_per_doubling": None if law is None else law.measured_slope})
     return out
 
 
@@ -376,6 +417,17 @@ COLUMNS = ("family", "engagement", "route", "radiation", "variant", "gear_set", 
            "mean_diff_dB", "sd_diff_dB", "speeds_in_mean", "measured_mean_dB", "measured_sd_dB", "thesis_calc_mean_dB",
            "thesis_calc_sd_dB", "LwA_max_dBA", "at_rpm", "measured_max_dBA", "thesis_calc_max_dBA",
            "LwA_energy_mean_800_1500_dBA", "basis", "model_s", "runup_s")
+
+
+# <family>_torque_law.csv: one row per torque-law group and route (torque_law), ours beside the measured; with
+# runup.as_made on, TORQUE_LAW_AS_MADE_COLUMNS (as made) after them
+TORQUE_LAW_COLUMNS = ("gear_set", "bearings", "route", "from_nm", "to_nm", "step_mean_dB", "step_sd_dB",
+                      "step_at_1500rpm_dB", "measured_step_dBA", "slope_dB_per_doubling",
+                      "measured_slope_dBA_per_doubling", "torques_nm", "energy_means_dBA")
+TORQUE_LAW_AS_MADE_COLUMNS = {"as_made_iso_grade": None, "step_mean_as_made_dB": "step_mean_dB",
+                              "step_sd_as_made_dB": "step_sd_dB", "step_at_1500rpm_as_made_dB": "step_at_1500rpm_dB",
+                              "slope_as_made_dB_per_doubling": "slope_dB_per_doubling",
+                              "energy_means_as_made_dBA": "energy_means_dBA"}
 
 
 # with runup.as_made on: the as-made comparison as columns beside each row's periodic ones (<family>.csv)
@@ -415,6 +467,60 @@ def _num(x, fmt="{:.1f}") -> str:
     return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else fmt.format(x)
 
 
+def _group_key(t: dict) -> tuple:
+    return t["gear_set"], t["bearings"], t["route"]
+
+
+def _group_label(result: StudyResult, t: dict) -> str:
+    """A torque-law group as the tables name it: its bearings, with its gear set where the family's torque laws
+    span several gear sets."""
+    return t["bearings"] if len({x["gear_set"] for x in result.torque_law}) == 1 else f"{t['gear_set']}, {t['bearings']}"
+
+
+def _group_header(result: StudyResult) -> str:
+    return "bearings" if len({x["gear_set"] for x in result.torque_law}) == 1 else "gear set, bearings"
+
+
+def _torque_law_heading(result: StudyResult, label: str = "") -> str:
+    src = result.family.torque_law_source
+    return f"## Torque law{label}" + (f" ({src})" if src else "")
+
+
+def _has_measured_slope(result: StudyResult) -> bool:
+    return any(t.measured_slope is not None for t in result.family.torque_laws)
+
+
+def _common_step(laws: list) -> tuple | None:
+    """(from_nm, to_nm) when every group's step is between the same two torques, else None."""
+    steps = {(t["from_nm"], t["to_nm"]) for t in laws}
+    return next(iter(steps)) if len(steps) == 1 else None
+
+
+def _step_header(laws: list, label: str = "") -> str:
+    common = _common_step(laws)
+    which = f"L_WA({common[1]:g}) − L_WA({common[0]:g} N m)" if common else "L_WA(to) − L_WA(from)"
+    return f"{which}{label}, mean ± s.d. 800–1500 rpm"
+
+
+def _step_cell(laws: list, t: dict) -> str:
+    prefix = "" if _common_step(laws) else f"{t['from_nm']:g} → {t['to_nm']:g} N m: "
+    return prefix + _pm(t["step_mean_dB"], t["step_sd_dB"])
+
+
+def _torque_law_text(t: dict, periodic: str | None = None) -> str:
+    """One torque-law line of the summary: the step, ours (with the periodic one and) the measured beside it, then
+    the slope over the group's torques with the measured one."""
+    beside = [periodic] if periodic else []
+    if t["measured_step_dBA"] is not None:
+        beside.append(f"measured {t['measured_step_dBA']:+.1f}")
+    text = (f"{t['from_nm']:g} -> {t['to_nm']:g} N m {t['step_mean_dB']:+.1f} ± {t['step_sd_dB']:.1f} dB(A)"
+            + (f" ({', '.join(beside)})" if beside else "")
+            + f"; slope {t['slope_dB_per_doubling']:+.1f} dB(A) per doubling over {t['torques_nm']} N m")
+    if t["measured_slope_dBA_per_doubling"] is not None:
+        text += f" (measured {t['measured_slope_dBA_per_doubling']:+.1f})"
+    return text
+
+
 def markdown(result: StudyResult, wall_s: float | None = None) -> str:
     """The family's comparison table, rankings and (double helical) torque law as Markdown."""
     fam = result.family
@@ -446,15 +552,19 @@ def markdown(result: StudyResult, wall_s: float | None = None) -> str:
                          f"{yn[k['quietest']]} | {yn[k['loudest']]} |")
         lines.append("")
     if result.torque_law:
-        lines += ["## Torque law (Sec. 5.9, Fig. 5.21)", "",
-                  "| bearings | route | L_WA(2000) − L_WA(1000 N m), mean ± s.d. 800–1500 rpm | at 1500 rpm | measured "
-                  "| slope over torques, dB(A) per doubling | energy means 800–1500 rpm, dB(A) |",
-                  "|---|---|---|---|---|---|---|"]
-        for t in result.torque_law:
-            lines.append(f"| {t['bearings']} | {t['route']} | {_pm(t['step_mean_dB'], t['step_sd_dB'])} | "
-                         f"{t['step_at_1500rpm_dB']:+.1f} | {t['measured_step_dBA']:+.1f} | "
-                         f"{_num(t['slope_dB_per_doubling'], '{:+.1f}')} | {t['energy_means_dBA']} "
-                         f"(at {t['torques_nm']} N m) |")
+        laws = result.torque_law
+        slopes = _has_measured_slope(result)
+        lines += [_torque_law_heading(result), "",
+                  f"| {_group_header(result)} | route | {_step_header(laws)} | at 1500 rpm | measured "
+                  "| slope over torques, dB(A) per doubling |" + (" measured slope |" if slopes else "")
+                  + " energy means 800–1500 rpm, dB(A) |",
+                  "|---|---|---|---|---|---|---|" + ("---|" if slopes else "")]
+        for t in laws:
+            lines.append(f"| {_group_label(result, t)} | {t['route']} | {_step_cell(laws, t)} | "
+                         f"{t['step_at_1500rpm_dB']:+.1f} | {_num(t['measured_step_dBA'], '{:+.1f}')} | "
+                         f"{_num(t['slope_dB_per_doubling'], '{:+.1f}')} | "
+                         + (f"{_num(t['measured_slope_dBA_per_doubling'], '{:+.1f}')} | " if slopes else "")
+                         + f"{t['energy_means_dBA']} (at {t['torques_nm']} N m) |")
         lines.append("")
     if result.as_made:
         lines += markdown_as_made(result)
@@ -503,19 +613,23 @@ def markdown_as_made(result: StudyResult) -> list[str]:
                          f"{yn[k['quietest']]} | {yn[k['loudest']]} |")
         lines.append("")
     if made["torque_law"]:
-        periodic = {(t["bearings"], t["route"]): t for t in result.torque_law}
-        lines += [f"## Torque law, {label} (Sec. 5.9, Fig. 5.21)", "",
-                  f"| bearings | route | L_WA(2000) − L_WA(1000 N m), {label}, mean ± s.d. 800–1500 rpm | periodic "
-                  "| measured | at 1500 rpm | slope over torques, dB(A) per doubling | energy means 800–1500 rpm, "
-                  "dB(A) |",
-                  "|---|---|---|---|---|---|---|---|"]
-        for t in made["torque_law"]:
-            p = periodic.get((t["bearings"], t["route"]))
-            lines.append(f"| {t['bearings']} | {t['route']} | {_pm(t['step_mean_dB'], t['step_sd_dB'])} | "
+        laws = made["torque_law"]
+        periodic = {_group_key(t): t for t in result.torque_law}
+        slopes = _has_measured_slope(result)
+        lines += [_torque_law_heading(result, f", {label}"), "",
+                  f"| {_group_header(result)} | route | {_step_header(laws, f', {label}')} | periodic "
+                  "| measured | at 1500 rpm | slope over torques, dB(A) per doubling |"
+                  + (" periodic slope | measured slope |" if slopes else "") + " energy means 800–1500 rpm, dB(A) |",
+                  "|---|---|---|---|---|---|---|---|" + ("---|---|" if slopes else "")]
+        for t in laws:
+            p = periodic.get(_group_key(t))
+            lines.append(f"| {_group_label(result, t)} | {t['route']} | {_step_cell(laws, t)} | "
                          f"{_pm(p['step_mean_dB'], p['step_sd_dB']) if p else '-'} | "
-                         f"{t['measured_step_dBA']:+.1f} | {t['step_at_1500rpm_dB']:+.1f} | "
-                         f"{_num(t['slope_dB_per_doubling'], '{:+.1f}')} | {t['energy_means_dBA']} "
-                         f"(at {t['torques_nm']} N m) |")
+                         f"{_num(t['measured_step_dBA'], '{:+.1f}')} | {t['step_at_1500rpm_dB']:+.1f} | "
+                         f"{_num(t['slope_dB_per_doubling'], '{:+.1f}')} | "
+                         + (f"{_num(p['slope_dB_per_doubling'] if p else None, '{:+.1f}')} | "
+                            f"{_num(t['measured_slope_dBA_per_doubling'], '{:+.1f}')} | " if slopes else "")
+                         + f"{t['energy_means_dBA']} (at {t['torques_nm']} N m) |")
         lines.append("")
     return lines
 
@@ -549,6 +663,15 @@ def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> Non
               ([s] + [round(float(result.runs[k].curves_of(kind)[route][1][i]), 3)
                       for kind in kinds for route in result.routes for k in keys]
                for i, s in enumerate(first)))
+    if result.torque_law:
+        made_laws = {_group_key(t): t for t in result.as_made.get("torque_law", [])}
+        write_csv(folder / f"{name}_torque_law.csv",
+                  list(TORQUE_LAW_COLUMNS) + (list(TORQUE_LAW_AS_MADE_COLUMNS) if made else []),
+                  ([t[c] for c in TORQUE_LAW_COLUMNS]
+                   + ([result.as_made_grade] + [made_laws[_group_key(t)][c]
+                                                for c in list(TORQUE_LAW_AS_MADE_COLUMNS.values())[1:]]
+                      if made else [])
+                   for t in result.torque_law))
     (folder / f"{name}.md").write_text(markdown(result, wall_s))
     data = {
         "family": name, "scene": result.family.scene, "engagement": result.engagement,
@@ -650,8 +773,7 @@ def summary_text(result: StudyResult, wall_s: float | None = None) -> str:
         out.append(f"ranking {k['route']}, {k['measure']}: ours {k['ours']}; measured {k['measured']}; "
                    f"{'same order' if k['matches'] else 'different order'}")
     for t in result.torque_law:
-        out.append(f"torque law {t['bearings']}, {t['route']}: 1000 -> 2000 N m {t['step_mean_dB']:+.1f} ± "
-                   f"{t['step_sd_dB']:.1f} dB(A) (measured {t['measured_step_dBA']:+.1f})")
+        out.append(f"torque law {_group_label(result, t)}, {t['route']}: {_torque_law_text(t)}")
     if result.as_made:
         label = result.as_made_label
         out.append(f"{label} (runup.as_made = {result.as_made_grade}: expected sidebands of tooth-to-tooth "
@@ -667,12 +789,11 @@ def summary_text(result: StudyResult, wall_s: float | None = None) -> str:
         for k in result.as_made["rankings"]:
             out.append(f"ranking {label}, {k['route']}, {k['measure']}: ours {k['ours']}; measured {k['measured']}; "
                        f"{'same order' if k['matches'] else 'different order'}")
-        periodic = {(t["bearings"], t["route"]): t for t in result.torque_law}
+        periodic = {_group_key(t): t for t in result.torque_law}
         for t in result.as_made["torque_law"]:
-            p = periodic.get((t["bearings"], t["route"]))
-            out.append(f"torque law {label}, {t['bearings']}, {t['route']}: 1000 -> 2000 N m "
-                       f"{t['step_mean_dB']:+.1f} ± {t['step_sd_dB']:.1f} dB(A) (periodic "
-                       f"{_pm(p['step_mean_dB'], None) if p else '-'}, measured {t['measured_step_dBA']:+.1f})")
+            p = periodic.get(_group_key(t))
+            out.append(f"torque law {label}, {_group_label(result, t)}, {t['route']}: "
+                       + _torque_law_text(t, f"periodic {_pm(p['step_mean_dB'], None) if p else '-'}"))
     out.append(f"{result.basis_builds} basis for {len(result.runs)} variants"
                + (f"; wall time {wall_s:.1f} s" if wall_s is not None else ""))
     return "\n".join(out)
