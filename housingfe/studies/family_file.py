@@ -16,13 +16,22 @@
     measured_mean_db = -5.1             # optional (not on the reference): the user's measured mean and s.d. of the
     measured_sd_db = 6.0                #   L_WA difference to the reference over 800-1500 rev/min, dB
     measured_max_dba = 92.3             # optional: the measured largest L_WA over the run-up, dB(A)
+    [[torque_laws]]                     # optional: a measured torque law of variants that differ only in torque
+    gear_set = "B"                      # optional (default: the scene's drivetrain.gear_set)
+    bearings = "ball"                   # optional (default: the scene's drivetrain.bearings)
+    from_nm = 1000                      # optional: the step's torques, N m, each a variant's of this gear set and
+    to_nm = 2000                        #   bearings (default: their lowest and highest)
+    measured_step_dba = 3.4             # the measured L_WA(to_nm) - L_WA(from_nm), mean over 800-1500 rev/min, dB(A)
+    measured_slope_dba_per_doubling = 3.0   # and/or the measured slope, dB(A) per doubling of torque
 
 `read_family_file` gives the fields of the `Family` and its `Variant`s that housingfe.studies.design_variants.family_of
 makes of it (this module does not import that one: no import cycle), so a file family is run by the same machinery
 as the built-in ones: every variant of the same layout re-uses one modal basis.  Everything a user can get wrong is
 found here, before any folder or FE model is made, as an InputError "<file>: <key>: <what>": the gear sets and
 bearing configurations are checked by the run-up scene's own validators (housingfe.runup.scene.DrivetrainSpec), the
-torques by the gear pair's strength, each drivetrain's bearings by their loads.
+torques by the gear pair's strength, each drivetrain's bearings by their loads, each measured torque law against
+the variants (a gear set and bearings that some variant has, at two or more torques; from_nm and to_nm torques of
+such variants; one law per gear set and bearings).
 """
 from __future__ import annotations
 
@@ -63,6 +72,18 @@ class VariantEntry(_Strict):
         return key
 
 
+class TorqueLawEntry(_Strict):
+    """One [[torque_laws]] entry: a measured torque law of the variants of one gear set and bearing configuration
+    (units: N m, dB(A), dB(A) per doubling of torque)."""
+
+    gear_set: Optional[str] = None
+    bearings: Optional[str] = None
+    from_nm: Optional[PositiveFloat] = Field(None, json_schema_extra={"unit": "N m"})
+    to_nm: Optional[PositiveFloat] = Field(None, json_schema_extra={"unit": "N m"})
+    measured_step_dba: Optional[float] = Field(None, json_schema_extra={"unit": "dB(A)"})
+    measured_slope_dba_per_doubling: Optional[float] = Field(None, json_schema_extra={"unit": "dB(A)"})
+
+
 class FamilyFileSpec(_Strict):
     """The family file (module docstring)."""
 
@@ -74,6 +95,7 @@ class FamilyFileSpec(_Strict):
     notes: list[str] = []
     set: list[str] = []
     variants: list[VariantEntry]
+    torque_laws: list[TorqueLawEntry] = []
 
     @field_validator("variants")
     @classmethod
@@ -99,6 +121,12 @@ def _unknown_key(data: dict, path: Path) -> None:
         for key in entry if isinstance(entry, dict) else ():
             if key not in VariantEntry.model_fields:
                 raise InputError(f"{path}: variants.{i}.{key}: unknown key (known: {', '.join(_known(VariantEntry))})")
+    laws = data.get("torque_laws")
+    for i, entry in enumerate(laws if isinstance(laws, list) else []):
+        for key in entry if isinstance(entry, dict) else ():
+            if key not in TorqueLawEntry.model_fields:
+                raise InputError(f"{path}: torque_laws.{i}.{key}: unknown key (known: "
+                                 f"{', '.join(_known(TorqueLawEntry))})")
     for required in ("scene", "reference"):
         if required not in data:
             what = ("the run-up scene the variants run on (a built-in name such as test-gearbox-runup, or a "
@@ -190,6 +218,7 @@ def read_family_file(file: str | Path, controlled: tuple) -> dict:
         variants.append({"key": v.key, "gear_set": drive.gear_set, "bearings": drive.bearings, "torque": torque,
                          "measured_mean": v.measured_mean_db, "measured_sd": v.measured_sd_db,
                          "measured_max": v.measured_max_dba})
+    torque_laws = _torque_laws(spec, variants, base, path)
     name = spec.name or path.stem
     problem = scene_name_problem(name)
     if problem is not None:             # a stem such as ".fam" names no result file
@@ -198,4 +227,49 @@ def read_family_file(file: str | Path, controlled: tuple) -> dict:
             "title": spec.title or f"{name}: {len(variants)} variants on {spec.scene}", "variants": variants,
             "reference": spec.reference,
             "source": spec.source or f"the family file {path.name} (measured values as given there)",
-            "notes": tuple(spec.notes), "controlled": tuple(controlled), "overrides": tuple(spec.set), "path": path}
+            "notes": tuple(spec.notes), "controlled": tuple(controlled), "overrides": tuple(spec.set), "path": path,
+            "torque_laws": torque_laws}
+
+
+def _torque_laws(spec: FamilyFileSpec, variants: list, drivetrain: dict, path: Path) -> list[dict]:
+    """The [[torque_laws]] entries as keyword arguments of design_variants.MeasuredTorqueLaw (torques N m, step
+    dB(A), slope dB(A) per doubling), checked against the variants (`variants`: as read_family_file makes them;
+    `drivetrain`: the scene's, for the defaults)."""
+    torques: dict = {}
+    for v in variants:
+        torques.setdefault((v["gear_set"], v["bearings"]), set()).add(v["torque"])
+    out, seen = [], {}
+    for i, law in enumerate(spec.torque_laws):
+        where = f"torque_laws.{i}"
+        gear_set = law.gear_set if law.gear_set is not None else drivetrain["gear_set"]
+        bearings = law.bearings if law.bearings is not None else drivetrain["bearings"]
+        group = f"gear set {gear_set!r} and bearings {bearings!r}"
+        if (gear_set, bearings) not in torques:
+            have = "; ".join(f"{g}/{b}" for g, b in torques)
+            key = "bearings" if any(g == gear_set for g, _ in torques) else "gear_set"
+            raise InputError(f"{path}: {where}.{key}: no variant has {group} (the variants' gear set/bearings: "
+                             f"{have})")
+        run = sorted(torques[gear_set, bearings])
+        listed = ", ".join(f"{t:g}" for t in run)
+        if len(run) < 2:
+            raise InputError(f"{path}: {where}: the variants with {group} are at one torque ({listed} N m): a torque "
+                             "law needs variants at two or more torques that differ in nothing else")
+        if (gear_set, bearings) in seen:
+            raise InputError(f"{path}: {where}: {group} has a torque law already (torque_laws."
+                             f"{seen[gear_set, bearings]})")
+        seen[gear_set, bearings] = i
+        for key, value in (("from_nm", law.from_nm), ("to_nm", law.to_nm)):
+            if value is not None and float(value) not in run:
+                raise InputError(f"{path}: {where}.{key}: {value:g} N m: no variant with {group} runs at it (their "
+                                 f"torques: {listed} N m)")
+        low = float(law.from_nm) if law.from_nm is not None else run[0]
+        high = float(law.to_nm) if law.to_nm is not None else run[-1]
+        if high <= low:
+            raise InputError(f"{path}: {where}.to_nm: {high:g} N m: give a torque above from_nm ({low:g} N m)")
+        if law.measured_step_dba is None and law.measured_slope_dba_per_doubling is None:
+            raise InputError(f"{path}: {where}.measured_step_dba: missing: give measured_step_dba (dB(A), "
+                             "L_WA(to_nm) - L_WA(from_nm), mean over 800-1500 rev/min) and/or "
+                             "measured_slope_dba_per_doubling")
+        out.append({"gear_set": gear_set, "bearings": bearings, "from_nm": low, "to_nm": high,
+                    "measured_step": law.measured_step_dba, "measured_slope": law.measured_slope_dba_per_doubling})
+    return out
