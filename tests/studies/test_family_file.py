@@ -20,10 +20,11 @@ from housingfe.bearings.configurations import configurations
 from housingfe.drivetrain.description import GEAR_SETS
 from housingfe.errors import InputError
 from housingfe.scenefile import SCENE_DIR
-from housingfe.studies.design_variants import family_of
+from housingfe.studies.design_variants import MeasuredTorqueLaw, family_of
 from tests.test_cli import housingfe
 
 EXAMPLE = Path(__file__).parents[2] / "examples" / "study_family.toml"
+TORQUE_EXAMPLE = Path(__file__).parents[2] / "examples" / "study_family_torque.toml"
 COARSE = ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500", "runup.speed_min_rpm=800",
           "runup.speed_step_rpm=350"]          # 800, 1150, 1500 rev/min
 
@@ -46,7 +47,8 @@ measured_mean_db = -5.1
 BAD = {
     "malformed": (GOOD.replace('reference = "ball"', 'reference = ball"'), "malformed TOML"),
     "unknown_top_key": (GOOD.replace("reference =", "refrence ="),
-                        "refrence: unknown key (known: name, scene, title, reference, source, notes, set, variants)"),
+                        "refrence: unknown key (known: name, scene, title, reference, source, notes, set, variants, "
+                        "torque_laws)"),
     "unknown_variant_key": (GOOD.replace("measured_mean_db", "measured_mean"),
                             "variants.1.measured_mean: unknown key (known: key, gear_set, bearings, torque_nm, "
                             "measured_mean_db, measured_sd_db, measured_max_dba)"),
@@ -80,6 +82,48 @@ BAD = {
 }
 
 
+# a family with a torque-law group (ball at 1000 and 2000 N m) and a [[torque_laws]] entry of it
+TORQUE = GOOD.replace("torque_nm = 1500.0\n[[", "torque_nm = 2000.0\n[[") + """[[variants]]
+key = "ball@1000"
+gear_set = "B"
+bearings = "ball"
+torque_nm = 1000.0
+[[torque_laws]]
+gear_set = "B"
+bearings = "ball"
+from_nm = 1000.0
+to_nm = 2000.0
+measured_step_dba = 3.4
+"""
+
+BAD_TORQUE_LAWS = {
+    "unknown_key": (TORQUE.replace("measured_step_dba", "measured_step"),
+                    "torque_laws.0.measured_step: unknown key (known: gear_set, bearings, from_nm, to_nm, "
+                    "measured_step_dba, measured_slope_dba_per_doubling)"),
+    "torque_no_variant_has": (TORQUE.replace("from_nm = 1000.0", "from_nm = 1200.0"),
+                              "torque_laws.0.from_nm: 1200 N m: no variant with gear set 'B' and bearings 'ball' runs "
+                              "at it (their torques: 1000, 2000 N m)"),
+    "to_below_from": (TORQUE.replace("from_nm = 1000.0\nto_nm = 2000.0", "from_nm = 2000.0\nto_nm = 1000.0"),
+                      "torque_laws.0.to_nm: 1000 N m: give a torque above from_nm (2000 N m)"),
+    "bearings_no_variant_has": (TORQUE.replace('bearings = "ball"\nfrom_nm', 'bearings = "tapered_roller"\nfrom_nm'),
+                                "torque_laws.0.bearings: no variant has gear set 'B' and bearings 'tapered_roller'"),
+    "gear_set_no_variant_has": (TORQUE.replace('gear_set = "B"\nbearings = "ball"\nfrom_nm',
+                                               'gear_set = "C"\nbearings = "ball"\nfrom_nm'),
+                                "torque_laws.0.gear_set: no variant has gear set 'C' and bearings 'ball'"),
+    "one_torque": (TORQUE.replace('bearings = "ball"\nfrom_nm = 1000.0\nto_nm = 2000.0\n',
+                                  'bearings = "self_aligning"\n'),
+                   "torque_laws.0: the variants with gear set 'B' and bearings 'self_aligning' are at one torque "
+                   "(1500 N m)"),
+    "nothing_measured": (TORQUE.replace("measured_step_dba = 3.4\n", ""), "torque_laws.0.measured_step_dba: missing"),
+    "step_not_a_number": (TORQUE.replace("measured_step_dba = 3.4", 'measured_step_dba = "a lot"'),
+                          "torque_laws.0.measured_step_dba: Input should be a valid number"),
+    "negative_torque": (TORQUE.replace("from_nm = 1000.0", "from_nm = -1000.0"),
+                        "torque_laws.0.from_nm: Input should be greater than 0"),
+    "twice": (TORQUE + '[[torque_laws]]\ngear_set = "B"\nbearings = "ball"\nmeasured_slope_dba_per_doubling = 3.0\n',
+              "torque_laws.1: gear set 'B' and bearings 'ball' has a torque law already (torque_laws.0)"),
+}
+
+
 def _assert_refused(proc, message, tmp_path, out):
     assert proc.returncode == 2, proc.stderr
     lines = proc.stderr.strip().splitlines()
@@ -96,6 +140,39 @@ def test_bad_family_file_is_one_line_exit_2_and_no_folder(tmp_path, case):
     out = tmp_path / "out"
     proc = housingfe("study", str(family), "--out", str(out))
     _assert_refused(proc, f"{family}: {message}", tmp_path, out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["fam.toml"]
+
+
+def test_torque_laws_of_a_family_file(tmp_path):
+    """A [[torque_laws]] entry names its group's gear set and bearings (defaults: the scene's) and two of its
+    torques (defaults: the lowest and highest)."""
+    family = tmp_path / "fam.toml"
+    family.write_text(TORQUE)
+    assert family_of(str(family)).torque_laws == (MeasuredTorqueLaw("B", "ball", 1000.0, 2000.0, 3.4),)
+    # the scene's drivetrain (gear set A, ball bearings) and the group's lowest and highest torque
+    family.write_text('scene = "test-gearbox-runup"\nreference = "a"\n[[variants]]\nkey = "a"\ntorque_nm = 500\n'
+                      '[[variants]]\nkey = "b"\ntorque_nm = 1500\n[[variants]]\nkey = "c"\ntorque_nm = 1000\n'
+                      '[[torque_laws]]\nmeasured_slope_dba_per_doubling = 3.0\n')
+    assert family_of(str(family)).torque_laws == (MeasuredTorqueLaw("A", "ball", 500.0, 1500.0, None, 3.0),)
+
+
+@pytest.mark.parametrize("case", list(BAD_TORQUE_LAWS))
+def test_bad_torque_law_names_the_file_and_key(tmp_path, case):
+    text, message = BAD_TORQUE_LAWS[case]
+    family = tmp_path / "fam.toml"
+    family.write_text(text)
+    with pytest.raises(InputError) as err:
+        family_of(str(family))
+    assert str(err.value).startswith(f"{family}: {message}"), str(err.value)
+
+
+def test_bad_torque_law_is_one_line_exit_2_and_no_folder(tmp_path):
+    """As a user hits it: the torque law is checked before any FE work or folder."""
+    text, message = BAD_TORQUE_LAWS["torque_no_variant_has"]
+    family = tmp_path / "fam.toml"
+    family.write_text(text)
+    out = tmp_path / "out"
+    _assert_refused(housingfe("study", str(family), "--out", str(out)), f"{family}: {message}", tmp_path, out)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["fam.toml"]
 
 
@@ -195,3 +272,36 @@ def test_a_file_reproducing_the_bearings_family_is_the_same_family(tmp_path):
         (builtin.name, builtin.scene, builtin.reference, builtin.controlled, builtin.overrides)
     assert mine.variants == builtin.variants
     assert [v.measured_mean for v in mine.variants] == [None, -4.2, -5.1, -3.6]
+
+
+@pytest.mark.slow
+def test_torque_example_end_to_end_through_the_cli(tmp_path):
+    """examples/study_family_torque.toml on the coarse gearbox: per bearings group (1000 and 2000 N m) and route
+    the step is the mean of the speed-by-speed difference of the written run-up curves, the slope of two torques
+    the step of their 800-1500 rev/min energy means (per doubling: log2(2000 / 1000) = 1), the measured +3.4 /
+    +2.7 dB(A) of the file beside them in study.json, <name>_torque_law.csv, <name>.md and the printed summary."""
+    out = tmp_path / "out"
+    proc = housingfe("study", str(TORQUE_EXAMPLE), "--out", str(out), *[x for s in COARSE for x in ("--set", s)])
+    assert proc.returncode == 0, proc.stderr
+    name = "double-helical-torque"
+    curves = list(csv.DictReader(open(out / f"{name}_runup.csv")))
+    laws = json.loads((out / "study.json").read_text())["torque_law"]
+    assert [(t["bearings"], t["route"]) for t in laws] == [(b, r) for b in ("cylindrical_roller", "fluid_film")
+                                                           for r in ("tf_omega", "mesh_force")]
+    assert list(csv.DictReader(open(out / f"{name}_torque_law.csv")))[0]["measured_step_dBA"] == "3.4"
+    prefix = {"cylindrical_roller": "roller", "fluid_film": "fluid_film"}
+    for t in laws:
+        hi, lo = ([float(c[f"LwA_{t['route']}_{prefix[t['bearings']]}@{torque}_dBA"]) for c in curves]
+                  for torque in (2000, 1000))
+        assert (t["from_nm"], t["to_nm"], t["torques_nm"]) == (1000.0, 2000.0, "1000 2000")
+        assert t["step_mean_dB"] == pytest.approx(np.mean(np.subtract(hi, lo)), abs=0.006)
+        assert t["step_sd_dB"] == pytest.approx(np.std(np.subtract(hi, lo)), abs=0.006)
+        energy = [10 * math.log10(np.mean([10 ** (x / 10) for x in lw])) for lw in (lo, hi)]
+        assert t["slope_dB_per_doubling"] == pytest.approx(energy[1] - energy[0], abs=0.006)
+        assert t["measured_step_dBA"] == {"cylindrical_roller": 3.4, "fluid_film": 2.7}[t["bearings"]]
+        line = (f"torque law {t['bearings']}, {t['route']}: 1000 -> 2000 N m {t['step_mean_dB']:+.1f} ± "
+                f"{t['step_sd_dB']:.1f} dB(A) (measured {t['measured_step_dBA']:+.1f}); slope "
+                f"{t['slope_dB_per_doubling']:+.1f} dB(A) per doubling over 1000 2000 N m")
+        assert line in proc.stdout
+        assert f"| {t['bearings']} | {t['route']} | {t['step_mean_dB']:+.1f} ± {t['step_sd_dB']:.1f} |" in \
+            (out / f"{name}.md").read_text()
