@@ -489,8 +489,7 @@ def study_data(family: str, engagement: str, radiation: str, routes: tuple, curv
     result = StudyResult(fam, engagement, radiation, tuple(routes), runs)
     result.rows = compare(result)
     result.rankings = rankings(result)
-    if fam.name == "double-helical":
-        result.torque_law = torque_law(result)
+    result.torque_law = torque_law(result)
     return {"family": fam.name, "engagement": engagement, "radiation": radiation, "reference": fam.reference,
             "source": fam.source, "rows": result.rows, "rankings": result.rankings, "torque_law": result.torque_law}
 

@@ -129,3 +129,21 @@ def test_double_helical_keeps_its_measured_1000_to_2000_law():
         [(b, 1000.0, 2000.0, m, "500 1000 1500 2000") for b, m in (("cylindrical_roller", 3.4), ("fluid_film", 2.7))
          for _ in ROUTES]
     assert all(t["slope_dB_per_doubling"] == pytest.approx(6.02, abs=0.005) for t in law)
+
+
+def test_groups_of_several_gear_sets_are_named_by_gear_set_and_bearings():
+    """Ball bearings on gear sets B and C, each at 1000 and 2000 N m: two groups, never mixed (C is 30 dB louder
+    and steps by 40 lg 2), labelled "B, ball" / "C, ball" in the table and the summary."""
+    variants = tuple(dv.Variant(f"{g}@{t:g}", g, "ball", t) for g in ("B", "C") for t in (1000.0, 2000.0))
+    fam = dv.Family("two-sets", "test-gearbox-runup", "two gear sets", variants, "B@2000", "analytic")
+    runs = {v.key: dv.VariantRun(v, {r: (SPEEDS, _level(SPEEDS, v.torque, 20.0 if v.gear_set == "B" else 40.0, r,
+                                                         0.0 if v.gear_set == "B" else 30.0)) for r in ROUTES},
+                                 "built", 0.0, 0.0) for v in variants}
+    result = dv.analyse(dv.StudyResult(fam, "face-width", "erp", ROUTES, runs))
+    steps = {(t["gear_set"], t["route"]): t["step_mean_dB"] for t in result.torque_law}
+    assert steps == pytest.approx({("B", r): 20 * math.log10(2) for r in ROUTES}
+                                  | {("C", r): 40 * math.log10(2) for r in ROUTES}, abs=0.005)
+    md = dv.markdown(result)
+    assert "| gear set, bearings | route | L_WA(2000) − L_WA(1000 N m), mean ± s.d. 800–1500 rpm |" in md
+    assert "| C, ball | mesh_force | +12.0 ± 0.0 |" in md
+    assert "torque law C, ball, tf_omega: 1000 -> 2000 N m +12.0 ± 0.0 dB(A); slope +12.0" in dv.summary_text(result)
