@@ -9,17 +9,20 @@ re-analyses).
 * `bearings` (Sec. 5.8): gear set B with ball (reference), angular contact, self-aligning and tapered roller
   bearings, 2000 N m;
 * `double-helical` (Sec. 5.9): the double helical set with cylindrical roller (reference at 2000 N m) and
-  fluid-film bearings at 500, 1000, 1500 and 2000 N m; its torque law is the only measured one.
+  fluid-film bearings at 500, 1000, 1500 and 2000 N m, with the measured torque law (1000 -> 2000 N m, Fig. 5.21).
 * a family file of the user's own (`housingfe study my_family.toml`, housingfe.studies.family_file): any variants
-  of a run-up scene, with the user's measured numbers beside ours.
+  of a run-up scene, with the user's measured numbers beside ours (also measured torque laws, [[torque_laws]]).
 
 Per variant and route (housingfe.runup.chain.ROUTES) on the scene's first radiation model (sigma = 1 for the
 built-in scenes): the mean and standard deviation over 800-1500 rev/min of L_WA(variant) - L_WA(reference), speed
 by speed (the thesis' measure), and the largest L_WA over the run-up with its speed; beside them the measured
 values and the thesis' calculated ones (housingfe/data/roosmalen1994.toml), and the ranking of the variants
-(quietest first) ours against measured.  The run-up scene's options pass through `--set` as for `housingfe run`
-(e.g. `--set runup.engagement=thesis-2d`, the thesis' two-dimensional engagement shock); the keys a family sets
-itself (gear set, bearings, torques) are refused.
+(quietest first) ours against measured.  Of every group of variants that share gear set and bearings and differ
+only in torque (`torque_groups`, two or more torques) the torque law (`torque_law`): the slope of the 800-1500
+rev/min energy mean per doubling of torque and the step between two torques, beside a measured torque law of the
+family (MeasuredTorqueLaw) where there is one; also in <family>_torque_law.csv.  The run-up scene's options pass
+through `--set` as for `housingfe run` (e.g. `--set runup.engagement=thesis-2d`, the thesis' two-dimensional
+engagement shock); the keys a family sets itself (gear set, bearings, torques) are refused.
 
 With `--set runup.as_made=<ISO 1328-1 grade>` every variant's run-up also computes the expected sidebands of
 tooth-to-tooth deviations of gears of that grade on the same model and source (housingfe.runup.as_made, as
@@ -28,8 +31,8 @@ BESIDE the periodic one, labelled "as made, ISO grade g": extra columns *_as_mad
 <family>_runup.csv, sections after the periodic ones in <family>.md, "as_made" in study.json, lines in the summary.
 The periodic tables stay as with the option off ("none", the default: nothing changes).
 
-Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route) and
-study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
+Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route),
+<family>_torque_law.csv (where there is a torque law) and study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
 (default results/study-<family>-<engagement>); several families in one command share the housing model and the
 bases that fit (profile-corrections and bearings are one layout) and go to <out>/<family>/.
 """
