@@ -106,9 +106,14 @@ def _internal(key: str, rule: float) -> float:
     return rule if values is None else float(values.get(key, rule))
 
 
-def _roller_profile() -> str:
+def _roller_profile(est: dict) -> str:
+    """The roller profile in effect (rule: straight), noted in `est`."""
     values = _INTERNALS.get()
-    return "straight" if values is None else str(values.get("roller_profile", "straight"))
+    profile = "straight" if values is None else str(values.get("roller_profile", "straight"))
+    est["roller_profile"] = ("straight: full line contact (the thesis' rollers; SKF publishes no profile)"
+                             if profile == "straight" else
+                             f"{profile}: ISO/TS 16281 default crown (the real profile is not published)")
+    return profile
 
 
 def normalise(designation: str) -> str:
@@ -171,7 +176,7 @@ def lookup(designation: str) -> RollingBearing:
         return RollingBearing(designation=name, kind=kind, bore=d, outer_diameter=outer, width=width,
                               n_elements=z, element_diameter=dw, pitch_diameter=pitch, contact_angle=0.0,
                               radial_clearance=radial_clearance, roller_length=0.6 * width,
-                              roller_profile=_roller_profile(), estimated=est)
+                              roller_profile=_roller_profile(est), estimated=est)
     dw = 0.22 * (outer - d)
     z = round(0.80 * math.pi * pitch / dw)
     est.update(element_diameter="0.22 (D - d)", roller_length="0.4 B per row",
@@ -182,7 +187,7 @@ def lookup(designation: str) -> RollingBearing:
                           contact_angle=math.radians(_internal("spherical_contact_angle_deg",
                                                                _SPHERICAL_CONTACT_ANGLE_DEG)),
                           radial_clearance=radial_clearance, roller_length=0.4 * width, rows=2,
-                          roller_profile=_roller_profile(), estimated=est)
+                          roller_profile=_roller_profile(est), estimated=est)
 
 
 def _tapered(key: str, d: float, outer: float, width: float) -> RollingBearing:
@@ -203,7 +208,7 @@ def _tapered(key: str, d: float, outer: float, width: float) -> RollingBearing:
     return RollingBearing(designation=f"SKF {key[:-2]} {key[-2:]}", kind="tapered_roller", bore=d,
                           outer_diameter=outer, width=width, n_elements=z, element_diameter=dw,
                           pitch_diameter=pitch, contact_angle=alpha, radial_clearance=0.0,
-                          roller_length=0.6 * width, roller_profile=_roller_profile(), estimated=est)
+                          roller_length=0.6 * width, roller_profile=_roller_profile(est), estimated=est)
 
 
 def tapered_data(designation: str) -> dict:

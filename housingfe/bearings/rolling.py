@@ -234,6 +234,9 @@ def bearing_from_table(table: dict, where: str = "bearing", key_names: dict | No
                 raise InputError(f"{where}: {key}: need a whole number, got {value!r}")
         elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise InputError(f"{where}: {key}: need a number, got {value!r}")
+        if key == "roller_profile" and value not in ROLLER_PROFILES:
+            raise InputError(f"{where}: {(key_names or {}).get(key, key)}: {value!r}: must be one of "
+                             f"{', '.join(ROLLER_PROFILES)}")
         if key == "contact_angle_deg":
             if not 0.0 <= value < 90.0:
                 raise InputError(f"{where}: {key}: {value} deg must lie in [0, 90)")
