@@ -204,3 +204,28 @@ def logarithmic_profile_drop(x, roller_diameter: float, roller_length: float, ki
     flat = length - 2.5 * d
     u = np.clip((2.0 * x - flat) / (2.5 * d), 0.0, None)
     return 0.0005 * d * np.log(1.0 / (1.0 - u**2))
+
+
+# A spherical roller as an elliptical point contact (the way a public implementation of ISO/TS 16281 treats
+# spherical roller bearings, with the ball-bearing method): both raceways of radius r = d_pw / (2 cos alpha) + D_w / 2
+# across the rolling direction, the roller's own profile radius 0.97 r (osculation 0.97).  Here the rolling
+# direction keeps the roller diameter D_w (that implementation puts a ball of diameter 2 * 0.97 r there).
+SPHERICAL_ROLLER_OSCULATION = 0.97
+
+
+def spherical_roller_effective_stiffness(roller_d: float, pitch_d: float, contact_angle: float, E: float,
+                                         nu: float, osculation: float = SPHERICAL_ROLLER_OSCULATION) -> float:
+    """Effective K_n [N/m^1.5] of inner race – spherical roller – outer race, both Hertz point contacts in series
+    (Q = K_n delta^1.5): curvatures 2/D_w (roller, rolling direction), 1/(osculation r) (roller profile),
+    +-2/D_w gamma/(1 -+ gamma) (raceways, rolling direction), -1/r (raceways across), r = d_pw/(2 cos a) + D_w/2."""
+    if not 0.5 < osculation < 1.0:
+        raise InputError(f"spherical roller: osculation={osculation}: need 0.5 < roller profile / raceway radius < 1")
+    race = pitch_d / (2.0 * math.cos(contact_angle)) + roller_d / 2.0
+    gamma = roller_d * math.cos(contact_angle) / pitch_d
+    roll, profile, across = 2.0 / roller_d, 1.0 / (osculation * race), -1.0 / race
+    constants = []
+    for race_roll in (roll * gamma / (1.0 - gamma), -roll * gamma / (1.0 + gamma)):     # inner, outer raceway
+        total = roll + profile + race_roll + across
+        difference = abs((roll - profile) + (race_roll - across)) / total
+        constants.append(point_contact_constant(total, difference, E, nu))
+    return (constants[0] ** (-2.0 / 3.0) + constants[1] ** (-2.0 / 3.0)) ** -1.5

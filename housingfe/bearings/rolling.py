@@ -488,6 +488,24 @@ class SelfAligningRoller(LimRoller):
 
 
 @register_bearing_model
+class SphericalPointContact(SelfAligningRoller):
+    """Double-row spherical roller bearing with Hertz point contacts (n = 3/2): the self-aligning kinematics, each
+    roller pressed between two elliptical contacts of osculation 0.97 (hertz.spherical_roller_effective_stiffness,
+    the ISO/TS 16281 treatment of spherical rollers).  A crowned alternative to the line-contact "self-aligning"."""
+    name = "spherical-point-contact"
+    exponent = 1.5
+
+    def __init__(self, bearing: RollingBearing):
+        if bearing.roller_profile != "straight":
+            raise InputError(f"{bearing.designation}: model 'spherical-point-contact' has its crown from the "
+                             "osculation; roller_profile must be 'straight'")
+        super().__init__(bearing)
+        b = bearing
+        self.k_n = self.k_row = hertz.spherical_roller_effective_stiffness(
+            b.element_diameter, b.pitch_diameter, b.contact_angle, b.youngs_modulus, b.poisson_ratio)
+
+
+@register_bearing_model
 class SlicedRoller(_Model):
     """Thesis Sec. 3.3.2: rollers sliced along their length, non-uniform load, Weber–Banaschek per slice.
 

@@ -144,3 +144,25 @@ def test_cli_roller_profile(tmp_path):
     assert bad.returncode == 2
     assert bad.stderr.strip().count("\n") == 0
     assert "roller_profile: 'barrel'" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_spherical_point_contact_against_stribeck_and_hertz():
+    """spherical-point-contact at zero clearance: Stribeck's point-contact distribution Q_max = 4.37 F_r /
+    (i Z cos alpha) (Harris; NSK Technical Report E728g Sec. 5.1) and the Hertz deflection of the two elliptical
+    contacts, delta_r = (Q_max / K_n)^(2/3) / cos alpha, k_r = F_r / (2/3 delta_r): 1 % (Z = 40, the integral
+    limit)."""
+    import dataclasses
+
+    b = dataclasses.replace(lookup("22219CC"), n_elements=40, radial_clearance=0.0)
+    fr = 20000.0
+    res = bearing_stiffness(b, [fr, 0, 0, 0, 0], model="spherical-point-contact", fixed_tilt=(0, 0))
+    i, z, alpha = 2, b.n_elements, b.contact_angle
+    q_max = 4.37 * fr / (i * z * math.cos(alpha))
+    assert res.element_loads.max() == pytest.approx(q_max, rel=0.01)
+    k_n = hertz.spherical_roller_effective_stiffness(b.element_diameter, b.pitch_diameter, alpha, b.youngs_modulus,
+                                                     b.poisson_ratio)
+    delta_r = (q_max / k_n) ** (2 / 3) / math.cos(alpha)
+    assert res.displacement[0] == pytest.approx(delta_r, rel=0.01)
+    assert res.K[0, 0] == pytest.approx(fr / (2 / 3 * delta_r), rel=0.01)
+    assert np.all(res.K[3:5, :] == 0) and np.all(res.K[:, 3:5] == 0)
+
