@@ -18,31 +18,44 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from runup_factors import Patched, gear_set_b_args, metrics  # noqa: E402
+from runup_factors import gear_set_b_args, metrics  # noqa: E402
 
 TORQUE = 2000.0
 
 
-def rollers_as(profile: str = "straight", spherical_model: str | None = None):
-    """Patch of a coupling spec: every roller bearing's K recomputed with `profile` (and the spherical rollers with
-    `spherical_model` if given) at the spec's load, model and tilt; ball bearings kept."""
-    from housingfe.bearings import bearing_stiffness, lookup
-    from housingfe.bearings.catalogue import estimated_internals
+class Variant:
+    """A Drivetrain whose FE reduction (to_coupling_spec) resolves its bearing matrices with other roller internals:
+    `internals` for catalogue.estimated_internals (e.g. roller_profile="logarithmic"), and the spherical roller
+    bearings with `spherical_model` at the same loads (tilt held, as configurations.evaluate does); all else
+    delegated.  The bearing matrices are computed when to_coupling_spec is called, so the context must be there."""
 
-    def patch(spec):
-        new = []
-        with estimated_internals(roller_profile=profile):
+    def __init__(self, drivetrain, spherical_model: str | None = None, **internals):
+        self._dt, self._model, self._internals = drivetrain, spherical_model, internals
+
+    def __getattr__(self, key):
+        return getattr(self._dt, key)
+
+    def to_coupling_spec(self, forces=None):
+        from housingfe.bearings import bearing_stiffness
+        from housingfe.bearings.catalogue import estimated_internals
+        from housingfe.bearings.configurations import configurations
+
+        with estimated_internals(**self._internals):
+            spec = self._dt.to_coupling_spec(forces)
+            if self._model is None:
+                return spec
+            choices = configurations()[self._dt.bearing_configuration].positions
+            loads = self._dt.bearing_loads(forces or self._dt.gear_forces())
+            new = []
             for b in spec.bearings:
-                kind = lookup(b.designation).kind if b.designation else "ball"
-                if kind == "ball":
-                    new.append(b)
-                    continue
-                model = spherical_model if (spherical_model and kind == "spherical_roller") else b.model
-                k = bearing_stiffness(b.designation, b.load, model=model, fixed_tilt=b.fixed_tilt).K
-                new.append(b.model_copy(update={"designation": None, "load": None, "model": None, "fixed_tilt": None,
-                                                "stiffness_matrix": k.tolist()}))
-        return spec.model_copy(update={"bearings": new})
-    return patch
+                choice = choices[b.name]
+                if choice.designation and "CC" in choice.designation:        # the spherical roller bearings
+                    k = bearing_stiffness(choice.designation, loads[b.name], model=self._model,
+                                          fixed_tilt=(0.0, 0.0)).K
+                    k[5, :] = k[:, 5] = 0.0
+                    b = b.model_copy(update={"stiffness_matrix": k.tolist()})
+                new.append(b)
+            return spec.model_copy(update={"bearings": new})
 
 
 def main(argv=None):
@@ -69,13 +82,13 @@ def main(argv=None):
     ref = runup(gm, None, spec.speeds, [TORQUE], lines=lines)
     variants = {
         "self_aligning, straight rollers (catalogue)": config["self_aligning"],
-        "self_aligning, logarithmic crown (ISO/TS 16281)": Patched(config["self_aligning"],
-                                                                   rollers_as("logarithmic")),
-        "self_aligning, Hertz point contacts (spherical-point-contact)": Patched(
-            config["self_aligning"], rollers_as("straight", "spherical-point-contact")),
+        "self_aligning, logarithmic crown (ISO/TS 16281)": Variant(config["self_aligning"],
+                                                                   roller_profile="logarithmic"),
+        "self_aligning, Hertz point contacts (spherical-point-contact)": Variant(
+            config["self_aligning"], spherical_model="spherical-point-contact"),
         "tapered_roller, straight rollers (catalogue)": config["tapered_roller"],
-        "tapered_roller, logarithmic crown (ISO/TS 16281)": Patched(config["tapered_roller"],
-                                                                    rollers_as("logarithmic")),
+        "tapered_roller, logarithmic crown (ISO/TS 16281)": Variant(config["tapered_roller"],
+                                                                    roller_profile="logarithmic"),
     }
     rows = []
     for name, dt in variants.items():
