@@ -54,7 +54,8 @@ def bearing_stiffness(bearing: str | RollingBearing, load, *, model: str | None 
     """6x6 mean stiffness of a rolling bearing under a mean load.
 
     bearing: catalogue designation (str) or RollingBearing; load: (Fx, Fy, Fz, Mx, My) [N, N m] on the inner
-    ring (a sixth value Mz must be 0); model: "lim-ball", "lim-roller", "sliced-roller", "self-aligning" or
+    ring (a sixth value Mz must be 0); model: "lim-ball", "lim-roller", "sliced-roller", "self-aligning",
+    "spherical-point-contact" (spherical rollers as Hertz point contacts, osculation 0.97) or
     None (the thesis' choice for the kind); preload_axial [N] is added to Fz; fixed_tilt=(bx, by) [rad]
     prescribes the tilt instead of the moments (result.load then holds the moments it takes).
     Returns BearingResult (K [N/m, N/rad, N m/rad], displacement [m, rad], element_loads [N]).

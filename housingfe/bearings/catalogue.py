@@ -77,7 +77,7 @@ _SPHERICAL_CONTACT_ANGLE_DEG = 9.0
 # the estimated internals in effect (`estimated_internals`); None: the rules of the module docstring
 _INTERNALS: contextvars.ContextVar = contextvars.ContextVar("bearing_internals", default=None)
 INTERNAL_KEYS = ("clearance_position", "groove_inner", "groove_outer", "spherical_contact_angle_deg",
-                 "tapered_e_scale")
+                 "tapered_e_scale", "roller_profile")
 
 
 @contextmanager
@@ -88,8 +88,9 @@ def estimated_internals(**values):
     clearance_position: where in the ISO 5753-1 Group N diametral clearance range [0 = lowest, 1 = highest] the
     radial clearance (half the diametral) sits (the rule: 0.5, mid-range; bearings adjusted to 0 stay at 0);
     groove_inner, groove_outer: groove curvature ratios f_i, f_o (rule 0.52, 0.53); spherical_contact_angle_deg
-    (rule 9 deg); tapered_e_scale: factor on the recalled calculation factor e of the tapered rollers (rule 1).
-    Unknown keys -> InputError."""
+    (rule 9 deg); tapered_e_scale: factor on the recalled calculation factor e of the tapered rollers (rule 1);
+    roller_profile: "straight" (rule: full line contact, as the thesis) or "logarithmic" (ISO/TS 16281 crown) for
+    every roller bearing.  Unknown keys -> InputError."""
     unknown = sorted(set(values) - set(INTERNAL_KEYS))
     if unknown:
         raise InputError(f"estimated_internals: {', '.join(unknown)} unknown (known: {', '.join(INTERNAL_KEYS)})")
@@ -103,6 +104,16 @@ def estimated_internals(**values):
 def _internal(key: str, rule: float) -> float:
     values = _INTERNALS.get()
     return rule if values is None else float(values.get(key, rule))
+
+
+def _roller_profile(est: dict) -> str:
+    """The roller profile in effect (rule: straight), noted in `est`."""
+    values = _INTERNALS.get()
+    profile = "straight" if values is None else str(values.get("roller_profile", "straight"))
+    est["roller_profile"] = ("straight: full line contact (the thesis' rollers; SKF publishes no profile)"
+                             if profile == "straight" else
+                             f"{profile}: ISO/TS 16281 default crown (the real profile is not published)")
+    return profile
 
 
 def normalise(designation: str) -> str:
@@ -164,7 +175,8 @@ def lookup(designation: str) -> RollingBearing:
         est.update(element_diameter="0.26 (D - d)", roller_length="0.6 B", n_elements="round(0.80 pi d_m / D_w)")
         return RollingBearing(designation=name, kind=kind, bore=d, outer_diameter=outer, width=width,
                               n_elements=z, element_diameter=dw, pitch_diameter=pitch, contact_angle=0.0,
-                              radial_clearance=radial_clearance, roller_length=0.6 * width, estimated=est)
+                              radial_clearance=radial_clearance, roller_length=0.6 * width,
+                              roller_profile=_roller_profile(est), estimated=est)
     dw = 0.22 * (outer - d)
     z = round(0.80 * math.pi * pitch / dw)
     est.update(element_diameter="0.22 (D - d)", roller_length="0.4 B per row",
@@ -174,7 +186,8 @@ def lookup(designation: str) -> RollingBearing:
                           element_diameter=dw, pitch_diameter=pitch,
                           contact_angle=math.radians(_internal("spherical_contact_angle_deg",
                                                                _SPHERICAL_CONTACT_ANGLE_DEG)),
-                          radial_clearance=radial_clearance, roller_length=0.4 * width, rows=2, estimated=est)
+                          radial_clearance=radial_clearance, roller_length=0.4 * width, rows=2,
+                          roller_profile=_roller_profile(est), estimated=est)
 
 
 def _tapered(key: str, d: float, outer: float, width: float) -> RollingBearing:
@@ -195,7 +208,7 @@ def _tapered(key: str, d: float, outer: float, width: float) -> RollingBearing:
     return RollingBearing(designation=f"SKF {key[:-2]} {key[-2:]}", kind="tapered_roller", bore=d,
                           outer_diameter=outer, width=width, n_elements=z, element_diameter=dw,
                           pitch_diameter=pitch, contact_angle=alpha, radial_clearance=0.0,
-                          roller_length=0.6 * width, estimated=est)
+                          roller_length=0.6 * width, roller_profile=_roller_profile(est), estimated=est)
 
 
 def tapered_data(designation: str) -> dict:

@@ -26,6 +26,8 @@ _FLAGS = {
                            "radial play of the centred rings = HALF the diametral clearance [m]"),
     "--contact-angle-deg": ("contact_angle_deg", float, "DEG", "unloaded contact angle [deg]"),
     "--roller-length": ("roller_length", float, "M", "effective roller length [m] (rollers)"),
+    "--roller-profile": ("roller_profile", str, "PROFILE",
+                         "straight (full line contact, default) or logarithmic (ISO/TS 16281 crowned rollers)"),
     "--youngs-modulus": ("youngs_modulus", float, "PA", "Young's modulus of rings and elements [Pa] (208e9)"),
     "--poisson-ratio": ("poisson_ratio", float, "NU", "Poisson ratio [-] (0.3)"),
 }

@@ -176,3 +176,56 @@ class LineContactSlices:
         integral = self.c * (s * f**2 / 2.0 - 2.0 * (f**2 / 2.0 * np.log(f) - f**2 / 4.0))
         out[on] = f * np.asarray(approach, float)[on] - integral
         return out
+
+
+# ISO/TS 16281:2008 roller profile "when the actual profile is not known" (Lundberg's logarithmic crown), Eqs.
+# (42)-(44), read from a public implementation of the standard (the standard itself was not at hand): drop of ONE
+# contact at x from the roller centre, P(x) = c D_we ln(1 / (1 - (2x / L_we)^2)) with c = 0.00035 (cylindrical and
+# needle rollers, L_we <= 2.5 D_we) and 0.00045 (tapered rollers); longer cylindrical rollers have a straight middle
+# of L_we - 2.5 D_we and P = 0.0005 D_we ln(1 / (1 - ((2|x| - (L_we - 2.5 D_we)) / (2.5 D_we))^2)) outside it.
+# The approach of lamina k is delta - x_k tan(psi) - 2 P(x_k) (both contacts).
+LOGARITHMIC_PROFILE_COEFFICIENT = {"cylindrical_roller": 0.00035, "tapered_roller": 0.00045,
+                                   "spherical_roller": 0.00035}
+
+
+def logarithmic_profile_drop(x, roller_diameter: float, roller_length: float, kind: str) -> np.ndarray:
+    """Crown drop P(x) [m] of one roller–raceway contact at x [m] from the roller centre (|x| < l/2) for the
+    ISO/TS 16281 logarithmic profile (coefficients above; spherical rollers take the cylindrical one, an
+    assumption: the standard's roller formula does not name them).  Infinite at the roller ends."""
+    if kind not in LOGARITHMIC_PROFILE_COEFFICIENT:
+        raise InputError(f"roller profile: kind={kind!r}: a logarithmic profile needs a roller bearing")
+    x = np.abs(np.asarray(x, float))
+    d, length = roller_diameter, roller_length
+    if np.any(x >= length / 2.0):
+        raise InputError(f"roller profile: |x| = {x.max()} m at or beyond the roller end ({length / 2} m)")
+    if kind != "cylindrical_roller" or length <= 2.5 * d:
+        u = 2.0 * x / length
+        return LOGARITHMIC_PROFILE_COEFFICIENT[kind] * d * np.log(1.0 / (1.0 - u**2))
+    flat = length - 2.5 * d
+    u = np.clip((2.0 * x - flat) / (2.5 * d), 0.0, None)
+    return 0.0005 * d * np.log(1.0 / (1.0 - u**2))
+
+
+# A spherical roller as an elliptical point contact (the way a public implementation of ISO/TS 16281 treats
+# spherical roller bearings, with the ball-bearing method): both raceways of radius r = d_pw / (2 cos alpha) + D_w / 2
+# across the rolling direction, the roller's own profile radius 0.97 r (osculation 0.97).  Here the rolling
+# direction keeps the roller diameter D_w (that implementation puts a ball of diameter 2 * 0.97 r there).
+SPHERICAL_ROLLER_OSCULATION = 0.97
+
+
+def spherical_roller_effective_stiffness(roller_d: float, pitch_d: float, contact_angle: float, E: float,
+                                         nu: float, osculation: float = SPHERICAL_ROLLER_OSCULATION) -> float:
+    """Effective K_n [N/m^1.5] of inner race – spherical roller – outer race, both Hertz point contacts in series
+    (Q = K_n delta^1.5): curvatures 2/D_w (roller, rolling direction), 1/(osculation r) (roller profile),
+    +-2/D_w gamma/(1 -+ gamma) (raceways, rolling direction), -1/r (raceways across), r = d_pw/(2 cos a) + D_w/2."""
+    if not 0.5 < osculation < 1.0:
+        raise InputError(f"spherical roller: osculation={osculation}: need 0.5 < roller profile / raceway radius < 1")
+    race = pitch_d / (2.0 * math.cos(contact_angle)) + roller_d / 2.0
+    gamma = roller_d * math.cos(contact_angle) / pitch_d
+    roll, profile, across = 2.0 / roller_d, 1.0 / (osculation * race), -1.0 / race
+    constants = []
+    for race_roll in (roll * gamma / (1.0 - gamma), -roll * gamma / (1.0 + gamma)):     # inner, outer raceway
+        total = roll + profile + race_roll + across
+        difference = abs((roll - profile) + (race_roll - across)) / total
+        constants.append(point_contact_constant(total, difference, E, nu))
+    return (constants[0] ** (-2.0 / 3.0) + constants[1] ** (-2.0 / 3.0)) ** -1.5

@@ -35,6 +35,7 @@ from housingfe.bearings import hertz
 from housingfe.errors import InputError
 
 DOF_NAMES = ("x", "y", "z", "theta_x", "theta_y", "theta_z")
+ROLLER_PROFILES = ("straight", "logarithmic")
 
 
 # Bearing steel (through-hardened 100Cr6 / AISI 52100): E = 208 GPa, nu = 0.3.  Handbook values for this steel
@@ -57,6 +58,8 @@ class RollingBearing:
     radial_clearance: Lim's r_L [m], the radial play of the unloaded, centred rings (half the diametral one).
     groove_inner/groove_outer: groove conformities f_i = r_i / D_w, f_o = r_o / D_w [-], > 0.5 (balls only).
     roller_length: effective contact length of one roller [m] (rollers only).
+    roller_profile: "straight" (full line contact, the thesis' rollers; default) or "logarithmic" (the
+    ISO/TS 16281 crowned profile, hertz.logarithmic_profile_drop; rollers cut into `profile_slices` laminae).
     youngs_modulus [Pa], poisson_ratio [-]: rings and elements (default bearing steel, 208 GPa, 0.3).
     estimated: {field name: estimation rule} for every value that is not public catalogue data.
     """
@@ -74,6 +77,8 @@ class RollingBearing:
     groove_outer: float = 0.53
     roller_length: float = 0.0
     rows: int = 1
+    roller_profile: str = "straight"
+    profile_slices: int = 20
     youngs_modulus: float = BEARING_STEEL_YOUNGS_MODULUS
     poisson_ratio: float = BEARING_STEEL_POISSON_RATIO
     estimated: dict = field(default_factory=dict, compare=False, hash=False)
@@ -116,6 +121,14 @@ class RollingBearing:
         if self.kind == "ball" and max(self.groove_inner, self.groove_outer) >= 1.0:
             raise InputError(f"{name}: groove conformities f_i, f_o must be < 1 (got {self.groove_inner}, "
                              f"{self.groove_outer}): a groove radius of a whole ball diameter or more")
+        if self.roller_profile not in ROLLER_PROFILES:
+            raise InputError(f"{name}: roller_profile={self.roller_profile!r}: must be one of "
+                             f"{', '.join(ROLLER_PROFILES)}")
+        if self.kind == "ball" and self.roller_profile != "straight":
+            raise InputError(f"{name}: roller_profile={self.roller_profile!r}: balls have no roller profile")
+        if isinstance(self.profile_slices, bool) or not isinstance(self.profile_slices, int) \
+                or self.profile_slices < 2:
+            raise InputError(f"{name}: profile_slices={self.profile_slices}: need a whole number >= 2")
         if self.rows not in (1, 2):
             raise InputError(f"{name}: rows={self.rows}: must be 1 or 2")
         if not (self.youngs_modulus > 0 and math.isfinite(self.youngs_modulus)):
@@ -184,6 +197,8 @@ GEOMETRY_KEYS = {
     "contact_angle_deg": ("contact_angle", "unloaded contact angle [deg] (default 0)"),
     "roller_length": ("roller_length", "effective roller length [m] (rollers only)"),
     "rows": ("rows", "1 or 2"),
+    "roller_profile": ("roller_profile", "straight (default: full line contact) or logarithmic (ISO/TS 16281 "
+                                         "crowned rollers)"),
     "bore": ("bore", "bore d [m], optional"),
     "outer_diameter": ("outer_diameter", "outside diameter D [m], optional"),
     "width": ("width", "width B [m], optional"),
@@ -211,7 +226,7 @@ def bearing_from_table(table: dict, where: str = "bearing", key_names: dict | No
     kwargs: dict = {"designation": "user bearing", "kind": "ball"}
     for key, value in table.items():
         name = GEOMETRY_KEYS[key][0]
-        if key in ("designation", "kind"):
+        if key in ("designation", "kind", "roller_profile"):
             if not isinstance(value, str):
                 raise InputError(f"{where}: {key}: need a string, got {value!r}")
         elif key in ("elements", "rows"):
@@ -219,6 +234,9 @@ def bearing_from_table(table: dict, where: str = "bearing", key_names: dict | No
                 raise InputError(f"{where}: {key}: need a whole number, got {value!r}")
         elif isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
             raise InputError(f"{where}: {key}: need a number, got {value!r}")
+        if key == "roller_profile" and value not in ROLLER_PROFILES:
+            raise InputError(f"{where}: {(key_names or {}).get(key, key)}: {value!r}: must be one of "
+                             f"{', '.join(ROLLER_PROFILES)}")
         if key == "contact_angle_deg":
             if not 0.0 <= value < 90.0:
                 raise InputError(f"{where}: {key}: {value} deg must lie in [0, 90)")
@@ -390,9 +408,22 @@ class LimBall(_Model):
         return self.r_j
 
 
+def profile_drops(bearing: RollingBearing, slice_centres: np.ndarray) -> np.ndarray:
+    """Approach lost to the roller profile at each lamina centre [m]: 2 P(x_k) (inner and outer contact, ISO/TS
+    16281) for roller_profile "logarithmic", zeros for "straight"."""
+    if bearing.roller_profile == "straight":
+        return np.zeros(len(slice_centres))
+    return 2.0 * hertz.logarithmic_profile_drop(slice_centres, bearing.element_diameter, bearing.roller_length,
+                                                bearing.kind)
+
+
 @register_bearing_model
 class LimRoller(_Model):
-    """Lim's roller bearing, Eqs. (3.13)-(3.14), (C-2): fixed contact angle, n = 10/9, uniform load per roller."""
+    """Lim's roller bearing, Eqs. (3.13)-(3.14), (C-2): fixed contact angle, n = 10/9, uniform load per roller.
+
+    roller_profile "logarithmic": every roller is cut into `profile_slices` laminae of Palmgren's law with
+    k_n / slices each (so that a straight roller gives Lim's law exactly), lamina k approached by
+    delta_j - 2 P(x_k) (ISO/TS 16281); the ring tilt does not enter (as in Lim's model)."""
     name = "lim-roller"
     kinds = ("cylindrical_roller", "tapered_roller")
     exponent = 10.0 / 9.0
@@ -405,15 +436,32 @@ class LimRoller(_Model):
         a = b.contact_angle
         self.g = math.cos(a) * self.radial_direction() + math.sin(a) * self.axial_direction(self.r_j)
         self.gap = b.radial_clearance * math.cos(a)
+        self._slice_for_profile()
+
+    def _slice_for_profile(self):
+        """Rows of laminae for a crowned roller (see the class docstring); nothing for a straight one."""
+        b = self.bearing
+        self.laminae = 1
+        self.k_row = self.k_n
+        self.g_row, self.gap_row = self.g, self.gap
+        if b.roller_profile == "straight":
+            return
+        ns = b.profile_slices
+        x = (np.arange(ns) + 0.5) * b.roller_length / ns - b.roller_length / 2.0
+        self.laminae = ns
+        self.k_row = self.k_n / ns
+        self.g_row = np.repeat(self.g, ns, axis=0)                                  # row j*ns + k
+        self.gap_row = self.gap + np.tile(profile_drops(b, x), self.g.shape[0])
 
     def _evaluate(self, q):
-        n = self.exponent
-        d = np.maximum(self.g @ q - self.gap, 0.0)                  # Eq. (3.13)
-        q_j = self.k_n * d**n
-        force = q_j @ self.g                                        # Eq. (3.14)
-        jac = (self.g.T * (n * self.k_n * d ** (n - 1.0))) @ self.g  # (C-2)
-        energy = self.k_n / (n + 1.0) * np.sum(d ** (n + 1.0))
-        return energy, force, jac, q_j, np.full(len(d), self.bearing.contact_angle)
+        n, k = self.exponent, self.k_row
+        d = np.maximum(self.g_row @ q - self.gap_row, 0.0)               # Eq. (3.13) (per lamina if crowned)
+        q_j = k * d**n
+        force = q_j @ self.g_row                                         # Eq. (3.14)
+        jac = (self.g_row.T * (n * k * d ** (n - 1.0))) @ self.g_row     # (C-2)
+        energy = k / (n + 1.0) * np.sum(d ** (n + 1.0))
+        per_roller = q_j.reshape(self.g.shape[0], self.laminae).sum(axis=1)
+        return energy, force, jac, per_roller, np.full(self.g.shape[0], self.bearing.contact_angle)
 
 
 @register_bearing_model
@@ -436,6 +484,25 @@ class SelfAligningRoller(LimRoller):
         self.g = np.vstack([math.cos(a) * rad + math.sin(a) * ax, math.cos(a) * rad - math.sin(a) * ax])
         self.psi = np.concatenate([self.psi, self.psi])
         self.gap = b.radial_clearance * math.cos(a)
+        self._slice_for_profile()
+
+
+@register_bearing_model
+class SphericalPointContact(SelfAligningRoller):
+    """Double-row spherical roller bearing with Hertz point contacts (n = 3/2): the self-aligning kinematics, each
+    roller pressed between two elliptical contacts of osculation 0.97 (hertz.spherical_roller_effective_stiffness,
+    the ISO/TS 16281 treatment of spherical rollers).  A crowned alternative to the line-contact "self-aligning"."""
+    name = "spherical-point-contact"
+    exponent = 1.5
+
+    def __init__(self, bearing: RollingBearing):
+        if bearing.roller_profile != "straight":
+            raise InputError(f"{bearing.designation}: model 'spherical-point-contact' has its crown from the "
+                             "osculation; roller_profile must be 'straight'")
+        super().__init__(bearing)
+        b = bearing
+        self.k_n = self.k_row = hertz.spherical_roller_effective_stiffness(
+            b.element_diameter, b.pitch_diameter, b.contact_angle, b.youngs_modulus, b.poisson_ratio)
 
 
 @register_bearing_model
@@ -469,7 +536,8 @@ class SlicedRoller(_Model):
         # (Z, slices, 5) -> (Z*slices, 5)
         arm = self.tilt_factor * self.a
         self.g = (g_centre[:, None, :] - arm[None, :, None] * tilt[:, None, :]).reshape(-1, 5)
-        self.gap = b.radial_clearance * math.cos(alpha)
+        # a crowned roller: lamina k starts 2 P(a_k) further from contact (ISO/TS 16281)
+        self.gap = b.radial_clearance * math.cos(alpha) + np.tile(profile_drops(b, self.a), len(self.psi))
         inner_race = b.pitch_diameter / 2.0 - b.element_diameter / 2.0
         outer_race = b.pitch_diameter / 2.0 + b.element_diameter / 2.0
         self.law = hertz.LineContactSlices(b.element_diameter, inner_race, outer_race, dl, b.youngs_modulus, b.poisson_ratio)

@@ -15,7 +15,8 @@ from housingfe.bearings.rolling import (
 from housingfe.drivetrain.interior import BearingSpec
 from housingfe.errors import InputError
 
-BUILT_IN = {"lim-ball", "lim-roller", "sliced-roller", "sliced-roller-thesis", "self-aligning"}
+BUILT_IN = {"lim-ball", "lim-roller", "sliced-roller", "sliced-roller-thesis", "self-aligning",
+            "spherical-point-contact"}
 LOAD = (2000.0, 0.0, 500.0, 0.0, 0.0)
 
 
