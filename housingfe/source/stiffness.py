@@ -723,7 +723,7 @@ def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = N
                      torque_configuration=model.torque_configuration,
                      include_plate_coupling=model.include_plate_coupling,
                      lead_gap=model.lead_gap if lead_gap is None else float(lead_gap),
-                     include_body_torsion=model.include_body_torsion)
+                     include_body_torsion=model.include_body_torsion, edge_refinement=model.edge_refinement)
     n_bins = n_bins or model.n_slices
     b = model.pair.contact_width
     acc = np.zeros((bare.helices, n_bins))
