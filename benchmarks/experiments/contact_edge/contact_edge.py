@@ -7,6 +7,7 @@ makes it, aligned gears), at 128 positions per base pitch (dyn.DEFAULT_STIFFNESS
 
     PYTHONPATH=. OPENBLAS_NUM_THREADS=1 /work/main/.venv/bin/python \
         benchmarks/experiments/contact_edge/contact_edge.py --label after [--sets A,B] [--slices 24,48] [--out DIR]
+        [--refinement R]
 
 Runs on whatever `housingfe` PYTHONPATH imports (the "before" rows: the same script on a checkout of the code before the
 fix) and appends rows (label, set, n_slices, n, amp_rel, k_m, ms_per_position) to contact_edge_<label>.csv.
@@ -37,9 +38,11 @@ def model_of(name: str):
     return pair, model
 
 
-def measure(name: str, n_slices: int, positions: int = dyn.DEFAULT_STIFFNESS_POSITIONS):
+def measure(name: str, n_slices: int, positions: int = dyn.DEFAULT_STIFFNESS_POSITIONS, refinement: int | None = None):
     pair, model = model_of(name)
     model = replace(model, n_slices=n_slices)
+    if refinement is not None:             # MeshModel.edge_refinement (the code after the fix only)
+        model = replace(model, edge_refinement=refinement)
     force = normal_force_from_torque(pair, TORQUE)
     t0 = time.perf_counter()
     curve = stiffness_curve(model, force, positions)
@@ -54,6 +57,7 @@ def main():
     ap.add_argument("--sets", default="A,B,C,D,unc")
     ap.add_argument("--slices", default="24,48,96,192")
     ap.add_argument("--out", default=str(HERE))
+    ap.add_argument("--refinement", type=int, default=None, help="MeshModel.edge_refinement (default: the model's)")
     args = ap.parse_args()
     out = Path(args.out) / f"contact_edge_{args.label}.csv"
     new = not out.exists()
@@ -63,7 +67,7 @@ def main():
             wr.writerow(["label", "set", "n_slices", "n", "amp_rel", "k_m", "ms_per_position"])
         for n_slices in (int(x) for x in args.slices.split(",")):
             for name in args.sets.split(","):
-                k_m, amp, ms = measure(name, n_slices)
+                k_m, amp, ms = measure(name, n_slices, refinement=args.refinement)
                 for n, a in enumerate(amp, start=1):
                     wr.writerow([args.label, name, n_slices, n, f"{a:.6e}", f"{k_m:.6e}", f"{ms:.2f}"])
                 fh.flush()
