@@ -292,7 +292,10 @@ class MeshModel:
     gear's axial position w (housingfe.source.misalignment: sign conventions): gap = lead_gap * w for
     lead_gap >= 0 (the face w = 0 carries most), lead_gap * (w - total width) otherwise (the far face carries
     most), added to the gaps of the corrections.  0: perfectly aligned gears (the thesis' Sec. 2.3).
-    include_body_torsion: wheel-body torsion of Sec. 2.2.4 (False only for analytic checks)."""
+    include_body_torsion: wheel-body torsion of Sec. 2.2.4 (False only for analytic checks).
+
+    edge_refinement: segments cut into this many equal parts where a contact line's loaded contact edge lies
+    (`load_distribution`; 1: uniform points only)."""
 
     pair: GearPair
     shafts: tuple[ShaftBending, ShaftBending] | None = None
@@ -302,12 +305,15 @@ class MeshModel:
     include_plate_coupling: bool = True
     lead_gap: float = 0.0
     include_body_torsion: bool = True
+    edge_refinement: int = 8
 
     def __post_init__(self):
         if self.torque_configuration not in (1, 2):
             raise InputError(f"stiffness: torque_configuration: must be 1 or 2, got {self.torque_configuration}")
         if self.n_slices < 2:
             raise InputError("stiffness: n_slices: need at least 2 points per contact line")
+        if self.edge_refinement < 1:
+            raise InputError(f"stiffness: edge_refinement: need at least 1, got {self.edge_refinement}")
         if not math.isfinite(self.lead_gap):
             raise InputError(f"stiffness: lead_gap: {self.lead_gap} must be a finite slope (m/m)")
         p = self.pair
@@ -357,6 +363,27 @@ class MeshModel:
         if not out["s"]:
             return {k: np.zeros(0) for k in out}
         return {k: np.concatenate(v) for k, v in out.items()}
+
+    def split_segments(self, pts: dict[str, np.ndarray], split: np.ndarray) -> dict[str, np.ndarray]:
+        """The contact points `pts` (`contact_points`) with every segment where `split` (bool per point) is true cut
+        into `edge_refinement` equal segments along its contact line, each with a point at its middle, in place (a
+        line's points stay in order of the offset o).  Adds "parent": the index in `pts` each point comes from."""
+        r = self.edge_refinement
+        count = np.where(split, r, 1)
+        parent = np.repeat(np.arange(split.size), count)
+        # offset of each new point from its parent's middle along the contact line, in units of the parent's width
+        first = np.cumsum(count) - count
+        k = np.arange(parent.size) - first[parent]
+        frac = np.where(split[parent], (k + 0.5) / r - 0.5, 0.0)
+        do = frac * pts["width"][parent]
+        sign = np.where(pts["helix"][parent] == 0, 1.0, -1.0)          # helix 1 has the opposite hand
+        out = {key: v[parent] for key, v in pts.items()}
+        out["s"] = out["s"] + do * math.tan(self.pair.base_helix_angle)
+        out["w_local"] = out["w_local"] + sign * do
+        out["w"] = out["w"] + sign * do
+        out["width"] = np.where(split[parent], out["width"] / r, out["width"])
+        out["parent"] = parent
+        return out
 
     def _flex_at(self, s: np.ndarray) -> dict[str, np.ndarray]:
         p = self.pair
@@ -453,16 +480,61 @@ class MeshModel:
         [N] (Sec. 2.3).  Returns (points, forces, delta)."""
         if _cache is not None and _cache.get("u") == u:
             pts, C, e = _cache["pts"], _cache["C"], _cache["e"]
-        else:
-            pts = self.contact_points(u)
-            if pts["s"].size == 0:
-                raise SolverError(f"stiffness: no contact at mesh position {u}")
+            return (pts, *self._solve(pts, C, e, u, total_force, tol, max_iter))
+        pts = self.contact_points(u)
+        if pts["s"].size == 0:
+            raise SolverError(f"stiffness: no contact at mesh position {u}")
+        C, e = self.compliance(pts), self.gaps(pts)
+        F, delta = self._solve(pts, C, e, u, total_force, tol, max_iter)
+        if self.edge_refinement > 1:
+            pts, C, e, F, delta = self._refine_edges(pts, C, e, F, delta, u, total_force, tol, max_iter)
+        if _cache is not None:
+            _cache.update(u=u, pts=pts, C=C, e=e)
+        return pts, F, delta
+
+    def _refine_edges(self, coarse, C, e, F, delta, u, total_force, tol, max_iter, max_rounds: int = 6):
+        """Resolve the loaded contact edges (`load_distribution`): cut the segments on both sides of every change
+        between a point in contact and one out of contact along a contact line (a relief's or a misalignment's
+        edge) into `edge_refinement` parts and solve again, until every such change lies inside cut segments.
+
+        Why: a point stands for its whole segment, in contact or not; with equal segments the edge, which moves
+        continuously with the mesh position, jumps by a segment whenever it crosses a point, and the stiffness curve
+        carries these steps as wiggles whose harmonics converge slowly with the points per line
+        (benchmarks/experiments/contact_edge).  Cut segments make the steps edge_refinement times finer at the
+        cost of a few points per edge, where the smooth rest of the line needs none."""
+        split = np.zeros(coarse["s"].size, dtype=bool)
+        pts, parent = coarse, np.arange(coarse["s"].size)
+        line = coarse["pair"] * 2 + coarse["helix"]
+        for _ in range(max_rounds):
+            inside = F > 0
+            lp = line[parent]
+            change = np.flatnonzero((lp[1:] == lp[:-1]) & (inside[1:] != inside[:-1]))
+            need = np.zeros_like(split)
+            need[parent[change]] = True
+            need[parent[change + 1]] = True
+            if not (need & ~split).any():
+                break
+            split |= need
+            coarse_force = np.bincount(parent, weights=F, minlength=split.size)
+            pts = self.split_segments(coarse, split)
+            parent = pts.pop("parent")
             C, e = self.compliance(pts), self.gaps(pts)
-            if _cache is not None:
-                _cache.update(u=u, pts=pts, C=C, e=e)
+            # start from the last solution, a segment's force shared among its parts (fewer iterations)
+            start = coarse_force[parent] / np.bincount(parent, minlength=split.size)[parent]
+            F, delta = self._solve(pts, C, e, u, total_force, tol, max_iter, start)
+        return pts, C, e, F, delta
+
+    def _solve(self, pts, C, e, u, total_force, tol, max_iter, start=None):
+        """(forces [N], approach [m]) of the active-set iteration of `load_distribution` on given points,
+        compliance C [m/N] and gaps e [m]; start: initial forces [N] (None: the total spread evenly), points with
+        none start out of contact."""
         n = pts["s"].size
-        active = np.ones(n, dtype=bool)
-        F = np.full(n, total_force / n)
+        if start is None:
+            active = np.ones(n, dtype=bool)
+            F = np.full(n, total_force / n)
+        else:
+            active = start > 0
+            F = np.where(active, start, 0.0)
         for _ in range(max_iter):
             h = self.hertz(pts, F) / np.maximum(F, 1e-9)          # secant Hertz compliance
             idx = np.flatnonzero(active)
@@ -490,7 +562,7 @@ class MeshModel:
                 active |= penetrating
                 continue
             if change < tol:
-                return pts, F, delta
+                return F, delta
         raise SolverError(f"stiffness: load distribution did not converge at u = {u:.3e} m")
 
     def stiffness_at(self, u: float, total_force: float, rel_step: float = 1e-3) -> dict[str, float]:
@@ -651,7 +723,7 @@ def face_load_share(model: MeshModel, total_force: float, n_bins: int | None = N
                      torque_configuration=model.torque_configuration,
                      include_plate_coupling=model.include_plate_coupling,
                      lead_gap=model.lead_gap if lead_gap is None else float(lead_gap),
-                     include_body_torsion=model.include_body_torsion)
+                     include_body_torsion=model.include_body_torsion, edge_refinement=model.edge_refinement)
     n_bins = n_bins or model.n_slices
     b = model.pair.contact_width
     acc = np.zeros((bare.helices, n_bins))
