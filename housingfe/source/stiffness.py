@@ -190,20 +190,24 @@ def plate_green_matrix(length: float, S1: float, S2: float, S3: float, xi, x) ->
     ref_l = np.where(grow[None, :], xi[:, None], 0.0)             # (n, 4)
     ref_r = np.where(grow[None, :], length, xi[:, None])
 
-    def rows(pt, ref, order):                                     # pt (n,) -> (n, 4)
-        return lam**order * np.exp(lam * (pt[:, None] - ref))
-
+    # the row of derivative order k is lam**k * exp(lam (pt - ref)): one exponential per point set, reused for
+    # every order (the same floating-point operations as evaluating each row on its own)
+    power = [lam**order for order in range(4)]
     zero, ell = np.zeros(n), np.full(n, length)
+    e_0l = np.exp(lam * (zero[:, None] - ref_l))                  # (n, 4)
+    e_lr = np.exp(lam * (ell[:, None] - ref_r))
+    e_xl = np.exp(lam * (xi[:, None] - ref_l))
+    e_xr = np.exp(lam * (xi[:, None] - ref_r))
     A = np.zeros((n, 8, 8), dtype=complex)
-    A[:, 0, :4] = rows(zero, ref_l, 2)
-    A[:, 1, :4] = rows(zero, ref_l, 3) - a * rows(zero, ref_l, 1)
-    A[:, 2, 4:] = rows(ell, ref_r, 2)
-    A[:, 3, 4:] = rows(ell, ref_r, 3) - a * rows(ell, ref_r, 1)
-    for k, order in enumerate((0, 1, 2)):                          # continuity of f, f', f'' at xi
-        A[:, 4 + k, :4] = rows(xi, ref_l, order)
-        A[:, 4 + k, 4:] = -rows(xi, ref_r, order)
-    A[:, 7, :4] = -rows(xi, ref_l, 3)                              # jump of f''' = P / S1
-    A[:, 7, 4:] = rows(xi, ref_r, 3)
+    A[:, 0, :4] = power[2] * e_0l
+    A[:, 1, :4] = power[3] * e_0l - a * (power[1] * e_0l)
+    A[:, 2, 4:] = power[2] * e_lr
+    A[:, 3, 4:] = power[3] * e_lr - a * (power[1] * e_lr)
+    for k in range(3):                                             # continuity of f, f', f'' at xi
+        A[:, 4 + k, :4] = power[k] * e_xl
+        A[:, 4 + k, 4:] = -(power[k] * e_xr)
+    A[:, 7, :4] = -(power[3] * e_xl)                               # jump of f''' = P / S1
+    A[:, 7, 4:] = power[3] * e_xr
     rhs = np.zeros((n, 8, 1), dtype=complex)
     rhs[:, 7, 0] = 1.0 / S1
     coef = np.linalg.solve(A, rhs)[..., 0]                         # (n, 8)
@@ -238,16 +242,25 @@ def beam_influence(z: np.ndarray, shaft: ShaftBending, gear_diameter: float, fac
                    gear_offset: float, E: float, n_grid: int = 1500) -> np.ndarray:
     """Deflection at axial positions z_i [m] (measured from the gear's first face) per unit transverse
     force at z_j, of a simply supported stepped Euler beam (unit-load method) [m/N]."""
+    L, zz, w = _beam_grid(shaft, gear_diameter, face_width, E, n_grid)
+    zp = shaft.left_span + gear_offset + np.asarray(z)
+    m = np.where(zz[None, :] <= zp[:, None], zz[None, :] * (L - zp[:, None]) / L,
+                 zp[:, None] * (L - zz[None, :]) / L)
+    return (m * w) @ m.T
+
+
+@functools.lru_cache(maxsize=64)   # the same shafts for every mesh position: grid and weights once
+def _beam_grid(shaft: ShaftBending, gear_diameter: float, face_width: float, E: float, n_grid: int):
+    """(length L [m], grid z [m], quadrature weight dz / EI [1/(N m)]) of `beam_influence` (read-only arrays)."""
     L = shaft.left_span + face_width + shaft.right_span
     zz = np.linspace(0.0, L, n_grid)
     in_gear = (zz >= shaft.left_span) & (zz <= shaft.left_span + face_width)
     d = np.where(in_gear, gear_diameter, shaft.shaft_diameter)
     EI = E * math.pi * d**4 / 64
-    zp = shaft.left_span + gear_offset + np.asarray(z)
-    m = np.where(zz[None, :] <= zp[:, None], zz[None, :] * (L - zp[:, None]) / L,
-                 zp[:, None] * (L - zz[None, :]) / L)
     w = np.gradient(zz) / EI
-    return (m * w) @ m.T
+    zz.flags.writeable = False
+    w.flags.writeable = False
+    return L, zz, w
 
 
 # ----------------------------------------------------------------------------- flank gaps
@@ -324,6 +337,9 @@ class MeshModel:
         self.plate = [plate_coefficients(f, nu) for f in self.flex]
         self.f_etot = [f.c_tooth[-1] + f.c_root[-1] for f in self.flex]
         self.total_width = self.helices * p.contact_width + (self.helices - 1) * p.helix_gap
+        # constants of the per-point interpolation (`_flex_at`), evaluated once rather than at every iteration
+        self._line_of_action = p.line_of_action_length
+        self._flex_total = [f.c_tooth + f.c_root for f in self.flex]
 
     # -------------------------------------------------------------- contact points
     def contact_points(self, u: float) -> dict[str, np.ndarray]:
@@ -386,13 +402,12 @@ class MeshModel:
         return out
 
     def _flex_at(self, s: np.ndarray) -> dict[str, np.ndarray]:
-        p = self.pair
-        rho_t = [s, p.line_of_action_length - s]
+        rho_t = [s, self._line_of_action - s]
         out = {}
         for g in (0, 1):
             f = self.flex[g]
-            r = np.clip(rho_t[g], f.rho_t[0], f.rho_t[-1])
-            out[f"c{g}"] = np.interp(r, f.rho_t, f.c_tooth + f.c_root)
+            r = np.minimum(np.maximum(rho_t[g], f.rho_t[0]), f.rho_t[-1])     # np.clip, without its overhead
+            out[f"c{g}"] = np.interp(r, f.rho_t, self._flex_total[g])
             out[f"t{g}"] = np.interp(r, f.rho_t, f.t_hertz)
             out[f"rho{g}"] = np.interp(r, f.rho_t, f.rho_n)
         return out
@@ -454,13 +469,24 @@ class MeshModel:
     def hertz(self, pts, forces: np.ndarray) -> np.ndarray:
         """Hertzian approach [m] of each contact point under its normal force [N] (eq. 2.40), with the
         contact-line length of its segment width / cos(beta_b)."""
+        return self._hertz_of(self._hertz_factors(pts), forces)
+
+    def _hertz_factors(self, pts) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The load-independent factors of `hertz` at the points: t0 t1 pi E L [N m], 2 rho_v (1 - nu^2)
+        [m] and pi E L [N/m] (the same products, in the same order, as `hertz` evaluates them)."""
         p = self.pair
         fl = self._flex_at(pts["s"])
         E, nu = p.youngs_modulus, p.poisson_ratio
         L = pts["width"] / math.cos(p.base_helix_angle)
         rho_v = fl["rho0"] * fl["rho1"] / (fl["rho0"] + fl["rho1"])
+        return fl["t0"] * fl["t1"] * math.pi * E * L, 2 * rho_v * (1 - nu**2), math.pi * E * L
+
+    def _hertz_of(self, factors, forces: np.ndarray) -> np.ndarray:
+        """`hertz` [m] from its load-independent `factors` (`_hertz_factors`) and the forces [N]."""
+        numerator, denominator, pi_E_L = factors
+        nu = self.pair.poisson_ratio
         F = np.maximum(forces, 1e-9)
-        arg = fl["t0"] * fl["t1"] * math.pi * E * L / (2 * rho_v * (1 - nu**2) * F)
+        arg = numerator / (denominator * F)
         # arg = (2 t0 / a)(2 t1 / a) with a the Hertzian half-width: Weber's formula holds for a well below the
         # tooth thicknesses.  Its approach F (ln(arg) - nu/(1-nu)) peaks where ln(arg) = 1 + nu/(1-nu) and beyond
         # (larger line loads, a approaching t) falls, then turns negative: an approach that shrinks as the load grows
@@ -471,7 +497,7 @@ class MeshModel:
         # as 1/L and a contact line of length -> 0 carries a load -> 0 at a given approach.  Loads of the
         # contact lines inside the path (arg ~ 1e2) are untouched
         bracket = np.maximum(np.log(arg), 1.0 + nu / (1 - nu)) - nu / (1 - nu)
-        return 2 * F * (1 - nu**2) / (math.pi * E * L) * bracket
+        return 2 * F * (1 - nu**2) / pi_E_L * bracket
 
     # -------------------------------------------------------------- load distribution
     def load_distribution(self, u: float, total_force: float, tol: float = 1e-10, max_iter: int = 60,
@@ -535,12 +561,14 @@ class MeshModel:
         else:
             active = start > 0
             F = np.where(active, start, 0.0)
+        hertz_factors = self._hertz_factors(pts)                   # the points do not change in the iteration
         for _ in range(max_iter):
-            h = self.hertz(pts, F) / np.maximum(F, 1e-9)          # secant Hertz compliance
+            h = self._hertz_of(hertz_factors, F) / np.maximum(F, 1e-9)      # secant Hertz compliance
             idx = np.flatnonzero(active)
             m = idx.size
             K = np.zeros((m + 1, m + 1))
-            K[:m, :m] = C[np.ix_(idx, idx)] + np.diag(h[idx])
+            K[:m, :m] = C[idx][:, idx]
+            K[np.arange(m), np.arange(m)] += h[idx]
             K[:m, m] = -1.0
             K[m, :m] = 1.0
             rhs = np.concatenate([-e[idx], [total_force]])
