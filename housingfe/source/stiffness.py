@@ -211,11 +211,12 @@ def plate_green_matrix(length: float, S1: float, S2: float, S3: float, xi, x) ->
     rhs = np.zeros((n, 8, 1), dtype=complex)
     rhs[:, 7, 0] = 1.0 / S1
     coef = np.linalg.solve(A, rhs)[..., 0]                         # (n, 8)
-    el = np.exp(lam[None, None, :] * (x[:, None, None] - ref_l[None, :, :]))   # (nx, n, 4)
-    er = np.exp(lam[None, None, :] * (x[:, None, None] - ref_r[None, :, :]))
-    left = np.einsum("ijk,jk->ij", el, coef[:, :4])
-    right = np.einsum("ijk,jk->ij", er, coef[:, 4:])
-    return np.where(x[:, None] <= xi[None, :], left, right).real
+    # each x_i lies left or right of the load xi_j: evaluate only that side's solution (one exponential per entry)
+    left_side = (x[:, None] <= xi[None, :])[..., None]                         # (nx, n, 1)
+    ref = np.where(left_side, ref_l[None, :, :], ref_r[None, :, :])             # (nx, n, 4)
+    c = np.where(left_side, coef[None, :, :4], coef[None, :, 4:])
+    e = np.exp(lam[None, None, :] * (x[:, None, None] - ref))
+    return np.einsum("ijk,ijk->ij", e, c).real
 
 
 def plate_green(length: float, S1: float, S2: float, S3: float, xi: float, x) -> np.ndarray:
@@ -241,26 +242,41 @@ def plate_coefficients(flex: _ToothFlex, nu: float) -> tuple[float, float, float
 def beam_influence(z: np.ndarray, shaft: ShaftBending, gear_diameter: float, face_width: float,
                    gear_offset: float, E: float, n_grid: int = 1500) -> np.ndarray:
     """Deflection at axial positions z_i [m] (measured from the gear's first face) per unit transverse
-    force at z_j, of a simply supported stepped Euler beam (unit-load method) [m/N]."""
-    L, zz, w = _beam_grid(shaft, gear_diameter, face_width, E, n_grid)
-    zp = shaft.left_span + gear_offset + np.asarray(z)
-    m = np.where(zz[None, :] <= zp[:, None], zz[None, :] * (L - zp[:, None]) / L,
-                 zp[:, None] * (L - zz[None, :]) / L)
-    return (m * w) @ m.T
+    force at z_j, of a simply supported stepped Euler beam (unit-load method) [m/N].
+
+    The unit-load integral sum_k w_k m_i(z_k) m_j(z_k) over the grid z_k (weights w_k = dz / EI, bending moment
+    m_i(z) = z (L - z_i) / L left of z_i, z_i (L - z) / L right of it) is split where z_k passes min(z_i, z_j) and
+    max(z_i, z_j); on each part the moments factor, so the sum is three prefix sums over the grid times factors
+    of z_i, z_j: the same quadrature as the (n, n_grid) moment matrix product, summed in another order (equal to
+    ~1e-15 relative), at O(n^2 + n_grid) instead of O(n^2 n_grid)."""
+    L, zz, lower2, middle, upper2 = _beam_grid(shaft, gear_diameter, face_width, E, n_grid)
+    zp = shaft.left_span + gear_offset + np.atleast_1d(np.asarray(z, dtype=float))
+    count = np.searchsorted(zz, zp, side="right")            # grid points with z_k <= z_i (left of the load)
+    left = zp[:, None] <= zp[None, :]
+    a = np.where(left, zp[:, None], zp[None, :])              # min(z_i, z_j)
+    b = np.where(left, zp[None, :], zp[:, None])              # max(z_i, z_j)
+    ca = np.where(left, count[:, None], count[None, :])
+    cb = np.where(left, count[None, :], count[:, None])
+    return ((L - a) * (L - b) * lower2[ca] + a * (L - b) * (middle[cb] - middle[ca]) + a * b * upper2[cb]) / L**2
 
 
 @functools.lru_cache(maxsize=64)   # the same shafts for every mesh position: grid and weights once
 def _beam_grid(shaft: ShaftBending, gear_diameter: float, face_width: float, E: float, n_grid: int):
-    """(length L [m], grid z [m], quadrature weight dz / EI [1/(N m)]) of `beam_influence` (read-only arrays)."""
+    """(length L [m], grid z [m], and over the grid with weights w = dz / EI [1/(N m)]: the prefix sums
+    sum_{k<c} w z^2 and sum_{k<c} w z (L - z), the suffix sum sum_{k>=c} w (L - z)^2 for c = 0..n_grid [m^3/N])
+    of `beam_influence` (read-only arrays)."""
     L = shaft.left_span + face_width + shaft.right_span
     zz = np.linspace(0.0, L, n_grid)
     in_gear = (zz >= shaft.left_span) & (zz <= shaft.left_span + face_width)
     d = np.where(in_gear, gear_diameter, shaft.shaft_diameter)
     EI = E * math.pi * d**4 / 64
     w = np.gradient(zz) / EI
-    zz.flags.writeable = False
-    w.flags.writeable = False
-    return L, zz, w
+    lower2 = np.concatenate([[0.0], np.cumsum(w * zz**2)])
+    middle = np.concatenate([[0.0], np.cumsum(w * zz * (L - zz))])
+    upper2 = np.concatenate([np.cumsum((w * (L - zz) ** 2)[::-1])[::-1], [0.0]])
+    for arr in (zz, lower2, middle, upper2):
+        arr.flags.writeable = False
+    return L, zz, lower2, middle, upper2
 
 
 # ----------------------------------------------------------------------------- flank gaps
