@@ -356,6 +356,7 @@ class MeshModel:
         # constants of the per-point interpolation (`_flex_at`), evaluated once rather than at every iteration
         self._line_of_action = p.line_of_action_length
         self._flex_total = [f.c_tooth + f.c_root for f in self.flex]
+        self._plate_memo: dict = {}      # plate matrices of the last `compliance` call, by (gear, w_local bytes)
 
     # -------------------------------------------------------------- contact points
     def contact_points(self, u: float) -> dict[str, np.ndarray]:
@@ -469,17 +470,24 @@ class MeshModel:
         fl = self._flex_at(pts["s"])
         C = self.body_compliance(pts["w"])
         b = self.pair.contact_width
-        for g in (0, 1):
-            S1, S2, S3 = self.plate[g]
-            gg = np.sqrt(fl[f"c{g}"] / self.f_etot[g])
-            plate = np.zeros_like(C)
-            for key in set(zip(pr.tolist(), hx.tolist())):      # one plate per tooth pair and helix
-                idx = np.flatnonzero((pr == key[0]) & (hx == key[1]))
+        gg = [np.sqrt(fl[f"c{g}"] / self.f_etot[g]) for g in (0, 1)]
+        # A contact line's plate matrix depends only on its points' w_local: the solve on edge-refined points
+        # (`_refine_edges`) takes the matrices of the lines it did not cut from the solve before it
+        reuse, self._plate_memo = self._plate_memo, {}
+        for key in set(zip(pr.tolist(), hx.tolist())):          # one plate per tooth pair and helix
+            idx = np.flatnonzero((pr == key[0]) & (hx == key[1]))
+            block = np.ix_(idx, idx)
+            for g in (0, 1):
+                S1, S2, S3 = self.plate[g]
                 if self.include_plate_coupling:
-                    plate[np.ix_(idx, idx)] = plate_green_matrix(b, S1, S2, S3, wl[idx], wl[idx])
+                    memo_key = (g, wl[idx].tobytes())
+                    plate = reuse.get(memo_key)
+                    if plate is None:
+                        plate = plate_green_matrix(b, S1, S2, S3, wl[idx], wl[idx])
+                    self._plate_memo[memo_key] = plate
                 else:                                   # independent slices (no plate coupling)
-                    plate[idx, idx] = 1.0 / (S3 * pts["width"][idx])
-            C += plate * np.outer(gg, gg)
+                    plate = np.diag(1.0 / (S3 * pts["width"][idx]))
+                C[block] += plate * np.outer(gg[g][idx], gg[g][idx])
         return C
 
     def hertz(self, pts, forces: np.ndarray) -> np.ndarray:
