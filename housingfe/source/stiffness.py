@@ -24,6 +24,7 @@ Assumptions where the thesis' figures are missing are listed in docs/source.md.
 """
 from __future__ import annotations
 
+import collections
 import functools
 import math
 from dataclasses import dataclass, field
@@ -181,6 +182,26 @@ def plate_green_matrix(length: float, S1: float, S2: float, S3: float, xi, x) ->
     Appendix A's cases."""
     xi = np.atleast_1d(np.asarray(xi, dtype=float))
     x = np.atleast_1d(np.asarray(x, dtype=float))
+    return _plate_evaluate(*_plate_solution(length, S1, S2, S3, xi), xi, x)
+
+
+def plate_green_blocks(length: float, S1: float, S2: float, S3: float, lines) -> list[np.ndarray]:
+    """`plate_green_matrix(length, S1, S2, S3, w, w)` [m/N] for each array w [m] of `lines` (the points of one
+    contact line each), with the 8x8 systems of all lines solved in one batch: the same numbers, fewer calls."""
+    lines = [np.atleast_1d(np.asarray(w, dtype=float)) for w in lines]
+    lam, ref_l, ref_r, coef = _plate_solution(length, S1, S2, S3, np.concatenate(lines))
+    out, start = [], 0
+    for w in lines:
+        part = slice(start, start + w.size)
+        out.append(_plate_evaluate(lam, ref_l[part], ref_r[part], coef[part], w, w))
+        start += w.size
+    return out
+
+
+def _plate_solution(length: float, S1: float, S2: float, S3: float, xi: np.ndarray):
+    """(roots lam (4,), references ref_l, ref_r (n, 4) [m], coefficients (n, 8)) of `plate_green_matrix` for unit
+    loads at xi [m]: column j's edge deflection is sum_k coef[j, k] exp(lam_k (x - ref_l[j, k])) left of xi_j and
+    sum_k coef[j, 4 + k] exp(lam_k (x - ref_r[j, k])) right of it."""
     a, b = S2 / S1, S3 / S1
     disc = np.sqrt(complex(a * a / 4 - b))
     lam = np.array([np.sqrt(a / 2 + disc), -np.sqrt(a / 2 + disc), np.sqrt(a / 2 - disc), -np.sqrt(a / 2 - disc)])
@@ -211,6 +232,11 @@ def plate_green_matrix(length: float, S1: float, S2: float, S3: float, xi, x) ->
     rhs = np.zeros((n, 8, 1), dtype=complex)
     rhs[:, 7, 0] = 1.0 / S1
     coef = np.linalg.solve(A, rhs)[..., 0]                         # (n, 8)
+    return lam, ref_l, ref_r, coef
+
+
+def _plate_evaluate(lam, ref_l, ref_r, coef, xi: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """G[i, j] [m/N] at x_i for the loads xi_j of a `_plate_solution`."""
     # each x_i lies left or right of the load xi_j: evaluate only that side's solution (one exponential per entry)
     left_side = (x[:, None] <= xi[None, :])[..., None]                         # (nx, n, 1)
     ref = np.where(left_side, ref_l[None, :, :], ref_r[None, :, :])             # (nx, n, 4)
@@ -309,6 +335,9 @@ def flank_gaps(pair: GearPair, corrections: Corrections, s, w_local, w, helix) -
 
 
 # ----------------------------------------------------------------------------- mesh model
+_PLATE_MEMO_SIZE = 64     # plate matrices a MeshModel keeps (each <= 30 kB at 60 points per contact line)
+
+
 @dataclass
 class MeshModel:
     """Everything that does not change with mesh position: flexibilities, plate Green's functions,
@@ -356,7 +385,8 @@ class MeshModel:
         # constants of the per-point interpolation (`_flex_at`), evaluated once rather than at every iteration
         self._line_of_action = p.line_of_action_length
         self._flex_total = [f.c_tooth + f.c_root for f in self.flex]
-        self._plate_memo: dict = {}      # plate matrices of the last `compliance` call, by (gear, w_local bytes)
+        # recent plate matrices of `compliance`, by (gear, w_local bytes), least recently used first
+        self._plate_memo: collections.OrderedDict = collections.OrderedDict()
 
     # -------------------------------------------------------------- contact points
     def contact_points(self, u: float) -> dict[str, np.ndarray]:
@@ -472,21 +502,37 @@ class MeshModel:
         b = self.pair.contact_width
         gg = [np.sqrt(fl[f"c{g}"] / self.f_etot[g]) for g in (0, 1)]
         # A contact line's plate matrix depends only on its points' w_local: the solve on edge-refined points
-        # (`_refine_edges`) takes the matrices of the lines it did not cut from the solve before it
-        reuse, self._plate_memo = self._plate_memo, {}
-        for key in set(zip(pr.tolist(), hx.tolist())):          # one plate per tooth pair and helix
-            idx = np.flatnonzero((pr == key[0]) & (hx == key[1]))
+        # (`_refine_edges`) takes the matrices of the lines it did not cut from the solve before it, and a line that
+        # lies wholly inside the path of contact has the same points at every mesh position
+        memo = self._plate_memo
+        lines = [np.flatnonzero((pr == key[0]) & (hx == key[1]))                 # one plate per tooth pair and helix
+                 for key in set(zip(pr.tolist(), hx.tolist()))]
+        plates = [{}, {}]
+        for g in (0, 1):
+            if not self.include_plate_coupling:
+                continue
+            S1, S2, S3 = self.plate[g]
+            missing = []
+            for idx in lines:
+                memo_key = (g, wl[idx].tobytes())
+                if memo_key in memo:
+                    memo.move_to_end(memo_key)
+                    plates[g][memo_key] = memo[memo_key]
+                else:
+                    missing.append((memo_key, idx))
+            if missing:
+                for (memo_key, _), plate in zip(missing, plate_green_blocks(b, S1, S2, S3,
+                                                                            [wl[idx] for _, idx in missing])):
+                    plates[g][memo_key] = memo[memo_key] = plate
+            while len(memo) > _PLATE_MEMO_SIZE:
+                memo.popitem(last=False)
+        for idx in lines:
             block = np.ix_(idx, idx)
             for g in (0, 1):
-                S1, S2, S3 = self.plate[g]
                 if self.include_plate_coupling:
-                    memo_key = (g, wl[idx].tobytes())
-                    plate = reuse.get(memo_key)
-                    if plate is None:
-                        plate = plate_green_matrix(b, S1, S2, S3, wl[idx], wl[idx])
-                    self._plate_memo[memo_key] = plate
+                    plate = plates[g][(g, wl[idx].tobytes())]
                 else:                                   # independent slices (no plate coupling)
-                    plate = np.diag(1.0 / (S3 * pts["width"][idx]))
+                    plate = np.diag(1.0 / (self.plate[g][2] * pts["width"][idx]))
                 C[block] += plate * np.outer(gg[g][idx], gg[g][idx])
         return C
 
