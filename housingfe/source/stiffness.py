@@ -278,11 +278,8 @@ def beam_influence(z: np.ndarray, shaft: ShaftBending, gear_diameter: float, fac
     L, zz, lower2, middle, upper2 = _beam_grid(shaft, gear_diameter, face_width, E, n_grid)
     zp = shaft.left_span + gear_offset + np.atleast_1d(np.asarray(z, dtype=float))
     count = np.searchsorted(zz, zp, side="right")            # grid points with z_k <= z_i (left of the load)
-    left = zp[:, None] <= zp[None, :]
-    a = np.where(left, zp[:, None], zp[None, :])              # min(z_i, z_j)
-    b = np.where(left, zp[None, :], zp[:, None])              # max(z_i, z_j)
-    ca = np.where(left, count[:, None], count[None, :])
-    cb = np.where(left, count[None, :], count[:, None])
+    a, b = np.minimum.outer(zp, zp), np.maximum.outer(zp, zp)
+    ca, cb = np.minimum.outer(count, count), np.maximum.outer(count, count)   # count grows with z
     return ((L - a) * (L - b) * lower2[ca] + a * (L - b) * (middle[cb] - middle[ca]) + a * b * upper2[cb]) / L**2
 
 
@@ -479,14 +476,15 @@ class MeshModel:
         p = self.pair
         cb2 = math.cos(p.base_helix_angle) ** 2
         rb = p.base_diameter / 2
-        wi, wj = np.meshgrid(w, w, indexing="ij")
-        body = np.zeros_like(wi)
+        w = np.asarray(w, dtype=float)
+        nearer, farther = np.minimum.outer(w, w), np.maximum.outer(w, w)
+        body = np.zeros_like(nearer)
         for g in (0, 1):
             Ip = math.pi * (float(p.pitch_diameter[g]) / 2) ** 4 / 2
             if g == 1 and self.torque_configuration == 2:
-                twist_length = self.total_width - np.maximum(wi, wj)
+                twist_length = self.total_width - farther
             else:
-                twist_length = np.minimum(wi, wj)
+                twist_length = nearer
             if self.include_body_torsion:
                 body += cb2 * rb[g] ** 2 * twist_length / (self.G_shear * Ip)
             if self.shafts is not None:
@@ -636,11 +634,12 @@ class MeshModel:
             h = self._hertz_of(hertz_factors, F) / np.maximum(F, 1e-9)      # secant Hertz compliance
             idx = np.flatnonzero(active)
             m = idx.size
-            K = np.zeros((m + 1, m + 1))
-            K[:m, :m] = C[idx][:, idx]
-            K[np.arange(m), np.arange(m)] += h[idx]
+            K = np.empty((m + 1, m + 1))
+            K[:m, :m] = C.take(idx, axis=0).take(idx, axis=1)
+            K.ravel()[: m * (m + 2): m + 2] += h[idx]                 # the diagonal of the active block
             K[:m, m] = -1.0
             K[m, :m] = 1.0
+            K[m, m] = 0.0
             rhs = np.concatenate([-e[idx], [total_force]])
             sol = np.linalg.solve(K, rhs)
             F_new = np.zeros(n)
