@@ -266,10 +266,9 @@ def plate_coefficients(flex: _ToothFlex, nu: float) -> tuple[float, float, float
 
 # ----------------------------------------------------------------------------- shafts and torsion
 def beam_influence(z: np.ndarray, shaft: ShaftBending, gear_diameter: float, face_width: float,
-                   gear_offset: float, E: float, n_grid: int = 1500, z_load=None) -> np.ndarray:
+                   gear_offset: float, E: float, n_grid: int = 1500) -> np.ndarray:
     """Deflection at axial positions z_i [m] (measured from the gear's first face) per unit transverse
-    force at z_j, of a simply supported stepped Euler beam (unit-load method) [m/N].  z_load: the load positions
-    z_j [m] if they are not z (a rectangular block of the matrix).
+    force at z_j, of a simply supported stepped Euler beam (unit-load method) [m/N].
 
     The unit-load integral sum_k w_k m_i(z_k) m_j(z_k) over the grid z_k (weights w_k = dz / EI, bending moment
     m_i(z) = z (L - z_i) / L left of z_i, z_i (L - z) / L right of it) is split where z_k passes min(z_i, z_j) and
@@ -278,11 +277,9 @@ def beam_influence(z: np.ndarray, shaft: ShaftBending, gear_diameter: float, fac
     ~1e-15 relative), at O(n^2 + n_grid) instead of O(n^2 n_grid)."""
     L, zz, lower2, middle, upper2 = _beam_grid(shaft, gear_diameter, face_width, E, n_grid)
     zp = shaft.left_span + gear_offset + np.atleast_1d(np.asarray(z, dtype=float))
-    zq = zp if z_load is None else shaft.left_span + gear_offset + np.atleast_1d(np.asarray(z_load, dtype=float))
     count = np.searchsorted(zz, zp, side="right")            # grid points with z_k <= z_i (left of the load)
-    count_q = count if z_load is None else np.searchsorted(zz, zq, side="right")
-    a, b = np.minimum.outer(zp, zq), np.maximum.outer(zp, zq)
-    ca, cb = np.minimum.outer(count, count_q), np.maximum.outer(count, count_q)   # count grows with z
+    a, b = np.minimum.outer(zp, zp), np.maximum.outer(zp, zp)
+    ca, cb = np.minimum.outer(count, count), np.maximum.outer(count, count)   # count grows with z
     return ((L - a) * (L - b) * lower2[ca] + a * (L - b) * (middle[cb] - middle[ca]) + a * b * upper2[cb]) / L**2
 
 
@@ -473,16 +470,14 @@ class MeshModel:
             return self.lead_gap * w
         return self.lead_gap * (w - self.total_width)
 
-    def body_compliance(self, w: np.ndarray, w_load: np.ndarray | None = None) -> np.ndarray:
+    def body_compliance(self, w: np.ndarray) -> np.ndarray:
         """Compliance [m/N] between axial positions w through shaft bending and wheel-body torsion of
-        both gears, projected on the flank normal (cos^2(beta_b)); w_load: the load positions [m] if they are not w.
-        Every entry depends on its own two positions only."""
+        both gears, projected on the flank normal (cos^2(beta_b))."""
         p = self.pair
         cb2 = math.cos(p.base_helix_angle) ** 2
         rb = p.base_diameter / 2
         w = np.asarray(w, dtype=float)
-        wq = w if w_load is None else np.asarray(w_load, dtype=float)
-        nearer, farther = np.minimum.outer(w, wq), np.maximum.outer(w, wq)
+        nearer, farther = np.minimum.outer(w, w), np.maximum.outer(w, w)
         body = np.zeros_like(nearer)
         for g in (0, 1):
             Ip = math.pi * (float(p.pitch_diameter[g]) / 2) ** 4 / 2
@@ -494,44 +489,8 @@ class MeshModel:
                 body += cb2 * rb[g] ** 2 * twist_length / (self.G_shear * Ip)
             if self.shafts is not None:
                 body += cb2 * beam_influence(w, self.shafts[g], float(p.root_diameter[g]), self.total_width,
-                                             0.0, p.youngs_modulus, n_grid=600, z_load=w_load)
+                                             0.0, p.youngs_modulus, n_grid=600)
         return body
-
-    def _compliance_block(self, pts: dict[str, np.ndarray], rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """The block C[rows][:, cols] of `compliance(pts)` [m/N], entry by entry the same arithmetic."""
-        pr, hx, wl = pts["pair"], pts["helix"], pts["w_local"]
-        fl = self._flex_at(pts["s"])
-        C = self.body_compliance(pts["w"][rows], pts["w"][cols])
-        b = self.pair.contact_width
-        gg = [np.sqrt(fl[f"c{g}"] / self.f_etot[g]) for g in (0, 1)]
-        for key in set(zip(pr.tolist(), hx.tolist())):
-            in_line = (pr == key[0]) & (hx == key[1])
-            r, c = np.flatnonzero(in_line[rows]), np.flatnonzero(in_line[cols])
-            if r.size == 0 or c.size == 0:
-                continue
-            pr_, pc_ = rows[r], cols[c]
-            for g in (0, 1):
-                if self.include_plate_coupling:
-                    plate = _plate_evaluate(*_plate_solution(b, *self.plate[g], wl[pc_]), wl[pc_], wl[pr_])
-                else:
-                    plate = np.where(pr_[:, None] == pc_[None, :], 1.0 / (self.plate[g][2] * pts["width"][pr_])[:, None],
-                                     0.0)
-                C[np.ix_(r, c)] += plate * np.outer(gg[g][pr_], gg[g][pc_])
-        return C
-
-    def _refined_compliance(self, coarse_C: np.ndarray, pts: dict[str, np.ndarray], parent: np.ndarray,
-                            new: np.ndarray) -> np.ndarray:
-        """`compliance(pts)` [m/N] of points from `split_segments` (parent: each one's coarse point, new: True where
-        it is a part of a cut segment) given the coarse points' compliance: an entry depends only on its two points,
-        and a point of an uncut segment is its coarse point, so between two such points the entry is copied; only
-        the rows and columns of the new points are computed."""
-        n = parent.size
-        old, fresh = np.flatnonzero(~new), np.flatnonzero(new)
-        C = np.empty((n, n))
-        C[np.ix_(old, old)] = coarse_C[np.ix_(parent[old], parent[old])]
-        C[fresh, :] = self._compliance_block(pts, fresh, np.arange(n))
-        C[np.ix_(old, fresh)] = self._compliance_block(pts, old, fresh)
-        return C
 
     def compliance(self, pts: dict[str, np.ndarray]) -> np.ndarray:
         """Linear part of the compliance matrix [m/N] between the contact points (no Hertz)."""
@@ -638,7 +597,7 @@ class MeshModel:
         (benchmarks/experiments/contact_edge).  Cut segments make the steps edge_refinement times finer at the
         cost of a few points per edge, where the smooth rest of the line needs none."""
         split = np.zeros(coarse["s"].size, dtype=bool)
-        pts, parent, coarse_C = coarse, np.arange(coarse["s"].size), C
+        pts, parent = coarse, np.arange(coarse["s"].size)
         line = coarse["pair"] * 2 + coarse["helix"]
         for _ in range(max_rounds):
             inside = F > 0
@@ -653,7 +612,7 @@ class MeshModel:
             coarse_force = np.bincount(parent, weights=F, minlength=split.size)
             pts = self.split_segments(coarse, split)
             parent = pts.pop("parent")
-            C, e = self._refined_compliance(coarse_C, pts, parent, split[parent]), self.gaps(pts)
+            C, e = self.compliance(pts), self.gaps(pts)
             # start from the last solution, a segment's force shared among its parts (fewer iterations)
             start = coarse_force[parent] / np.bincount(parent, minlength=split.size)[parent]
             F, delta = self._solve(pts, C, e, u, total_force, tol, max_iter, start)

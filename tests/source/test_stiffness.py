@@ -375,20 +375,3 @@ def test_a_vanishing_contact_line_carries_a_vanishing_load(test_gear):
     assert shares[1] / 3e-5 == pytest.approx(shares[-1] / 1e-7, rel=0.1)
     # the mean approach tends to that without the line
     assert np.ptp(deltas[2:]) < 1e-4 * deltas[-1]
-
-
-@pytest.mark.parametrize("coupling", [True, False])
-def test_edge_refined_compliance_is_the_full_compliance(coupling):
-    # the solve on edge-refined points copies the entries between uncut points from the coarse matrix and computes
-    # only the new points' rows and columns: it must equal the compliance built from scratch, entry for entry
-    pair = GearPair.from_table(REF["single_helical"])
-    model = MeshModel(pair, shafts=SHAFTS, include_plate_coupling=coupling,
-                      corrections=Corrections(tip_relief=(20e-6, 20e-6), tip_relief_length=(3e-3, 3e-3)))
-    coarse = model.contact_points(0.3 * pair.transverse_base_pitch)
-    split = np.zeros(coarse["s"].size, dtype=bool)
-    split[[3, 4, 30]] = True
-    pts = model.split_segments(coarse, split)
-    parent = pts.pop("parent")
-    got = model._refined_compliance(model.compliance(coarse), pts, parent, split[parent])
-    assert got.shape == (coarse["s"].size + 3 * (model.edge_refinement - 1),) * 2
-    assert np.array_equal(got, model.compliance(pts))
