@@ -24,6 +24,7 @@ Assumptions where the thesis' figures are missing are listed in docs/source.md.
 """
 from __future__ import annotations
 
+import collections
 import functools
 import math
 from dataclasses import dataclass, field
@@ -181,6 +182,26 @@ def plate_green_matrix(length: float, S1: float, S2: float, S3: float, xi, x) ->
     Appendix A's cases."""
     xi = np.atleast_1d(np.asarray(xi, dtype=float))
     x = np.atleast_1d(np.asarray(x, dtype=float))
+    return _plate_evaluate(*_plate_solution(length, S1, S2, S3, xi), xi, x)
+
+
+def plate_green_blocks(length: float, S1: float, S2: float, S3: float, lines) -> list[np.ndarray]:
+    """`plate_green_matrix(length, S1, S2, S3, w, w)` [m/N] for each array w [m] of `lines` (the points of one
+    contact line each), with the 8x8 systems of all lines solved in one batch: the same numbers, fewer calls."""
+    lines = [np.atleast_1d(np.asarray(w, dtype=float)) for w in lines]
+    lam, ref_l, ref_r, coef = _plate_solution(length, S1, S2, S3, np.concatenate(lines))
+    out, start = [], 0
+    for w in lines:
+        part = slice(start, start + w.size)
+        out.append(_plate_evaluate(lam, ref_l[part], ref_r[part], coef[part], w, w))
+        start += w.size
+    return out
+
+
+def _plate_solution(length: float, S1: float, S2: float, S3: float, xi: np.ndarray):
+    """(roots lam (4,), references ref_l, ref_r (n, 4) [m], coefficients (n, 8)) of `plate_green_matrix` for unit
+    loads at xi [m]: column j's edge deflection is sum_k coef[j, k] exp(lam_k (x - ref_l[j, k])) left of xi_j and
+    sum_k coef[j, 4 + k] exp(lam_k (x - ref_r[j, k])) right of it."""
     a, b = S2 / S1, S3 / S1
     disc = np.sqrt(complex(a * a / 4 - b))
     lam = np.array([np.sqrt(a / 2 + disc), -np.sqrt(a / 2 + disc), np.sqrt(a / 2 - disc), -np.sqrt(a / 2 - disc)])
@@ -190,28 +211,38 @@ def plate_green_matrix(length: float, S1: float, S2: float, S3: float, xi, x) ->
     ref_l = np.where(grow[None, :], xi[:, None], 0.0)             # (n, 4)
     ref_r = np.where(grow[None, :], length, xi[:, None])
 
-    def rows(pt, ref, order):                                     # pt (n,) -> (n, 4)
-        return lam**order * np.exp(lam * (pt[:, None] - ref))
-
+    # the row of derivative order k is lam**k * exp(lam (pt - ref)): one exponential per point set, reused for
+    # every order (the same floating-point operations as evaluating each row on its own)
+    power = [lam**order for order in range(4)]
     zero, ell = np.zeros(n), np.full(n, length)
+    e_0l = np.exp(lam * (zero[:, None] - ref_l))                  # (n, 4)
+    e_lr = np.exp(lam * (ell[:, None] - ref_r))
+    e_xl = np.exp(lam * (xi[:, None] - ref_l))
+    e_xr = np.exp(lam * (xi[:, None] - ref_r))
     A = np.zeros((n, 8, 8), dtype=complex)
-    A[:, 0, :4] = rows(zero, ref_l, 2)
-    A[:, 1, :4] = rows(zero, ref_l, 3) - a * rows(zero, ref_l, 1)
-    A[:, 2, 4:] = rows(ell, ref_r, 2)
-    A[:, 3, 4:] = rows(ell, ref_r, 3) - a * rows(ell, ref_r, 1)
-    for k, order in enumerate((0, 1, 2)):                          # continuity of f, f', f'' at xi
-        A[:, 4 + k, :4] = rows(xi, ref_l, order)
-        A[:, 4 + k, 4:] = -rows(xi, ref_r, order)
-    A[:, 7, :4] = -rows(xi, ref_l, 3)                              # jump of f''' = P / S1
-    A[:, 7, 4:] = rows(xi, ref_r, 3)
+    A[:, 0, :4] = power[2] * e_0l
+    A[:, 1, :4] = power[3] * e_0l - a * (power[1] * e_0l)
+    A[:, 2, 4:] = power[2] * e_lr
+    A[:, 3, 4:] = power[3] * e_lr - a * (power[1] * e_lr)
+    for k in range(3):                                             # continuity of f, f', f'' at xi
+        A[:, 4 + k, :4] = power[k] * e_xl
+        A[:, 4 + k, 4:] = -(power[k] * e_xr)
+    A[:, 7, :4] = -(power[3] * e_xl)                               # jump of f''' = P / S1
+    A[:, 7, 4:] = power[3] * e_xr
     rhs = np.zeros((n, 8, 1), dtype=complex)
     rhs[:, 7, 0] = 1.0 / S1
     coef = np.linalg.solve(A, rhs)[..., 0]                         # (n, 8)
-    el = np.exp(lam[None, None, :] * (x[:, None, None] - ref_l[None, :, :]))   # (nx, n, 4)
-    er = np.exp(lam[None, None, :] * (x[:, None, None] - ref_r[None, :, :]))
-    left = np.einsum("ijk,jk->ij", el, coef[:, :4])
-    right = np.einsum("ijk,jk->ij", er, coef[:, 4:])
-    return np.where(x[:, None] <= xi[None, :], left, right).real
+    return lam, ref_l, ref_r, coef
+
+
+def _plate_evaluate(lam, ref_l, ref_r, coef, xi: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """G[i, j] [m/N] at x_i for the loads xi_j of a `_plate_solution`."""
+    # each x_i lies left or right of the load xi_j: evaluate only that side's solution (one exponential per entry)
+    left_side = (x[:, None] <= xi[None, :])[..., None]                         # (nx, n, 1)
+    ref = np.where(left_side, ref_l[None, :, :], ref_r[None, :, :])             # (nx, n, 4)
+    c = np.where(left_side, coef[None, :, :4], coef[None, :, 4:])
+    e = np.exp(lam[None, None, :] * (x[:, None, None] - ref))
+    return np.einsum("ijk,ijk->ij", e, c).real
 
 
 def plate_green(length: float, S1: float, S2: float, S3: float, xi: float, x) -> np.ndarray:
@@ -237,17 +268,38 @@ def plate_coefficients(flex: _ToothFlex, nu: float) -> tuple[float, float, float
 def beam_influence(z: np.ndarray, shaft: ShaftBending, gear_diameter: float, face_width: float,
                    gear_offset: float, E: float, n_grid: int = 1500) -> np.ndarray:
     """Deflection at axial positions z_i [m] (measured from the gear's first face) per unit transverse
-    force at z_j, of a simply supported stepped Euler beam (unit-load method) [m/N]."""
+    force at z_j, of a simply supported stepped Euler beam (unit-load method) [m/N].
+
+    The unit-load integral sum_k w_k m_i(z_k) m_j(z_k) over the grid z_k (weights w_k = dz / EI, bending moment
+    m_i(z) = z (L - z_i) / L left of z_i, z_i (L - z) / L right of it) is split where z_k passes min(z_i, z_j) and
+    max(z_i, z_j); on each part the moments factor, so the sum is three prefix sums over the grid times factors
+    of z_i, z_j: the same quadrature as the (n, n_grid) moment matrix product, summed in another order (equal to
+    ~1e-15 relative), at O(n^2 + n_grid) instead of O(n^2 n_grid)."""
+    L, zz, lower2, middle, upper2 = _beam_grid(shaft, gear_diameter, face_width, E, n_grid)
+    zp = shaft.left_span + gear_offset + np.atleast_1d(np.asarray(z, dtype=float))
+    count = np.searchsorted(zz, zp, side="right")            # grid points with z_k <= z_i (left of the load)
+    a, b = np.minimum.outer(zp, zp), np.maximum.outer(zp, zp)
+    ca, cb = np.minimum.outer(count, count), np.maximum.outer(count, count)   # count grows with z
+    return ((L - a) * (L - b) * lower2[ca] + a * (L - b) * (middle[cb] - middle[ca]) + a * b * upper2[cb]) / L**2
+
+
+@functools.lru_cache(maxsize=64)   # the same shafts for every mesh position: grid and weights once
+def _beam_grid(shaft: ShaftBending, gear_diameter: float, face_width: float, E: float, n_grid: int):
+    """(length L [m], grid z [m], and over the grid with weights w = dz / EI [1/(N m)]: the prefix sums
+    sum_{k<c} w z^2 and sum_{k<c} w z (L - z), the suffix sum sum_{k>=c} w (L - z)^2 for c = 0..n_grid [m^3/N])
+    of `beam_influence` (read-only arrays)."""
     L = shaft.left_span + face_width + shaft.right_span
     zz = np.linspace(0.0, L, n_grid)
     in_gear = (zz >= shaft.left_span) & (zz <= shaft.left_span + face_width)
     d = np.where(in_gear, gear_diameter, shaft.shaft_diameter)
     EI = E * math.pi * d**4 / 64
-    zp = shaft.left_span + gear_offset + np.asarray(z)
-    m = np.where(zz[None, :] <= zp[:, None], zz[None, :] * (L - zp[:, None]) / L,
-                 zp[:, None] * (L - zz[None, :]) / L)
     w = np.gradient(zz) / EI
-    return (m * w) @ m.T
+    lower2 = np.concatenate([[0.0], np.cumsum(w * zz**2)])
+    middle = np.concatenate([[0.0], np.cumsum(w * zz * (L - zz))])
+    upper2 = np.concatenate([np.cumsum((w * (L - zz) ** 2)[::-1])[::-1], [0.0]])
+    for arr in (zz, lower2, middle, upper2):
+        arr.flags.writeable = False
+    return L, zz, lower2, middle, upper2
 
 
 # ----------------------------------------------------------------------------- flank gaps
@@ -280,6 +332,9 @@ def flank_gaps(pair: GearPair, corrections: Corrections, s, w_local, w, helix) -
 
 
 # ----------------------------------------------------------------------------- mesh model
+_PLATE_MEMO_SIZE = 64     # plate matrices a MeshModel keeps (each <= 30 kB at 60 points per contact line)
+
+
 @dataclass
 class MeshModel:
     """Everything that does not change with mesh position: flexibilities, plate Green's functions,
@@ -324,6 +379,11 @@ class MeshModel:
         self.plate = [plate_coefficients(f, nu) for f in self.flex]
         self.f_etot = [f.c_tooth[-1] + f.c_root[-1] for f in self.flex]
         self.total_width = self.helices * p.contact_width + (self.helices - 1) * p.helix_gap
+        # constants of the per-point interpolation (`_flex_at`), evaluated once rather than at every iteration
+        self._line_of_action = p.line_of_action_length
+        self._flex_total = [f.c_tooth + f.c_root for f in self.flex]
+        # recent plate matrices of `compliance`, by (gear, w_local bytes), least recently used first
+        self._plate_memo: collections.OrderedDict = collections.OrderedDict()
 
     # -------------------------------------------------------------- contact points
     def contact_points(self, u: float) -> dict[str, np.ndarray]:
@@ -386,13 +446,12 @@ class MeshModel:
         return out
 
     def _flex_at(self, s: np.ndarray) -> dict[str, np.ndarray]:
-        p = self.pair
-        rho_t = [s, p.line_of_action_length - s]
+        rho_t = [s, self._line_of_action - s]
         out = {}
         for g in (0, 1):
             f = self.flex[g]
-            r = np.clip(rho_t[g], f.rho_t[0], f.rho_t[-1])
-            out[f"c{g}"] = np.interp(r, f.rho_t, f.c_tooth + f.c_root)
+            r = np.minimum(np.maximum(rho_t[g], f.rho_t[0]), f.rho_t[-1])     # np.clip, without its overhead
+            out[f"c{g}"] = np.interp(r, f.rho_t, self._flex_total[g])
             out[f"t{g}"] = np.interp(r, f.rho_t, f.t_hertz)
             out[f"rho{g}"] = np.interp(r, f.rho_t, f.rho_n)
         return out
@@ -417,14 +476,15 @@ class MeshModel:
         p = self.pair
         cb2 = math.cos(p.base_helix_angle) ** 2
         rb = p.base_diameter / 2
-        wi, wj = np.meshgrid(w, w, indexing="ij")
-        body = np.zeros_like(wi)
+        w = np.asarray(w, dtype=float)
+        nearer, farther = np.minimum.outer(w, w), np.maximum.outer(w, w)
+        body = np.zeros_like(nearer)
         for g in (0, 1):
             Ip = math.pi * (float(p.pitch_diameter[g]) / 2) ** 4 / 2
             if g == 1 and self.torque_configuration == 2:
-                twist_length = self.total_width - np.maximum(wi, wj)
+                twist_length = self.total_width - farther
             else:
-                twist_length = np.minimum(wi, wj)
+                twist_length = nearer
             if self.include_body_torsion:
                 body += cb2 * rb[g] ** 2 * twist_length / (self.G_shear * Ip)
             if self.shafts is not None:
@@ -438,29 +498,63 @@ class MeshModel:
         fl = self._flex_at(pts["s"])
         C = self.body_compliance(pts["w"])
         b = self.pair.contact_width
+        gg = [np.sqrt(fl[f"c{g}"] / self.f_etot[g]) for g in (0, 1)]
+        # A contact line's plate matrix depends only on its points' w_local: the solve on edge-refined points
+        # (`_refine_edges`) takes the matrices of the lines it did not cut from the solve before it, and a line that
+        # lies wholly inside the path of contact has the same points at every mesh position
+        memo = self._plate_memo
+        lines = [np.flatnonzero((pr == key[0]) & (hx == key[1]))                 # one plate per tooth pair and helix
+                 for key in set(zip(pr.tolist(), hx.tolist()))]
+        plates = [{}, {}]
         for g in (0, 1):
+            if not self.include_plate_coupling:
+                continue
             S1, S2, S3 = self.plate[g]
-            gg = np.sqrt(fl[f"c{g}"] / self.f_etot[g])
-            plate = np.zeros_like(C)
-            for key in set(zip(pr.tolist(), hx.tolist())):      # one plate per tooth pair and helix
-                idx = np.flatnonzero((pr == key[0]) & (hx == key[1]))
+            missing = []
+            for idx in lines:
+                memo_key = (g, wl[idx].tobytes())
+                if memo_key in memo:
+                    memo.move_to_end(memo_key)
+                    plates[g][memo_key] = memo[memo_key]
+                else:
+                    missing.append((memo_key, idx))
+            if missing:
+                for (memo_key, _), plate in zip(missing, plate_green_blocks(b, S1, S2, S3,
+                                                                            [wl[idx] for _, idx in missing])):
+                    plates[g][memo_key] = memo[memo_key] = plate
+            while len(memo) > _PLATE_MEMO_SIZE:
+                memo.popitem(last=False)
+        for idx in lines:
+            block = np.ix_(idx, idx)
+            for g in (0, 1):
                 if self.include_plate_coupling:
-                    plate[np.ix_(idx, idx)] = plate_green_matrix(b, S1, S2, S3, wl[idx], wl[idx])
+                    plate = plates[g][(g, wl[idx].tobytes())]
                 else:                                   # independent slices (no plate coupling)
-                    plate[idx, idx] = 1.0 / (S3 * pts["width"][idx])
-            C += plate * np.outer(gg, gg)
+                    plate = np.diag(1.0 / (self.plate[g][2] * pts["width"][idx]))
+                C[block] += plate * np.outer(gg[g][idx], gg[g][idx])
         return C
 
     def hertz(self, pts, forces: np.ndarray) -> np.ndarray:
         """Hertzian approach [m] of each contact point under its normal force [N] (eq. 2.40), with the
         contact-line length of its segment width / cos(beta_b)."""
+        return self._hertz_of(self._hertz_factors(pts), forces)
+
+    def _hertz_factors(self, pts) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The load-independent factors of `hertz` at the points: t0 t1 pi E L [N m], 2 rho_v (1 - nu^2)
+        [m] and pi E L [N/m] (the same products, in the same order, as `hertz` evaluates them)."""
         p = self.pair
         fl = self._flex_at(pts["s"])
         E, nu = p.youngs_modulus, p.poisson_ratio
         L = pts["width"] / math.cos(p.base_helix_angle)
         rho_v = fl["rho0"] * fl["rho1"] / (fl["rho0"] + fl["rho1"])
+        return fl["t0"] * fl["t1"] * math.pi * E * L, 2 * rho_v * (1 - nu**2), math.pi * E * L
+
+    def _hertz_of(self, factors, forces: np.ndarray) -> np.ndarray:
+        """`hertz` [m] from its load-independent `factors` (`_hertz_factors`) and the forces [N]."""
+        numerator, denominator, pi_E_L = factors
+        nu = self.pair.poisson_ratio
         F = np.maximum(forces, 1e-9)
-        arg = fl["t0"] * fl["t1"] * math.pi * E * L / (2 * rho_v * (1 - nu**2) * F)
+        arg = numerator / (denominator * F)
         # arg = (2 t0 / a)(2 t1 / a) with a the Hertzian half-width: Weber's formula holds for a well below the
         # tooth thicknesses.  Its approach F (ln(arg) - nu/(1-nu)) peaks where ln(arg) = 1 + nu/(1-nu) and beyond
         # (larger line loads, a approaching t) falls, then turns negative: an approach that shrinks as the load grows
@@ -471,7 +565,7 @@ class MeshModel:
         # as 1/L and a contact line of length -> 0 carries a load -> 0 at a given approach.  Loads of the
         # contact lines inside the path (arg ~ 1e2) are untouched
         bracket = np.maximum(np.log(arg), 1.0 + nu / (1 - nu)) - nu / (1 - nu)
-        return 2 * F * (1 - nu**2) / (math.pi * E * L) * bracket
+        return 2 * F * (1 - nu**2) / pi_E_L * bracket
 
     # -------------------------------------------------------------- load distribution
     def load_distribution(self, u: float, total_force: float, tol: float = 1e-10, max_iter: int = 60,
@@ -535,14 +629,17 @@ class MeshModel:
         else:
             active = start > 0
             F = np.where(active, start, 0.0)
+        hertz_factors = self._hertz_factors(pts)                   # the points do not change in the iteration
         for _ in range(max_iter):
-            h = self.hertz(pts, F) / np.maximum(F, 1e-9)          # secant Hertz compliance
+            h = self._hertz_of(hertz_factors, F) / np.maximum(F, 1e-9)      # secant Hertz compliance
             idx = np.flatnonzero(active)
             m = idx.size
-            K = np.zeros((m + 1, m + 1))
-            K[:m, :m] = C[np.ix_(idx, idx)] + np.diag(h[idx])
+            K = np.empty((m + 1, m + 1))
+            K[:m, :m] = C.take(idx, axis=0).take(idx, axis=1)
+            K.ravel()[: m * (m + 2): m + 2] += h[idx]                 # the diagonal of the active block
             K[:m, m] = -1.0
             K[m, :m] = 1.0
+            K[m, m] = 0.0
             rhs = np.concatenate([-e[idx], [total_force]])
             sol = np.linalg.solve(K, rhs)
             F_new = np.zeros(n)

@@ -17,6 +17,8 @@ from housingfe.source.stiffness import (
     iso6336_stiffness,
     normal_force_from_torque,
     plate_green,
+    plate_green_blocks,
+    plate_green_matrix,
     stiffness_curve,
 )
 from tests.source.thesis_gears import REF
@@ -75,6 +77,39 @@ def test_beam_influence_uniform_simply_supported():
     a = beam_influence(np.array([0.025]), shaft, 0.05, 0.05, 0.0, 2.1e11, n_grid=4001)
     EI = 2.1e11 * math.pi * 0.05**4 / 64
     assert a[0, 0] == pytest.approx(0.25**3 / (48 * EI), rel=1e-4)
+
+
+def test_beam_influence_matrix_is_the_uniform_beams_influence_function():
+    # every entry, loads left and right of the point and on it: w(x) = P b x (L^2 - b^2 - x^2) / (6 E I L) for
+    # x <= a, b = L - a (load at a); the prefix-sum evaluation must split the unit-load integral at the right points
+    shaft = ShaftBending(0.1, 0.07, 0.05)
+    z = np.array([0.0, 0.003, 0.02, 0.02, 0.041, 0.05])
+    got = beam_influence(z, shaft, 0.05, 0.05, 0.0, 2.1e11, n_grid=4001)
+    EI, L = 2.1e11 * math.pi * 0.05**4 / 64, 0.22
+    x = 0.1 + z
+    lo, hi = np.minimum.outer(x, x), np.maximum.outer(x, x)
+    exact = (L - hi) * lo * (L**2 - (L - hi) ** 2 - lo**2) / (6 * EI * L)
+    np.testing.assert_allclose(got, exact, rtol=1e-5)
+
+
+def test_cached_plate_matrices_give_the_compliance_of_a_fresh_model():
+    # MeshModel keeps the plate matrices of contact lines it has seen (a line inside the path of contact recurs at
+    # every position, the edge-refined solve reuses the uncut lines): the compliance after a sweep over positions
+    # must be exactly that of a model that never saw one
+    pair = GearPair.from_table(REF["single_helical"])
+    corr = Corrections(tip_relief=(20e-6, 20e-6), tip_relief_length=(3e-3, 3e-3))
+    warm = MeshModel(pair, shafts=SHAFTS, corrections=corr)
+    pbt = pair.transverse_base_pitch
+    for x in np.arange(6) / 6:
+        warm.load_distribution(x * pbt, 20e3)
+    assert warm._plate_memo                       # the sweep filled the cache
+    for u in (0.0, 0.5 * pbt):                     # seen (refined lines in the cache) and unseen
+        pts = warm.contact_points(u)
+        fresh = MeshModel(pair, shafts=SHAFTS, corrections=corr)
+        assert np.array_equal(warm.compliance(pts), fresh.compliance(pts))
+        blocks = plate_green_blocks(pair.contact_width, *fresh.plate[0], [pts["w_local"][:5], pts["w_local"][5:12]])
+        for block, w in zip(blocks, (pts["w_local"][:5], pts["w_local"][5:12])):
+            assert np.array_equal(block, plate_green_matrix(pair.contact_width, *fresh.plate[0], w, w))
 
 
 # ---------------------------------------------------------------- the test gears of Chapter 5
