@@ -32,7 +32,7 @@ BESIDE the periodic one, labelled "as made, ISO grade g": extra columns *_as_mad
 The periodic tables stay as with the option off ("none", the default: nothing changes).
 
 Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route),
-<family>_torque_law.csv (where there is a torque law) and study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
+<family>_torque_law.csv and <family>_torque_law.png (where there is a torque law; plot_torque_law) and study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
 (default results/study-<family>-<engagement>); several families in one command share the housing model and the
 bases that fit (profile-corrections and bearings are one layout) and go to <out>/<family>/.
 """
