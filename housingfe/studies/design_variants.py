@@ -837,7 +837,10 @@ def plot_torque_law(path: Path, result: StudyResult) -> list[dict]:
         ax.set_ylabel("L_WA energy mean 800–1500 rpm [dB(A)]")
         ax.set_title(f"{_group_label(result, group_laws[0])}", fontsize=10)
         ax.grid(True, color="0.9")
-        ax.legend(fontsize=7)
+        # below the panel: inside, it would hide the measured segments, which end where the lines are
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14))
+    entries = max(len(ax.get_legend_handles_labels()[1]) for ax in axes[0])
+    fig.set_size_inches(6.0 * len(laws), 4.6 + 0.17 * entries)
     fam = result.family
     notes = [f"measured: {fam.torque_law_source}, drawn from ours at the lower torque"
              if fam.torque_law_source else "measured: drawn from ours at the lower torque"] \
@@ -847,7 +850,7 @@ def plot_torque_law(path: Path, result: StudyResult) -> list[dict]:
     fig.suptitle(f"housingfe study {fam.name}: torque law (engagement {result.engagement}, radiation "
                  f"{result.radiation})" + ("\n" + "; ".join(notes) if notes else ""), fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return plotted
 
