@@ -32,7 +32,7 @@ BESIDE the periodic one, labelled "as made, ISO grade g": extra columns *_as_mad
 The periodic tables stay as with the option off ("none", the default: nothing changes).
 
 Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route),
-<family>_torque_law.csv (where there is a torque law) and study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
+<family>_torque_law.csv and <family>_torque_law.png (where there is a torque law; plot_torque_law) and study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
 (default results/study-<family>-<engagement>); several families in one command share the housing model and the
 bases that fit (profile-corrections and bearings are one layout) and go to <out>/<family>/.
 """
@@ -375,6 +375,11 @@ def torque_groups(result: StudyResult) -> list[tuple[str, str, dict]]:
     return [(g, b, runs) for (g, b), runs in groups.items() if len(runs) >= 2]
 
 
+def _energy_means(runs: dict, torques: list, route: str, kind: str) -> list[float]:
+    """The energy mean of L_WA over 800-1500 rev/min (dB(A)) of a torque group's run at each torque (N m)."""
+    return [energy_mean_db(*runs[t].curves_of(kind)[route]) for t in torques]
+
+
 def torque_law(result: StudyResult, kind: str = "periodic") -> list[dict]:
     """The torque law of every group of variants that differ only in torque (`torque_groups`), per group and route:
 
@@ -402,7 +407,7 @@ def torque_law(result: StudyResult, kind: str = "periodic") -> list[dict]:
             _, low = runs[lo].curves_of(kind)[route]
             mean, sd, _ = difference_stats(s, high, low)
             at = float(high[np.argmin(np.abs(s - 1500.0))] - low[np.argmin(np.abs(s - 1500.0))])
-            means = [energy_mean_db(*runs[t].curves_of(kind)[route]) for t in torques]
+            means = _energy_means(runs, torques, route, kind)
             slope = float(np.polyfit(np.log2(torques), means, 1)[0])
             out.append({"bearings": bearings, "route": route, "step_mean_dB": round(mean, 2),
                         "step_sd_dB": round(sd, 2), "step_at_1500rpm_dB": round(at, 2),
@@ -638,7 +643,8 @@ def markdown_as_made(result: StudyResult) -> list[str]:
 
 
 def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> None:
-    """<family>.csv, <family>.md, <family>.png, <family>_runup.csv and study.json in `folder`."""
+    """<family>.csv, <family>.md, <family>.png, <family>_runup.csv and study.json in `folder`; where the study has
+    a torque law also <family>_torque_law.csv and <family>_torque_law.png."""
     from housingfe.outputs import write_csv, write_json
 
     name = result.family.name
@@ -688,6 +694,8 @@ def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> Non
                            "assumptions": list(result.as_made_assumptions), **result.as_made}
     write_json(folder / "study.json", data)
     plot(folder / f"{name}.png", result)
+    if result.torque_law:
+        plot_torque_law(folder / f"{name}_torque_law.png", result)
 
 
 def plot(path: Path, result: StudyResult) -> None:
@@ -756,6 +764,95 @@ def plot(path: Path, result: StudyResult) -> None:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def plot_torque_law(path: Path, result: StudyResult) -> list[dict]:
+    """The torque law as a figure (<family>_torque_law.png), one panel per torque-law group: per route the energy
+    mean of L_WA over 800-1500 rev/min (dB(A)) against the pinion torque (N m, log2 axis), markers, and the least
+    squares line with its slope per doubling in the legend (`torque_law`); where a measured law is known, the
+    measured step (and/or slope) as a segment from our energy mean at its lower torque; with runup.as_made the
+    same of gears as made, dashed.  Returns what was plotted, read back from the lines: per line {"gear_set",
+    "bearings", "route", "kind" (PERIODIC / AS_MADE / "measured_step" / "measured_slope"), "what" ("means",
+    "fit", "measured"), "torques_nm", "LwA_dBA" (arrays), "linestyle"}."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    groups = {(g, b): runs for g, b, runs in torque_groups(result)}
+    laws: dict = {}
+    for t in result.torque_law:
+        laws.setdefault((t["gear_set"], t["bearings"]), []).append(t)
+    made_laws = {_group_key(t): t for t in result.as_made.get("torque_law", [])}
+    kinds = (PERIODIC, AS_MADE) if result.as_made else (PERIODIC,)
+    fig, axes = plt.subplots(1, len(laws), figsize=(6.0 * len(laws), 5.2), squeeze=False)
+    plotted: list[dict] = []
+
+    def line(ax, meta, x, y, **style):
+        drawn = ax.plot(x, y, **style)[0]
+        plotted.append({**meta, "torques_nm": np.asarray(drawn.get_xdata(), float),
+                        "LwA_dBA": np.asarray(drawn.get_ydata(), float), "linestyle": drawn.get_linestyle()})
+
+    for ax, ((gear_set, bearings), group_laws) in zip(axes[0], laws.items()):
+        runs = groups[gear_set, bearings]
+        torques = sorted(runs)
+        ends = np.array([torques[0], torques[-1]], float)
+        for j, t in enumerate(group_laws):
+            route, colour = t["route"], f"C{j}"
+            for kind in kinds:
+                law = t if kind == PERIODIC else made_laws[_group_key(t)]
+                meta = {"gear_set": gear_set, "bearings": bearings, "route": route, "kind": kind}
+                means = _energy_means(runs, torques, route, kind)
+                slope, intercept = np.polyfit(np.log2(torques), means, 1)
+                dashed = kind == AS_MADE
+                line(ax, {**meta, "what": "means"}, torques, means, ls="none", color=colour,
+                     marker="s" if dashed else "o", mfc="none" if dashed else colour, ms=6)
+                line(ax, {**meta, "what": "fit"}, ends, intercept + slope * np.log2(ends), color=colour,
+                     ls="--" if dashed else "-", lw=1.4,
+                     label=f"{route}{', as made' if dashed else ''}: "
+                           f"{law['slope_dB_per_doubling']:+.1f} dB(A) per doubling")
+                if kind != PERIODIC:
+                    continue
+                lo, hi = t["from_nm"], t["to_nm"]
+                at_lo = means[torques.index(lo)]
+                # the measured law drawn from OUR level at its lower torque: the measured step or slope is then
+                # read against our line directly
+                if t["measured_step_dBA"] is not None:
+                    line(ax, {**meta, "kind": "measured_step", "what": "measured"}, [lo, hi],
+                         [at_lo, at_lo + t["measured_step_dBA"]], color=colour, ls=":", lw=1.6, marker="*",
+                         markevery=[1], ms=11, mec="k",
+                         label=f"{route}: measured step {t['measured_step_dBA']:+.1f} dB(A), "
+                               f"{lo:g} → {hi:g} N m")
+                if t["measured_slope_dBA_per_doubling"] is not None:
+                    line(ax, {**meta, "kind": "measured_slope", "what": "measured"}, [lo, hi],
+                         [at_lo, at_lo + t["measured_slope_dBA_per_doubling"] * math.log2(hi / lo)],
+                         color=colour, ls="-.", lw=1.2, marker="D", markevery=[1], ms=6, mec="k",
+                         label=f"{route}: measured slope {t['measured_slope_dBA_per_doubling']:+.1f} dB(A) "
+                               "per doubling")
+        ax.set_xscale("log", base=2)
+        ax.set_xticks(torques, [f"{x:g}" for x in torques])
+        ax.minorticks_off()
+        ax.set_xlim(torques[0] / 1.2, torques[-1] * 1.2)
+        ax.set_xlabel("pinion torque [N m] (log2 axis)")
+        ax.set_ylabel("L_WA energy mean 800–1500 rpm [dB(A)]")
+        ax.set_title(f"{_group_label(result, group_laws[0])}", fontsize=10)
+        ax.grid(True, color="0.9")
+        # below the panel: inside, it would hide the measured segments, which end where the lines are
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14))
+    entries = max(len(ax.get_legend_handles_labels()[1]) for ax in axes[0])
+    fig.set_size_inches(6.0 * len(laws), 4.6 + 0.17 * entries)
+    fam = result.family
+    notes = [f"measured: {fam.torque_law_source}, drawn from ours at the lower torque"
+             if fam.torque_law_source else "measured: drawn from ours at the lower torque"] \
+        if fam.torque_laws else []
+    if result.as_made:
+        notes.append(f"dashed, open markers: {result.as_made_label}")
+    fig.suptitle(f"housingfe study {fam.name}: torque law (engagement {result.engagement}, radiation "
+                 f"{result.radiation})" + ("\n" + "; ".join(notes) if notes else ""), fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return plotted
 
 
 def summary_text(result: StudyResult, wall_s: float | None = None) -> str:
