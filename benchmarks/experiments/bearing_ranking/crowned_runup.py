@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from runup_factors import gear_set_b_args, metrics  # noqa: E402
+from runup_factors import ball_reference, gear_set_b_args, metrics  # noqa: E402
 
 TORQUE = 2000.0
 
@@ -60,26 +60,12 @@ class Variant:
 
 def main(argv=None):
     import numpy as np
-    from mpi4py import MPI
 
-    from housingfe.radiation.radiators import RADIATORS
-    from housingfe.runup.chain import build_gearbox_model, runup, source_lines, with_drivetrain
-    from housingfe.runup.scene import drivetrain_of, housing_model_for, load_runup_scene
-    from housingfe.scene import load_housing_scene
+    from housingfe.runup.chain import runup, with_drivetrain
 
     args, overrides = gear_set_b_args(__doc__, "/tmp/bearing_ranking_crowned_runup", argv)
     t0 = time.perf_counter()
-    scene, _ = load_runup_scene("test-gearbox-runup", overrides)
-    spec = scene.runup
-    hs, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
-    hm = housing_model_for(hs, spec.f_max_hz, MPI.COMM_WORLD)
-    ball = drivetrain_of(scene.drivetrain, TORQUE)
-    config = {name: drivetrain_of(scene.drivetrain.model_copy(update={"bearings": name}), TORQUE)
-              for name in ("self_aligning", "tapered_roller")}
-    gm = build_gearbox_model(hm, ball, spec.f_max_hz, damping_ratio=spec.damping_ratio,
-                             basis_factor=spec.basis_factor, radiators={"erp": RADIATORS["erp"]()})
-    lines, _ = source_lines(ball.source_model(harmonics=spec.harmonics), spec.speeds, [TORQUE], spec.f_max_hz)
-    ref = runup(gm, None, spec.speeds, [TORQUE], lines=lines)
+    spec, ball, config, gm, lines, ref = ball_reference(overrides, ("self_aligning", "tapered_roller"))
     variants = {
         "self_aligning, straight rollers (catalogue)": config["self_aligning"],
         "self_aligning, logarithmic crown (ISO/TS 16281)": Variant(config["self_aligning"],

@@ -89,27 +89,39 @@ def gear_set_b_args(doc: str, default_out: str, argv=None, extra=()) -> tuple[ar
     return args, overrides
 
 
-def main(argv=None):
+def ball_reference(overrides, others=()):
+    """The experiments' reference: test-gearbox-runup with `overrides`, ball bearings at TORQUE, a fresh basis (erp
+    radiation), the rigid-bore source lines and the ball run-up.  Returns (spec, ball drivetrain, {name: drivetrain of
+    bearing configuration name for name in others}, gearbox model, lines, reference run-up)."""
     from mpi4py import MPI
 
     from housingfe.radiation.radiators import RADIATORS
-    from housingfe.runup.chain import build_gearbox_model, runup, source_lines, with_drivetrain
+    from housingfe.runup.chain import build_gearbox_model, runup, source_lines
     from housingfe.runup.scene import drivetrain_of, housing_model_for, load_runup_scene
     from housingfe.scene import load_housing_scene
 
-    args, overrides = gear_set_b_args(__doc__, "/tmp/bearing_ranking_runup", argv)
     t0 = time.perf_counter()
     scene, _ = load_runup_scene("test-gearbox-runup", overrides)
     spec = scene.runup
     hs, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
     hm = housing_model_for(hs, spec.f_max_hz, MPI.COMM_WORLD)
     ball = drivetrain_of(scene.drivetrain, TORQUE)
-    sa = drivetrain_of(scene.drivetrain.model_copy(update={"bearings": "self_aligning"}), TORQUE)
+    config = {name: drivetrain_of(scene.drivetrain.model_copy(update={"bearings": name}), TORQUE) for name in others}
     gm = build_gearbox_model(hm, ball, spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators={"erp": RADIATORS["erp"]()})
     print(f"model {time.perf_counter() - t0:.0f} s", flush=True)
     lines, _ = source_lines(ball.source_model(harmonics=spec.harmonics), spec.speeds, [TORQUE], spec.f_max_hz)
     ref = runup(gm, None, spec.speeds, [TORQUE], lines=lines)
+    return spec, ball, config, gm, lines, ref
+
+
+def main(argv=None):
+    from housingfe.runup.chain import runup, source_lines, with_drivetrain
+
+    args, overrides = gear_set_b_args(__doc__, "/tmp/bearing_ranking_runup", argv)
+    t0 = time.perf_counter()
+    spec, ball, config, gm, lines, ref = ball_reference(overrides, ("self_aligning",))
+    sa = config["self_aligning"]
     ball_spec, sa_spec = ball.to_coupling_spec(), sa.to_coupling_spec()
     structural = {
         "self_aligning (spherical roller model)": sa,
