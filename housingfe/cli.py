@@ -187,7 +187,22 @@ def build_parser() -> argparse.ArgumentParser:
 
     for name in _EXTENSIONS:
         _register_extension(name, sub)
+    _describe_subcommands(parser)
     return parser
+
+
+def _describe_subcommands(parser: argparse.ArgumentParser) -> None:
+    """`housingfe CMD --help` says what CMD does: a sub-command registered with a help line but no description
+    (argparse shows the help only in the parent's list) gets that line as its description, at every level."""
+    for action in parser._actions:
+        if not isinstance(action, argparse._SubParsersAction):
+            continue
+        helps = {choice.dest: choice.help for choice in action._choices_actions}
+        for name, child in action.choices.items():
+            if child.description is None and helps.get(name):
+                line = helps[name]
+                child.description = line[0].upper() + line[1:] + ("" if line.endswith(".") else ".")
+            _describe_subcommands(child)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -107,3 +107,27 @@ def test_a_process_without_launcher_gets_the_shared_memory_mpi_layer(env, expect
                           capture_output=True, text=True, env={**base, **env}, timeout=60)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip() == str(expected)
+
+
+def test_every_subcommand_help_says_what_it_does():
+    """`housingfe CMD --help` (at every level) has a description line, not only usage and options: a newcomer
+    reading `housingfe run --help` learns what `run` does.  Before, only `bearing` had one."""
+    import argparse
+
+    from housingfe.cli import build_parser
+
+    def walk(parser, path):
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                for name, child in action.choices.items():
+                    yield f"{path} {name}", child
+                    yield from walk(child, f"{path} {name}")
+
+    commands = dict(walk(build_parser(), "housingfe"))
+    assert {"housingfe run", "housingfe study", "housingfe radiation foller"} <= set(commands)
+    missing = [cmd for cmd, p in commands.items() if not (p.description or "").strip()]
+    assert not missing, f"no description in --help: {missing}"
+    assert "Run the analyses a scene lists" in commands["housingfe run"].format_help()
+    # one end to end: the console entry prints it and exits 0
+    proc = housingfe("scenes", "--help")
+    assert proc.returncode == 0 and "List the built-in scenes." in proc.stdout, proc.stdout + proc.stderr
