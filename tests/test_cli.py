@@ -38,6 +38,11 @@ BAD_SCENES = {
     "unknown_material": (BOX.replace('name = "steel"', 'name = "unobtainium"'), "material.name"),
     "walls_too_thick": (BOX.replace("wall_thickness = 0.008", "wall_thickness = 0.2"),
                         "geometry.wall_thickness"),
+    # a scene written in millimetres, mesh size too: before, nothing stopped it (a 325 m box of 2.4e10 kg)
+    "millimetres": (BOX.replace("length = 0.325", "length = 325.0").replace("width = 0.225", "width = 225.0")
+                    .replace("height = 0.125", "height = 125.0").replace("[mesh]", "[mesh]\nsize = 40.0"),
+                    "geometry.length: 325 m is implausible for a housing (at most 20 m across); scene lengths are "
+                    "in m: it looks like millimetres (325 mm = 0.325 m)"),
 }
 
 
