@@ -174,6 +174,7 @@ def test_describe_a_mesh_file_scene(tmp_path):
             "[analysis.modal]\nf_max = 3000.0\n")
     scene.write_text(text)
     out = describe(str(scene))
+    assert out.startswith("scene block ("), out[:200]          # nothing before it (meshio's stray blank line)
     assert "bounding box x 0 .. 0.3, y 0 .. 0.2, z 0 .. 0.04 m" in out
     areas = {m.group(1): float(m.group(2)) for m in re.finditer(r"^\s*(outer|feet)\s+([0-9.e-]+)\s+\d+$", out, re.M)}
     assert areas == pytest.approx({"outer": 0.16, "feet": 0.06}, rel=1e-9), out
