@@ -21,7 +21,14 @@ from housingfe.drivetrain.interior import CouplingSpec
 from housingfe.errors import InputError
 from housingfe.geometry.specs import Geometry
 from housingfe.materials import LIBRARY, Material
-from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table, read_scene_dict
+from housingfe.scenefile import (
+    SceneInfo,
+    _Strict,
+    apply_overrides,
+    naming_the_override,
+    parse_table,
+    read_scene_dict,
+)
 
 
 class MaterialSpec(_Strict):
@@ -366,8 +373,11 @@ def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) ->
         raise InputError(f"{path}: scene.kind: this is a run-up scene, not a housing scene; run it with "
                          "`housingfe run`")
     _resolve_geometry_file(data, path)
-    scene = parse_table(HousingScene, data, path)
-    _check_block_extent(scene.geometry, path)
+    try:
+        scene = parse_table(HousingScene, data, path)
+        _check_block_extent(scene.geometry, path)
+    except InputError as exc:
+        raise naming_the_override(exc, overrides) from None
     return scene, path
 
 

@@ -70,6 +70,27 @@ def test_unknown_scene_and_bad_override(tmp_path):
     assert proc.returncode == 2 and "not found" in proc.stderr
 
 
+@pytest.mark.parametrize("argv, expected", [
+    (["run", "box-free", "--set", "mesh.sise=0.01"], "mesh.sise: unknown key (from --set mesh.sise=0.01)"),
+    (["describe", "box-free", "--set", "analysis.modal.f_max=4kHz"],
+     "analysis.modal.f_max: Input should be a valid number, unable to parse string as a number "
+     "(from --set analysis.modal.f_max=4kHz)"),
+    (["run", "test-gearbox-runup", "--set", "runup.enggement=thesis-2d", "--out", "x"],
+     "runup.enggement: unknown key (from --set runup.enggement=thesis-2d)"),
+])
+def test_a_bad_override_is_named_as_the_set_it_came_from(argv, expected, tmp_path, capsys, monkeypatch):
+    """A --set typo named only the built-in scene file (which holds no such key); the line now also names the
+    --set it came from.  In-process (the console script is covered above)."""
+    from housingfe import cli
+
+    monkeypatch.chdir(tmp_path)
+    code = cli.main(argv)
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert err.startswith("housingfe: error: ") and err.rstrip().endswith(expected), err
+    assert not list(tmp_path.iterdir())
+
+
 def test_scenes_lists_builtins():
     proc = housingfe("scenes")
     assert proc.returncode == 0
