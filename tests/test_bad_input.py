@@ -745,6 +745,9 @@ SWEEP_CASES = [
     # passed the check, built the model and did not finish
     ("bearing-variants-torque", ["bearing-variants", "--torque", "-5", "--out", "bv"],
      ["--torque", "-5 must be a pinion torque > 0 N m"]),
+    # a misspelt --configs name was refused only after the housing model was built (16 s, a progress line first)
+    ("bearing-variants-config-unknown", ["bearing-variants", "--configs", "ball", "bogus", "--out", "bv"],
+     ["--configs: 'bogus': unknown (known: ball,", "ball_zero_moment"]),
     ("reduce-cutoff-infinite", ["reduce", "test-gearbox-interior", "--cutoff", "inf", "--out", "r"],
      ["--cutoff", "inf Hz must be a finite positive"]),
     # a cut-off far above what the mesh resolves meshed the housing, then the eigensolver failed (exit 3, PETSc's
