@@ -34,8 +34,10 @@ _EXTENSIONS = (
 def _cmd_scenes(args: argparse.Namespace) -> int:
     from housingfe import scenefile
 
-    for name, description in scenefile.builtin_scenes().items():
-        print(f"{name:24s} {description}")
+    scenes = scenefile.builtin_scenes()
+    width = max(map(len, scenes), default=0)      # the longest name (33 characters) ran into its description
+    for name, description in scenes.items():
+        print(f"{name:{width}s}  {description}")
     return 0
 
 

@@ -94,6 +94,12 @@ def test_a_bad_override_is_named_as_the_set_it_came_from(argv, expected, tmp_pat
 def test_scenes_lists_builtins():
     proc = housingfe("scenes")
     assert proc.returncode == 0
+    # one column of names, the descriptions aligned after it (test-gearbox-runup-double-helical ran into its own)
+    from housingfe.scenefile import builtin_scenes
+
+    scenes = builtin_scenes()
+    starts = {line.index(scenes[line.split()[0]]) for line in proc.stdout.splitlines()}
+    assert starts == {max(map(len, scenes)) + 2}, starts
     assert "box-free" in proc.stdout and "nafems-fv12" in proc.stdout
 
 
