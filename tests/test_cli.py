@@ -163,3 +163,20 @@ def test_every_subcommand_help_says_what_it_does():
     # one end to end: the console entry prints it and exits 0
     proc = housingfe("scenes", "--help")
     assert proc.returncode == 0 and "List the built-in scenes." in proc.stdout, proc.stdout + proc.stderr
+
+
+@pytest.mark.parametrize("example, command", [("study_family.toml", "housingfe study"),
+                                              ("correlate_box.toml", "housingfe update")])
+def test_run_on_a_family_file_or_update_spec_names_the_command_that_takes_it(example, command, tmp_path, capsys,
+                                                                            monkeypatch):
+    """`housingfe run examples/study_family.toml` (the examples folder holds scenes' neighbours) said "name: unknown
+    key (also missing: geometry, analysis; ...)"; now one line naming the command that takes the file."""
+    from housingfe import cli
+
+    path = Path(__file__).resolve().parents[1] / "examples" / example
+    monkeypatch.chdir(tmp_path)
+    code = cli.main(["run", str(path)])
+    err = capsys.readouterr().err
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
+    assert err.startswith(f"housingfe: error: {path}: ") and f"run it with `{command} {path}`" in err, err
+    assert not list(tmp_path.iterdir())
