@@ -745,6 +745,10 @@ SWEEP_CASES = [
     # passed the check, built the model and did not finish
     ("bearing-variants-torque", ["bearing-variants", "--torque", "-5", "--out", "bv"],
      ["--torque", "-5 must be a pinion torque > 0 N m"]),
+    # a misspelt scene name was refused only when validate reached it: after the scenes before it (box-free: an FE
+    # run) and a progress line
+    ("validate-unknown-scene", ["validate", "box-free", "no-such-scene", "--out", "v"],
+     ["no-such-scene: no such scene"]),
     # a misspelt --configs name was refused only after the housing model was built (16 s, a progress line first)
     ("bearing-variants-config-unknown", ["bearing-variants", "--configs", "ball", "bogus", "--out", "bv"],
      ["--configs: 'bogus': unknown (known: ball,", "ball_zero_moment"]),
