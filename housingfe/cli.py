@@ -135,6 +135,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _OneLineParser(
         prog="housingfe", description="Gearbox noise: gear source, bearings, FE housing, radiation."
     )
+    from housingfe import __version__
+
+    # `housingfe --version` said "the following arguments are required: command"
+    parser.add_argument("--version", action="version", version=f"housingfe {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("run", help="run the analyses a scene lists (built-in name or TOML path)")

@@ -163,6 +163,10 @@ def test_every_subcommand_help_says_what_it_does():
     # one end to end: the console entry prints it and exits 0
     proc = housingfe("scenes", "--help")
     assert proc.returncode == 0 and "List the built-in scenes." in proc.stdout, proc.stdout + proc.stderr
+    import housingfe as package
+
+    proc = housingfe("--version")
+    assert proc.returncode == 0 and proc.stdout.strip() == f"housingfe {package.__version__}", proc.stdout + proc.stderr
 
 
 @pytest.mark.parametrize("example, command", [("study_family.toml", "housingfe study"),
