@@ -707,6 +707,9 @@ SWEEP_CASES = [
     ("bench-size-infinite", ["bench", "imported", "--size", "inf"], ["--size", "inf must be a finite positive"]),
     # correlate: a non-positive --f-max was a ValueError traceback after meshing, --loss-factor was not checked,
     # an --export into a folder (or a missing one) a traceback after the solve, with <name>.tmp left behind
+    # --out with --export was ignored silently (the solve ran, only the .uff was written, the folder never)
+    ("correlate-export-with-out", ["correlate", "box-free", "--export", "x.uff", "--out", "c"],
+     ["--out: c: applies to --measured", "--export writes the one file x.uff"]),
     ("correlate-f-max-negative", ["correlate", "box-free", "--export", "x.uff", "--f-max", "-100"],
      ["--f-max", "-100 Hz must be a finite positive"]),
     ("correlate-loss-factor", ["correlate", "box-free", "--export", "x.uff", "--loss-factor", "1.5"],
