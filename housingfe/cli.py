@@ -220,10 +220,17 @@ def main(argv: list[str] | None = None) -> int:
     stops every rank together (housingfe.ranks.stop_together): its line printed once, never one rank left
     waiting in a collective."""
     import logging
+    import os
 
     from housingfe import ranks
 
     logging.disable(logging.INFO)  # FFCx/distutils report each JIT compile at INFO
+    # PETSc traps SIGPIPE (and other signals) when it initialises: `housingfe describe mesh.toml | head` then ended
+    # in "PETSC ERROR: Caught signal number 13 Broken Pipe" and MPI_ABORT (exit 59) instead of stopping quietly
+    # (the BrokenPipeError below); set before any PETSc import, inherited by the worker processes
+    petsc_options = os.environ.get("PETSC_OPTIONS", "")
+    if "-no_signal_handler" not in petsc_options.split():
+        os.environ["PETSC_OPTIONS"] = f"{petsc_options} -no_signal_handler".strip()
     comm = ranks.world()
     _OneLineParser.quiet = comm is not None and comm.rank != 0
     parser = build_parser()

@@ -184,3 +184,18 @@ def test_run_on_a_family_file_or_update_spec_names_the_command_that_takes_it(exa
     assert code == 2 and err.count("\n") == 1 and "Traceback" not in err, err
     assert err.startswith(f"housingfe: error: {path}: ") and f"run it with `{command} {path}`" in err, err
     assert not list(tmp_path.iterdir())
+
+
+def test_a_reader_that_stops_early_ends_the_run_quietly(tmp_path):
+    """`housingfe run ... | head`: PETSc, once imported, trapped SIGPIPE and ended the run with "PETSC ERROR: Caught
+    signal number 13 Broken Pipe" and MPI_ABORT (exit 59); the CLI now starts PETSc without its signal handlers, so
+    the closed pipe is Python's BrokenPipeError, which the CLI turns into a quiet exit 141."""
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
+    cmd = [sys.executable, "-m", "housingfe", "run", "box-free", "--out", str(tmp_path / "box"), "--set",
+           "mesh.degree=1", "--set", "mesh.size=0.04", "--set", "analysis.modal.f_max=300.0", "--set",
+           "output.pictures=false"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, cwd=tmp_path)
+    proc.stdout.close()                     # the reader is gone before the run prints its summary
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=300) == 141, err
+    assert "PETSC ERROR" not in err and "MPI_ABORT" not in err and "Traceback" not in err, err
