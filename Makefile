@@ -9,7 +9,7 @@ export OPENBLAS_NUM_THREADS = 1
 bootstrap:
 	@bash scripts/bootstrap.sh
 
-# the main job: the Ch. 5 test gearbox's run-up, gear set -> L_WA over speed (about a minute)
+# the main job: the Ch. 5 test gearbox's run-up, gear set -> L_WA over speed (~15 s on a quiet machine, README.md)
 demo: bootstrap
 	$(VENV)/bin/housingfe run test-gearbox-runup --out results/test-gearbox-runup
 

@@ -34,8 +34,10 @@ _EXTENSIONS = (
 def _cmd_scenes(args: argparse.Namespace) -> int:
     from housingfe import scenefile
 
-    for name, description in scenefile.builtin_scenes().items():
-        print(f"{name:24s} {description}")
+    scenes = scenefile.builtin_scenes()
+    width = max(map(len, scenes), default=0)      # the longest name (33 characters) ran into its description
+    for name, description in scenes.items():
+        print(f"{name:{width}s}  {description}")
     return 0
 
 
@@ -133,6 +135,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _OneLineParser(
         prog="housingfe", description="Gearbox noise: gear source, bearings, FE housing, radiation."
     )
+    from housingfe import __version__
+
+    # `housingfe --version` said "the following arguments are required: command"
+    parser.add_argument("--version", action="version", version=f"housingfe {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     p = sub.add_parser("run", help="run the analyses a scene lists (built-in name or TOML path)")
@@ -187,7 +193,22 @@ def build_parser() -> argparse.ArgumentParser:
 
     for name in _EXTENSIONS:
         _register_extension(name, sub)
+    _describe_subcommands(parser)
     return parser
+
+
+def _describe_subcommands(parser: argparse.ArgumentParser) -> None:
+    """`housingfe CMD --help` says what CMD does: a sub-command registered with a help line but no description
+    (argparse shows the help only in the parent's list) gets that line as its description, at every level."""
+    for action in parser._actions:
+        if not isinstance(action, argparse._SubParsersAction):
+            continue
+        helps = {choice.dest: choice.help for choice in action._choices_actions}
+        for name, child in action.choices.items():
+            if child.description is None and helps.get(name):
+                line = helps[name]
+                child.description = line[0].upper() + line[1:] + ("" if line.endswith(".") else ".")
+            _describe_subcommands(child)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -199,10 +220,17 @@ def main(argv: list[str] | None = None) -> int:
     stops every rank together (housingfe.ranks.stop_together): its line printed once, never one rank left
     waiting in a collective."""
     import logging
+    import os
 
     from housingfe import ranks
 
     logging.disable(logging.INFO)  # FFCx/distutils report each JIT compile at INFO
+    # PETSc traps SIGPIPE (and other signals) when it initialises: `housingfe describe mesh.toml | head` then ended
+    # in "PETSC ERROR: Caught signal number 13 Broken Pipe" and MPI_ABORT (exit 59) instead of stopping quietly
+    # (the BrokenPipeError below); set before any PETSc import, inherited by the worker processes
+    petsc_options = os.environ.get("PETSC_OPTIONS", "")
+    if "-no_signal_handler" not in petsc_options.split():
+        os.environ["PETSC_OPTIONS"] = f"{petsc_options} -no_signal_handler".strip()
     comm = ranks.world()
     _OneLineParser.quiet = comm is not None and comm.rank != 0
     parser = build_parser()

@@ -464,7 +464,7 @@ def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: 
         size_ladder,
     )
     from housingfe.geometry.mesh import estimate_dofs
-    from housingfe.geometry.registry import block_model_for
+    from housingfe.geometry.registry import block_model_for, own_mesh_kind
     from housingfe.geometry.surfaces import bounding_box
     from housingfe.outputs import format_table
     from housingfe.scene import load_housing_scene
@@ -485,30 +485,40 @@ def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: 
         raise InputError(f"{path}: scene.kind: describe knows housing and run-up scenes; this is a {kind} scene")
     scene, path = load_housing_scene(name_or_path, overrides)
     g = scene.geometry
-    model = block_model_for(g)
-    lo, hi = bounding_box(model)
     out = [f"scene {scene.scene.name} ({path}): {scene.scene.description}".rstrip(": "),
            f"geometry kind \"{g.kind}\" (lengths in m):"]
     dims = [(k, v) for k, v in g.model_dump().items() if k != "kind"]
     out += [f"  {k} = {_value_text(v)}" for k, v in dims]
-    out.append(f"material bounding box: x {lo[0]:g} .. {hi[0]:g}, y {lo[1]:g} .. {hi[1]:g}, z {lo[2]:g} .. "
-               f"{hi[2]:g} m; volume {model.volume():.4g} m^3, centroid ("
-               + ", ".join(f"{c:.4g}" if abs(c) > 1e-12 else "0" for c in model.centroid()) + ") m")
-    note = _coordinates_note(type(g))
-    if note:
-        out.append(note)
-    rows = surface_rows(model)
-    out += ["", f"surfaces ({len(rows)}; use these names in supports, loads, radiation plates, coupling bores):",
-            format_table(["surface", "area m^2", "outward normals", "bounds features"], rows)]
-    if model.points:
-        out += ["", "points (m):"]
-        out += [f"  {name}: " + "; ".join("(" + ", ".join(f"{c:g}" for c in p) + ")" for p in pts)
-                for name, pts in model.points.items()]
-    if model.bores:
-        out += ["", "bores (m):"]
-        out += [f"  {b.name}: axis {'xyz'[b.axis]} through ({', '.join(f'{c:g}' for c in b.centre)}), "
-                f"diameter {2 * b.radius:g}" + (f", also in {', '.join(b.groups)}" if b.groups else "")
-                for b in model.bores]
+    imported = own_mesh_kind(g) is not None
+    if imported:
+        # a CAD file or a mesh file: no block model; what the file holds and what the scene names in it
+        try:
+            lines, volume = _imported_geometry_lines(g)
+        except InputError as exc:       # name the scene, as `housingfe run` does
+            raise InputError(f"{path}: {exc}") from None
+        out += lines
+    else:
+        model = block_model_for(g)
+        volume = model.volume()
+        lo, hi = bounding_box(model)
+        out.append(f"material bounding box: x {lo[0]:g} .. {hi[0]:g}, y {lo[1]:g} .. {hi[1]:g}, z {lo[2]:g} .. "
+                   f"{hi[2]:g} m; volume {volume:.4g} m^3, centroid ("
+                   + ", ".join(f"{c:.4g}" if abs(c) > 1e-12 else "0" for c in model.centroid()) + ") m")
+        note = _coordinates_note(type(g))
+        if note:
+            out.append(note)
+        rows = surface_rows(model)
+        out += ["", f"surfaces ({len(rows)}; use these names in supports, loads, radiation plates, coupling bores):",
+                format_table(["surface", "area m^2", "outward normals", "bounds features"], rows)]
+        if model.points:
+            out += ["", "points (m):"]
+            out += [f"  {name}: " + "; ".join("(" + ", ".join(f"{c:g}" for c in p) + ")" for p in pts)
+                    for name, pts in model.points.items()]
+        if model.bores:
+            out += ["", "bores (m):"]
+            out += [f"  {b.name}: axis {'xyz'[b.axis]} through ({', '.join(f'{c:g}' for c in b.centre)}), "
+                    f"diameter {2 * b.radius:g}" + (f", also in {', '.join(b.groups)}" if b.groups else "")
+                    for b in model.bores]
     if scene.supports:
         out += ["", "supports:"] + [f"  {s.kind} on {s.surface}" + (
             f" (normal {s.normal_stiffness:g} N/m^3)" if s.normal_stiffness else "") for s in scene.supports]
@@ -540,21 +550,84 @@ def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: 
     f_mesh = a.f_max if mesh_f_max is None else mesh_f_max
     size = element_size(m, g, f_mesh, material)
     unrounded = derived_element_size(m, g, f_mesh, material)
-    rule = "mesh.size" if m.size is not None else (
-        f"bending wavelength of the thinnest wall ({g.min_thickness * 1e3:g} mm) at {f_mesh:g} Hz / "
-        f"mesh.elements_per_wavelength = {m.elements_per_wavelength:g} = {unrounded * 1e3:.7g} mm, rounded down to "
-        f"{DERIVED_SIZE_DIGITS} significant digits; only if that mesh fails the quality rule, finer: "
-        f"{', '.join(format(s * 1e3, 'g') for s in size_ladder(size)[1:])} mm")
     dofs = estimate_dofs(g, m.element, m.degree, size, m.layers, m.layer_size)
     memory = MEMORY_BASE_BYTES + MEMORY_PER_DOF_BYTES * dofs
-    out += ["", f"mesh: {m.element} degree {m.degree}, element size {size * 1e3:.3g} mm ({rule}), "
-                f"{'layer size ' + format(m.layer_size * 1e3, 'g') + ' mm' if m.layer_size else f'{m.layers} layer(s)'}"
-                " through the walls",
-            f"  estimated ~{dofs:,} DOFs, ~{memory / 1e9:.1f} GB (housingfe.geometry.mesh.estimate_dofs: within "
-            "10 % for hexes, a factor 3 for tets)",
-            f"material {material.name}: E = {material.youngs_modulus:.4g} Pa, nu = {material.poisson_ratio:g}, "
-            f"rho = {material.density:g} kg/m^3; mass ~{material.density * model.volume():.4g} kg"]
+    if g.min_thickness is None and m.size is None:      # a mesh file: its own cells
+        out += ["", f"mesh: the file's cells, displacement degree {m.degree} (mesh.element, size and layers do not "
+                    "apply to a mesh file)",
+                f"  ~{dofs:,} DOFs (counted from the file), ~{memory / 1e9:.1f} GB"]
+    else:
+        rule = "mesh.size" if m.size is not None else (
+            f"bending wavelength of the thinnest wall ({g.min_thickness * 1e3:g} mm"
+            + (", estimated from the CAD file" if imported and getattr(g, "thickness", None) is None else "")
+            + f") at {f_mesh:g} Hz / mesh.elements_per_wavelength = {m.elements_per_wavelength:g} = "
+            f"{unrounded * 1e3:.7g} mm, rounded down to {DERIVED_SIZE_DIGITS} significant digits; only if that mesh "
+            f"fails the quality rule, finer: {', '.join(format(s * 1e3, 'g') for s in size_ladder(size)[1:])} mm")
+        layers = ("" if imported else ", " + (f"layer size {m.layer_size * 1e3:g} mm" if m.layer_size
+                                             else f"{m.layers} layer(s)") + " through the walls")
+        out += ["", f"mesh: {m.element} degree {m.degree}, element size {size * 1e3:.3g} mm ({rule}){layers}",
+                f"  estimated ~{dofs:,} DOFs, ~{memory / 1e9:.1f} GB (housingfe.geometry.mesh.estimate_dofs: within "
+                "10 % for hexes, a factor 3 for tets)"]
+    out.append(f"material {material.name}: E = {material.youngs_modulus:.4g} Pa, nu = {material.poisson_ratio:g}, "
+               f"rho = {material.density:g} kg/m^3; "
+               + (f"mass ~{material.density * volume:.4g} kg" if volume is not None
+                  else "mass: from the meshed volume (housingfe run reports it)"))
     return "\n".join(out)
+
+
+def _imported_geometry_lines(g) -> tuple[list[str], float | None]:
+    """describe's lines for a geometry that brings its own mesh (kind "cad" or "mesh"): what the file holds and
+    the surfaces the scene names in it (checked as a run checks them: an unknown set or a selector that matches
+    nothing stops with its key), and the volume (m^3) where it is known without meshing (CAD), else None."""
+    import numpy as np
+
+    from housingfe.outputs import format_table
+
+    if g.kind == "cad":
+        from housingfe.geometry.cad import cad_facts, face_groups
+
+        facts = cad_facts(g)
+        lo, hi = facts.lo, facts.hi
+        area: dict[str, float] = {}
+        kinds: dict[str, set] = {}
+        groups = face_groups(g, facts)
+        for face in facts.faces:
+            for name in groups[face.tag]:
+                area[name] = area.get(name, 0.0) + face.area
+                kinds.setdefault(name, set()).add(face.kind)
+        rows = [[n, f"{area[n]:.4g}", ", ".join(sorted(kinds[n]))] for n in sorted(area, key=_natural)]
+        lines = [f"CAD file: {facts.solids} solid(s); bounding box x {lo[0]:.4g} .. {hi[0]:.4g}, y {lo[1]:.4g} .. "
+                 f"{hi[1]:.4g}, z {lo[2]:.4g} .. {hi[2]:.4g} m; volume {facts.volume:.4g} m^3, centroid ("
+                 + ", ".join(f"{c:.4g}" if abs(c) > 1e-12 else "0" for c in facts.centroid) + ") m; thinnest wall "
+                 f"~{facts.thin_wall * 1e3:.3g} mm (`housingfe inspect` lists bores and flat faces)",
+                 "", f"surfaces ({len(rows)}; use these names in supports, loads, radiation plates, coupling bores):",
+                 format_table(["surface", "area m^2", "faces"], rows)]
+        return lines, facts.volume
+    from housingfe.geometry.imported_mesh import _groups, read_mesh_file
+
+    mf = read_mesh_file(g.file, g.units)
+    facet_groups, values, _ = _groups(mf, g, "geometry")
+    pts = mf.points
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    corners = pts[mf.boundary]                      # (F, 3 or 4, 3): the boundary facets' corners
+    tri = 0.5 * np.linalg.norm(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]), axis=1)
+    if corners.shape[1] == 4:                       # a quadrilateral: its two triangles (0, 1, 2) and (0, 2, 3)
+        tri = tri + 0.5 * np.linalg.norm(np.cross(corners[:, 2] - corners[:, 0], corners[:, 3] - corners[:, 0]),
+                                         axis=1)
+    rows = []
+    for name, tags in facet_groups.items():
+        mask = np.isin(values, tags)
+        rows.append([name, f"{tri[mask].sum():.4g}", f"{int(mask.sum())}"])
+    sets = ", ".join(sorted(set(mf.node_sets) | set(mf.surface_sets))) or "none"
+    lines = [f"mesh file: {len(mf.cells):,} {mf.source_cell} cells, {len(pts):,} nodes; bounding box x {lo[0]:.4g} .. "
+             f"{hi[0]:.4g}, y {lo[1]:.4g} .. {hi[1]:.4g}, z {lo[2]:.4g} .. {hi[2]:.4g} m; median edge "
+             f"{mf.element_size * 1e3:.3g} mm",
+             f"node and surface sets in the file: {sets}",
+             f"cell sets (for [regions]): {', '.join(sorted(mf.cell_sets)) or 'none'}",
+             "", f"surfaces ({len(rows)}; use these names in supports, loads, radiation plates, coupling bores; "
+                 "areas of the straight facets):",
+             format_table(["surface", "area m^2", "facets"], rows)]
+    return lines, None
 
 
 def _value_text(v) -> str:

@@ -38,9 +38,18 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     write its result folder; returns its path."""
     from housingfe.scenefile import read_scene_dict
 
-    data, _ = read_scene_dict(name_or_path)
+    data, path = read_scene_dict(name_or_path)
     info = data.get("scene")
     kind = info.get("kind") if isinstance(info, dict) else None
+    if not isinstance(info, dict):
+        # the other TOML files of the package are no scenes: say which command takes them (else the housing
+        # schema reported "name: unknown key (also missing: geometry, analysis; ...)")
+        if "variants" in data:
+            raise InputError(f"{path}: a design-variant family file ([[variants]]), not a scene: run it with "
+                             f"`housingfe study {name_or_path}`")
+        if "parameters" in data and "targets" in data:
+            raise InputError(f"{path}: a model-updating spec ([[parameters]], [[targets]]), not a scene: run it "
+                             f"with `housingfe update {name_or_path}`")
     runner = SCENE_RUNNERS.get(kind, run_housing_scene)
     return runner(name_or_path, out_dir, overrides)
 

@@ -21,7 +21,14 @@ from housingfe.drivetrain.interior import CouplingSpec
 from housingfe.errors import InputError
 from housingfe.geometry.specs import Geometry
 from housingfe.materials import LIBRARY, Material
-from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table, read_scene_dict
+from housingfe.scenefile import (
+    SceneInfo,
+    _Strict,
+    apply_overrides,
+    naming_the_override,
+    parse_table,
+    read_scene_dict,
+)
 
 
 class MaterialSpec(_Strict):
@@ -366,7 +373,33 @@ def load_housing_scene(name_or_path: str, overrides: list[str] | None = None) ->
         raise InputError(f"{path}: scene.kind: this is a run-up scene, not a housing scene; run it with "
                          "`housingfe run`")
     _resolve_geometry_file(data, path)
-    return parse_table(HousingScene, data, path), path
+    try:
+        scene = parse_table(HousingScene, data, path)
+        _check_block_extent(scene.geometry, path)
+    except InputError as exc:
+        raise naming_the_override(exc, overrides) from None
+    return scene, path
+
+
+# the largest extent of a built-in (block-model) housing, as for CAD and mesh files (geometry.cad,
+# geometry.imported_mesh): beyond it a scene was almost surely written in millimetres
+PLAUSIBLE_BLOCK_EXTENT_M = 20.0
+
+
+def _check_block_extent(geometry, path: Path) -> None:
+    """InputError naming the key when a top-level length of a built-in (block-model) housing exceeds
+    PLAUSIBLE_BLOCK_EXTENT_M: lengths in millimetres would otherwise mesh a 325 m box (the memory guard stops only
+    some of them, and with `mesh.size` in millimetres too nothing would).  The spec's own fields, not its block
+    model: building that costs 0.2 s for a gearbox, on every scene load."""
+    from housingfe.geometry.registry import own_mesh_kind
+
+    if own_mesh_kind(geometry) is not None:
+        return      # CAD and mesh files check their own extent against their `units`
+    for key, value in geometry.model_dump().items():
+        if isinstance(value, float) and value > PLAUSIBLE_BLOCK_EXTENT_M:
+            raise InputError(f"{path}: geometry.{key}: {value:g} m is implausible for a housing (at most "
+                             f"{PLAUSIBLE_BLOCK_EXTENT_M:g} m across); scene lengths are in m: it looks like "
+                             f"millimetres ({value:g} mm = {value / 1e3:g} m)")
 
 
 def _resolve_geometry_file(data: dict, path: Path) -> None:

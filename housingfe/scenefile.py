@@ -147,6 +147,17 @@ def apply_overrides(data: dict, overrides: list[str], source: str = "--set") -> 
     return data
 
 
+def naming_the_override(exc: InputError, overrides: list[str] | None, source: str = "--set") -> InputError:
+    """The error of a scene check, with " (from --set KEY=VALUE)" added when the key it names came from an override:
+    `housingfe run box-free --set mesh.sise=0.01` named only the built-in scene file, which holds no such key."""
+    message = str(exc)
+    for item in overrides or []:
+        key = item.split("=", 1)[0].strip()
+        if key and (f": {key}:" in message or f": {key}." in message):
+            return InputError(f"{message} (from {source} {item})")
+    return exc
+
+
 def parse_table(model_cls, data, path, prefix: str = ""):
     """model_cls.model_validate(data), or InputError "<path>: <prefix><key>: <problem>" naming the first bad
     key (an unknown key before the missing one it causes).  Shared by every kind of scene."""

@@ -707,6 +707,9 @@ SWEEP_CASES = [
     ("bench-size-infinite", ["bench", "imported", "--size", "inf"], ["--size", "inf must be a finite positive"]),
     # correlate: a non-positive --f-max was a ValueError traceback after meshing, --loss-factor was not checked,
     # an --export into a folder (or a missing one) a traceback after the solve, with <name>.tmp left behind
+    # --out with --export was ignored silently (the solve ran, only the .uff was written, the folder never)
+    ("correlate-export-with-out", ["correlate", "box-free", "--export", "x.uff", "--out", "c"],
+     ["--out: c: applies to --measured", "--export writes the one file x.uff"]),
     ("correlate-f-max-negative", ["correlate", "box-free", "--export", "x.uff", "--f-max", "-100"],
      ["--f-max", "-100 Hz must be a finite positive"]),
     ("correlate-loss-factor", ["correlate", "box-free", "--export", "x.uff", "--loss-factor", "1.5"],
@@ -745,6 +748,13 @@ SWEEP_CASES = [
     # passed the check, built the model and did not finish
     ("bearing-variants-torque", ["bearing-variants", "--torque", "-5", "--out", "bv"],
      ["--torque", "-5 must be a pinion torque > 0 N m"]),
+    # a misspelt scene name was refused only when validate reached it: after the scenes before it (box-free: an FE
+    # run) and a progress line
+    ("validate-unknown-scene", ["validate", "box-free", "no-such-scene", "--out", "v"],
+     ["no-such-scene: no such scene"]),
+    # a misspelt --configs name was refused only after the housing model was built (16 s, a progress line first)
+    ("bearing-variants-config-unknown", ["bearing-variants", "--configs", "ball", "bogus", "--out", "bv"],
+     ["--configs: 'bogus': unknown (known: ball,", "ball_zero_moment"]),
     ("reduce-cutoff-infinite", ["reduce", "test-gearbox-interior", "--cutoff", "inf", "--out", "r"],
      ["--cutoff", "inf Hz must be a finite positive"]),
     # a cut-off far above what the mesh resolves meshed the housing, then the eigensolver failed (exit 3, PETSc's

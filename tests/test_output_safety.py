@@ -184,6 +184,34 @@ def test_other_commands_refuse_a_user_folder_too(work):
     assert not (work / "cache").exists()
 
 
+@pytest.mark.parametrize("argv, module, attr", [
+    (["source-spectrum"], "housingfe.source.roosmalen.studies", "excitation_spectrum"),
+    (["radiation", "foller", "builtin:scale-model"], "housingfe.radiation.foller", "foller_radiation_index"),
+])
+def test_spectrum_and_foller_refuse_a_user_folder_before_computing(argv, module, attr, work, capsys, monkeypatch):
+    """`source-spectrum --out mine` computed for over a minute before refusing; `radiation foller --out mine`
+    printed its whole table (looking like a finished run) and then refused.  Now the place is checked first: the
+    computation is never reached, nothing on stdout."""
+    import importlib
+
+    from housingfe import cli
+
+    mine = work / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("precious")
+
+    def reached(*args, **kwargs):
+        raise AssertionError(f"{attr} ran before the output place was checked")
+
+    monkeypatch.setattr(importlib.import_module(module), attr, reached)
+    monkeypatch.chdir(work)
+    code = cli.main([*argv, "--out", "mine"])
+    captured = capsys.readouterr()
+    assert_refused(subprocess.CompletedProcess([], code, captured.out, captured.err), "mine", "not a housingfe result")
+    assert not captured.out.strip(), captured.out
+    assert (mine / "notes.txt").read_text() == "precious" and sorted(p.name for p in mine.iterdir()) == ["notes.txt"]
+
+
 @pytest.mark.parametrize("name", ["", "  ", ".", "..", "../escaped", "a/b", ".hidden", "back\\\\slash"])
 def test_empty_or_path_like_scene_name_is_refused(name, work, capsys, monkeypatch):
     """name = "" used to make results/ itself the output (every earlier result deleted), "../x" a place outside.

@@ -135,3 +135,69 @@ def test_describe_runup_scene_describes_its_housing():
     text = describe("test-gearbox-runup")
     assert "its housing is the scene test-gearbox" in text and "runup.f_max_hz = 4000 Hz" in text
     assert 'geometry kind "gearbox"' in text and "bore_pinion" in text and "at 4000 Hz" in text
+
+
+def _block_file(path: Path, scale: float) -> Path:
+    """A 300 x 200 x 40 mm block written by gmsh (coordinates x scale: 1 = mm, 1e-3 = m), its underside a
+    physical surface FEET; a .msh gets 3-D elements, a .step only the solid."""
+    import gmsh
+
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("block")
+        v = gmsh.model.occ.addBox(0, 0, 0, 300 * scale, 200 * scale, 40 * scale)
+        gmsh.model.occ.synchronize()
+        if path.suffix == ".msh":
+            bottom = [t for d, t in gmsh.model.getBoundary([(3, v)], oriented=False)
+                      if abs(gmsh.model.occ.getCenterOfMass(2, t)[2]) < 1e-9]
+            gmsh.model.setPhysicalName(3, gmsh.model.addPhysicalGroup(3, [v]), "solid")
+            gmsh.model.setPhysicalName(2, gmsh.model.addPhysicalGroup(2, bottom), "FEET")
+            gmsh.option.setNumber("Mesh.MeshSizeMax", 40 * scale)
+            gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+            gmsh.model.mesh.generate(3)
+        gmsh.write(str(path))
+    finally:
+        gmsh.finalize()
+    return path
+
+
+def test_describe_a_mesh_file_scene(tmp_path):
+    """`housingfe describe` on `kind = "mesh"` (before: "geometry.kind: a 'mesh' geometry is a mesh, not a block
+    model", exit 2): the file's extent in m, its sets, and the named surfaces' areas, which for a block are exact
+    (outer skin 2 (0.3 x 0.2 + 0.3 x 0.04 + 0.2 x 0.04) = 0.16 m^2, the underside 0.06 m^2); a set the file lacks is
+    one line naming the scene and the key."""
+    _block_file(tmp_path / "block.msh", 1.0)
+    scene = tmp_path / "block.toml"
+    text = ('[scene]\nname = "block"\nkind = "housing"\n[geometry]\nkind = "mesh"\nfile = "block.msh"\n'
+            'units = "mm"\n[[geometry.surfaces]]\nname = "feet"\nset = "FEET"\n[mesh]\ndegree = 2\n'
+            "[analysis.modal]\nf_max = 3000.0\n")
+    scene.write_text(text)
+    out = describe(str(scene))
+    assert out.startswith("scene block ("), out[:200]          # nothing before it (meshio's stray blank line)
+    assert "bounding box x 0 .. 0.3, y 0 .. 0.2, z 0 .. 0.04 m" in out
+    areas = {m.group(1): float(m.group(2)) for m in re.finditer(r"^\s*(outer|feet)\s+([0-9.e-]+)\s+\d+$", out, re.M)}
+    assert areas == pytest.approx({"outer": 0.16, "feet": 0.06}, rel=1e-9), out
+    assert "DOFs (counted from the file)" in out
+    scene.write_text(text.replace('set = "FEET"', 'set = "FEEET"'))
+    proc = subprocess.run([str(HOUSINGFE), "describe", str(scene)], capture_output=True, text=True, timeout=60,
+                          check=False)
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert str(scene) in proc.stderr and "geometry.surfaces.0.set: no node or surface set 'FEEET'" in proc.stderr
+    assert "Traceback" not in proc.stderr and not proc.stdout.strip()
+
+
+def test_describe_a_cad_scene(tmp_path):
+    """`housingfe describe` on `kind = "cad"` (before: "geometry.kind: an imported CAD housing has no block model",
+    exit 2): volume 0.3 x 0.2 x 0.04 = 2.4e-3 m^3 and the mass 18.84 kg of steel, the skin 0.16 m^2, the selected
+    underside 0.06 m^2, the element size from the thinnest wall the file gives (40 mm)."""
+    _block_file(tmp_path / "block.step", 1e-3)
+    scene = tmp_path / "block.toml"
+    scene.write_text('[scene]\nname = "block"\nkind = "housing"\n[geometry]\nkind = "cad"\nfile = "block.step"\n'
+                     'units = "m"\n[[geometry.surfaces]]\nname = "feet"\nplane = { point = [0.1, 0.1, 0.0], '
+                     'normal = [0, 0, -1] }\n[material]\nname = "steel"\n[analysis.modal]\nf_max = 3000.0\n')
+    out = describe(str(scene))
+    assert "volume 0.0024 m^3" in out and "mass ~18.84 kg" in out, out
+    areas = {m.group(1): float(m.group(2)) for m in re.finditer(r"^\s*(outer|feet)\s+([0-9.e-]+)\s+plane$", out, re.M)}
+    assert areas == pytest.approx({"outer": 0.16, "feet": 0.06}, rel=1e-6), out
+    assert "thinnest wall (40 mm, estimated from the CAD file)" in out

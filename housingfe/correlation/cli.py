@@ -77,6 +77,9 @@ def _cmd_correlate(args: argparse.Namespace) -> int:
     if not 0.0 <= args.loss_factor < 1.0:
         raise InputError(f"--loss-factor: {args.loss_factor:g} is not in [0, 1)")
     if args.export is not None:
+        if args.out is not None:    # it was ignored: the modes were solved and only FILE.uff written
+            raise InputError(f"--out: {args.out}: applies to --measured (its result folder); --export writes the one "
+                             f"file {args.export}")
         check_export_path(args.export)
     from mpi4py import MPI
 

@@ -230,7 +230,9 @@ def import_solid(path: Path, units: str, heal: str = "auto", key: str | None = "
     if not gmsh.model.getEntities():
         raise InputError(f"{where}: the file holds no geometry")
     x0, y0, z0, x1, y1, z1 = gmsh.model.getBoundingBox(-1, -1)
-    check_units(max(x1 - x0, y1 - y0, z1 - z0) / scale, units, f"{where}: units")
+    # a scene's key is geometry.units; `housingfe inspect` (key None) takes the unit as its flag --units
+    check_units(max(x1 - x0, y1 - y0, z1 - z0) / scale, units, f"{where}: units" if key else f"{where}: --units",
+                flag=not key)
     solids = gmsh.model.getEntities(3)
     if heal == "always" or (heal == "auto" and not solids):
         # the solids if there are any (healing everything turns solids into loose faces in gmsh 4.8), else
@@ -268,16 +270,16 @@ def import_solid(path: Path, units: str, heal: str = "auto", key: str | None = "
     return {"solids": solids, "volumes": volumes, "scale": scale}
 
 
-def check_units(extent: float, units: str, key: str) -> None:
+def check_units(extent: float, units: str, key: str, flag: bool = False) -> None:
     """InputError (naming `key`) when a largest extent of `extent` (in `units`) is implausible for a housing,
-    saying which unit would fit."""
+    saying which unit would fit (as the scene value `units = "mm"`, or with flag as the option `--units mm`)."""
     metres = extent * UNIT_SCALE[units]
     lo, hi = PLAUSIBLE_EXTENT_M
     if lo <= metres <= hi:
         return
     fits = [u for u, s in UNIT_SCALE.items() if lo <= extent * s <= hi and u != units]
-    hint = f"; this looks like {'millimetres' if fits == ['mm'] else 'metres'}: set units = \"{fits[0]}\"" \
-        if fits else ""
+    fix = f"give --units {fits[0]}" if flag and fits else f"set units = \"{fits[0]}\"" if fits else ""
+    hint = f"; this looks like {'millimetres' if fits == ['mm'] else 'metres'}: {fix}" if fits else ""
     # 3 digits: OpenCASCADE's bounding box carries the shape tolerance (0.2002 mm for a 0.2 mm part)
     raise InputError(f"{key}: the part is {extent:.3g} {units} across ({metres:.3g} m), implausible for a housing "
                      f"({lo * 1e3:g} mm to {hi:g} m){hint}")

@@ -32,6 +32,8 @@ naming the mesh file and the scene key, raised on all ranks.
 """
 from __future__ import annotations
 
+import contextlib
+import io
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -145,7 +147,10 @@ def read_mesh_file(path, units: str, key: str = "geometry") -> MeshFile:
     if stamp in _CACHE:
         return _CACHE[stamp]
     try:
-        raw = meshio.read(str(path))
+        # meshio 5.0 prints the error of every format it tried first to stdout (a .msh is tried as ANSYS first:
+        # a blank line before our output); a format that fails for good still raises
+        with contextlib.redirect_stdout(io.StringIO()):
+            raw = meshio.read(str(path))
     except Exception as exc:    # meshio raises anything from ReadError to KeyError and IndexError
         what = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InputError(f"{path}: {key}.file: cannot read as a mesh ({what}); meshio reads Abaqus .inp, "

@@ -9,7 +9,7 @@ import numpy as np
 
 from housingfe import levels
 from housingfe.errors import InputError
-from housingfe.outputs import atomic_output_dir, format_table, write_csv, write_json
+from housingfe.outputs import atomic_output_dir, format_table, reserve_output, write_csv, write_json
 from housingfe.radiation import foller
 
 # Quantity name in FollerResult -> (key in the published table, label, format)
@@ -71,6 +71,10 @@ def cmd_foller(args: argparse.Namespace) -> int:
     plates, c = foller.load_plate_table(args.table)
     if not 0 < args.fmin < args.fmax:
         raise InputError("--fmin/--fmax: need 0 < fmin < fmax (Hz)")
+    # the default folder is named after the table, not its path (`/x/plates.toml` made results/radiation-foller-/x/plates)
+    out = Path(args.out or f"results/radiation-foller-{Path(args.table.replace('builtin:', '')).stem}")
+    # a refused --out stops before the table is printed (it read as a finished run followed by an error)
+    reserve_output(out, inputs=[] if args.table.startswith("builtin:") else [args.table])
     bands = levels.third_octave_bands(args.fmin, args.fmax)
     result = foller.foller_radiation_index(plates, bands.center, c=c)
     published = None
@@ -81,8 +85,6 @@ def cmd_foller(args: argparse.Namespace) -> int:
     print(format_table(["quantity", "ours", "printed (App. E)" if published else ""], rows))
     print(f"compact (eq. 4.15): {'yes' if result.is_compact else 'no'}; slope 25 dB/decade "
           "(App. E prints 'dB/octave'; its numbers follow from dB/decade)")
-    # the default folder is named after the table, not its path (`/x/plates.toml` made results/radiation-foller-/x/plates)
-    out = Path(args.out or f"results/radiation-foller-{Path(args.table.replace('builtin:', '')).stem}")
     with atomic_output_dir(out) as tmp:
         write_csv(tmp / "foller.csv",
                   ["band_nominal_hz", "band_center_hz", "L_piston_db", "L_plates_db", "L_sigma_db"],

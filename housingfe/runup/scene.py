@@ -23,7 +23,14 @@ from pydantic import Field, PositiveFloat, PositiveInt, field_validator, model_v
 
 from housingfe.errors import InputError
 from housingfe.scene import RadiationPlate
-from housingfe.scenefile import SceneInfo, _Strict, apply_overrides, parse_table, read_scene_dict
+from housingfe.scenefile import (
+    SceneInfo,
+    _Strict,
+    apply_overrides,
+    naming_the_override,
+    parse_table,
+    read_scene_dict,
+)
 from housingfe.solvers.blas import single_thread
 from housingfe.source.roosmalen.dynamics import DEFAULT_ENGAGEMENT, ENGAGEMENT_MODELS
 from housingfe.source.roosmalen.operating import SPEED_RANGE_RPM
@@ -295,7 +302,10 @@ def load_runup_scene(name_or_path: str, overrides: list[str] | None = None) -> t
         ref = Path(housing["scene"]).expanduser()
         if ref.suffix == ".toml" and not ref.is_absolute() and (path.parent / ref).is_file():
             housing["scene"] = str(path.parent / ref)
-    scene = parse_table(RunupScene, data, path)
+    try:
+        scene = parse_table(RunupScene, data, path)
+    except InputError as exc:
+        raise naming_the_override(exc, overrides) from None
     # a torque beyond the teeth's strength has no load distribution (GearPair.torque_problem, docs/source.md): named
     # here, before the housing is meshed, instead of a solver error in the mesh stiffness
     pair = drivetrain_of(scene.drivetrain, scene.runup.torques_nm[0]).gears.pair

@@ -376,6 +376,12 @@ def _cmd(args: argparse.Namespace) -> int:
     from housingfe.source.roosmalen.run import scene_pair
 
     known = configurations()
+    # a misspelt configuration stops here, not after the housing model is built (16 s)
+    names = [*known, THESIS_SELF_ALIGNING, ZERO_TILT_STIFFNESS, APPENDIX_C_MOMENTS]
+    unknown = [c for c in args.configs or () if c not in names]
+    if unknown:
+        raise InputError(f"bearing-variants: --configs: {', '.join(map(repr, unknown))}: unknown (known: "
+                         f"{', '.join(names)})")
     for gear_set in sorted({known[c].gear_set for c in (args.configs or known) if c in known}):
         problem = scene_pair(GEAR_SCENES[gear_set]).torque_problem(args.torque)
         if problem is not None:       # beyond the teeth's strength: no load distribution (docs/source.md)

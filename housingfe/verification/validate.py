@@ -130,6 +130,11 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
                               + "; ".join(failures))
         return rows
     names = scenes or default_scenes(quick)
+    if scenes:
+        from housingfe.scenefile import resolve_scene_path
+
+        for name in scenes:     # a misspelt name stops here, not after a progress line (or the scenes before it)
+            resolve_scene_path(name)
     rows: list[dict] = []
     failures: list[str] = []
     modal: dict[str, dict] = {}

@@ -252,7 +252,9 @@ def test_bad_cad_input_is_one_line_naming_the_file_and_key(files, tmp_path, caps
         scene = _scene(tmp_path / f"case{n}.toml", {"kind": "cad", **geometry}, **extra)
         _fails(capsys, scene, out, *pieces)
     for args, piece in (([str(files["junk"])], "junk.step: not a STEP, IGES or BREP file"),
-                        ([str(files["block"]), "--units", "mm"], "block.step: units: the part is 0.2 mm across"),
+                        # inspect takes the unit as a flag: the fix it names is the flag, not a scene key
+                        ([str(files["block"]), "--units", "mm"], "block.step: --units: the part is 0.2 mm across "
+                         "(0.0002 m), implausible for a housing (5 mm to 20 m); this looks like metres: give --units m"),
                         ([str(files["open"]), "--units", "m"], "open.step: no closed solid")):
         code = cli.main(["inspect", *args, "--out", str(out)])
         err = capsys.readouterr().err

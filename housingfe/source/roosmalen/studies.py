@@ -235,7 +235,7 @@ def write_excitation_spectrum(rows: list[dict], out_dir: Path) -> dict:
 
 def _cmd_spectrum(args: argparse.Namespace) -> int:
     from housingfe.errors import InputError
-    from housingfe.outputs import atomic_output_dir
+    from housingfe.outputs import atomic_output_dir, reserve_output
     from housingfe.source.cli import load_scene
 
     scenes = args.scenes or list(SPECTRUM_SCENES)
@@ -243,8 +243,10 @@ def _cmd_spectrum(args: argparse.Namespace) -> int:
         raise InputError(f"source-spectrum: --harmonics: {args.harmonics} must be >= 2")
     if args.torque is not None and not (math.isfinite(args.torque) and args.torque > 0):
         raise InputError(f"source-spectrum: --torque: {args.torque:g} must be a pinion torque > 0 N m")
+    paths = []
     for name in scenes:                      # bad names stop here, before any computation or folder
         scene, path = load_scene(name)
+        paths.append(path)
         if scene["source"]["model"] != "roosmalen":
             raise InputError(f"{path}: source.model: source-spectrum needs 'roosmalen', not {scene['source']['model']!r}")
         if args.torque is not None:
@@ -253,8 +255,9 @@ def _cmd_spectrum(args: argparse.Namespace) -> int:
             problem = scene_pair(str(path)).torque_problem(args.torque)
             if problem is not None:
                 raise InputError(f"{path}: --torque: {problem}")
+    # a refused --out (a folder of your own) stops now, not after the minute the spectra take
+    out_dir = reserve_output(args.out, inputs=paths)
     rows = excitation_spectrum(scenes, harmonics=args.harmonics, torque_nm=args.torque)
-    out_dir = Path(args.out)
     with atomic_output_dir(out_dir) as tmp:
         write_excitation_spectrum(rows, tmp)
     print((out_dir / "excitation_spectrum.md").read_text())
