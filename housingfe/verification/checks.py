@@ -8,8 +8,10 @@ unit, source, note) with these fields added (`tag`):
   bound: the envelope bound's rows "28.bound.<the check's id after 28.>" (`as_bound`), reported beside the checks,
   never judged, without a band and counted apart; and as_made: the rows "28.as_made.<the check's id after 28.>" of
   the default run-up and of the design-variant studies (28.as_made.variants.*) with the expected sidebands of gears
-  as made (`as_made_row`; runup.as_made, docs/runup.md), reported, never judged, without a band and counted apart
-  as well;
+  as made (`as_made_row`; runup.as_made, docs/runup.md), and "28.as_made.<pitch>.<the check's id after 28.>", the
+  default chain's checks on a run with the sidebands in its totals (`as_made_check`; runup.as_made_totals), reported,
+  never judged, without a band and counted apart as well (the count line says how many of those the checks would
+  pass);
 * measured, thesis_calculated — the published numbers beside ours (either may be None);
 * tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
 * passed — "yes", "no" or "" (a report row: nothing to pass);

@@ -34,9 +34,18 @@ judged, no band; docs/runup.md "Gears as made in the run-up"), ours with the sid
 * 28.as_made.default.max_lwa.<route> — max L_WA over speed at the highest torque, sigma the scene's first radiation
   model (LwA_as_made_dB); why: the loudest 1/3-octave band at that maximum and its speed, the periodic maximum;
 * 28.as_made.l_omega.flexible.<500,1000,1500>rpm — the mesh_force route's wheel L_omega in the tooth band on the
-  flexible housing (L_omega_tooth_band_as_made_dB); why: the periodic value and what the sidebands add.
+  flexible housing (L_omega_tooth_band_as_made_dB); why: the periodic value and what the sidebands add;
 
-Besides the as-made run nothing is computed here that validate does not compute anyway: with the caches valid these rows take well under
+and, since that run also folds the sidebands into its totals and checks (runup.as_made_totals = true; and once more
+with runup.as_made_pitch = "runout", <results>/test-gearbox-runup-5-true-runout/), every check of the default chain
+on gears as made (`as_made_chain_rows`, checks.as_made_check: reported, never judged, no band; the verdict the check
+would give in `why` and in "as_made_passes", which the count line sums per pitch model):
+
+* 28.as_made.<independent,runout>.<the check's id after 28.> — 28.default.*, 28.speed_law.*, 28.l_omega.* by the
+  same row functions (validate.run_check_rows tagged, `chain_rows`) on that run's runup.json, runup.csv and
+  runup_harmonics.csv.
+
+Besides the two as-made runs nothing is computed here that validate does not compute anyway: with the caches valid these rows take well under
 a second; with quick and a stale cache they are left out (a note on the console).  `only_rows` collects every check
 row of issue 28 (these and the ones tagged by the other providers) for `housingfe validate --only runup-checks`.
 """
