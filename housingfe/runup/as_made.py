@@ -29,9 +29,11 @@ upper bound of the high-order sideband energy), "runout" (the tooth positions on
 F_p / 2: sidebands only at tooth orders +- 1 shaft order) or "none" (no pitch deviations: the first-order limit of a
 pure eccentricity); the flank deviations stay independent per tooth in all three.
 
-Least invasive: runup.csv, runup_harmonics.csv and the checks stay the periodic model's; the sideband lines run
+By default runup.csv, runup_harmonics.csv and the checks stay the periodic model's; the sideband lines run
 through the routes as a second set of Lines on the SAME models, and runup_as_made.csv holds the tooth band and the
-total with and without them."""
+total with and without them.  With runup.as_made_totals = true, `folded_result` makes one RunupResult of both sets
+(Lines.incoherent flags the sidebands): its totals, tooth band, spectra, slope terms, peaks and checks then hold the
+sideband energy beside the coherent periodic harmonics (energy sums; at a tooth-harmonic order |D|^2 + E|X|^2)."""
 from __future__ import annotations
 
 import math
@@ -42,7 +44,7 @@ import numpy as np
 
 from housingfe import levels
 from housingfe.errors import InputError
-from housingfe.runup.chain import Lines, RunupResult, mesh_reference_stiffness, runup
+from housingfe.runup.chain import Lines, RouteResult, RunupResult, mesh_reference_stiffness, runup
 
 AS_MADE_OFF = "none"
 # ISO 1328-1:1995 defines the accuracy grades 0 (finest) to 12
@@ -305,3 +307,112 @@ def summary_lines(run: AsMadeRun, radiation: str) -> list[str]:
                    f"harmonics 1-{run.n_max}, {run.lines} lines, {run.seconds:.1f} s): max L_WA " + "; ".join(parts)
                    + f"; sigma {radiation} ({CSV})")
     return out
+
+
+# ------------------------------------------------------------------------------------------ folded into the totals
+def _cat(a, b, order) -> np.ndarray:
+    return np.concatenate([np.asarray(a), np.asarray(b)])[order]
+
+
+def _energy_sum(values_db, groups, n_groups: int) -> np.ndarray:
+    power = np.zeros(n_groups)
+    np.add.at(power, groups, 10.0 ** (np.asarray(values_db, float) / 10.0))
+    with np.errstate(divide="ignore"):
+        return 10.0 * np.log10(power)
+
+
+def sideband_wheel_levels(model, lines: Lines) -> np.ndarray:
+    """L_omega [dB re 5e-8 rad/s] of the wheel on the coupled model per sideband line: its mesh force alone (the
+    Lines' mesh_excitation, no moment) on the model's gear mesh, what the mesh_force route's L_omega_coupled is for
+    these lines (used where that route was not run)."""
+    from housingfe.response.observers import node_key
+
+    freq = lines.frequency
+    c = model.reduction.coefficients(freq, {"mesh": lines.mesh_excitation})
+    node = model.reduction.reduced.points[node_key(model.wheel_node)]
+    rot = (model.wheel_axis / np.linalg.norm(model.wheel_axis)) @ (node[3:6] @ c)
+    return levels.level(np.abs(2 * math.pi * freq * rot) ** 2, levels.OMEGA0)
+
+
+def folded_result(model, periodic: RunupResult, sidebands: RunupResult) -> RunupResult:
+    """One RunupResult of a torque's periodic lines and its expected sidebands (`as_made_run`'s, on the same model
+    and operating points) with Lines.incoherent flagging the sidebands, ordered per operating point by frequency
+    (the periodic line before a sideband at the same frequency).  Energies add: the totals (runup.csv's columns)
+    sum every line of a point; the tooth band (L_omega_dB: the rigid-bore source's; L_omega_coupled_dB: the wheel
+    on the coupled model; Lv_tooth_dB) sums the lines of harmonic 1 (the periodic tooth line and the sidebands in
+    its 1/3-octave band, `sideband_lines`), so at the tooth order the line's expected power is |D|^2 + E|X|^2.
+    "harmonics" stays the number of periodic tooth harmonics.  L_omega_flexible (the coupled source's wheel) of a
+    sideband line is its mesh force's wheel level on the coupled model (`sideband_wheel_levels`).  The sidebands
+    carry no shuttling moment nor friction (zeros where the periodic lines have them)."""
+    P, S = periodic.lines, sidebands.lines
+    nP, nS = len(P.frequency), len(S.frequency)
+    flag = np.r_[np.zeros(nP, bool), np.ones(nS, bool)]
+    point = np.r_[P.point, S.point]
+    freq = np.r_[P.frequency, S.frequency]
+    order = np.lexsort((flag, freq, point))
+    n = len(P.points)
+    tooth_S = S.harmonic == 1
+    # the rigid-bore source's tooth band with the sidebands in it (points[3], the checks' L_omega rows)
+    rigid_S = np.zeros(n)
+    np.add.at(rigid_S, S.point[tooth_S], 10.0 ** (S.L_omega[tooth_S] / 10.0))
+    points = [(t, s, f, float(10.0 * np.log10(10.0 ** (L / 10.0) + rigid_S[p])), k)
+              for p, (t, s, f, L, k) in enumerate(P.points)]
+    zeros = np.zeros(nS, complex)
+    flexible = None
+    if P.L_omega_flexible is not None:
+        side = (sidebands.routes["mesh_force"].L_omega_coupled if "mesh_force" in sidebands.routes
+                else sideband_wheel_levels(model, S))
+        flexible = _cat(P.L_omega_flexible, side, order)
+    mu = None
+    if P.friction_mu is not None:       # a sideband line's friction coefficient: its operating point's
+        mu_point = np.zeros(n)
+        mu_point[P.point] = P.friction_mu
+        mu = _cat(P.friction_mu, mu_point[S.point], order)
+    lines = Lines(torque=_cat(P.torque, S.torque, order), speed=_cat(P.speed, S.speed, order),
+                  harmonic=_cat(P.harmonic, S.harmonic, order).astype(int), frequency=freq[order],
+                  L_omega=_cat(P.L_omega, S.L_omega, order),
+                  mesh_excitation=_cat(P.mesh_excitation, S.mesh_excitation, order), point=point[order],
+                  points=points, receptance=P.receptance, L_omega_flexible=flexible,
+                  shuttle_moment=None if P.shuttle_moment is None else _cat(P.shuttle_moment, zeros, order),
+                  friction=None if P.friction is None else {k: _cat(v, zeros, order) for k, v in P.friction.items()},
+                  friction_mu=mu, incoherent=flag[order])
+    routes = {}
+    for name, rp in periodic.routes.items():
+        rs = sidebands.routes[name]
+        routes[name] = RouteResult(
+            name, _cat(rp.L_v, rs.L_v, order), None,
+            np.concatenate([rp.coefficients, rs.coefficients], axis=1)[:, order],
+            _cat(rp.L_omega_coupled, rs.L_omega_coupled, order),
+            None if rp.tf_omega is None else _cat(rp.tf_omega, rs.tf_omega, order),
+            None if rp.excitation_db is None else _cat(rp.excitation_db, rs.excitation_db, order),
+            rp.excitation_name, rp.transfer_name)
+    L_sigma = {k: _cat(v, sidebands.L_sigma[k], order) for k, v in periodic.L_sigma.items()}
+    L_W = {k: _cat(v, sidebands.L_W[k], order) for k, v in periodic.L_W.items()}
+    totals = folded_totals(lines, routes, L_W, periodic.radiators)
+    return RunupResult(lines, routes, L_sigma, L_W, periodic.area_level_db, list(periodic.radiators), totals,
+                       dict(periodic.timings))
+
+
+def folded_totals(lines: Lines, routes: dict, L_W: dict, radiators) -> list[dict]:
+    """The totals rows (the keys of housingfe.runup.chain.runup's) of lines that hold incoherent ones: every level
+    the energy sum of its lines, the tooth band that of the harmonic-1 lines (module docstring of `folded_result`)."""
+    n = len(lines.points)
+    tooth = lines.harmonic == 1
+    a_w = levels.a_weighting_db(lines.frequency)
+    count = np.bincount(lines.point[~lines.incoherent], minlength=n)
+    rows = []
+    for name, rr in routes.items():
+        Lv_tot = _energy_sum(rr.L_v, lines.point, n)
+        Lv_band = _energy_sum(rr.L_v[tooth], lines.point[tooth], n)
+        Lc_band = _energy_sum(rr.L_omega_coupled[tooth], lines.point[tooth], n)
+        Lc_all = _energy_sum(rr.L_omega_coupled, lines.point, n)
+        for rad in radiators:
+            Lw_tot = _energy_sum(L_W[name, rad], lines.point, n)
+            LwA_tot = _energy_sum(L_W[name, rad] + a_w, lines.point, n)
+            for p, (torque, speed, f_t, L_om, k_m) in enumerate(lines.points):
+                rows.append({"route": name, "radiation": rad, "torque_nm": torque, "speed_rpm": speed,
+                             "tooth_frequency_hz": f_t, "L_omega_dB": L_om,
+                             "L_omega_coupled_dB": float(Lc_band[p]), "L_omega_coupled_all_dB": float(Lc_all[p]),
+                             "Lv_tooth_dB": float(Lv_band[p]), "Lv_dB": float(Lv_tot[p]),
+                             "Lw_dB": float(Lw_tot[p]), "LwA_dB": float(LwA_tot[p]), "harmonics": int(count[p])})
+    return rows

@@ -228,6 +228,10 @@ class Lines:
     # friction coefficient of each line [-] (`friction_lines`); None: not applied (mesh_friction = "none")
     friction: dict | None = None
     friction_mu: np.ndarray | None = None
+    # which lines are incoherent (True: an expected line of gears as made, housingfe.runup.as_made, whose energy adds
+    # to the others'); None: every line is a periodic tooth harmonic, one per harmonic and operating point.  With it,
+    # a harmonic n names the lines in the 1/3-octave band of n f_tooth (the periodic line and the sidebands beside it)
+    incoherent: np.ndarray | None = None
 
     def mesh_amplitudes(self) -> dict:
         """{unit load name: complex rms amplitude per line} of the mesh excitation the mesh_force route applies:
@@ -582,7 +586,8 @@ class RunupResult:
     timings: dict
 
     def harmonic_rows(self) -> list[dict]:
-        """One row per route, radiator and line (runup_harmonics.csv)."""
+        """One row per route, radiator and line (runup_harmonics.csv; with incoherent lines, Lines.incoherent, a
+        "line" of "periodic" or "sideband")."""
         rows = []
         ln = self.lines
         a_w = levels.a_weighting_db(ln.frequency)
@@ -597,6 +602,8 @@ class RunupResult:
                                  "L_omega_coupled_dB": rr.L_omega_coupled[k], "Lv_dB": rr.L_v[k],
                                  "L_sigma_dB": self.L_sigma[route, rad][k], "Lw_dB": Lw[k],
                                  "LwA_dB": Lw[k] + a_w[k]})
+                    if ln.incoherent is not None:
+                        rows[-1]["line"] = "sideband" if ln.incoherent[k] else "periodic"
         return rows
 
     def series(self, route: str, radiation: str, torque: float, key: str) -> tuple[np.ndarray, np.ndarray]:
@@ -664,12 +671,16 @@ def peak_contributions(model: GearboxModel, result: RunupResult, route: str, poi
     carries the most A-weighted power (first radiator), and the modes with the largest shares of <v^2> on that
     line: {"harmonic", "frequency_hz", "share_of_LwA", "modes": [(frequency Hz, share of <v^2>, interior energy
     share of the nearest basis mode)]}.  Shares sum to 1 over all modes; a share above 1 is partly cancelled by
-    modes of negative share (out of phase)."""
+    modes of negative share (out of phase).  With incoherent lines (Lines.incoherent: gears as made folded into the
+    totals) the harmonic is the one whose 1/3-octave band carries the most A-weighted power, its modes' shares the
+    <v^2>-weighted mean over the band's lines, and "lines" their number (`_band_contributions`)."""
     ln = result.lines
     idx = np.flatnonzero(ln.point == point)
     rad = result.radiators[0]
     lwa = result.L_W[route, rad][idx] + levels.a_weighting_db(ln.frequency[idx])
     power = 10.0 ** (lwa / 10.0)
+    if ln.incoherent is not None:       # gears as made: the harmonic's 1/3-octave band, its lines energy-summed
+        return _band_contributions(model, result, route, idx, power, top)
     k = int(idx[np.argmax(lwa)])
     freqs, share = model.reduction.modal_contributions(ln.frequency[k], result.routes[route].coefficients[:, k])
     n = model.basis.rigid_count
@@ -682,3 +693,33 @@ def peak_contributions(model: GearboxModel, result: RunupResult, route: str, poi
                       float(model.interior_share[j]) if len(elastic) else float("nan")))
     return {"harmonic": int(ln.harmonic[k]), "frequency_hz": float(ln.frequency[k]),
             "share_of_LwA": float(power.max() / power.sum()), "modes": modes}
+
+
+def _band_contributions(model: GearboxModel, result: RunupResult, route: str, idx: np.ndarray, power: np.ndarray,
+                        top: int) -> dict:
+    """peak_contributions of an operating point whose lines include incoherent ones (Lines.incoherent): the
+    harmonic n whose lines (the periodic line n f_tooth and the sidebands in its 1/3-octave band) carry the most
+    A-weighted power together, "frequency_hz" its strongest line, and each mode's share of the band's <v^2>: the
+    lines' shares weighted by their <v^2> (incoherent lines: mean squares add)."""
+    ln = result.lines
+    h = ln.harmonic[idx]
+    harmonics, group = np.unique(h, return_inverse=True)
+    band_power = np.bincount(group, weights=power)
+    g = int(np.argmax(band_power))
+    members = idx[group == g]
+    v2 = 10.0 ** (result.routes[route].L_v[members] / 10.0)
+    share = None
+    for k, w in zip(members, v2):
+        freqs, s = model.reduction.modal_contributions(ln.frequency[k], result.routes[route].coefficients[:, k])
+        share = w * s if share is None else share + w * s
+    share = share / v2.sum() if v2.sum() > 0 else share
+    strongest = int(members[np.argmax(power[group == g])])
+    n = model.basis.rigid_count
+    elastic = model.basis.frequencies_hz[n:]
+    modes = []
+    for i in np.argsort(-share)[:top]:
+        j = int(np.argmin(np.abs(elastic - freqs[i]))) if len(elastic) else 0
+        modes.append((float(freqs[i]), float(share[i]),
+                      float(model.interior_share[j]) if len(elastic) else float("nan")))
+    return {"harmonic": int(harmonics[g]), "frequency_hz": float(ln.frequency[strongest]),
+            "share_of_LwA": float(band_power[g] / power.sum()), "modes": modes, "lines": int(members.size)}

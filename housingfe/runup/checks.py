@@ -91,7 +91,16 @@ def l_omega_rows(res, measured: dict) -> list[dict]:
     pts = lines.points
     speeds = np.array([p[1] for p in pts])
     rigid = np.array([p[3] for p in pts], float)
-    if lines.receptance == "coupled":
+    if lines.receptance == "coupled" and lines.incoherent is not None:
+        # gears as made in the totals: the tooth band's lines (the periodic line and its sidebands) energy-summed
+        tooth = lines.harmonic == 1
+        power = np.zeros(len(pts))
+        np.add.at(power, lines.point[tooth], 10.0 ** (lines.L_omega_flexible[tooth] / 10.0))
+        with np.errstate(divide="ignore"):
+            flexible = 10.0 * np.log10(power)
+        how = ("the source's harmonic balance on the coupled gearbox's mesh receptance (runup.source_receptance), "
+               "with the expected sidebands of gears as made in the tooth band (runup.as_made_totals)")
+    elif lines.receptance == "coupled":
         tooth = {int(p): k for k, p in reversed(list(enumerate(lines.point))) if lines.harmonic[k] == 1}
         flexible = np.array([lines.L_omega_flexible[tooth[p]] for p in range(len(pts))], float)
         how = "the source's harmonic balance on the coupled gearbox's mesh receptance (runup.source_receptance)"
@@ -176,8 +185,10 @@ def evaluate(scene, results: dict, gm) -> tuple[list[dict], list[dict]]:
                                   "modes": [{"frequency_hz": f, "share": sh, "interior_share": si}
                                             for f, sh, si in pc["modes"]]})
             made_by = ", ".join(f"{f:.0f} Hz ({sh:.2f} of <v^2>, interior {si:.0%})" for f, sh, si in pc["modes"])
-            rows.append(_row("peak_modes", f"{route}: L_WA peak at {peak:g} rpm: harmonic {pc['harmonic']} "
-                             f"({pc['frequency_hz']:.0f} Hz, {pc['share_of_LwA']:.0%} of the L_WA) made by",
+            what = (f"harmonic {pc['harmonic']} ({pc['frequency_hz']:.0f} Hz" if "lines" not in pc else
+                    f"harmonic {pc['harmonic']}'s band ({pc['lines']} lines, the strongest at {pc['frequency_hz']:.0f} Hz")
+            rows.append(_row("peak_modes", f"{route}: L_WA peak at {peak:g} rpm: {what}, "
+                             f"{pc['share_of_LwA']:.0%} of the L_WA) made by",
                              made_by, None, None, "report"))
     if set_a:
         rows += l_omega_rows(res, tg["meas_L_omega_tooth_band_dB"])

@@ -170,6 +170,12 @@ class RunupSpec(_Strict):
     # at tooth orders +- 1 shaft order); "none" = no pitch deviations (the first-order limit of a pure eccentricity:
     # no tooth-band sidebands).  The flank deviations stay independent per tooth; used only with runup.as_made on
     as_made_pitch: Literal["independent", "runout", "none"] = "independent"
+    # gears as made in the totals (housingfe.runup.as_made.folded_result; docs/runup.md "Gears as made in the
+    # totals"): false (default) = runup.csv, runup_harmonics.csv, the spectra, the slope terms and the checks are the
+    # periodic model's, the sidebands only in runup_as_made.csv; true = all of them hold the expected sidebands as
+    # incoherent lines beside the periodic harmonics (energies add; the tooth band the lines in the 1/3-octave band of
+    # f_tooth).  Needs runup.as_made = <ISO grade>
+    as_made_totals: bool = False
 
     @field_validator("as_made", mode="before")
     @classmethod
@@ -177,6 +183,13 @@ class RunupSpec(_Strict):
         from housingfe.runup.as_made import check_as_made
 
         return _checked("as_made", check_as_made, value)
+
+    @model_validator(mode="after")
+    def _as_made_totals(self):
+        if self.as_made_totals and self.as_made == "none":
+            raise ValueError("as_made_totals: true needs runup.as_made = <ISO 1328-1 grade 0..12> (the sidebands to "
+                             "fold into the totals), but runup.as_made is \"none\"")
+        return self
 
     @field_validator("as_made_pitch", mode="before")
     @classmethod
@@ -434,6 +447,17 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         as_made = as_made_run(results, source, spec.as_made, spec.f_max_hz, spec.routes, spec.as_made_pitch)
         timings["as_made_s"] = as_made.seconds
         notes += summary_lines(as_made, scene.radiation.models[0])
+        if spec.as_made_totals:     # one set of lines, the sidebands flagged incoherent: totals, spectra, checks
+            from housingfe.runup.as_made import folded_result
+
+            t1 = time.perf_counter()
+            results = {t: (m, folded_result(m, res, as_made.sidebands[t])) for t, (m, res) in results.items()}
+            check_rows, contributions = checks.evaluate(scene, results, gm)
+            timings["as_made_totals_s"] = time.perf_counter() - t1
+            notes.append(f"  gears as made in the totals (runup.as_made_totals): runup.csv, runup_harmonics.csv, the "
+                         f"spectra, the slope terms and the checks hold the expected sidebands of ISO 1328-1 grade "
+                         f"{as_made.grade} (pitch {as_made.pitch_model}) beside the periodic harmonics, energies "
+                         "added")
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
     with outputs.atomic_output_dir(out, comm) as tmp:

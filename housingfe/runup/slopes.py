@@ -16,7 +16,8 @@ Two choices of what "the level at a speed" is:
 * "tooth_band": the tooth-frequency line alone (the 1/3-octave band of the tooth frequency holds only that line:
   the 2nd harmonic is an octave above).  The identity above holds line by line, so it holds exactly at every
   speed, and because a least-squares slope is linear in the data, the terms' slopes add up to L_WA's slope
-  exactly (round-off).
+  exactly (round-off).  With gears as made folded into the totals (runup.as_made_totals) the band also holds the
+  incoherent sidebands (harmonic 1 = the lines in the tooth band): they are energy-summed as in the total below.
 * "total": every harmonic energy-summed, the quantity of the run-up curves and of the speed-law check.  A sum
   of powers does not split into a sum of levels, so each total term is defined as the power-weighted mean of
   its per-line values, which telescopes:  L_exc,tot = 10 lg sum 10^(L_exc/10);  T_tot = L_v,tot - L_exc,tot
@@ -76,9 +77,16 @@ def term_levels(point, n_points: int, harmonic, frequency, excitation_db, L_v_db
     a_w = levels.a_weighting_db(frequency)
     L_W = L_v + area_level_db + sigma
     L_WA = L_W + a_w
-    if basis == "tooth_band":
+    tooth = np.flatnonzero(np.asarray(harmonic) == 1)
+    if basis == "tooth_band" and tooth.size > n_points:
+        # incoherent lines beside the tooth line (gears as made folded into the totals, Lines.incoherent): the
+        # tooth band holds several lines, energy-summed like the total, its terms the power-weighted means
+        E, V, W, WA = (_energy_sum(x[tooth], point[tooth], n_points) for x in (exc, L_v, L_W, L_WA))
+        with np.errstate(invalid="ignore"):
+            out = {"excitation": E, "transfer": V - E, "L_sigma": W - V - area_level_db, "A_weighting": WA - W,
+                   "L_v": V, "L_W": W, "L_WA": WA}
+    elif basis == "tooth_band":
         idx = np.full(n_points, -1)
-        tooth = np.flatnonzero(np.asarray(harmonic) == 1)
         idx[point[tooth]] = tooth
         if np.any(idx < 0):
             raise ValueError("term_levels: an operating point has no tooth-frequency line")

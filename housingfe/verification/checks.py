@@ -8,8 +8,10 @@ unit, source, note) with these fields added (`tag`):
   bound: the envelope bound's rows "28.bound.<the check's id after 28.>" (`as_bound`), reported beside the checks,
   never judged, without a band and counted apart; and as_made: the rows "28.as_made.<the check's id after 28.>" of
   the default run-up and of the design-variant studies (28.as_made.variants.*) with the expected sidebands of gears
-  as made (`as_made_row`; runup.as_made, docs/runup.md), reported, never judged, without a band and counted apart
-  as well;
+  as made (`as_made_row`; runup.as_made, docs/runup.md), and "28.as_made.<pitch>.<the check's id after 28.>", the
+  default chain's checks on a run with the sidebands in its totals (`as_made_check`; runup.as_made_totals), reported,
+  never judged, without a band and counted apart as well (the count line says how many of those the checks would
+  pass);
 * measured, thesis_calculated — the published numbers beside ours (either may be None);
 * tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
 * passed — "yes", "no" or "" (a report row: nothing to pass);
@@ -125,6 +127,45 @@ def is_as_made(row: dict) -> bool:
 def is_reported_beside(row: dict) -> bool:
     """A row shown beside the checks but not one of them (the envelope bound's, gears as made)."""
     return is_bound(row) or is_as_made(row)
+
+
+# the default chain's checks evaluated on gears as made (runup.as_made = AS_MADE_GRADE with runup.as_made_totals:
+# the sidebands in the run's totals, spectra and checks), one set of rows per shape of the pitch deviations'
+# spectrum (runup.as_made_pitch): 28.as_made.<pitch>.<the check's id after 28.>
+AS_MADE_PITCHES = ("independent", "runout")
+
+
+def is_as_made_check(row: dict) -> bool:
+    """A default-chain check evaluated on gears as made (28.as_made.<pitch>.*, `as_made_check`)."""
+    return is_as_made(row) and row["check_id"].split(".")[2] in AS_MADE_PITCHES
+
+
+def as_made_check(row: dict, pitch: str, periodic: dict | None = None) -> dict:
+    """The counterpart on gears as made of a check row made by the check's own row function on a run-up with the
+    sidebands in its totals (runup.as_made_totals): check_id 28.as_made.<pitch>.<the check's id after "28.">, ours /
+    measured / thesis calculated as made, passed "" (reported, not judged: the pitch spectrum's shape is an
+    assumption), no band; the verdict the check would give kept in "as_made_passes" ("yes" / "no" / "") and said in
+    `why` after AS_MADE_WHY with the tolerance, and the periodic check's ours and verdict (periodic: the check's row
+    of the periodic run, or None) before the check's own why."""
+    if not is_check(row) or is_reported_beside(row):
+        raise ValueError(f"as_made_check: {row.get('check_id')!r} is not a check row")
+    if pitch not in AS_MADE_PITCHES:
+        raise ValueError(f"as_made_check: pitch {pitch!r} is not one of {AS_MADE_PITCHES}")
+    verdict = row.get("passed") or ""
+    parts = [f"pitch deviations {pitch} (runup.as_made_pitch), sidebands in the totals (runup.as_made_totals)"]
+    if verdict:
+        parts.append(f"as made the check would pass: {verdict} (tolerance {row.get('tolerance') or '-'})")
+    if periodic is not None:
+        parts.append(f"periodic: ours {_cell(periodic.get('ours'))}"
+                     + (f", passed {periodic['passed']}" if periodic.get("passed") else ""))
+    if row.get("why"):
+        parts.append(row["why"])
+    why = f"{AS_MADE_WHY}; " + "; ".join(parts)
+    row.update(check_id=f"28.{AS_MADE_GROUP}.{pitch}.{row['check_id'][3:]}", passed="", tolerance="", why=why,
+               note=f"reported, not judged: {why}", band=None, as_made_passes=verdict)
+    for key in ("band_passes", "band_note"):
+        row.pop(key, None)
+    return row
 
 
 def as_made_row(check_id: str, scene: str, quantity: str, ours, unit: str, source: str, *, measured=None,
@@ -279,15 +320,26 @@ def checks_markdown(rows) -> str:
     bound = sum(is_bound(r) for r in found)
     made = sum(is_as_made(r) for r in found)
     variants = sum(is_as_made(r) and r["check_id"].startswith(AS_MADE_VARIANTS) for r in found)
+    chain = {p: [r for r in found if is_as_made_check(r) and r["check_id"].split(".")[2] == p]
+             for p in AS_MADE_PITCHES}
+    n_chain = sum(len(v) for v in chain.values())
     checks = len(found) - bound - made
     passed = sum(r.get("passed") == "yes" for r in found)
     failed = sum(r.get("passed") == "no" for r in found)
+    parts = [f"{made - variants - n_chain} of the default run-up"]
+    if n_chain:
+        would = ", ".join(f"{p} {sum(r.get('as_made_passes') == 'yes' for r in v)} of "
+                          f"{sum(bool(r.get('as_made_passes')) for r in v)}" for p, v in chain.items() if v)
+        parts.append(f"{n_chain} of the default chain's checks as made (28.{AS_MADE_GROUP}.<pitch>.*; they would "
+                     f"pass: {would})")
+    if variants:
+        parts.append(f"{variants} of the design variants {AS_MADE_VARIANTS}*")
+    detail = f": {', '.join(parts)}" if (variants or n_chain) else ""
     lines += ["", f"{checks} checks: {passed} passed, {failed} failed, {checks - passed - failed} reported"
               + (f"; and {bound} rows of the envelope bound (28.bound.*), reported: a bound, not the model" if bound
                  else "")
-              + (f"; and {made} rows of gears as made (28.as_made.*, ISO grade {AS_MADE_GRADE} sidebands"
-                 + (f": {made - variants} of the default run-up, {variants} of the design variants "
-                    f"{AS_MADE_VARIANTS}*" if variants else "") + "), reported: not checks" if made else "")]
+              + (f"; and {made} rows of gears as made (28.as_made.*, ISO grade {AS_MADE_GRADE} sidebands{detail}), "
+                 "reported: not checks" if made else "")]
     return "\n".join(lines) + "\n"
 
 
@@ -331,11 +383,19 @@ def peak_windows(peaks, windows=PEAK_WINDOWS_RPM, tolerance=PEAK_TOLERANCE_RPM, 
 
 
 def carrying_harmonic(harmonics, lwa_db) -> tuple[int, float]:
-    """(harmonic, its share of the total power) of the line with the largest L_WA at one speed."""
+    """(harmonic, its share of the total power) of the line with the largest L_WA at one speed.  Where a harmonic
+    has several lines (gears as made in the totals: the periodic line and the incoherent sidebands in its 1/3-octave
+    band, runup.as_made_totals) they are energy-summed first: the harmonic whose band carries the most."""
     lw = np.asarray(lwa_db, float)
     power = 10.0 ** (lw / 10.0)
+    h = np.asarray(harmonics).astype(int)
+    if np.unique(h).size < h.size:
+        uniq, group = np.unique(h, return_inverse=True)
+        band = np.bincount(group, weights=np.nan_to_num(power))
+        g = int(np.argmax(band))
+        return int(uniq[g]), float(band[g] / np.nansum(power))
     i = int(np.nanargmax(lw))
-    return int(np.asarray(harmonics)[i]), float(power[i] / np.nansum(power))
+    return int(h[i]), float(power[i] / np.nansum(power))
 
 
 def third_octave_index(frequency_hz) -> np.ndarray:

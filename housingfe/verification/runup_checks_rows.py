@@ -34,9 +34,18 @@ judged, no band; docs/runup.md "Gears as made in the run-up"), ours with the sid
 * 28.as_made.default.max_lwa.<route> — max L_WA over speed at the highest torque, sigma the scene's first radiation
   model (LwA_as_made_dB); why: the loudest 1/3-octave band at that maximum and its speed, the periodic maximum;
 * 28.as_made.l_omega.flexible.<500,1000,1500>rpm — the mesh_force route's wheel L_omega in the tooth band on the
-  flexible housing (L_omega_tooth_band_as_made_dB); why: the periodic value and what the sidebands add.
+  flexible housing (L_omega_tooth_band_as_made_dB); why: the periodic value and what the sidebands add;
 
-Besides the as-made run nothing is computed here that validate does not compute anyway: with the caches valid these rows take well under
+and, since that run also folds the sidebands into its totals and checks (runup.as_made_totals = true; and once more
+with runup.as_made_pitch = "runout", <results>/test-gearbox-runup-5-true-runout/), every check of the default chain
+on gears as made (`as_made_chain_rows`, checks.as_made_check: reported, never judged, no band; the verdict the check
+would give in `why` and in "as_made_passes", which the count line sums per pitch model):
+
+* 28.as_made.<independent,runout>.<the check's id after 28.> — 28.default.*, 28.speed_law.*, 28.l_omega.* by the
+  same row functions (validate.run_check_rows tagged, `chain_rows`) on that run's runup.json, runup.csv and
+  runup_harmonics.csv.
+
+Besides the two as-made runs nothing is computed here that validate does not compute anyway: with the caches valid these rows take well under
 a second; with quick and a stale cache they are left out (a note on the console).  `only_rows` collects every check
 row of issue 28 (these and the ones tagged by the other providers) for `housingfe validate --only runup-checks`.
 """
@@ -69,17 +78,27 @@ def published_rows(results: Path | None = None, quick: bool = False, failures: l
     folder = study_rows.study_folder(results, quick)
     if folder is not None:
         out += replica_rows(folder)
-    try:
-        made = validate.runup_folder(validate.DEFAULT_RUNUP, AS_MADE_OVERRIDES, results, quick)
-    except (validate.ComputationFailed, SolverError) as exc:
-        message = f"gears as made (28.as_made.* left out): {exc}"
-        if failures is None:
-            print(f"validate: {message}", flush=True)
-        else:
-            failures.append(message)
-        made = None
-    if made is not None:
-        out += as_made_rows(*made)
+    periodic = {}       # the default chain's check rows, by check_id: the periodic verdicts beside the as-made ones
+    if found is not None:
+        data = json.loads((found[1] / "runup.json").read_text())
+        periodic = {r["check_id"]: r for r in ck.check_rows(validate.run_check_rows(found[0], data["checks"])
+                                                            + default_chain_rows(*found))}
+    for pitch in ck.AS_MADE_PITCHES:
+        try:
+            made = validate.runup_folder(validate.DEFAULT_RUNUP, as_made_overrides(pitch), results, quick)
+        except (validate.ComputationFailed, SolverError) as exc:
+            left = ("28.as_made.default.*, 28.as_made.l_omega.*, " if pitch == ck.AS_MADE_PITCHES[0] else "") + \
+                f"28.as_made.{pitch}.*"
+            message = f"gears as made, pitch {pitch} ({left} left out): {exc}"
+            if failures is None:
+                print(f"validate: {message}", flush=True)
+            else:
+                failures.append(message)
+            made = None
+        if made is not None:
+            if pitch == ck.AS_MADE_PITCHES[0]:
+                out += as_made_rows(*made)
+            out += as_made_chain_rows(*made, periodic)
     return out
 
 
@@ -149,8 +168,41 @@ def bound_chain_rows(label: str, folder: Path) -> list[dict]:
     return [ck.as_bound(r) for r in kept]
 
 
-# the default run-up once more with the expected sidebands of gears as made (runup.as_made, docs/runup.md)
-AS_MADE_OVERRIDES = (ck.AS_MADE_OVERRIDE,)
+# the default run-up once more with the expected sidebands of gears as made (runup.as_made, docs/runup.md), in its
+# totals and checks too (runup.as_made_totals): its runup_as_made.csv gives the rows 28.as_made.default.* and
+# 28.as_made.l_omega.*, its checks the rows 28.as_made.independent.*; the same with runup.as_made_pitch = "runout"
+# the rows 28.as_made.runout.* (`as_made_overrides`)
+AS_MADE_OVERRIDES = (ck.AS_MADE_OVERRIDE, "runup.as_made_totals=true")
+
+
+def as_made_overrides(pitch: str) -> tuple[str, ...]:
+    """validate's overrides of the default run-up as made with the pitch deviations' spectrum `pitch`
+    (checks.AS_MADE_PITCHES; the first is runup.as_made_pitch's default)."""
+    if pitch not in ck.AS_MADE_PITCHES:
+        raise ValueError(f"as_made_overrides: pitch {pitch!r} is not one of {ck.AS_MADE_PITCHES}")
+    return AS_MADE_OVERRIDES + (() if pitch == ck.AS_MADE_PITCHES[0] else (f"runup.as_made_pitch={pitch}",))
+
+
+def as_made_chain_rows(label: str, folder: Path, periodic: dict | None = None) -> list[dict]:
+    """The default chain's checks on gears as made (28.as_made.<pitch>.*, checks.as_made_check) from a run-up result
+    folder run with runup.as_made and runup.as_made_totals: the same row functions as the checks'
+    (validate.run_check_rows tagged, `chain_rows`) on its runup.json checks, runup.csv, runup_harmonics.csv and peak
+    contributions, which hold the sidebands; periodic: {check_id: the periodic check's row} for `why`.  None when
+    the run did not fold the sidebands into its totals (runup.json "as_made" without "in_totals")."""
+    from housingfe.verification import validate
+
+    data = json.loads((folder / "runup.json").read_text())
+    made = data.get("as_made")
+    if not made or not made.get("in_totals") or made.get("pitch_model") not in ck.AS_MADE_PITCHES:
+        return []
+    rad = data["scene_settings"]["radiation"]["models"][0]
+    scene = (f"{label} (gears as made, ISO grade {made['grade']}, pitch {made['pitch_model']}, sidebands in the "
+             "totals)")
+    rows = validate.run_check_rows(scene, data["checks"])
+    rows += chain_rows(scene, rad, _read_csv(folder / "runup.csv"), _read_csv(folder / "runup_harmonics.csv"),
+                       data["peak_contributions"])
+    periodic = periodic or {}
+    return [ck.as_made_check(r, made["pitch_model"], periodic.get(r["check_id"])) for r in ck.check_rows(rows)]
 AS_MADE_SPEEDS_RPM = (500, 1000, 1500)          # the measured L_omega's speeds (28.l_omega.flexible.<speed>rpm)
 
 
@@ -241,12 +293,16 @@ def max_harmonic_row(label: str, route: str, where: str, totals: list[dict], lin
     s = float(speeds[int(np.nanargmax(lwa))])
     at = [r for r in lines if _num(r["speed_rpm"]) == s]
     n, share = ck.carrying_harmonic([int(r["harmonic"]) for r in at], [_num(r["LwA_dB"]) for r in at])
-    f = next(_num(r["frequency_hz"]) for r in at if int(r["harmonic"]) == n)
+    # its strongest line (one line per harmonic, but with gears as made in the totals the band's sidebands too)
+    band = [r for r in at if int(r["harmonic"]) == n]
+    f = _num(max(band, key=lambda r: _num(r["LwA_dB"]))["frequency_hz"])
+    what = (f"harmonic {n}'s 1/3-octave band ({len(band)} lines, the strongest at {f:.0f} Hz)" if len(band) > 1
+            else f"harmonic {n} at {f:.0f} Hz")
     return ck.check_row(f"28.default.max_lwa_harmonic.{route}", label,
                         f"{where}: harmonic carrying the L_WA maximum ({s:g} rpm, {lwa.max():.1f} dB(A))", n, "-",
                         SOURCE, measured="1 or 2", tolerance=f"n <= {ck.HIGHEST_MAKING_HARMONIC}",
                         passed=n <= ck.HIGHEST_MAKING_HARMONIC,
-                        why=f"harmonic {n} at {f:.0f} Hz carries {share:.0%} of the L_WA; measured: the tooth "
+                        why=f"{what} carries {share:.0%} of the L_WA; measured: the tooth "
                             "frequency and its 2nd harmonic only (Fig. 5.6)")
 
 

@@ -504,8 +504,9 @@ def test_the_as_made_rows_are_reported_with_the_sidebands_and_leave_the_checks_a
     assert {(r["passed"], r["band"]) for r in written[-5:]} == {("report", "")}
     with pytest.raises(ValueError):
         ck.as_made_row("28.default.max_lwa.tf_omega", "s", "q", 1.0, "dB", "src")
-    # validate computes them on the default run-up with runup.as_made = 5
-    assert runup_checks_rows.AS_MADE_OVERRIDES == ("runup.as_made=5",)
+    # validate computes them on the default run-up with runup.as_made = 5 (the sidebands in its totals too: the rows
+    # 28.as_made.independent.*, tests/runup/test_as_made_totals.py)
+    assert runup_checks_rows.AS_MADE_OVERRIDES == ("runup.as_made=5", "runup.as_made_totals=true")
 
 
 def test_a_failed_as_made_run_loses_its_rows_alone(tmp_path, monkeypatch):
@@ -523,8 +524,11 @@ def test_a_failed_as_made_run_loses_its_rows_alone(tmp_path, monkeypatch):
     rows = runup_checks_rows.published_rows(tmp_path, failures=failures)
     assert [r["check_id"] for r in rows] == [r["check_id"] for r in
                                              runup_checks_rows.default_chain_rows("test-gearbox-runup", tmp_path)]
-    assert failures == ["gears as made (28.as_made.* left out): housingfe run test-gearbox-runup --set "
-                        "runup.as_made=5: exit 1: boom"]
+    assert failures == ["gears as made, pitch independent (28.as_made.default.*, 28.as_made.l_omega.*, "
+                        "28.as_made.independent.* left out): housingfe run test-gearbox-runup --set "
+                        "runup.as_made=5: exit 1: boom",
+                        "gears as made, pitch runout (28.as_made.runout.* left out): housingfe run test-gearbox-runup "
+                        "--set runup.as_made=5: exit 1: boom"]
 
 
 # ----------------------------------------------------------- the design variants as made (28.as_made.variants.*)
