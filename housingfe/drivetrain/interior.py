@@ -177,7 +177,7 @@ class AuxGearboxSpec(_Strict):
     axis: Vector3
     pinion_line: str
     wheel_line: str
-    ratio: PositiveFloat
+    ratio: PositiveFloat = Field(json_schema_extra={"unit": "-"})
     inertia: PositiveFloat = Field(json_schema_extra={"unit": "kg m^2"})
     ground_stiffness: float = Field(0.0, ge=0.0, json_schema_extra={"unit": "N m/rad"})
 
