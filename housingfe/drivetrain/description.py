@@ -27,7 +27,11 @@ Where the thesis' two models genuinely differ, the description keeps both as nam
   polar inertia, the far quill to ground; torsion only), in the FE reduction from the shaft's front end node (the
   shafts end flush with the bearing plates, `ShaftLine.ends`) when `drive_line` = "quill-shafts"; with "none" (the
   description's default, what the housing-side studies and scenes were built with) the FE shafts end there without
-  it and the FE gear train has a free rigid rotation (one zero mode).
+  it and the FE gear train has a free rigid rotation (one zero mode).  With "back-to-back" (FE reduction only) the
+  far quills do not end at ground but close the rig's loop through the auxiliary gearbox (`AuxGearbox`,
+  `aux_gearbox_parts`): its gear pair imposes the ratio, the motor sits on its pinion shaft, the motor's
+  electromagnetic stiffness holds the loop's rigid rotation.  The lumped source keeps Appendix C's grounded ends
+  (the thesis' model: DOF 15 held to apply the preload), whatever `drive_line` says.
 
 The layer contract puts housingfe.source below housingfe.drivetrain: the interior takes its gears, tooth forces and
 mesh stiffness from the source, never the other way round.
@@ -55,8 +59,34 @@ from housingfe.source.stiffness import (
 Vector3 = tuple[float, float, float]
 SHAFTS = ("pinion", "wheel")
 # the FE reduction's drive line beyond the shaft ends (Drivetrain.drive_line): "quill-shafts" = the lumped model's
-# quill shafts and couplings (Appendix C shafts 1-4, DOFs 13, 14), "none" = shafts ending at the bearing plates
-DRIVE_LINES = ("quill-shafts", "none")
+# quill shafts and couplings (Appendix C shafts 1-4, DOFs 13, 14), far ends grounded; "none" = shafts ending at the
+# bearing plates; "back-to-back" = the same quills and couplings, their far ends on the auxiliary gearbox, which
+# closes the rig's loop (Sec. 5.2, Fig. 5.1; `AuxGearbox`)
+DRIVE_LINES = ("quill-shafts", "none", "back-to-back")
+# The auxiliary gearbox (Sec. 5.2: "the same transmission gear ratio of 3.0 but with different tooth numbers", 19/57
+# against the test set's 24/72).  The thesis gives no masses or inertias of it, nor of the motor; the numbers below are
+# ASSUMPTIONS (docs/drivetrain.md, "The back-to-back loop"):
+# * its gears: the test gearbox's gear bodies (solid cylinders, `GearSet.gear_body`) scaled by the tooth numbers at the
+#   same module and face width, i.e. polar inertia x (19/24)^4 = (57/72)^4 = 0.393 (`scaled_aux_gearbox`); its shafts
+#   are left out (a Ø80 mm shaft between the bearings is ~0.009 kg m^2 at the pinion, <5 % of what sits there);
+AUX_TEETH = (19, 57)
+# * the motor's rotor on the aux pinion shaft (the thesis: 20 kW, frequency-controlled, 0-1500 rev/min, i.e. a 4-pole
+#   induction motor): 0.15 kg m^2, within the 0.13-0.19 kg m^2 that IEC frame 180 M/L 4-pole 18.5/22 kW catalogue motors
+#   list (remembered catalogue range, not one verified data sheet); the torque coupling's flanges near the aux gearbox
+#   are not added (unknown; inside the x0.5..x2 sensitivity of docs/drivetrain.md);
+MOTOR_ROTOR_INERTIA = 0.15
+# * the loop's rigid rotation (the whole rig turning) is held by the motor alone.  A frequency-controlled induction
+#   motor pulls its rotor towards the rotating field: at frequencies above its rotor time constant (~0.1-0.3 s at
+#   20 kW) the small-signal torque per mechanical angle is of the order of pole pairs x pull-out torque
+#   = 2 x 2.5 x T_rated, T_rated = 20 kW / (1500 rev/min) = 127 N m: ~640 N m/rad (an order of magnitude, not the
+#   drive's measured characteristic).  A torsion spring of that stiffness from the aux pinion (motor) to ground:
+#   the rig's rigid rotation becomes a ~7 Hz mode, below every tooth frequency of the run-up (20 Hz at 50 rev/min)
+#   and far below the loop's elastic modes; it restrains nothing else.
+MOTOR_POLE_PAIRS = 2
+MOTOR_RATED_POWER = 20e3           # W (Sec. 5.2)
+MOTOR_SPEED_RPM = 1500.0           # rev/min, the top of the drive's range (Sec. 5.2)
+MOTOR_PULLOUT_RATIO = 2.5          # pull-out / rated torque of a standard cage motor (assumed)
+MOTOR_STIFFNESS = MOTOR_POLE_PAIRS * MOTOR_PULLOUT_RATIO * MOTOR_RATED_POWER / (MOTOR_SPEED_RPM * math.pi / 30)
 # the FE shaft node the drive line leaves from: the front end (node 0).  Fig. 5.1: both quill shafts leave the test
 # gearbox on the side of the auxiliary gearbox; which plate that is was not recoverable (assumed).  Torsion only,
 # so the side changes only the 140 mm of shaft between gear and end (~2e6 N m/rad, 20x the quills)
@@ -169,6 +199,56 @@ class GearForces:
     point: np.ndarray
 
 
+@dataclass(frozen=True)
+class AuxGearbox:
+    """The auxiliary gearbox of a back-to-back rig with the drive motor (Sec. 5.2, Fig. 5.1): tooth numbers
+    (pinion, wheel), polar inertias (kg m^2) of its pinion and wheel (each with what turns rigidly with it), the motor
+    rotor's polar inertia on the pinion shaft (kg m^2), and motor_stiffness (N m/rad), the torsion spring from the
+    motor to ground that stands for the motor's hold on the loop's rigid rotation (0: the rotation is free).  Its gears
+    are rigid: the pair imposes the ratio, aux wheel angle = -aux pinion angle / ratio, the same sense as the test
+    pair (so the loop through both pairs closes).  Numbers: `scaled_aux_gearbox` and the constants above."""
+
+    teeth: tuple[int, int]
+    pinion_inertia: float
+    wheel_inertia: float
+    motor_inertia: float = MOTOR_ROTOR_INERTIA
+    motor_stiffness: float = MOTOR_STIFFNESS
+
+    def __post_init__(self):
+        if not (len(self.teeth) == 2 and all(int(z) == z and z > 0 for z in self.teeth)):
+            raise InputError(f"aux_gearbox: teeth: {self.teeth!r} must be two positive integers")
+        for key in ("pinion_inertia", "wheel_inertia", "motor_inertia"):
+            value = getattr(self, key)
+            if not (math.isfinite(value) and value > 0):
+                raise InputError(f"aux_gearbox: {key}: {value} kg m^2 must be finite and > 0")
+        if not (math.isfinite(self.motor_stiffness) and self.motor_stiffness >= 0):
+            raise InputError(f"aux_gearbox: motor_stiffness: {self.motor_stiffness} N m/rad must be finite and >= 0")
+
+    @property
+    def ratio(self) -> float:
+        """z_wheel / z_pinion."""
+        return self.teeth[1] / self.teeth[0]
+
+    def inertia_at_pinion(self) -> float:
+        """Polar inertia (kg m^2) of the gearbox and motor about the aux pinion's angle: pinion + motor + wheel /
+        ratio^2 (rigid gears)."""
+        return self.pinion_inertia + self.motor_inertia + self.wheel_inertia / self.ratio**2
+
+
+def scaled_aux_gearbox(gears: GearSet, teeth: tuple[int, int] = AUX_TEETH, motor_inertia: float = MOTOR_ROTOR_INERTIA,
+                       motor_stiffness: float = MOTOR_STIFFNESS) -> AuxGearbox:
+    """The auxiliary gearbox as the test gears scaled by the tooth numbers at the same module and face width (an
+    ASSUMPTION, see AUX_TEETH): each gear body a solid cylinder (`GearSet.gear_body`) whose diameter scales with
+    z_aux / z_test, polar inertia x (z_aux / z_test)^4."""
+    pair = gears.pair
+    inertia = []
+    for g in (0, 1):
+        d, width, rho = gears.gear_body(g)
+        d_aux = d * teeth[g] / pair.teeth[g]
+        inertia.append(rho * math.pi * d_aux**4 * width / 32)
+    return AuxGearbox(tuple(int(z) for z in teeth), inertia[0], inertia[1], motor_inertia, motor_stiffness)
+
+
 # ------------------------------------------------------------------------------------------- description
 @dataclass(frozen=True)
 class Drivetrain:
@@ -184,7 +264,9 @@ class Drivetrain:
     own bearings in the FE reduction, at the statics loads of `torque` and, for the speed-dependent fluid film, the
     pinion speed bearing_speed_rpm (rev/min; the wheel turns the other way at z1/z2 of it); None: the seats' own
     designations / matrices.  drive_line (DRIVE_LINES): the FE reduction's drive line beyond the shaft ends,
-    "quill-shafts" (`drive_line_parts`, the lumped model's) or "none"."""
+    "quill-shafts" (`drive_line_parts`, the lumped model's, far ends grounded), "none", or "back-to-back" (the same
+    quills, their far ends closing the loop through `aux_gearbox`, `aux_gearbox_parts`).  aux_gearbox: the rig's
+    auxiliary gearbox and motor (AuxGearbox; needed by "back-to-back" only)."""
 
     gears: GearSet
     shafts: tuple[ShaftLine, ShaftLine]
@@ -201,10 +283,14 @@ class Drivetrain:
     bearing_configuration: str | None = None
     bearing_speed_rpm: float = 1500.0
     drive_line: str = "none"
+    aux_gearbox: AuxGearbox | None = None
 
     def __post_init__(self):
         if self.drive_line not in DRIVE_LINES:
             raise InputError(f"drive_line: {self.drive_line!r} is not one of {', '.join(DRIVE_LINES)}")
+        if self.drive_line == "back-to-back" and self.aux_gearbox is None:
+            raise InputError("drive_line: 'back-to-back' needs the rig's auxiliary gearbox (Drivetrain.aux_gearbox), "
+                             "this drivetrain has none")
         if [s.name for s in self.shafts] != list(SHAFTS):
             raise InputError("drivetrain: shafts: need (pinion, wheel)")
         if not (math.isfinite(self.torque) and self.torque > 0):
@@ -286,6 +372,17 @@ class Drivetrain:
         k = [q.stiffness(G) for q in self.quill_shafts]          # shafts 1, 2, 3, 4
         return {"pinion": (k[1], self.couplings[0].inertia, k[0]),
                 "wheel": (k[2], self.couplings[1].inertia, k[3])}
+
+    def aux_gearbox_parts(self) -> dict:
+        """The back-to-back loop's auxiliary gearbox as the FE reduction takes it: {"inertia": polar inertia at the
+        aux pinion's angle phi [kg m^2] (`AuxGearbox.inertia_at_pinion`), "ratio": z_wheel / z_pinion,
+        "ground_stiffness": the motor's torsion spring to ground on phi [N m/rad]}.  The pinion line's far quill
+        (shaft 1) ends on the aux pinion (angle phi), the wheel line's (shaft 4) on the aux wheel (angle
+        -phi / ratio)."""
+        aux = self.aux_gearbox
+        if aux is None:
+            raise InputError("drive_line: 'back-to-back' needs the rig's auxiliary gearbox (Drivetrain.aux_gearbox)")
+        return {"inertia": aux.inertia_at_pinion(), "ratio": aux.ratio, "ground_stiffness": aux.motor_stiffness}
 
     # ------------------------------------------------------------------------- lumped <-> housing frames
     def lumped_frame(self) -> np.ndarray:
@@ -540,13 +637,19 @@ class Drivetrain:
                 "stiffness": forces.stiffness, "point": tuple(float(x) for x in forces.point),
                 "direction": tuple(float(x) for x in forces.direction)}
         drive_lines = []
-        if self.drive_line == "quill-shafts":
+        if self.drive_line in ("quill-shafts", "back-to-back"):
             for name, (near, inertia, far) in self.drive_line_parts().items():
                 coupling = self.couplings[SHAFTS.index(name)].name
                 drive_lines.append({"name": f"coupling_{coupling}", "shaft_node": f"{name}:{DRIVE_LINE_NODE}",
                                     "near_stiffness": near, "inertia": inertia, "far_stiffness": far})
+        extra = {}
+        if self.drive_line == "back-to-back":
+            # the pinion quill ends on the aux pinion (the motor's shaft), the wheel quill on the aux wheel
+            extra["aux_gearbox"] = {"name": "aux_gearbox", "axis": self.shaft("pinion").axis,
+                                    "pinion_line": drive_lines[0]["name"], "wheel_line": drive_lines[1]["name"],
+                                    **self.aux_gearbox_parts()}
         return CouplingSpec.model_validate({"bores": bores, "shafts": shafts, "bearings": bearings,
-                                            "gear_meshes": [mesh], "drive_lines": drive_lines})
+                                            "gear_meshes": [mesh], "drive_lines": drive_lines, **extra})
 
 
 # ------------------------------------------------------------------------------------------ test gearbox
@@ -565,7 +668,8 @@ def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 20
     model, the front bearings locating) or a configuration of housingfe.bearings.configurations (Secs. 5.8, 5.9:
     "angular_contact", "self_aligning", "tapered_roller" with the single helical sets; "cylindrical_roller",
     "fluid_film" with the double helical set, which puts no axial load on them), pinion torque (N m).  Shaft, quill-shaft and coupling dimensions are the
-    ASSUMPTIONS of docs/source.md (Appendix C's parameter table did not survive)."""
+    ASSUMPTIONS of docs/source.md (Appendix C's parameter table did not survive); the auxiliary gearbox and motor
+    (for drive_line "back-to-back") those of `scaled_aux_gearbox` and MOTOR_*."""
     if gear_set not in GEAR_SETS:
         raise InputError(f"test_gearbox: gear_set: {gear_set!r} unknown (known: {', '.join(GEAR_SETS)})")
     from housingfe.bearings.configurations import configurations
@@ -581,9 +685,11 @@ def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 20
                   for shaft in SHAFTS for side, s in (("front", -0.1075), ("back", 0.1075)))
     quills = (QuillShaft("motor_far", 0.040, 1.5), QuillShaft("motor_pinion", 0.060, 0.25),
               QuillShaft("wheel_brake", 0.075, 0.25), QuillShaft("brake_far", 0.055, 1.5))
-    return Drivetrain(gears=GearSet.from_scene(GEAR_SETS[gear_set]), shafts=shafts, bearings=seats,
+    gears = GearSet.from_scene(GEAR_SETS[gear_set])
+    return Drivetrain(gears=gears, shafts=shafts, bearings=seats,
                       quill_shafts=quills, couplings=(Coupling("motor", 0.02), Coupling("brake", 0.05)),
-                      torque=torque, bearing_configuration=None if bearings == "ball" else bearings)
+                      torque=torque, bearing_configuration=None if bearings == "ball" else bearings,
+                      aux_gearbox=scaled_aux_gearbox(gears))
 
 
 test_gearbox.__test__ = False     # not a pytest test despite its name

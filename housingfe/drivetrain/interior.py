@@ -164,6 +164,28 @@ class DriveLineSpec(_Strict):
     far_stiffness: PositiveFloat = Field(json_schema_extra={"unit": "N m/rad"})
 
 
+class AuxGearboxSpec(_Strict):
+    """The auxiliary gearbox that closes a back-to-back rig's loop (the thesis' test rig, Sec. 5.2): the far quills
+    of the drive lines `pinion_line` and `wheel_line` end on its pinion and wheel instead of ground.  Its gears are
+    rigid, so it is ONE torsion node `name` (housingfe.drivetrain.coupling torsion node, like a coupling): the
+    rotation phi of its pinion about `axis`; its wheel turns by -phi / `ratio` about the same axis (the sense of an
+    external pair, as the test pair's, so the loop closes).  `inertia`: everything that turns with it, at phi
+    (kg m^2: pinion, motor rotor, wheel / ratio^2); `ground_stiffness`: a torsion spring from phi to ground (N m/rad;
+    the drive motor's hold on the loop's rigid rotation; 0 leaves it free, one zero mode)."""
+
+    name: str = Field(pattern=r"^[A-Za-z0-9_]+$")
+    axis: Vector3
+    pinion_line: str
+    wheel_line: str
+    ratio: PositiveFloat = Field(json_schema_extra={"unit": "-"})
+    inertia: PositiveFloat = Field(json_schema_extra={"unit": "kg m^2"})
+    ground_stiffness: float = Field(0.0, ge=0.0, json_schema_extra={"unit": "N m/rad"})
+
+    def far_factor(self, line: str) -> float:
+        """The far end's angle per unit phi of the drive line named `line`: 1 on the pinion, -1/ratio on the wheel."""
+        return 1.0 if line == self.pinion_line else -1.0 / self.ratio
+
+
 class CouplingSpec(_Strict):
     bores: list[BoreMasterSpec] = []
     shafts: list[ShaftSpec] = []
@@ -171,14 +193,27 @@ class CouplingSpec(_Strict):
     gear_meshes: list[GearMeshSpec] = []
     tie_rods: list[TieRodSpec] = []
     drive_lines: list[DriveLineSpec] = []
+    aux_gearbox: AuxGearboxSpec | None = None
 
 
     @model_validator(mode="after")
     def _unique(self):
         names = [b.name for b in self.bores] + [s.name for s in self.shafts] + [d.name for d in self.drive_lines]
+        if self.aux_gearbox is not None:
+            names.append(self.aux_gearbox.name)
         dup = sorted({n for n in names if names.count(n) > 1})
         if dup:
-            raise ValueError(f"bores: names must be unique among bores, shafts and drive lines ({', '.join(dup)})")
+            raise ValueError(f"bores: names must be unique among bores, shafts, drive lines and the aux gearbox "
+                             f"({', '.join(dup)})")
+        aux = self.aux_gearbox
+        if aux is not None:
+            lines = [d.name for d in self.drive_lines]
+            for key in ("pinion_line", "wheel_line"):
+                if getattr(aux, key) not in lines:
+                    raise ValueError(f"aux_gearbox.{key}: {getattr(aux, key)!r} is not a drive line (known: "
+                                     f"{', '.join(lines) or 'none'})")
+            if aux.pinion_line == aux.wheel_line:
+                raise ValueError("aux_gearbox: pinion_line and wheel_line must be two drive lines")
         return self
 
 
@@ -265,6 +300,7 @@ def parts(spec: CouplingSpec, bore_centres: dict) -> Parts:
     rods = [tie_rod_element(t, position[t.a], position[t.b], f"coupling.tie_rods.{i}")
             for i, t in enumerate(spec.tie_rods)]
     lines, torsion = [], {}
+    aux = spec.aux_gearbox
     for i, d in enumerate(spec.drive_lines):
         shaft = shafts.get(d.shaft_node.split(":")[0]) if ":" in d.shaft_node else None
         if shaft is None or d.shaft_node not in position:
@@ -272,7 +308,16 @@ def parts(spec: CouplingSpec, bore_centres: dict) -> Parts:
                              "('<shaft>:<index>')")
         axis = np.asarray(shaft.axis, float) / np.linalg.norm(shaft.axis)
         torsion[d.name] = (position[d.shaft_node], axis)
-        lines += drive_line_elements(d, axis)
+        far = (aux.name, aux.far_factor(d.name)) if aux is not None and d.name in (aux.pinion_line,
+                                                                                  aux.wheel_line) else None
+        lines += drive_line_elements(d, axis, far)
+    if aux is not None:
+        axis = np.asarray(aux.axis, float) / np.linalg.norm(aux.axis)
+        # a torsion node's position only enters the rigid-body vectors, which hold no translation for it: the
+        # pinion line's shaft end stands for the motor room
+        pinion_line = next(d for d in spec.drive_lines if d.name == aux.pinion_line)
+        torsion[aux.name] = (position[pinion_line.shaft_node], axis)
+        lines += aux_gearbox_elements(aux, axis)
     return Parts(connections, shafts, bearings, meshes, rods, position, lines, torsion)
 
 
@@ -285,14 +330,32 @@ def torsion_block(value: float, axis) -> np.ndarray:
     return out
 
 
-def drive_line_elements(d: DriveLineSpec, axis) -> list:
+def drive_line_elements(d: DriveLineSpec, axis, far: tuple[str, float] | None = None) -> list:
     """The Elements of a drive line (DriveLineSpec): the near torsion spring shaft node - coupling node, the
-    coupling's polar inertia, the far torsion spring coupling node - ground."""
+    coupling's polar inertia, the far torsion spring coupling node - ground; far = (torsion node, factor): the far
+    spring ends instead on a torsion node whose angle phi turns the far end by factor x phi (an aux gearbox,
+    `aux_gearbox_elements`): energy k/2 (a.theta_coupling - factor phi)^2."""
     from housingfe.drivetrain import coupling as cp
 
-    return [cp.spring(d.shaft_node, d.name, torsion_block(d.near_stiffness, axis)),
-            cp.point_mass(d.name, torsion_block(d.inertia, axis)),
-            cp.spring(d.name, None, torsion_block(d.far_stiffness, axis))]
+    out = [cp.spring(d.shaft_node, d.name, torsion_block(d.near_stiffness, axis)),
+           cp.point_mass(d.name, torsion_block(d.inertia, axis))]
+    if far is None:
+        return out + [cp.spring(d.name, None, torsion_block(d.far_stiffness, axis))]
+    node, factor = far
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    b = np.concatenate([np.zeros(3), a, np.zeros(3), -factor * a])
+    return out + [cp.Element((d.name, node), d.far_stiffness * np.outer(b, b))]
+
+
+def aux_gearbox_elements(aux: AuxGearboxSpec, axis) -> list:
+    """The aux gearbox's own Elements (AuxGearboxSpec): its polar inertia at phi and, if any, the torsion spring
+    to ground (the motor); the far quills that end on it are the drive lines' (`drive_line_elements`)."""
+    from housingfe.drivetrain import coupling as cp
+
+    out = [cp.point_mass(aux.name, torsion_block(aux.inertia, axis))]
+    if aux.ground_stiffness > 0:
+        out.append(cp.spring(aux.name, None, torsion_block(aux.ground_stiffness, axis)))
+    return out
 
 
 def tie_rod_element(t: TieRodSpec, pa: np.ndarray, pb: np.ndarray, key: str):

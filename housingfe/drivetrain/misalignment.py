@@ -38,7 +38,7 @@ def static_gear_tilts(drivetrain, forces=None) -> tuple[np.ndarray, np.ndarray, 
     forces = forces or drivetrain.gear_forces()
     spec = drivetrain.to_coupling_spec(forces)
     # the drive line beyond the shaft ends is torsion only, and the spin is held here: it changes no tilt
-    spec = spec.model_copy(update={"gear_meshes": [], "drive_lines": []})
+    spec = spec.model_copy(update={"gear_meshes": [], "drive_lines": [], "aux_gearbox": None})
     centres = {}
     for seat in drivetrain.bearings:
         centres[seat.name] = drivetrain.shaft(seat.shaft).point(seat.position)
@@ -92,7 +92,8 @@ def coupled_gear_tilts(housing_model, drivetrain, forces=None) -> tuple[np.ndarr
     from housingfe.drivetrain.interior import bore_centres, parts
 
     forces = forces or drivetrain.gear_forces()
-    spec = drivetrain.to_coupling_spec(forces).model_copy(update={"gear_meshes": [], "drive_lines": []})
+    spec = drivetrain.to_coupling_spec(forces).model_copy(update={"gear_meshes": [], "drive_lines": [],
+                                                                  "aux_gearbox": None})
     centres = bore_centres(housing_model, spec)
     p = parts(spec, centres)
     loads, axes = _gear_loads(drivetrain, forces)

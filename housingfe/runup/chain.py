@@ -125,7 +125,8 @@ def unit_loads(structure, drivetrain, friction: bool = False) -> tuple[dict, str
 def bearing_pairs(structure) -> list:
     """Self-equilibrated unit force and moment pairs across every bearing (shaft node +, bore master -), six per
     bearing, and unit torques across each drive line's quills (about the shaft axis: shaft end +, coupling node -;
-    on the coupling node alone for the far quill to ground), as coupled vectors: the static vectors that make a
+    on the coupling node alone for the far quill to ground; and on the aux gearbox node of a back-to-back loop), as
+    coupled vectors: the static vectors that make a
     re-analysis with other bearing or quill stiffnesses (another torque, another configuration, the uncertainty's
     quill samples) accurate."""
     out = []
@@ -138,6 +139,10 @@ def bearing_pairs(structure) -> list:
         e = np.r_[np.zeros(3), structure.shaft_axis(d.shaft_node)]
         out.append(structure.system.load(node_loads={d.shaft_node: e, d.name: -e}))
         out.append(structure.system.load(node_loads={d.name: e}))
+    aux = getattr(structure.spec, "aux_gearbox", None)
+    if aux is not None:         # the back-to-back loop: with the coupling nodes' torques these span its far quills
+        a = np.asarray(aux.axis, float) / np.linalg.norm(aux.axis)
+        out.append(structure.system.load(node_loads={aux.name: np.r_[np.zeros(3), a]}))
     return out
 
 

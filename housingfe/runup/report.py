@@ -296,9 +296,11 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
     friction = friction_line(scene, results)
     if friction:
         lines.append(friction)
-    if scene.runup.drive_line_model == "quill-shafts":
-        lines.append("drive line: the quill shafts and couplings to motor and brake (runup.drive_line) are in the "
-                     "coupled model; its lowest elastic mode "
+    if scene.runup.drive_line_model in ("quill-shafts", "back-to-back"):
+        what = ("the quill shafts and couplings to motor and brake" if scene.runup.drive_line_model == "quill-shafts"
+                else "the back-to-back loop (quill shafts, couplings, the auxiliary gearbox and motor: assumed "
+                     "inertias, docs/drivetrain.md)")
+        lines.append(f"drive line: {what} (runup.drive_line) are in the coupled model; its lowest elastic mode "
                      + (f"{b.frequencies_hz[b.rigid_count]:.1f} Hz" if len(b.frequencies_hz) > b.rigid_count else "-"))
     lines += list(notes)
     lines.append("checks (ours | measured | thesis calc. | pass):")

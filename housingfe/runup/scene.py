@@ -155,8 +155,11 @@ class RunupSpec(_Strict):
     # = the quill shafts and couplings to the motor and the brake (torsion springs, coupling inertias: the lumped
     # source's, Appendix C shafts 1-4) from the shafts' front ends to ground, which restrain the gear train's rigid
     # rotation (a rig torsion mode near 76 Hz instead of a zero mode); "none" = the shafts end at the bearing
-    # plates.  Default: "quill-shafts", and "none" with the thesis' replica "thesis-2d" (docs/runup.md)
-    drive_line: Optional[Literal["quill-shafts", "none"]] = None
+    # plates; "back-to-back" = the same quills and couplings, their far ends closing the rig's loop through the
+    # auxiliary gearbox (ratio 57/19, rigid gears) with the drive motor on its pinion shaft (ASSUMED inertias and the
+    # motor's hold on the loop's rotation: housingfe.drivetrain.description.AuxGearbox, docs/drivetrain.md).
+    # Default: "quill-shafts", and "none" with the thesis' replica "thesis-2d" (docs/runup.md)
+    drive_line: Optional[Literal["quill-shafts", "none", "back-to-back"]] = None
     # gears as made (housingfe.runup.as_made; docs/runup.md "Gears as made in the run-up"): "none" = the periodic
     # lines of identical teeth alone; an ISO 1328-1 accuracy grade 0..12 (e.g. 5, the thesis' DIN 5) = also the
     # expected shaft-order sidebands of tooth-to-tooth deviations uniform within that grade's tolerances, through the

@@ -32,6 +32,7 @@ def test_builtin_scenes_validate(name):
     ('runup.engagement="envelope-bund"', "runup.engagement"),
     ('runup.mesh_moment="shutling"', "runup.mesh_moment"),
     ('runup.drive_line="quills"', "runup.drive_line"),
+    ('runup.drive_line="back-to-front"', "runup.drive_line"),
     ("runup.as_made=13", "runup.as_made"),
     ('runup.as_made="5"', "runup.as_made"),
 ])
@@ -72,16 +73,19 @@ def test_mesh_friction_choices(overrides, friction):
 @pytest.mark.parametrize("overrides, drive_line", [([], "quill-shafts"), (['runup.engagement="thesis-2d"'], "none"),
                                                    (['runup.drive_line="none"'], "none"),
                                                    (['runup.engagement="thesis-2d"', 'runup.drive_line="quill-shafts"'],
-                                                    "quill-shafts")])
+                                                    "quill-shafts"),
+                                                   (['runup.drive_line="back-to-back"'], "back-to-back")])
 def test_drive_line_choices(overrides, drive_line):
     """runup.drive_line: the quill shafts and couplings in the coupled model by default; the thesis' replica keeps
-    the shafts ending at the plates unless asked.  The run's drivetrains carry the choice to their FE reduction."""
+    the shafts ending at the plates unless asked; "back-to-back" closes the loop through the auxiliary gearbox.  The
+    run's drivetrains carry the choice to their FE reduction."""
     from housingfe.runup.scene import drivetrain_of
 
     scene, _ = load_runup_scene("test-gearbox-runup", overrides)
     assert scene.runup.drive_line_model == drive_line
     spec = drivetrain_of(scene.drivetrain, 2000.0, scene.runup.drive_line_model).to_coupling_spec()
-    assert len(spec.drive_lines) == (2 if drive_line == "quill-shafts" else 0)
+    assert len(spec.drive_lines) == (0 if drive_line == "none" else 2)
+    assert (spec.aux_gearbox is not None) == (drive_line == "back-to-back")
 
 
 @pytest.mark.parametrize("overrides, as_made", [([], "none"), (["runup.as_made=5"], 5), (["runup.as_made=none"], "none"),
@@ -114,7 +118,8 @@ def test_missing_drivetrain_is_named(tmp_path):
     (["--set", "runup.mesh_friction=-0.1"], "runup.mesh_friction: a mean friction coefficient must lie between 0"),
     (["--set", "runup.mesh_friction=0.5"], "runup.mesh_friction: a mean friction coefficient must lie between 0"),
     (["--set", "runup.mesh_friction=foo"], "runup.mesh_friction: 'foo' is not one of none, iso13989"),
-    (["--set", "runup.drive_line=quills"], "runup.drive_line: Input should be 'quill-shafts' or 'none'"),
+    (["--set", "runup.drive_line=quills"],
+     "runup.drive_line: Input should be 'quill-shafts', 'none' or 'back-to-back'"),
     (["--set", "runup.as_made=grade5"], "runup.as_made: 'grade5' is neither \"none\" nor an ISO 1328-1 accuracy grade"),
 ])
 def test_cli_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
