@@ -191,12 +191,16 @@ class Coupling:
 @dataclass(frozen=True)
 class GearForces:
     """Mean gear force on the pinion (N, housing frame) at the mesh `point` (m); mean mesh stiffness (N/m) along
-    the unit contact normal `direction`."""
+    the unit contact normal `direction`; `resultant` [-]: the length of the resultant of a unit normal mesh force
+    (1; cos(beta_b) for a double helical set, whose halves' normals cos(beta_b) l +- sin(beta_b) a add up to
+    cos(beta_b) l: `direction` is then the transverse line of action l, `stiffness` the normal stiffness S times
+    cos^2(beta_b) and the force T1 / r_b1 along it; docs/drivetrain.md)."""
 
     force_on_pinion: np.ndarray
     stiffness: float
     direction: np.ndarray
     point: np.ndarray
+    resultant: float = 1.0
 
 
 @dataclass(frozen=True)
@@ -419,9 +423,10 @@ class Drivetrain:
         """{gear node of the FE reduction: (6,) load [N, N m] in the housing frame} of a mesh force `force` (N,
         positive = compression, e.g. Excitation.mesh_force[n]) along the FE contact normal at the contact point:
         -force n on the pinion, +force n on the wheel, with their moments about the gear centres (the loads the
-        gear-mesh element of the coupled model carries)."""
+        gear-mesh element of the coupled model carries).  `force` is the NORMAL mesh force (of both helices of a
+        double helical set), n its resultant per unit (GearForces.resultant: cos(beta_b) l for double helical)."""
         forces = forces or self.gear_forces()
-        n = forces.direction
+        n = forces.direction * forces.resultant
         out = {}
         for name, sign in (("pinion", -1.0), ("wheel", 1.0)):
             node = f"{name}:{self.shaft_nodes(name)[1]['gear']}"
@@ -449,9 +454,9 @@ class Drivetrain:
         `moment` [N m] = F dw of a normal mesh force F [N] whose point moves by dw [m] along `mesh_face_direction`
         (w grows): the forces do not change, the moments about the gear centres change by +/- F (dw e_w x n):
         +moment (e_w x n) on the wheel, -moment (e_w x n) on the pinion (as `mesh_node_loads`: +F n on the wheel).
-        Self-equilibrated; |e_w x n| = cos(beta_b)."""
+        Self-equilibrated; |e_w x n| = cos(beta_b) (n: the resultant per unit normal force, as `mesh_node_loads`)."""
         forces = forces or self.gear_forces()
-        m = np.cross(self.mesh_face_direction(), forces.direction) * moment
+        m = np.cross(self.mesh_face_direction(), forces.direction * forces.resultant) * moment
         out = {}
         for name, sign in (("pinion", -1.0), ("wheel", 1.0)):
             node = f"{name}:{self.shaft_nodes(name)[1]['gear']}"
@@ -500,7 +505,9 @@ class Drivetrain:
     def gear_forces(self) -> GearForces:
         """Mean tooth force and mean mesh stiffness at `torque`, placed in the housing: the line of action in the
         transverse plane at the operating pressure angle from the common tangent, tilted out of it by the base
-        helix angle (0 for a double helical set, whose halves cancel axially); contact at the operating pitch
+        helix angle; a double helical set's halves cancel axially, so its direction is the transverse line of
+        action, its stiffness S cos^2(beta_b) and its force T1 / r_b1 (GearForces.resultant = cos(beta_b), as the
+        lumped model's housingfe.source.roosmalen.dynamics.mesh_direction); contact at the operating pitch
         point.  Remembered per gear set, shaft lines, lumped spans, torque and mesh positions (what it depends
         on; not the FE bearings, so another bearing configuration shares it): the mean mesh stiffness is a
         stiffness curve (0.2-0.8 s), and one run-up asks for it five times (coupling spec, unit loads,
@@ -528,15 +535,22 @@ class Drivetrain:
         e_c /= np.linalg.norm(e_c)
         tangent = np.cross(a, e_c)
         alpha = pair.operating_pressure_angle
-        beta_b = 0.0 if pair.kind == "double_helical" else pair.base_helix_angle
-        n = np.cos(beta_b) * (np.sin(alpha) * e_c + np.cos(alpha) * tangent) + np.sin(beta_b) * a
+        beta_b = pair.base_helix_angle
+        transverse = np.sin(alpha) * e_c + np.cos(alpha) * tangent
+        if pair.kind == "double_helical":
+            # the halves' normals cos(beta_b) l +- sin(beta_b) a, S / 2 each: S cos^2(beta_b) l l^T along l (the
+            # axial S sin^2(beta_b) of the halves against each other is not excited), force F_n cos(beta_b) l
+            resultant, n = math.cos(beta_b), transverse
+        else:
+            resultant, n = 1.0, np.cos(beta_b) * transverse + np.sin(beta_b) * a
+        stiffness *= resultant**2
         z1, z2 = pair.teeth
         point = np.asarray(p.centre, float) + pair.centre_distance * z1 / (z1 + z2) * e_c
         # the wheel pushes the pinion along -n
-        arrays = [np.array(a, float) for a in (-normal * n, n, point)]
+        arrays = [np.array(a, float) for a in (-normal * resultant * n, n, point)]
         for a in arrays:                    # shared by every caller (gear_forces remembers it): read-only
             a.setflags(write=False)
-        return GearForces(arrays[0], stiffness, arrays[1], arrays[2])
+        return GearForces(arrays[0], stiffness, arrays[1], arrays[2], resultant)
 
     def bearing_loads(self, forces: GearForces | None = None) -> dict:
         """{bearing name: (Fx, Fy, Fz, Mx, My)} (N) in each bearing's frame (housingfe.drivetrain.coupling.axis_frame

@@ -44,7 +44,8 @@ def static_gear_tilts(drivetrain, forces=None) -> tuple[np.ndarray, np.ndarray, 
         centres[seat.name] = drivetrain.shaft(seat.shaft).point(seat.position)
     K, _, _, names = interior_matrices(spec, centres)
     index = {n: 6 * i for i, n in enumerate(names)}
-    normal_force = float(np.linalg.norm(forces.force_on_pinion))
+    # the normal force (mesh_node_loads applies its resultant: cos(beta_b) of it for a double helical set)
+    normal_force = float(np.linalg.norm(forces.force_on_pinion)) / forces.resultant
     loads = drivetrain.mesh_node_loads(normal_force, forces)
     f = np.zeros(K.shape[0])
     scale = float(np.max(np.abs(np.diag(K))))
@@ -69,7 +70,7 @@ def static_gear_tilts(drivetrain, forces=None) -> tuple[np.ndarray, np.ndarray, 
 def _gear_loads(drivetrain, forces) -> tuple[dict, dict]:
     """({gear node: (6,) load of the mean tooth force without its moment about the shaft axis}, {gear node: unit
     shaft axis})."""
-    loads = drivetrain.mesh_node_loads(float(np.linalg.norm(forces.force_on_pinion)), forces)
+    loads = drivetrain.mesh_node_loads(float(np.linalg.norm(forces.force_on_pinion)) / forces.resultant, forces)
     out, axes = {}, {}
     for name in ("pinion", "wheel"):
         node = f"{name}:{drivetrain.shaft_nodes(name)[1]['gear']}"

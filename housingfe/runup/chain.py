@@ -266,7 +266,8 @@ def shuttle_moments(source, torque_nm: float, harmonics: np.ndarray) -> np.ndarr
     F the transmitted normal force [N] at the pinion torque [N m], W_n the one-sided harmonic n of the moment arm
     w_c + tan(beta_b) s_c [m] of the mesh load's centre of pressure (SourceModel.centre_of_pressure: the load
     distributions of the source's stiffness curve, same time origin as S(t) and F_e(t); CentreOfPressure
-    .moment_arm_harmonics; beta_b = 0 for a double helical pair as in the FE normal, Drivetrain.gear_forces).  The
+    .moment_arm_harmonics; no s term for a double helical pair, whose halves' terms cancel; the unit load applies
+    F as its resultant, cos(beta_b) F along the transverse line of action there, Drivetrain.shuttle_node_loads).  The
     s term is small (at most 2.4 N m against 98-157 N m of the axial term at n = 1 for sets A-D at 2000 N m,
     benchmarks/experiments/shuttling) but lies on the same axis, so it is kept.  The amplitude of the unit load
     "shuttle" (`unit_loads`).
@@ -391,11 +392,15 @@ DEFAULT_SOURCE_RECEPTANCE = "coupled"
 
 
 def mesh_reference_stiffness(model: GearboxModel) -> float:
-    """The mean mesh stiffness k_ref (N/m) that the coupled model's gear-mesh element holds."""
+    """The mean mesh stiffness k_ref (N/m) that the coupled model's gear-mesh element holds, per unit of the "mesh"
+    unit load's own compression (the normal force and approach, as S(t) of the source): the element's stiffness along
+    its unit direction divided by GearForces.resultant^2 (1; cos^2(beta_b) for a double helical set, whose element
+    holds S cos^2(beta_b) along the transverse line of action and whose unit load is the resultant cos(beta_b) l of a
+    unit normal force: the element's energy k_t delta_t^2 / 2 with delta_t = delta_n / cos(beta_b) is S delta_n^2 / 2)."""
     meshes = model.structure.spec.gear_meshes
     if len(meshes) != 1:
         raise InputError(f"source_receptance: the coupled source needs one gear mesh, the model has {len(meshes)}")
-    return float(meshes[0].stiffness)
+    return float(meshes[0].stiffness) / model.drivetrain.gear_forces().resultant ** 2
 
 
 def mesh_receptance(model: GearboxModel, frequencies_hz) -> np.ndarray:

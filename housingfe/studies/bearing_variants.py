@@ -23,6 +23,7 @@ couplings (the axial offset of a bearing's load centre) do, which in the test ge
 from __future__ import annotations
 
 import argparse
+import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -67,8 +68,8 @@ class GearForces:
 def gear_forces(gear_set: str, torque: float, point, pinion_centre, wheel_centre, shaft_axis) -> GearForces:
     """Tooth forces and mean mesh stiffness of a gear set (housingfe.source) for a pinion torque (N m), placed
     in the housing: the line of action lies in the transverse plane at the operating pressure angle from the
-    common tangent, tilted out of it by the base helix angle (0 for a double helical set, whose two halves
-    cancel axially)."""
+    common tangent, tilted out of it by the base helix angle; a double helical set's two halves cancel axially:
+    the transverse line of action with S cos^2(beta_b) and T1 / r_b1 (docs/drivetrain.md)."""
     from housingfe.scenefile import read_scene_dict
     from housingfe.source.roosmalen import run as roosmalen
     from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
@@ -83,11 +84,16 @@ def gear_forces(gear_set: str, torque: float, point, pinion_centre, wheel_centre
     e_c /= np.linalg.norm(e_c)
     tangent = np.cross(a, e_c)
     alpha = pair.operating_pressure_angle
-    beta_b = 0.0 if pair.kind == "double_helical" else pair.base_helix_angle
+    beta_b = pair.base_helix_angle
     transverse = np.sin(alpha) * e_c + np.cos(alpha) * tangent
-    n = np.cos(beta_b) * transverse + np.sin(beta_b) * a
+    if pair.kind == "double_helical":
+        # the halves' normal forces add up to F_n cos(beta_b) along the transverse line of action, their stiffness
+        # to S cos^2(beta_b) along it (as housingfe.drivetrain.description.Drivetrain.gear_forces)
+        resultant, n = math.cos(beta_b), transverse
+    else:
+        resultant, n = 1.0, np.cos(beta_b) * transverse + np.sin(beta_b) * a
     # the wheel pushes the pinion along -n: away from the wheel (radial), against the tangent, axially -a
-    return GearForces(-normal * n, stiffness, n, gear_set)
+    return GearForces(-normal * resultant * n, stiffness * resultant**2, n, gear_set)
 
 
 def shaft_bearing_loads(force, point, front, back, axis) -> tuple[np.ndarray, np.ndarray]:

@@ -119,13 +119,13 @@ def test_bad_descriptions_are_input_errors():
         dataclasses.replace(d, torque=0.0)
 
 
-@pytest.mark.parametrize("gear_set", ["A", "C"])
+@pytest.mark.parametrize("gear_set", ["A", "C", "double_helical"])
 def test_lumped_mesh_loads_map_onto_the_fe_mesh_loads(gear_set):
     """The lumped model's generalized mesh force on each gear (-F h, Appendix C with the axial tilt term) moved into
     the housing frame (`lumped_to_housing`, mirrored for the helix hand) is the FE reduction's mesh load on the gear
-    node: force along the contact normal and its moment about the gear centre, all six components.  (Single helical
-    only: for the double helical set the lumped normal keeps the axial component and cos(beta_b) of one helix,
-    the FE reduction takes beta_b = 0 as the halves cancel; docs/drivetrain.md.)"""
+    node: force along the contact normal and its moment about the gear centre, all six components.  Double helical:
+    both take the resultant of the two halves' normals, cos(beta_b) along the transverse line of action, no axial
+    force, no tilting moment (docs/drivetrain.md)."""
     from housingfe.source.roosmalen.dynamics import mesh_direction
 
     d = test_gearbox(gear_set)
@@ -176,6 +176,58 @@ def test_shuttle_loads_are_the_mesh_force_with_its_point_moved(gear_set):
         for node in base:
             np.testing.assert_allclose(both[node] - base[node], d.shuttle_node_loads(F * arm, forces)[node],
                                        atol=1e-9 * F)
-    m = np.cross(e_w, n)
-    assert np.linalg.norm(m) == pytest.approx(math.cos(0.0 if gear_set == "double_helical"
-                                                        else pair.base_helix_angle), rel=1e-12)
+    m = np.cross(e_w, n * forces.resultant)
+    assert np.linalg.norm(m) == pytest.approx(math.cos(pair.base_helix_angle), rel=1e-12)
+
+
+def test_double_helical_mesh_of_both_reductions_is_the_transverse_resultant():
+    """Double helical, 2000 N m: the halves' normals cos(bb) l +- sin(bb) a (S / 2 each) add up to the stiffness
+    S cos^2(bb) along the transverse line of action l and the force F_n cos(bb) = T / r_b1.  The FE reduction's
+    gear forces and the lumped model (mesh_direction, its static state under the preload) give the same transverse
+    stiffness and force for the same normal stiffness S (the MeshModel's, at the FE's mesh positions); no axial
+    part, and the FE force balances the pinion torque T."""
+    from housingfe.source.roosmalen import dynamics as dyn
+    from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
+
+    d = test_gearbox("double_helical", bearings="cylindrical_roller")
+    pair = d.gears.pair
+    forces = d.gear_forces()
+    S = stiffness_curve(d.to_lumped()[2], normal_force_from_torque(pair, d.torque), d.coupling_mesh_positions).mean
+    cb = math.cos(pair.base_helix_angle)
+    axis = np.asarray(d.shaft("pinion").axis, float)
+    assert forces.resultant == cb and forces.direction @ axis == 0.0
+    assert forces.stiffness == pytest.approx(S * cb**2, rel=1e-12)
+    rb1 = pair.base_diameter[0] / 2
+    assert np.linalg.norm(forces.force_on_pinion) == pytest.approx(d.torque / rb1, rel=1e-12)
+    arm = forces.point - np.asarray(d.shaft("pinion").centre)
+    assert abs(np.cross(arm, forces.force_on_pinion) @ axis) == pytest.approx(d.torque, rel=1e-12)
+    # the lumped model with the same S: stiffness along its transverse unit vector, static transverse mesh force
+    interior, _, _ = d.to_lumped()
+    mats = dyn.assemble(pair, interior, S)
+    h = mats.h
+    assert S * (h[0] ** 2 + h[1] ** 2) == pytest.approx(forces.stiffness, rel=1e-12)
+    q = np.linalg.solve(mats.K0 + S * np.outer(h, h), dyn.preload_force(mats, d.torque))
+    f = S * (h @ q) * h[:6]
+    assert f[2] == 0.0 and f[3] == 0.0 and f[4] == 0.0
+    assert math.hypot(f[0], f[1]) == pytest.approx(np.linalg.norm(forces.force_on_pinion), rel=1e-12)
+
+
+def test_single_helical_gear_forces_are_unchanged():
+    """Set A: bit for bit the unit normal cos(bb) l + sin(bb) a, the MeshModel's normal stiffness S and the force
+    -F_n n (the double helical resultant does not touch a single helical set)."""
+    from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
+
+    d = test_gearbox("A")
+    pair = d.gears.pair
+    forces = d.gear_forces()
+    normal = normal_force_from_torque(pair, d.torque)
+    assert forces.resultant == 1.0
+    assert forces.stiffness == stiffness_curve(d.to_lumped()[2], normal, d.coupling_mesh_positions).mean
+    a = np.asarray(d.shaft("pinion").axis, float) / np.linalg.norm(d.shaft("pinion").axis)
+    c = np.asarray(d.shaft("wheel").centre, float) - np.asarray(d.shaft("pinion").centre, float)
+    e_c = c - (c @ a) * a
+    e_c /= np.linalg.norm(e_c)
+    alpha, bb = pair.operating_pressure_angle, pair.base_helix_angle
+    n = np.cos(bb) * (np.sin(alpha) * e_c + np.cos(alpha) * np.cross(a, e_c)) + np.sin(bb) * a
+    assert np.array_equal(forces.direction, n)
+    assert np.array_equal(forces.force_on_pinion, -normal * n)

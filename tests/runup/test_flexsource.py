@@ -42,6 +42,27 @@ def test_static_mesh_receptance_is_one_over_the_mesh_stiffness(coarse):
     assert mesh_receptance(gm, [1e-3])[0] * k == pytest.approx(1.0, abs=1e-6)
 
 
+@pytest.mark.slow
+def test_double_helical_reference_stiffness_is_the_normal_mesh_stiffness(coarse):
+    """Double helical: the FE element holds S cos^2(beta_b) along the transverse line of action and the "mesh" unit
+    load is the resultant cos(beta_b) l of a unit normal force (docs/drivetrain.md), so along that load the static
+    receptance is 1 / S, S the MeshModel's normal stiffness, and k_ref must be S (not the element's S cos^2(beta_b)):
+    the balance's S(t) - k_ref then has zero mean."""
+    from housingfe.drivetrain.description import test_gearbox
+    from housingfe.runup.chain import build_gearbox_model
+    from housingfe.source.stiffness import stiffness_curve
+
+    dt = test_gearbox("double_helical", bearings="cylindrical_roller")
+    gm = build_gearbox_model(coarse[0].housing_model, dt, F_LINES)
+    pair = dt.gears.pair
+    S = stiffness_curve(dt.to_lumped()[2], normal_force_from_torque(pair, dt.torque), dt.coupling_mesh_positions).mean
+    k = mesh_reference_stiffness(gm)
+    assert k == pytest.approx(S, rel=1e-12)
+    assert gm.structure.spec.gear_meshes[0].stiffness == pytest.approx(S * math.cos(pair.base_helix_angle) ** 2,
+                                                                       rel=1e-12)
+    assert mesh_receptance(gm, [1e-3])[0] * k == pytest.approx(1.0, abs=1e-6)
+
+
 @pytest.fixture(scope="module")
 def coarse_drive_line(coarse):
     """The coarse model's housing and drivetrain with the quill shafts (runup.drive_line = "quill-shafts")."""

@@ -35,6 +35,14 @@ def test_gear_forces_are_the_source_tooth_loads():
     assert 5e8 < g.stiffness < 2e9                    # ISO 6336 order: c_gamma ~ 20 N/(mm um) x 62 mm
     d = bv.gear_forces("double_helical", 2000.0, (-0.076, 0.0, 0.2), pin, whl, (0, 1, 0))
     assert abs(d.force_on_pinion[1]) < 1e-9 and abs(d.direction[1]) < 1e-12
+    # the halves' resultant: T / r_b1 along the transverse line of action, S cos^2(beta_b) (docs/drivetrain.md), as
+    # the drivetrain description takes it
+    from housingfe.drivetrain.description import test_gearbox
+
+    ref = test_gearbox("double_helical", "cylindrical_roller").gear_forces()
+    rb1 = test_gearbox("double_helical", "cylindrical_roller").gears.pair.base_diameter[0] / 2
+    assert np.linalg.norm(d.force_on_pinion) == pytest.approx(2000.0 / rb1, rel=1e-12)
+    assert d.stiffness == pytest.approx(ref.stiffness, rel=5e-5)
 
 
 def test_builtin_scene_carries_the_computed_loads_and_mesh():

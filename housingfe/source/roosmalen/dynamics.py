@@ -158,11 +158,20 @@ def mesh_direction(pair: GearPair, axial_moment: bool = True) -> np.ndarray:
     centre line is the x axis (wheel at +x) and the contact is taken at the operating pitch point, mid
     face.  axial_moment=True adds the tilt coupling theta_y: the axial force component F sin(beta_b)
     acts at the operating pitch radius r_w (h_4 = r_w1 sin(beta_b), h_10 = r_w2 sin(beta_b)); Appendix C
-    lists only the x, y, z, theta_z terms, which leaves the bearing moments unexcited."""
+    lists only the x, y, z, theta_z terms, which leaves the bearing moments unexcited.
+
+    Double helical pair: the two helices have opposite hands, normals n_+- = cos(beta_b) l +- sin(beta_b) z, and
+    carry half the normal force each (S/2 each), so d = h^T q is the mean of the two helices' normal compressions
+    and F h the resultant of the normal force F: no axial component, no tilt term, the transverse part
+    cos(beta_b) l kept (h_3 = h_9 = h_5 = h_11 = 0).  Along the transverse line of action the mesh is then the
+    stiffness S cos^2(beta_b) and carries F cos(beta_b) = T1 / r_b1 (docs/drivetrain.md).  The axial stiffness
+    S sin^2(beta_b) of the halves against each other (relative axial motion compresses one, unloads the other) is
+    not in h h^T: it positions a floating wheel and is not excited by the mesh (no mean or periodic axial load)."""
     a, bb = pair.operating_pressure_angle, pair.base_helix_angle
     rb1, rb2 = pair.base_diameter / 2
     h = np.zeros(N_DOF)
-    h[0:3] = [math.sin(a) * math.cos(bb), math.cos(a) * math.cos(bb), -math.sin(bb)]
+    axial = 0.0 if pair.kind == "double_helical" else -math.sin(bb)     # the halves' axial parts cancel
+    h[0:3] = [math.sin(a) * math.cos(bb), math.cos(a) * math.cos(bb), axial]
     h[5] = rb1 * math.cos(bb)
     h[6:9] = -h[0:3]
     h[11] = rb2 * math.cos(bb)

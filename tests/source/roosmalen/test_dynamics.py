@@ -183,6 +183,46 @@ def test_static_tilt_moment_is_axial_force_times_pitch_radius():
     assert interior.pinion_bearings[2] * q[2] == pytest.approx(fn * sb, rel=1e-9)    # axial force on the pinion
 
 
+PAIR_DH = GearPair.from_table(REF["double_helical"])
+
+
+def test_single_helical_mesh_direction_is_the_appendix_c_normal():
+    """Bit for bit the single helical normal (sin a cos bb, cos a cos bb, -sin bb) with r_b cos bb and the tilt terms
+    r_w sin bb: the double helical change leaves it alone."""
+    a, bb = PAIR.operating_pressure_angle, PAIR.base_helix_angle
+    rb1, rb2 = PAIR.base_diameter / 2
+    h = np.zeros(dyn.N_DOF)
+    h[0:3] = [math.sin(a) * math.cos(bb), math.cos(a) * math.cos(bb), -math.sin(bb)]
+    h[5], h[6:9], h[11] = rb1 * math.cos(bb), -h[0:3], rb2 * math.cos(bb)
+    h[4], h[10] = rb1 / math.cos(a) * math.sin(bb), rb2 / math.cos(a) * math.sin(bb)
+    assert np.array_equal(dyn.mesh_direction(PAIR), h)
+
+
+def test_double_helical_mesh_puts_no_axial_force_or_moment_on_the_shafts():
+    """Double helical: the halves' axial forces are equal and opposite at the same radius, so the static mesh load
+    on each shaft is transverse, T / r_b1 along the line of action (torque balance: the normal force F_n =
+    T / (r_b1 cos bb) has the transverse resultant F_n cos bb), and the bearings carry no axial force and no
+    moment; the transverse mesh stiffness is S cos^2(beta_b)."""
+    interior = dyn.derive_interior(PAIR_DH, GEOMETRY)
+    mats = dyn.assemble(PAIR_DH, interior, K_MEAN)
+    h = mats.h
+    assert h[2] == 0.0 and h[8] == 0.0 and h[4] == 0.0 and h[10] == 0.0 and h[3] == 0.0 and h[9] == 0.0
+    cb = math.cos(PAIR_DH.base_helix_angle)
+    assert K_MEAN * (h[0] ** 2 + h[1] ** 2) == pytest.approx(K_MEAN * cb**2, rel=1e-14)
+    torque = 2000.0
+    q = np.linalg.solve(mats.K0 + K_MEAN * np.outer(h, h), dyn.preload_force(mats, torque))
+    mesh = -K_MEAN * (h @ q) * h                   # generalized mesh force on the 14 DOFs
+    rb1 = PAIR_DH.base_diameter[0] / 2
+    for shaft in (slice(0, 6), slice(6, 12)):
+        f = mesh[shaft]
+        assert f[2] == 0.0 and f[3] == 0.0 and f[4] == 0.0          # no axial force, no tilting moment
+        assert math.hypot(f[0], f[1]) == pytest.approx(torque / rb1, rel=1e-10)
+    assert K_MEAN * (h @ q) == pytest.approx(normal_force_from_torque(PAIR_DH, torque), rel=1e-10)
+    reaction = mats.K0[:5, :5] @ q[:5]             # the pinion bearings: transverse only
+    assert abs(reaction[2]) < 1e-12 * torque / rb1 and np.abs(reaction[3:5]).max() < 1e-12 * torque
+    assert math.hypot(reaction[0], reaction[1]) == pytest.approx(torque / rb1, rel=1e-10)
+
+
 # ------------------------------------------------------------------ engagement over the face width
 SET_A = Corrections.from_table(REF["profile_corrections"]["A"])
 
