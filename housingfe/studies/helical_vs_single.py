@@ -166,3 +166,18 @@ def write(folder: Path, rows: list[dict]) -> None:
         w.writeheader()
         w.writerows(rows)
     (Path(folder) / "double-helical_vs_single.md").write_text(markdown(rows))
+
+
+def from_studies(written) -> list[dict]:
+    """The comparison of families run together (`housingfe study double-helical profile-corrections bearings`):
+    written = [(family name, engagement, the folder its tables were written into)]; the double helical family
+    against the single helical families run with the same engagement shock (the first of each).  [] when the double
+    helical family, or every single helical one, is not among them."""
+    dh = next(((e, d) for f, e, d in written if f == FAMILY), None)
+    if dh is None:
+        return []
+    folders = {FAMILY: dh[1]}
+    for family, engagement, folder in written:
+        if family in {f for f, _, _ in SINGLE_HELICAL.values()} and engagement == dh[0]:
+            folders.setdefault(family, folder)
+    return compare(tables_of(folders)) if len(folders) > 1 else []

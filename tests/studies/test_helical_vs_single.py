@@ -116,3 +116,19 @@ def test_a_missing_run_is_named(tmp_path):
     table = hvs.read_runup_table(tmp_path / "profile-corrections-face-width" / "profile-corrections_runup.csv")
     with pytest.raises(InputError, match=r"pc\.csv: no column LwA_<route>_fluid_film@2000_dBA"):
         hvs.curves(table, "fluid_film@2000", "pc.csv")
+
+
+def test_families_run_together_are_compared_with_the_same_shock(tmp_path):
+    write_study(tmp_path)
+    written = [("double-helical", "face-width", tmp_path / "double-helical-face-width"),
+               ("profile-corrections", "thesis-2d", tmp_path / "nowhere"),          # another shock: not compared
+               ("profile-corrections", "face-width", tmp_path / "profile-corrections-face-width")]
+    rows = hvs.from_studies(written)
+    assert {(r["single_helical"], r["route"]) for r in rows} == {("A", "tf_omega"), ("A", "mesh_force")}
+    assert rows[0]["mean_diff_dB"] == round(-65.0 / 15.0, 2)
+    assert hvs.from_studies(written[1:]) == [] and hvs.from_studies(written[:1]) == []
+    hvs.write(tmp_path, rows)
+    with open(tmp_path / "double-helical_vs_single.csv") as fh:
+        assert [r["single_helical"] for r in csv.DictReader(fh)] == ["A"] * 4
+    assert "| roller | A | tf_omega | -4.3 (2.5) | -5.3 | +5.0 (90.0 / 95.0) | +9.5 |" in \
+        (tmp_path / "double-helical_vs_single.md").read_text()
