@@ -10,6 +10,9 @@ re-analyses).
   bearings, 2000 N m;
 * `double-helical` (Sec. 5.9): the double helical set with cylindrical roller (reference at 2000 N m) and
   fluid-film bearings at 500, 1000, 1500 and 2000 N m, with the measured torque law (1000 -> 2000 N m, Fig. 5.21).
+* run together with `profile-corrections` and/or `bearings` (`housingfe study double-helical profile-corrections
+  bearings`), the double helical set against single helical set A (ball) and set B on self-aligning bearings, all
+  2000 N m, as measured in Sec. 5.9 (housingfe.studies.helical_vs_single): <out>/double-helical_vs_single.csv / .md;
 * a family file of the user's own (`housingfe study my_family.toml`, housingfe.studies.family_file): any variants
   of a run-up scene, with the user's measured numbers beside ours (also measured torque laws, [[torque_laws]]).
 
@@ -47,6 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.errors import InputError
+from housingfe.studies import helical_vs_single
 from housingfe.studies.chain_session import (
     MEAN_RANGE_RPM,
     ChainSession,
@@ -940,15 +944,26 @@ def run_studies(jobs, out_dir: str | None = None, fresh_basis: bool = False) -> 
         t0 = time.perf_counter()
         results.append((run_family(fam, session, progress=say), sub, time.perf_counter() - t0))
     wall = time.perf_counter() - t_start
+    vs_single = []
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
+            written = []
             for result, sub, seconds in results:
                 folder = tmp / sub if sub else tmp
                 folder.mkdir(exist_ok=True)
                 write(folder, result, seconds if len(results) > 1 else wall)
+                written.append((result.family.name, result.engagement, folder))
+            # the double helical set run together with single helical families: the thesis' Sec. 5.9 comparison
+            vs_single = helical_vs_single.from_studies(written) if len(results) > 1 else []
+            if vs_single:
+                helical_vs_single.write(tmp, vs_single)
     if comm.rank == 0:
         for result, _, seconds in results:
             print(summary_text(result, seconds if len(results) > 1 else wall))
+        for r in vs_single:
+            print(f"double helical {r['double_helical']} - single helical {r['single_helical']}, {r['route']}: mean "
+                  f"{_pm(r['mean_diff_dB'], r['sd_diff_dB'])} dB (measured {r['measured_mean_dB']:+g}), max reduced "
+                  f"by {r['max_reduction_dBA']:+.1f} dB(A) (measured {r['measured_max_reduction_dBA']:+g})")
         print(f"total wall time {wall:.1f} s; results: {out}/")
     return out
 

@@ -11,7 +11,10 @@ unit, source, note) with these fields added (`tag`):
   as made (`as_made_row`; runup.as_made, docs/runup.md), and "28.as_made.<pitch>.<the check's id after 28.>", the
   default chain's checks on a run with the sidebands in its totals (`as_made_check`; runup.as_made_totals), reported,
   never judged, without a band and counted apart as well (the count line says how many of those the checks would
-  pass);
+  pass); and in the variants group the double helical set against single helical set A and self-aligning B
+  (VS_SINGLE, "28.variants.double_helical_vs_single.<roller|fluid_film>.<A|B_self_aligning>.<mean|max_reduction>.
+  <route>", study_rows.double_helical_vs_single_rows): the issue's checks do not name this comparison, so these are
+  reported beside them, never judged, without a band and counted apart;
 * measured, thesis_calculated — the published numbers beside ours (either may be None);
 * tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
 * passed — "yes", "no" or "" (a report row: nothing to pass);
@@ -124,9 +127,20 @@ def is_as_made(row: dict) -> bool:
     return is_check(row) and row["check_id"].split(".")[1] == AS_MADE_GROUP
 
 
+# the double helical set against the single helical ones (housingfe.studies.helical_vs_single; issue 28's checks do
+# not name this comparison): reported beside the checks, never judged, no band, counted apart
+VS_SINGLE = "28.variants.double_helical_vs_single."
+
+
+def is_vs_single(row: dict) -> bool:
+    """A row of the double helical set against single helical (28.variants.double_helical_vs_single.*): reported."""
+    return is_check(row) and row["check_id"].startswith(VS_SINGLE)
+
+
 def is_reported_beside(row: dict) -> bool:
-    """A row shown beside the checks but not one of them (the envelope bound's, gears as made)."""
-    return is_bound(row) or is_as_made(row)
+    """A row shown beside the checks but not one of them (the envelope bound's, gears as made, the double helical
+    set against single helical)."""
+    return is_bound(row) or is_as_made(row) or is_vs_single(row)
 
 
 # the default chain's checks evaluated on gears as made (runup.as_made = AS_MADE_GRADE with runup.as_made_totals:
@@ -312,8 +326,9 @@ def _cells(r: dict) -> list[str]:
 
 def checks_markdown(rows) -> str:
     """The check rows of `rows` as a Markdown table (the columns of CHECK_COLUMNS) and a count line; the envelope
-    bound's rows (28.bound.*) and those of gears as made (28.as_made.*; those of the design variants,
-    28.as_made.variants.*, named apart) are counted apart: they are not checks."""
+    bound's rows (28.bound.*), those of gears as made (28.as_made.*; those of the design variants,
+    28.as_made.variants.*, named apart) and those of the double helical set against single helical (VS_SINGLE) are
+    counted apart: they are not checks."""
     found = check_rows(rows)
     lines = ["| " + " | ".join(CHECK_COLUMNS) + " |", "|" + "---|" * len(CHECK_COLUMNS)]
     lines += ["| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in _cells(r)) + " |" for r in found]
@@ -323,7 +338,8 @@ def checks_markdown(rows) -> str:
     chain = {p: [r for r in found if is_as_made_check(r) and r["check_id"].split(".")[2] == p]
              for p in AS_MADE_PITCHES}
     n_chain = sum(len(v) for v in chain.values())
-    checks = len(found) - bound - made
+    vs_single = sum(is_vs_single(r) for r in found)
+    checks = len(found) - bound - made - vs_single
     passed = sum(r.get("passed") == "yes" for r in found)
     failed = sum(r.get("passed") == "no" for r in found)
     parts = [f"{made - variants - n_chain} of the default run-up"]
@@ -339,7 +355,9 @@ def checks_markdown(rows) -> str:
               + (f"; and {bound} rows of the envelope bound (28.bound.*), reported: a bound, not the model" if bound
                  else "")
               + (f"; and {made} rows of gears as made (28.as_made.*, ISO grade {AS_MADE_GRADE} sidebands{detail}), "
-                 "reported: not checks" if made else "")]
+                 "reported: not checks" if made else "")
+              + (f"; and {vs_single} rows of the double helical set against single helical ({VS_SINGLE}*), "
+                 "reported: not checks" if vs_single else "")]
     return "\n".join(lines) + "\n"
 
 

@@ -18,6 +18,10 @@ and from the design-variant study's cached result (<results>/study-validate/, ho
 
 * 28.replica.max_lwa — the thesis replica (engagement thesis-2d, the rigid-bore source's L_omega times TF_omega,
   sigma = 1, gear set A, ball bearings, 2000 N m): max L_WA within 1.5 dB of the thesis' calculated 89.4 dB(A).
+* 28.variants.double_helical_vs_single.<roller|fluid_film>.<A|B_self_aligning>.<mean|max_reduction>.<route> —
+  the double helical set against single helical set A (ball) and set B on self-aligning bearings, all 2000 N m,
+  from the study's run-up tables (study_rows.double_helical_vs_single_rows): reported beside the checks, not
+  checks (checks.VS_SINGLE); a missing run costs these rows alone (a failure line).
 
 and, where the default run-up also ran the envelope bound (set A's overlap ratio near an integer: runup_envelope_bound.csv,
 runup_envelope_bound_harmonics.csv and runup.json "envelope_bound"), the rows of the envelope bound (`bound_chain_rows`,
@@ -57,7 +61,7 @@ from pathlib import Path
 
 import numpy as np
 
-from housingfe.errors import SolverError
+from housingfe.errors import InputError, SolverError
 from housingfe.verification import checks as ck
 
 SOURCE = "van Roosmalen 1994, Ch. 5 (Secs. 5.4-5.6, Figs. 5.6, 5.7, 5.10) [test_gearbox]; issue 28"
@@ -78,6 +82,14 @@ def published_rows(results: Path | None = None, quick: bool = False, failures: l
     folder = study_rows.study_folder(results, quick)
     if folder is not None:
         out += replica_rows(folder)
+        try:
+            out += study_rows.double_helical_vs_single_rows(folder)
+        except InputError as exc:
+            message = f"double helical vs single helical ({ck.VS_SINGLE}* left out): {exc}"
+            if failures is None:
+                print(f"validate: {message}", flush=True)
+            else:
+                failures.append(message)
     periodic = {}       # the default chain's check rows, by check_id: the periodic verdicts beside the as-made ones
     if found is not None:
         data = json.loads((found[1] / "runup.json").read_text())

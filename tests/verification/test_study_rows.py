@@ -48,3 +48,52 @@ def test_provider_gets_the_cache_folder_and_quick(monkeypatch):
     monkeypatch.setattr(validate, "ROW_PROVIDERS", ("housingfe.verification.study_rows",))
     assert validate.provider_rows(results="somewhere", quick=True) == []
     assert seen == {"results": "somewhere", "quick": True}
+
+
+def test_double_helical_vs_single_rows_are_reported_beside_the_checks(tmp_path, monkeypatch):
+    """The rows of the double helical set against single helical A and self-aligning B: stable ids, ours from the
+    study's run-up tables (worked by hand in tests/studies/test_helical_vs_single.py), the measured numbers of
+    Sec. 5.9; reported (not checks: the count line is unchanged but for its own clause, no band attaches); a
+    missing run costs these rows alone, with one line naming the file."""
+    from housingfe.verification import checks as ck
+    from housingfe.verification import runup_checks_rows
+    from tests.studies.test_helical_vs_single import write_study
+
+    write_study(tmp_path)
+    rows = {r["check_id"]: r for r in study_rows.double_helical_vs_single_rows(tmp_path)}
+    ids = [f"28.variants.double_helical_vs_single.{b}.{ref}.{what}.{route}" for b in ("roller", "fluid_film")
+           for ref in ("A", "B_self_aligning") for route in ("tf_omega", "mesh_force")
+           for what in ("mean", "max_reduction")]
+    assert list(rows) == ids
+    measured = {(b, ref, what): rows[f"28.variants.double_helical_vs_single.{b}.{ref}.{what}.mesh_force"]["measured"]
+                for b in ("roller", "fluid_film") for ref in ("A", "B_self_aligning")
+                for what in ("mean", "max_reduction")}
+    assert measured == {("roller", "A", "mean"): -5.3, ("roller", "A", "max_reduction"): 9.5,
+                        ("fluid_film", "A", "mean"): -7.2, ("fluid_film", "A", "max_reduction"): 12.8,
+                        ("roller", "B_self_aligning", "mean"): -0.2,
+                        ("roller", "B_self_aligning", "max_reduction"): 1.3,
+                        ("fluid_film", "B_self_aligning", "mean"): -2.1,
+                        ("fluid_film", "B_self_aligning", "max_reduction"): 4.6}
+    r = rows["28.variants.double_helical_vs_single.roller.A.mean.tf_omega"]
+    assert (r["ours"], r["unit"], r["passed"], r["tolerance"]) == (round(-65 / 15, 2), "dB", "", "")
+    assert rows["28.variants.double_helical_vs_single.roller.A.max_reduction.tf_omega"]["ours"] == 5.0
+    assert all(ck.is_vs_single(x) and ck.is_reported_beside(x) for x in rows.values())
+    # beside a check the count line keeps its structure: the checks' count, then these counted apart
+    check = ck.check_row("28.variants.mean.bearings.ball.tf_omega", "s", "q", 1.0, "dB", "src", measured=1.0,
+                         tolerance="3 dB", passed=True)
+    line = ck.checks_markdown([check, *rows.values()]).splitlines()[-1]
+    assert line == ("1 checks: 1 passed, 0 failed, 0 reported; and 16 rows of the double helical set against single "
+                    "helical (28.variants.double_helical_vs_single.*), reported: not checks")
+    assert ck.attach_bands(list(rows.values()), {i: (0.0, 1.0) for i in ids}) == 0
+    # in validate: the provider reads them from the study folder; a missing run is one failure line
+    monkeypatch.setattr(validate, "runup_folder", lambda *a, **k: None)
+    monkeypatch.setattr(study_rows, "study_folder", lambda results=None, quick=False: tmp_path)
+    monkeypatch.setattr(runup_checks_rows, "replica_rows", lambda folder: [])
+    failures = []
+    assert [x["check_id"] for x in runup_checks_rows.published_rows(tmp_path, failures=failures)] == ids
+    assert failures == []
+    (tmp_path / "bearings-face-width" / "bearings_runup.csv").unlink()
+    assert runup_checks_rows.published_rows(tmp_path, failures=failures) == []
+    assert len(failures) == 1 and failures[0].startswith(
+        "double helical vs single helical (28.variants.double_helical_vs_single.* left out): ")
+    assert "bearings-face-width/bearings_runup.csv: cannot read the run-up table" in failures[0]
