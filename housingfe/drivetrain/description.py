@@ -529,20 +529,7 @@ class Drivetrain:
         normal = normal_force_from_torque(pair, self.torque)
         stiffness = stiffness_curve(lumped_model, normal, self.coupling_mesh_positions).mean
         p, w = self.shaft("pinion"), self.shaft("wheel")
-        a = np.asarray(p.axis, float) / np.linalg.norm(p.axis)
-        centres = np.asarray(w.centre, float) - np.asarray(p.centre, float)
-        e_c = centres - (centres @ a) * a
-        e_c /= np.linalg.norm(e_c)
-        tangent = np.cross(a, e_c)
-        alpha = pair.operating_pressure_angle
-        beta_b = pair.base_helix_angle
-        transverse = np.sin(alpha) * e_c + np.cos(alpha) * tangent
-        if pair.kind == "double_helical":
-            # the halves' normals cos(beta_b) l +- sin(beta_b) a, S / 2 each: S cos^2(beta_b) l l^T along l (the
-            # axial S sin^2(beta_b) of the halves against each other is not excited), force F_n cos(beta_b) l
-            resultant, n = math.cos(beta_b), transverse
-        else:
-            resultant, n = 1.0, np.cos(beta_b) * transverse + np.sin(beta_b) * a
+        n, resultant, e_c = mesh_line_of_action(pair, p.centre, w.centre, p.axis)
         stiffness *= resultant**2
         z1, z2 = pair.teeth
         point = np.asarray(p.centre, float) + pair.centre_distance * z1 / (z1 + z2) * e_c
@@ -674,6 +661,29 @@ TEST_GEARBOX_CENTRES = {"pinion": (-0.126, 0.0, 0.200), "wheel": (0.074, 0.0, 0.
 TEST_GEARBOX_BEARINGS = {"ball": {"pinion": "SKF 6316", "wheel": "SKF 6219"}}
 GEAR_SETS = {"A": "gearset-A", "B": "gearset-B", "C": "gearset-C", "D": "gearset-D",
              "uncorrected": "gearset-uncorrected", "double_helical": "gearset-double-helical"}
+
+
+def mesh_line_of_action(pair, pinion_centre, wheel_centre, shaft_axis) -> tuple[np.ndarray, float, np.ndarray]:
+    """The contact normal of a gear pair placed in the housing: (n, resultant, e_c).
+
+    n (unit, global): the transverse line of action at the operating pressure angle from the common tangent, tilted
+    out of the transverse plane by the base helix angle along +shaft_axis; for a double helical pair the transverse
+    line itself, because the halves' normals cos(beta_b) l +- sin(beta_b) a, S / 2 each, add up to S cos^2(beta_b)
+    l l^T and a force F_n cos(beta_b) along l (the axial S sin^2(beta_b) of the halves against each other is not
+    excited).  resultant: the factor on the normal force (and, squared, on the normal stiffness) along n: cos(beta_b)
+    for double helical, 1 otherwise.  e_c (unit): from the pinion centre towards the wheel centre, normal to the
+    axis.  Centres in m; the axis need not be unit."""
+    a = np.asarray(shaft_axis, float) / np.linalg.norm(shaft_axis)
+    centres = np.asarray(wheel_centre, float) - np.asarray(pinion_centre, float)
+    e_c = centres - (centres @ a) * a
+    e_c /= np.linalg.norm(e_c)
+    tangent = np.cross(a, e_c)
+    alpha = pair.operating_pressure_angle
+    beta_b = pair.base_helix_angle
+    transverse = np.sin(alpha) * e_c + np.cos(alpha) * tangent
+    if pair.kind == "double_helical":
+        return transverse, math.cos(beta_b), e_c
+    return np.cos(beta_b) * transverse + np.sin(beta_b) * a, 1.0, e_c
 
 
 def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 2000.0) -> Drivetrain:

@@ -23,7 +23,6 @@ couplings (the axial offset of a bearing's load centre) do, which in the test ge
 from __future__ import annotations
 
 import argparse
-import math
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -70,6 +69,7 @@ def gear_forces(gear_set: str, torque: float, point, pinion_centre, wheel_centre
     in the housing: the line of action lies in the transverse plane at the operating pressure angle from the
     common tangent, tilted out of it by the base helix angle; a double helical set's two halves cancel axially:
     the transverse line of action with S cos^2(beta_b) and T1 / r_b1 (docs/drivetrain.md)."""
+    from housingfe.drivetrain.description import mesh_line_of_action
     from housingfe.scenefile import read_scene_dict
     from housingfe.source.roosmalen import run as roosmalen
     from housingfe.source.stiffness import normal_force_from_torque, stiffness_curve
@@ -78,20 +78,7 @@ def gear_forces(gear_set: str, torque: float, point, pinion_centre, wheel_centre
     pair, _, _, _, model = roosmalen.build(roosmalen.parse(data, str(path)), str(path))
     normal = normal_force_from_torque(pair, torque)
     stiffness = stiffness_curve(model, normal, 16).mean
-    a = np.asarray(shaft_axis, float) / np.linalg.norm(shaft_axis)
-    centres = np.asarray(wheel_centre, float) - np.asarray(pinion_centre, float)
-    e_c = centres - (centres @ a) * a
-    e_c /= np.linalg.norm(e_c)
-    tangent = np.cross(a, e_c)
-    alpha = pair.operating_pressure_angle
-    beta_b = pair.base_helix_angle
-    transverse = np.sin(alpha) * e_c + np.cos(alpha) * tangent
-    if pair.kind == "double_helical":
-        # the halves' normal forces add up to F_n cos(beta_b) along the transverse line of action, their stiffness
-        # to S cos^2(beta_b) along it (as housingfe.drivetrain.description.Drivetrain.gear_forces)
-        resultant, n = math.cos(beta_b), transverse
-    else:
-        resultant, n = 1.0, np.cos(beta_b) * transverse + np.sin(beta_b) * a
+    n, resultant, _ = mesh_line_of_action(pair, pinion_centre, wheel_centre, shaft_axis)
     # the wheel pushes the pinion along -n: away from the wheel (radial), against the tangent, axially -a
     return GearForces(-normal * resultant * n, stiffness * resultant**2, n, gear_set)
 
