@@ -981,7 +981,9 @@ def register_cli(subparsers) -> None:
     p.add_argument("families", nargs="+", metavar="family",
                    help="profile-corrections | bearings | double-helical | a family file FILE.toml "
                         "(docs/design-variants.md, 'Your own family'; several: they share the housing model and "
-                        "the bases that fit, each written to <out>/<family name>/)")
+                        "the bases that fit, each written to <out>/<family name>/; double-helical together with "
+                        "profile-corrections and/or bearings also writes double-helical_vs_single.csv/.md, the "
+                        "double helical set against single helical A and self-aligning B)")
     p.add_argument("--out", default=None, help="result folder (default results/study-<family>-<engagement>, for "
                                                "several families results/study-<engagement>)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE",
