@@ -25,6 +25,7 @@ from housingfe.errors import InputError
 from housingfe.scene import build_model_from_scene
 from housingfe.solvers import modal
 from tests.conftest import load_scene, mumps_solve
+from tests.drivetrain.torsion_by_hand import base_ratio, gear_train_polar, near_quill_stiffness
 from tests.two_ranks import module_result
 
 
@@ -83,21 +84,12 @@ def _rig_chain_hz(dt) -> float:
     ratio; each as gear body + its whole FE shaft, solid cylinders), each near quill in series with its FE shaft's
     torsion from the gear to the shaft end (G pi d^4 / 32 / 0.14 m), the couplings' inertias, far quills to ground:
     three inertias on a spring chain."""
-    pair = dt.gears.pair
-    rho, G = pair.density, pair.youngs_modulus / (2 * (1 + pair.poisson_ratio))
-    polar = {}
-    for g, name in enumerate(("pinion", "wheel")):
-        dg, width, _ = dt.gears.gear_body(g)
-        line = dt.shaft(name)
-        length = line.ends[1] - line.ends[0]
-        polar[name] = rho * math.pi / 32 * (dg**4 * width + line.diameter**4 * (length - width))
-    ratio = pair.base_diameter[1] / pair.base_diameter[0]
+    polar = gear_train_polar(dt)
+    ratio = base_ratio(dt)
     parts = dt.drive_line_parts()
 
     def near(name):
-        line = dt.shaft(name)
-        shaft = G * math.pi * line.diameter**4 / 32 / (0 - line.ends[0])
-        return 1.0 / (1.0 / parts[name][0] + 1.0 / shaft)
+        return near_quill_stiffness(dt, name)
 
     kp, kw = near("pinion"), near("wheel") / ratio**2
     kpf, kwf = parts["pinion"][2], parts["wheel"][2] / ratio**2

@@ -21,6 +21,7 @@ from housingfe.drivetrain.interior import (
     rigid_bore_modes,
 )
 from housingfe.errors import InputError
+from tests.drivetrain.torsion_by_hand import base_ratio, gear_train_polar, near_quill_stiffness
 
 
 def _loop(gear_set="A", **aux):
@@ -89,21 +90,13 @@ def loop_chain_hz(dt) -> np.ndarray:
     near quills in series with their FE shaft's torsion from the gear to the front end (0.14 m), far quills from the
     couplings to the aux pinion / aux wheel, the motor from the aux pinion to ground.  Inertias: couplings, gear train
     (pinion + wheel / i^2, gear bodies with their whole FE shafts as solid cylinders), aux gearbox with the motor."""
-    pair = dt.gears.pair
-    rho, G = pair.density, pair.youngs_modulus / (2 * (1 + pair.poisson_ratio))
-    polar = {}
-    for g, name in enumerate(("pinion", "wheel")):
-        dg, width, _ = dt.gears.gear_body(g)
-        line = dt.shaft(name)
-        polar[name] = rho * math.pi / 32 * (dg**4 * width + line.diameter**4 * (line.ends[1] - line.ends[0] - width))
-    i = pair.base_diameter[1] / pair.base_diameter[0]
+    polar = gear_train_polar(dt)
+    i = base_ratio(dt)
     quills = dt.drive_line_parts()
     aux = dt.aux_gearbox
 
     def near(name):
-        line = dt.shaft(name)
-        shaft = G * math.pi * line.diameter**4 / 32 / (0 - line.ends[0])
-        return 1.0 / (1.0 / quills[name][0] + 1.0 / shaft)
+        return near_quill_stiffness(dt, name)
 
     springs = [(near("pinion"), [-1.0, 1.0, 0.0, 0.0]),              # theta_p - phi_cp
                (quills["pinion"][2], [1.0, 0.0, 0.0, -1.0]),          # phi_cp - phi_aux
