@@ -14,7 +14,7 @@ demo: bootstrap
 	$(VENV)/bin/housingfe run test-gearbox-runup --out results/test-gearbox-runup
 
 test: bootstrap
-	$(VENV)/bin/python -m pytest -q tests
+	$(VENV)/bin/python -m pytest -q --durations=25 tests
 
 bench: bootstrap
 	$(VENV)/bin/housingfe bench modal --out results/bench-modal
