@@ -250,7 +250,7 @@ def _rotation(angle: float) -> np.ndarray:
 # (housingfe.runup.chain.follow_speeds) asks for both bearings of a shaft at the same load and speed (the double
 # helical set loads them alike), each a ~0.3 s Reynolds solve with a root search
 _COEFFICIENTS: dict = {}
-COEFFICIENT_MEMO = 64
+COEFFICIENT_MEMO = 512          # ~1 kB each; a run-up asks for 2 shafts x its speeds per torque
 
 
 def journal_bearing_coefficients(bearing: JournalBearing, omega: float, load, *, n_theta: int = 90,

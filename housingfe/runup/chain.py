@@ -221,7 +221,7 @@ def with_drivetrain(model: GearboxModel, drivetrain) -> GearboxModel:
 
 # how speed-dependent bearings (fluid films, Drivetrain.speed_dependent_bearings) take the run-up's speed (scene key
 # runup.bearing_speeds): "fixed" = at the one pinion speed drivetrain.bearing_speed_rpm for the whole run-up;
-# "follow" = at each run-up speed (`follow_speeds`).  Rolling-element bearings are the same either way
+# "follow" = at each run-up speed (`follow_speeds`; the default).  Rolling-element bearings are the same either way
 BEARING_SPEEDS = ("fixed", "follow")
 
 
@@ -312,7 +312,7 @@ def held_speed_note(model: GearboxModel, torque: float) -> str:
         return ""
     speeds = sorted(model.held_speeds)
     at = sorted(set(model.held_speeds.values()))
-    why = model.held_reason.split(": ")[-1] if model.held_reason else "not carried"
+    why = model.held_reason.split(": ")[-1].removesuffix("; not carried") if model.held_reason else "no film"
     return (f"  bearings following the speed at {torque:g} N m: not carried at {', '.join(f'{s:g}' for s in speeds)} "
             f"rev/min ({why}); these speeds hold the matrices of {', '.join(f'{s:g}' for s in at)} rev/min "
             "(runup.json bearing_speeds.held)")

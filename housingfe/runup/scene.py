@@ -76,7 +76,9 @@ class DrivetrainSpec(_Strict):
     gearbox: str = "test_gearbox"
     gear_set: str = "A"
     bearings: str = "ball"
-    bearing_speed_rpm: PositiveFloat = 1500.0   # pinion speed at which speed-dependent bearings (fluid films) are taken
+    # pinion speed at which speed-dependent bearings (fluid films) are taken with runup.bearing_speeds = "fixed"; with
+    # "follow" (default) the speed of the model whose basis is re-analysed at each run-up speed
+    bearing_speed_rpm: PositiveFloat = 1500.0
 
     @field_validator("gearbox")
     @classmethod
@@ -184,8 +186,8 @@ class RunupSpec(_Strict):
     # one pinion speed drivetrain.bearing_speed_rpm at every run-up speed; "follow" = at each run-up speed (pinion at
     # the run-up speed, the wheel at z1/z2 of it), a re-analysis per speed on the same Ritz vectors; below the speed
     # at which a film carries its load the nearest speed that carries it (flagged in runup.json).  Rolling-element
-    # bearings do not depend on speed: the same either way
-    bearing_speeds: Literal["fixed", "follow"] = "fixed"
+    # bearings do not depend on speed: the same either way.  Default "follow" (since 2026-11-27; the physical one)
+    bearing_speeds: Literal["fixed", "follow"] = "follow"
 
     @field_validator("as_made", mode="before")
     @classmethod
@@ -438,6 +440,8 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
                 raise InputError(f"{path}: {torque:g} N m: {exc}") from None
             if m.speed_models:
                 timings[f"bearing_speeds_{torque:g}Nm_s"] = time.perf_counter() - t1
+                for k in ("bearing_matrices_s", "ritz_rows_s"):
+                    timings[f"bearing_speeds_{torque:g}Nm_{k}"] = m.timings[k]
             if comm.rank == 0 and m.held_speeds:
                 print(held_speed_note(m, torque).strip())
         lines, t_src = run_source(m, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance,

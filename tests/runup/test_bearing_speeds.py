@@ -128,9 +128,9 @@ def test_rolling_bearings_are_untouched(bearings):
 
 def test_bearing_speeds_setting():
     scene, _ = load_runup_scene("test-gearbox-runup-double-helical")
+    assert scene.runup.bearing_speeds == "follow"            # the default since 2026-11-27
+    scene, _ = load_runup_scene("test-gearbox-runup-double-helical", ['runup.bearing_speeds="fixed"'])
     assert scene.runup.bearing_speeds == "fixed"
-    scene, _ = load_runup_scene("test-gearbox-runup-double-helical", ['runup.bearing_speeds="follow"'])
-    assert scene.runup.bearing_speeds == "follow"
     with pytest.raises(InputError) as err:
         load_runup_scene("test-gearbox-runup-double-helical", ['runup.bearing_speeds="sometimes"'])
     assert ": runup.bearing_speeds" in str(err.value) and "\n" not in str(err.value).strip()
