@@ -442,8 +442,6 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
                 timings[f"bearing_speeds_{torque:g}Nm_s"] = time.perf_counter() - t1
                 for k in ("bearing_matrices_s", "ritz_rows_s"):
                     timings[f"bearing_speeds_{torque:g}Nm_{k}"] = m.timings[k]
-            if comm.rank == 0 and m.held_speeds:
-                print(held_speed_note(m, torque).strip())
         lines, t_src = run_source(m, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance,
                                   spec.mesh_moment_model, spec.mesh_friction)
         timings["source_s"] = timings.get("source_s", 0.0) + t_src
