@@ -23,7 +23,7 @@ The film carries no axial force and no torque: rows/columns z and theta_z are ze
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.sparse as sp
@@ -246,6 +246,13 @@ def _rotation(angle: float) -> np.ndarray:
     return out
 
 
+# the last results of journal_bearing_coefficients by their exact inputs: a run-up following its speed
+# (housingfe.runup.chain.follow_speeds) asks for both bearings of a shaft at the same load and speed (the double
+# helical set loads them alike), each a ~0.3 s Reynolds solve with a root search
+_COEFFICIENTS: dict = {}
+COEFFICIENT_MEMO = 512          # ~1 kB each; a run-up asks for 2 shafts x its speeds per torque
+
+
 def journal_bearing_coefficients(bearing: JournalBearing, omega: float, load, *, n_theta: int = 90,
                                  n_z: int = 24, cavitation: str = "reynolds",
                                  rel_step: float = 1e-4) -> FluidFilmResult:
@@ -253,8 +260,21 @@ def journal_bearing_coefficients(bearing: JournalBearing, omega: float, load, *,
 
     omega [rad/s] > 0 shaft speed about +z; load (Wx, Wy) [N] applied by the shaft to the journal (e.g.
     (0, -20763)).  Eccentricity from the load (the Sommerfeld number), then central differences of the film
-    force and moment with respect to journal displacement, tilt and their velocities."""
+    force and moment with respect to journal displacement, tilt and their velocities.  The same inputs again give
+    a copy of the remembered result (the last COEFFICIENT_MEMO)."""
     w = np.asarray(load, float).ravel()
+    key = (bearing, float(omega), tuple(w.tolist()), n_theta, n_z, cavitation, rel_step)
+    if key not in _COEFFICIENTS:
+        res = _coefficients(bearing, omega, w, n_theta, n_z, cavitation, rel_step)
+        while len(_COEFFICIENTS) >= COEFFICIENT_MEMO:
+            _COEFFICIENTS.pop(next(iter(_COEFFICIENTS)))
+        _COEFFICIENTS[key] = res
+    res = _COEFFICIENTS[key]
+    return replace(res, displacement=res.displacement.copy(), K=res.K.copy(), C=res.C.copy(), load=res.load.copy())
+
+
+def _coefficients(bearing: JournalBearing, omega: float, w: np.ndarray, n_theta: int, n_z: int, cavitation: str,
+                  rel_step: float) -> FluidFilmResult:
     if w.size != 2:
         raise InputError(f"journal bearing: load: need (Wx, Wy) in N, got {w.tolist()}")
     magnitude = float(np.hypot(*w))

@@ -565,6 +565,17 @@ class Drivetrain:
                 out[seat.name] = (float(local[0]), float(local[1]), float(local[2]), 0.0, 0.0)
         return out
 
+    @property
+    def speed_dependent_bearings(self) -> bool:
+        """Whether the FE bearings' K, C depend on the shaft speed (a configuration with a fluid-film position:
+        taken at bearing_speed_rpm); rolling-element bearings and the seats' own matrices do not."""
+        if self.bearing_configuration is None:
+            return False
+        from housingfe.bearings.configurations import configurations
+
+        config = configurations().get(self.bearing_configuration)
+        return config is not None and any(c.kind == "fluid_film" for c in config.positions.values())
+
     def configuration_matrices(self, loads: dict | None = None) -> dict | None:
         """{seat name: (K 6x6, C 6x6 or None)} of `bearing_configuration` at the statics loads (None without a
         configuration).  The seats must be named as the configuration's positions (pinion_front, ...); both

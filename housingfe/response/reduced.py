@@ -130,6 +130,22 @@ class RitzReduction:
         other.timings = {**self.timings, "reanalysis_s": time.perf_counter() - t0}
         return other
 
+    def with_change(self, dK: np.ndarray, dC: np.ndarray | None = None) -> "RitzReduction":
+        """The same Ritz vectors, surface data, loads and damping with the projected stiffness and damping changed
+        by dK, dC (n x n in Ritz coordinates, N/m and N s/m; may be non-symmetric): a re-analysis whose projected
+        change the caller already has (e.g. a few lumped elements' change, X_e^T dA_e X_e on their nodes' rows:
+        housingfe.runup.chain.follow_speeds), without any product with the coupled matrices.  `structure` stays
+        this reduction's, so it no longer holds the returned system's K and C."""
+        s = self.system
+        if np.shape(dK) != s.Kr.shape or (dC is not None and np.shape(dC) != s.Cr.shape):
+            raise InputError(f"with_change: dK, dC must be {s.Kr.shape[0]} x {s.Kr.shape[0]}")
+        other = object.__new__(RitzReduction)
+        other.__dict__.update(self.__dict__)
+        other.__dict__.pop("_unit_memo", None)
+        matrices = (s.Kr + dK, s.Mr.copy(), s.Cr + dC if dC is not None else s.Cr.copy())
+        other.system = other._project(self.structure, self.loads, matrices)
+        return other
+
     def _projected_change(self, structure):
         """(Kr, Mr, Cr) of `structure` as this reduction's plus the projection of the difference of the
         matrices, or None (project afresh).  Another drivetrain of the same layout changes only the rows of

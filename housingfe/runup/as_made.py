@@ -44,7 +44,14 @@ import numpy as np
 
 from housingfe import levels
 from housingfe.errors import InputError
-from housingfe.runup.chain import Lines, RouteResult, RunupResult, mesh_reference_stiffness, runup
+from housingfe.runup.chain import (
+    Lines,
+    RouteResult,
+    RunupResult,
+    line_coefficients,
+    mesh_reference_stiffness,
+    runup,
+)
 
 AS_MADE_OFF = "none"
 # ISO 1328-1:1995 defines the accuracy grades 0 (finest) to 12
@@ -254,7 +261,13 @@ def as_made_run(results: dict, source, grade: int, f_lines_max: float, routes,
         lines = sideband_lines(source, model, res.lines, float(torque), spectrum, f_lines_max)
         speeds = sorted({s for t, s, *_ in res.lines.points if t == float(torque)})
         # both routes' unit loads in one factorisation per line (the sideband lines are many: ~500 per speed)
-        model.reduction.prefetch_unit_coordinates(lines.frequency, [ROUTE_LOADS[r] for r in routes if r in ROUTE_LOADS])
+        names = [ROUTE_LOADS[r] for r in routes if r in ROUTE_LOADS]
+        if model.speed_models:          # bearings following the speed: each speed's lines on its own model
+            for s in np.unique(lines.speed):
+                at = np.flatnonzero(lines.speed == s)
+                model.at_speed(s).reduction.prefetch_unit_coordinates(lines.frequency[at], names)
+        else:
+            model.reduction.prefetch_unit_coordinates(lines.frequency, names)
         side[torque] = runup(model, None, speeds, [float(torque)], routes=tuple(routes), lines=lines)
         rows += table_rows(res, side[torque], grade, pitch_model)
         count += len(lines.frequency)
@@ -328,7 +341,7 @@ def sideband_wheel_levels(model, lines: Lines) -> np.ndarray:
     from housingfe.response.observers import node_key
 
     freq = lines.frequency
-    c = model.reduction.coefficients(freq, {"mesh": lines.mesh_excitation})
+    c = line_coefficients(model, freq, lines.speed, {"mesh": lines.mesh_excitation})
     node = model.reduction.reduced.points[node_key(model.wheel_node)]
     rot = (model.wheel_axis / np.linalg.norm(model.wheel_axis)) @ (node[3:6] @ c)
     return levels.level(np.abs(2 * math.pi * freq * rot) ** 2, levels.OMEGA0)

@@ -79,6 +79,24 @@ class GearboxModel:
     interior_share: np.ndarray
     timings: dict = field(default_factory=dict)
     bores: list = field(default_factory=list)     # the bearings' housing bores (bore_matching summary rows)
+    # speed-dependent bearings following the run-up's speed (`follow_speeds`, runup.bearing_speeds = "follow"):
+    # {pinion speed rev/min: the model at that speed}; empty: this one model at every speed
+    speed_models: dict = field(default_factory=dict)
+    # {speed rev/min: the speed whose bearing matrices it holds} where the bearings cannot carry their load at the
+    # speed itself (a fluid film below its speed limit), and why (the first refusal's message)
+    held_speeds: dict = field(default_factory=dict)
+    held_reason: str = ""
+
+    def at_speed(self, speed_rpm: float) -> "GearboxModel":
+        """The model at a pinion speed (rev/min): with the bearings following the run-up's speed
+        (`follow_speeds`) that speed's, else this model."""
+        if not self.speed_models:
+            return self
+        model = self.speed_models.get(float(speed_rpm))
+        if model is None:
+            raise InputError(f"runup.bearing_speeds: the model follows the speeds "
+                             f"{', '.join(f'{v:g}' for v in sorted(self.speed_models))} rev/min, not {speed_rpm:g}")
+        return model
 
     @property
     def area(self) -> float:
@@ -196,8 +214,125 @@ def with_drivetrain(model: GearboxModel, drivetrain) -> GearboxModel:
         raise InputError("drivetrain: another shaft layout than the model's (the wheel node moved): build a new "
                          "gearbox model")
     reduction = model.reduction.reanalyse(structure, loads)
-    return replace(model, drivetrain=drivetrain, structure=structure, reduction=reduction,
-                   timings={**model.timings, "reanalysis_s": time.perf_counter() - t0})
+    # a model following the run-up's speed held its speeds' bearings: another drivetrain starts from its own
+    return replace(model, drivetrain=drivetrain, structure=structure, reduction=reduction, speed_models={},
+                   held_speeds={}, held_reason="", timings={**model.timings, "reanalysis_s": time.perf_counter() - t0})
+
+
+# how speed-dependent bearings (fluid films, Drivetrain.speed_dependent_bearings) take the run-up's speed (scene key
+# runup.bearing_speeds): "fixed" = at the one pinion speed drivetrain.bearing_speed_rpm for the whole run-up;
+# "follow" = at each run-up speed (`follow_speeds`; the default).  Rolling-element bearings are the same either way
+BEARING_SPEEDS = ("fixed", "follow")
+
+
+def _node_rows(structure, vectors, nodes) -> dict:
+    """{node name: (6, vectors) displacements of an extra node in each coupled vector} (m, rad)."""
+    out = {n: np.empty((6, len(vectors))) for n in nodes}
+    for j, q in enumerate(vectors):
+        for n in nodes:
+            out[n][:, j] = structure.system.node_displacement(q, n)
+    return out
+
+
+@single_thread
+def follow_speeds(model: GearboxModel, speeds_rpm) -> GearboxModel:
+    """`model` with its speed-dependent bearings (fluid films: Drivetrain.speed_dependent_bearings) at each pinion
+    speed of `speeds_rpm` (rev/min; the wheel's at z1/z2 of it, turning the other way): per speed the drivetrain's
+    bearing matrices K, C (Drivetrain.configuration_matrices at bearing_speed_rpm = the speed) and a Rayleigh-Ritz
+    re-analysis on the same Ritz vectors, as `with_drivetrain` would do it, but projecting only the change of the
+    bearing elements: sum over bearings of X_e^T (A_e(speed) - A_e(model)) X_e, X_e the Ritz vectors' rows at the
+    bearing's shaft node and bore master (the coupled matrices are P^T A P, so this is the same projection, on 12
+    rows per bearing instead of the coupled matrices).  The result holds them in `speed_models` (`at_speed`);
+    the routes, the coupled source and peak_contributions solve each line on its speed's model.
+
+    Below the speed at which a film carries its load (the Reynolds solution needs an eccentricity ratio above 0.98,
+    housingfe.bearings.fluid_film), a speed holds the matrices of the nearest run-up speed that carries it
+    (`held_speeds`, `held_reason`; the film there is stiffer and more damped than the held matrices say).  No
+    speed that carries it: InputError.  A model without speed-dependent bearings is returned as it is (no
+    re-analysis)."""
+    from housingfe.drivetrain.interior import parts
+
+    dt = model.drivetrain
+    if not dt.speed_dependent_bearings:
+        return model
+    t0 = time.perf_counter()
+    base = replace(model, speed_models={}, held_speeds={}, held_reason="")
+    structure = model.structure
+    old = structure.parts.bearings
+    specs, refused = {}, {}
+    for s in sorted({float(v) for v in speeds_rpm}):
+        at = replace(dt, bearing_speed_rpm=s)
+        try:
+            specs[s] = (at, at.to_coupling_spec())
+        except InputError as exc:
+            refused[s] = str(exc)
+    if not specs:
+        first = next(iter(refused.values()))
+        raise InputError(f"runup.bearing_speeds: \"follow\": the bearings carry their load at none of the run-up's "
+                         f"speeds ({first})")
+    t_matrices = time.perf_counter() - t0
+    nodes = sorted({n for e in old for n in e.nodes})
+    rows = _node_rows(structure, model.reduction.vectors, nodes)
+    t_rows = time.perf_counter() - t0 - t_matrices
+    models = {}
+    for s, (at, spec) in specs.items():
+        if s == float(dt.bearing_speed_rpm):
+            models[s] = replace(base, drivetrain=at)
+            continue
+        new = parts(spec, structure.centres).bearings
+        n = len(model.reduction.vectors)
+        dK, dC = np.zeros((n, n)), np.zeros((n, n))
+        for e_old, e_new in zip(old, new):
+            if e_old.nodes != e_new.nodes:
+                raise InputError("runup.bearing_speeds: the bearings moved between speeds: build a new gearbox model")
+            X = np.vstack([rows[node] for node in e_old.nodes])
+            dK += X.T @ (e_new.K - e_old.K) @ X
+            if e_old.C is not None or e_new.C is not None:
+                c_old = np.zeros_like(e_new.K) if e_old.C is None else e_old.C
+                c_new = np.zeros_like(e_old.K) if e_new.C is None else e_new.C
+                dC += X.T @ (c_new - c_old) @ X
+        models[s] = replace(base, drivetrain=at, reduction=model.reduction.with_change(dK, dC))
+    valid = np.array(sorted(models))
+    held = {}
+    for s in refused:
+        near = float(valid[np.argmin(np.abs(valid - s))])
+        models[s] = models[near]
+        held[s] = near
+    # bearing_matrices_s: the films' K, C per speed (Reynolds equation); ritz_rows_s: the Ritz vectors at the
+    # bearings' nodes (once); the rest is the per-speed projection and the reduced systems' modes
+    timings = {**model.timings, "speed_reanalysis_s": time.perf_counter() - t0, "bearing_matrices_s": t_matrices,
+               "ritz_rows_s": t_rows, "speed_models": len(specs)}
+    reason = next(iter(refused.values()), "")
+    return replace(model, speed_models=models, held_speeds=held, held_reason=reason, timings=timings)
+
+
+def held_speed_note(model: GearboxModel, torque: float) -> str:
+    """One line on the speeds whose bearings hold another speed's matrices (`follow_speeds`), or ""."""
+    if not model.held_speeds:
+        return ""
+    speeds = sorted(model.held_speeds)
+    at = sorted(set(model.held_speeds.values()))
+    why = model.held_reason.split(": ")[-1].removesuffix("; not carried") if model.held_reason else "no film"
+    return (f"  bearings following the speed at {torque:g} N m: not carried at {', '.join(f'{s:g}' for s in speeds)} "
+            f"rev/min ({why}); these speeds hold the matrices of {', '.join(f'{s:g}' for s in at)} rev/min "
+            "(runup.json bearing_speeds.held)")
+
+
+def line_coefficients(model: GearboxModel, frequency, speed, amplitudes: dict) -> np.ndarray:
+    """(vectors, lines) Ritz coordinates of the response to the loads' complex rms `amplitudes` (name -> number or
+    array per line) at the lines' frequencies (Hz), each line solved on the model at its pinion speed `speed`
+    (rev/min; GearboxModel.at_speed: the bearings following the run-up's speed) or, without speed models, all on
+    `model` (RitzReduction.coefficients)."""
+    f = np.asarray(frequency, float)
+    if not model.speed_models:
+        return model.reduction.coefficients(f, amplitudes)
+    speed = np.broadcast_to(np.asarray(speed, float), f.shape)
+    c = np.zeros((len(model.reduction.vectors), len(f)), complex)
+    for s in np.unique(speed):
+        at = np.flatnonzero(speed == s)
+        part = {k: (np.asarray(v)[at] if np.ndim(v) else v) for k, v in amplitudes.items()}
+        c[:, at] = model.at_speed(s).reduction.coefficients(f[at], part)
+    return c
 
 
 def has_friction_loads(model: GearboxModel) -> bool:
@@ -457,7 +592,7 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
     t0 = time.perf_counter()
     H = int(harmonics or source.harmonics)
     k_ref = mesh_reference_stiffness(model)
-    g0 = static_mesh_receptance(model)
+    g0 = {float(v): static_mesh_receptance(model.at_speed(v)) for v in speeds_rpm}
     rigid, _ = source_lines(source, speeds_rpm, torques_nm, f_lines_max, mesh_moment, mesh_friction)
     cols = {k: [] for k in ("frequency", "mesh_excitation")}
     for torque in torques_nm:
@@ -465,9 +600,12 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
         F = normal_force_from_torque(source.pair, float(torque))
         f_t = np.array([source.pair.tooth_frequency(float(v)) for v in speeds_rpm])
         nn = np.arange(1, H + 1)
-        g = mesh_receptance(model, (f_t[:, None] * nn[None, :]).ravel()).reshape(len(f_t), H)
+        if model.speed_models:          # each speed on its own bearings (follow_speeds)
+            g = np.array([mesh_receptance(model.at_speed(v), f_t[i] * nn) for i, v in enumerate(speeds_rpm)])
+        else:
+            g = mesh_receptance(model, (f_t[:, None] * nn[None, :]).ravel()).reshape(len(f_t), H)
         for i in range(len(f_t)):
-            rec = np.concatenate([[g0], g[i]])
+            rec = np.concatenate([[g0[float(speeds_rpm[i])]], g[i]])
             st = mesh_harmonic_balance(rec, F / k_ref, S, shock, k_ref, f_t[i], first_order=first_order)
             f, exc = st.one_sided(st.excitation)
             keep = f <= f_lines_max * (1 + 1e-12)
@@ -479,7 +617,7 @@ def coupled_source_lines(model: GearboxModel, source, speeds_rpm, torques_nm, f_
     mesh_exc = np.array(cols["mesh_excitation"], complex)
     # the wheel's rotation from its kept node values alone (the surface quantities are the routes' business)
     lines = replace(rigid, mesh_excitation=mesh_exc, receptance="coupled")
-    c = model.reduction.coefficients(freq, lines.mesh_amplitudes())
+    c = line_coefficients(model, freq, lines.speed, lines.mesh_amplitudes())
     node = model.reduction.reduced.points[node_key(model.wheel_node)]
     rot = (model.wheel_axis / np.linalg.norm(model.wheel_axis)) @ (node[3:6] @ c)
     lines.L_omega_flexible = levels.level(np.abs(2 * math.pi * freq * rot) ** 2, levels.OMEGA0)
@@ -550,7 +688,7 @@ def tf_omega_route(model: GearboxModel, lines: Lines) -> RouteResult:
     """Eq. 5.5: L_v = L_omega (source) + TF_omega, TF_omega = L_v - L_omega of the coupled model under 1 N m at the
     wheel centre, at every line."""
     f = lines.frequency
-    c = model.reduction.coefficients(f, {"wheel_torque": 1.0})
+    c = line_coefficients(model, f, lines.speed, {"wheel_torque": 1.0})
     resp = model.reduction.response_of(f, c)
     tf = resp.velocity_level_db - _wheel_omega_level(model, resp, f)
     # the wheel's L_omega on this route is the source's (the route's input): no coupled value of its own
@@ -565,7 +703,7 @@ def mesh_force_route(model: GearboxModel, lines: Lines) -> RouteResult:
     excitation level stays L_F of the force: with the moment or friction on, the transfer L_v - L_F holds their
     share (the names say so)."""
     f = lines.frequency
-    c = model.reduction.coefficients(f, lines.mesh_amplitudes())
+    c = line_coefficients(model, f, lines.speed, lines.mesh_amplitudes())
     resp = model.reduction.response_of(f, c)
     L_F = levels.level(np.abs(lines.mesh_excitation) ** 2, levels.F0)
     extra = " and ".join(what for what, on in (("the shuttling moment", lines.shuttle_moment is not None),
@@ -692,7 +830,9 @@ def peak_contributions(model: GearboxModel, result: RunupResult, route: str, poi
     if ln.incoherent is not None:       # gears as made: the harmonic's 1/3-octave band, its lines energy-summed
         return _band_contributions(model, result, route, idx, power, top)
     k = int(idx[np.argmax(lwa)])
-    freqs, share = model.reduction.modal_contributions(ln.frequency[k], result.routes[route].coefficients[:, k])
+    # the modes of the model at the point's speed (bearings following the run-up's speed: GearboxModel.at_speed)
+    freqs, share = model.at_speed(ln.speed[k]).reduction.modal_contributions(
+        ln.frequency[k], result.routes[route].coefficients[:, k])
     n = model.basis.rigid_count
     elastic = model.basis.frequencies_hz[n:]
     order = np.argsort(-share)[:top]
@@ -720,7 +860,8 @@ def _band_contributions(model: GearboxModel, result: RunupResult, route: str, id
     v2 = 10.0 ** (result.routes[route].L_v[members] / 10.0)
     share = None
     for k, w in zip(members, v2):
-        freqs, s = model.reduction.modal_contributions(ln.frequency[k], result.routes[route].coefficients[:, k])
+        freqs, s = model.at_speed(ln.speed[k]).reduction.modal_contributions(
+            ln.frequency[k], result.routes[route].coefficients[:, k])
         share = w * s if share is None else share + w * s
     share = share / v2.sum() if v2.sum() > 0 else share
     strongest = int(members[np.argmax(power[group == g])])

@@ -123,6 +123,7 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "mesh_moment": scene.runup.mesh_moment_model,     # in effect (the setting may leave it to the default)
         "mesh_friction": friction_in_effect(scene, results),
         "drive_line": scene.runup.drive_line_model,       # in effect
+        "bearing_speeds": bearing_speeds_json(scene, results),
         "timings_s": timings,
         "modal_basis": gm.summary(),
         "housing_resolution": _resolution(gm),
@@ -238,6 +239,20 @@ def runup_plot(path: Path, scene, totals: list) -> None:
     plt.close(fig)
 
 
+def bearing_speeds_json(scene, results: dict) -> dict:
+    """runup.json "bearing_speeds": the setting (runup.bearing_speeds), whether the bearings depend on speed, and
+    per torque (text) the speeds with a model of their own and the speeds held at another speed's matrices
+    ({speed: held at}, housingfe.runup.chain.follow_speeds) with the reason."""
+    out = {"setting": scene.runup.bearing_speeds, "fixed_speed_rpm": scene.drivetrain.bearing_speed_rpm,
+           "speed_dependent": any(m.drivetrain.speed_dependent_bearings for m, _ in results.values()), "torques": {}}
+    for t, (m, _) in results.items():
+        if m.speed_models:
+            out["torques"][f"{t:g}"] = {
+                "models": len({id(v) for v in m.speed_models.values()}),
+                "held": {f"{s:g}": at for s, at in sorted(m.held_speeds.items())}, "reason": m.held_reason}
+    return out
+
+
 def _resolution(gm) -> dict | None:
     """The housing mesh's resolution of the highest line (housingfe.fe.resolution), None if not known."""
     res = getattr(getattr(gm, "housing_model", None), "resolution", None)
@@ -296,6 +311,13 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
     friction = friction_line(scene, results)
     if friction:
         lines.append(friction)
+    if any(m.drivetrain.speed_dependent_bearings for m, _ in results.values()):
+        if scene.runup.bearing_speeds == "follow":
+            lines.append("bearings: the fluid films' K, C at each run-up speed (runup.bearing_speeds = \"follow\"; "
+                         "docs/runup.md 'Fluid films over the run-up')")
+        else:
+            lines.append(f"bearings: the fluid films' K, C at {scene.drivetrain.bearing_speed_rpm:g} rev/min for the "
+                         "whole run-up (runup.bearing_speeds = \"fixed\"; \"follow\" takes each run-up speed's)")
     if scene.runup.drive_line_model in ("quill-shafts", "back-to-back"):
         what = ("the quill shafts and couplings to motor and brake" if scene.runup.drive_line_model == "quill-shafts"
                 else "the back-to-back loop (quill shafts, couplings, the auxiliary gearbox and motor: assumed "

@@ -76,7 +76,9 @@ class DrivetrainSpec(_Strict):
     gearbox: str = "test_gearbox"
     gear_set: str = "A"
     bearings: str = "ball"
-    bearing_speed_rpm: PositiveFloat = 1500.0   # pinion speed at which speed-dependent bearings (fluid films) are taken
+    # pinion speed at which speed-dependent bearings (fluid films) are taken with runup.bearing_speeds = "fixed"; with
+    # "follow" (default) the speed of the model whose basis is re-analysed at each run-up speed
+    bearing_speed_rpm: PositiveFloat = 1500.0
 
     @field_validator("gearbox")
     @classmethod
@@ -179,6 +181,13 @@ class RunupSpec(_Strict):
     # incoherent lines beside the periodic harmonics (energies add; the tooth band the lines in the 1/3-octave band of
     # f_tooth).  Needs runup.as_made = <ISO grade>
     as_made_totals: bool = False
+    # speed-dependent bearings (the fluid-film journal bearings, drivetrain.bearings = "fluid_film") over the run-up
+    # (housingfe.runup.chain.BEARING_SPEEDS; docs/runup.md "Fluid films over the run-up"): "fixed" = their K, C at the
+    # one pinion speed drivetrain.bearing_speed_rpm at every run-up speed; "follow" = at each run-up speed (pinion at
+    # the run-up speed, the wheel at z1/z2 of it), a re-analysis per speed on the same Ritz vectors; below the speed
+    # at which a film carries its load the nearest speed that carries it (flagged in runup.json).  Rolling-element
+    # bearings do not depend on speed: the same either way.  Default "follow" (since 2026-11-27; the physical one)
+    bearing_speeds: Literal["fixed", "follow"] = "follow"
 
     @field_validator("as_made", mode="before")
     @classmethod
@@ -349,7 +358,14 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
 
     from housingfe import outputs
     from housingfe.runup import checks, report, slopes
-    from housingfe.runup.chain import build_gearbox_model, run_source, runup, with_drivetrain
+    from housingfe.runup.chain import (
+        build_gearbox_model,
+        follow_speeds,
+        held_speed_note,
+        run_source,
+        runup,
+        with_drivetrain,
+    )
     from housingfe.scene import load_housing_scene
 
     t_start = time.perf_counter()
@@ -416,6 +432,16 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         t1 = time.perf_counter()
         m = gm if torque == reference_torque else with_drivetrain(gm, drivetrains[torque])
         timings[f"reanalysis_{torque:g}Nm_s"] = time.perf_counter() - t1 if m is not gm else 0.0
+        if spec.bearing_speeds == "follow":     # fluid films at each run-up speed (rolling bearings: m itself)
+            t1 = time.perf_counter()
+            try:
+                m = follow_speeds(m, spec.speeds)
+            except InputError as exc:
+                raise InputError(f"{path}: {torque:g} N m: {exc}") from None
+            if m.speed_models:
+                timings[f"bearing_speeds_{torque:g}Nm_s"] = time.perf_counter() - t1
+                for k in ("bearing_matrices_s", "ritz_rows_s"):
+                    timings[f"bearing_speeds_{torque:g}Nm_{k}"] = m.timings[k]
         lines, t_src = run_source(m, source, spec.speeds, [torque], spec.f_max_hz, spec.source_receptance,
                                   spec.mesh_moment_model, spec.mesh_friction)
         timings["source_s"] = timings.get("source_s", 0.0) + t_src
@@ -431,6 +457,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     check_rows, contributions = checks.evaluate(scene, results, gm)
     note = source.overlap_note(reference_torque)      # cached operating point: milliseconds
     notes = [note] if note else []
+    notes += [n for t, (m, _) in results.items() if (n := held_speed_note(m, t))]
     bound = bound_checks = None
     if note:      # the face-width default at the helix's cancellation: the envelope bound on the same models
         from housingfe.runup.chain import engagement_rerun

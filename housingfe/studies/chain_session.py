@@ -12,7 +12,8 @@ The machinery of the run-up studies (`housingfe study`, `housingfe runup-causes`
   normal) — by `housingfe.runup.chain.build_gearbox_model`; another drivetrain of the same layout (gear set of the
   same geometry, bearing configuration, torque) is a Rayleigh-Ritz re-analysis on the same Ritz vectors
   (`with_drivetrain`: seconds; its Ritz space holds the static responses to unit pairs across every bearing and to
-  the mesh load, docs/runup.md).  `fresh_basis=True` computes a basis per variant instead (to measure what the
+  the mesh load, docs/runup.md); with runup.bearing_speeds = "follow" the fluid films then take each run-up speed
+  (`follow`, housingfe.runup.chain.follow_speeds).  `fresh_basis=True` computes a basis per variant instead (to measure what the
   reuse costs in accuracy);
 * each run-up's source is the scene's, as `housingfe run` computes it (`scene_lines`: the coupled model's receptance
   at the mesh with runup.source_receptance = "coupled", the misalignment under load of runup.misalignment), so a
@@ -160,8 +161,21 @@ class ChainSession:
         else:
             model = base if base.drivetrain is drivetrain else with_drivetrain(base, drivetrain)
             how = "re-analysed"
+        model = self.follow(model)
         self.log.append(ModelEntry(label, key, how, time.perf_counter() - t0))
         return model
+
+    def follow(self, model):
+        """`model` with its speed-dependent bearings at each of the scene's speeds where runup.bearing_speeds is
+        "follow" (housingfe.runup.chain.follow_speeds; rolling bearings: the model itself), else the model."""
+        if self.spec.bearing_speeds != "follow":
+            return model
+        from housingfe.runup.chain import follow_speeds
+
+        try:
+            return follow_speeds(model, self.spec.speeds)
+        except InputError as exc:
+            raise InputError(f"{self.scene_path}: {model.drivetrain.torque:g} N m: {exc}") from None
 
     def source(self, drivetrain):
         """The lumped source (housingfe.source.roosmalen.operating.SourceModel) of a drivetrain with the scene's options,

@@ -166,7 +166,9 @@ def families() -> dict[str, Family]:
             ("measured: Fig. 5.19 (2000 N m, fluid film - roller -1.9 dB mean, s.d. 3.0, over 800-1500 rev/min; "
              "maxima 91.0 / 87.7 dB(A)) and Fig. 5.21 (torque law: 1000 -> 2000 N m +3.4 / +2.7 dB(A))",
              "thesis calculated: none (its TF_omega differences of Fig. 5.20 were 'not satisfactory at all')",
-             "fluid films at the pinion speed drivetrain.bearing_speed_rpm for the whole run-up (docs/runup.md)"),
+             "fluid films at each run-up speed (runup.bearing_speeds = \"follow\", the default; \"fixed\": at "
+             "drivetrain.bearing_speed_rpm for the whole run-up; below the film's speed limit the nearest carried "
+             "speed; docs/runup.md)"),
             torque_laws=tuple(MeasuredTorqueLaw("double_helical", b, *TORQUE_LAW_NM,
                                                 measured_step=dh["torque_doubling_1000_to_2000Nm_dBA"][key])
                               for b, key in TORQUE_LAW_MEASURED.items()),

@@ -380,7 +380,7 @@ def _runs(base: _Base, values: dict, gear_set: str, bearings: str, torque: float
         if values["damping_ratio"] != spec.damping_ratio:
             damping = harmonic.Damping(lambda f: np.zeros(np.shape(f)), modal_ratio=values["damping_ratio"])
             start = replace(start, reduction=start.reduction.with_damping(damping))
-        model = with_drivetrain(start, dt)
+        model = base.session.follow(with_drivetrain(start, dt))     # runup.bearing_speeds = "follow": per speed
         misalignment = _misalignment(base, dt, values)
         results = {}
         for engagement in engagements:

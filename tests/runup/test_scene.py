@@ -121,6 +121,7 @@ def test_missing_drivetrain_is_named(tmp_path):
     (["--set", "runup.drive_line=quills"],
      "runup.drive_line: Input should be 'quill-shafts', 'none' or 'back-to-back'"),
     (["--set", "runup.as_made=grade5"], "runup.as_made: 'grade5' is neither \"none\" nor an ISO 1328-1 accuracy grade"),
+    (["--set", "runup.bearing_speeds=sometimes"], "runup.bearing_speeds: Input should be 'fixed' or 'follow'"),
 ])
 def test_cli_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
     out = tmp_path / "out"
