@@ -109,7 +109,7 @@ def numerical_sigma(gm, scene, torque, lines) -> dict:
     30-speed run-up with erp, Föller and numerical; L_WA maxima per radiator."""
     from housingfe.radiation.radiators import RADIATORS
     from housingfe.response.reduced import RitzReduction
-    from housingfe.runup.chain import bearing_pairs, runup, unit_loads
+    from housingfe.runup.chain import bearing_pairs, runup, unit_loads, with_reduction
 
     spec = scene.runup
     t0 = time.perf_counter()
@@ -125,7 +125,7 @@ def numerical_sigma(gm, scene, torque, lines) -> dict:
     reduction = RitzReduction(gm.basis, loads, gm.reduction.damping, surface=spec.surface, nodes=(wheel,),
                               extra_points=extra, static_vectors=bearing_pairs(gm.structure))
     reduction_s = time.perf_counter() - t0
-    gm_num = replace(gm, reduction=reduction, radiators=radiators)
+    gm_num = with_reduction(replace(gm, radiators=radiators), reduction)
     t0 = time.perf_counter()
     res = runup(gm_num, None, spec.speeds, [torque], routes=tuple(spec.routes), lines=lines)
     wall = time.perf_counter() - t0

@@ -119,6 +119,10 @@ class RitzReduction:
         (same DOFs; e.g. the coupled model at another torque).  Loads: the same names."""
         if set(loads) != set(self.names):
             raise InputError(f"reanalyse: loads must be {', '.join(self.names)}")
+        if "_changed_from" in self.__dict__:
+            # a `with_change` reduction: its system is no projection of its structure, so the difference of the
+            # matrices must be taken from the reduction that was one; `structure` brings its own K, M, C whole
+            return self._changed_from[0].reanalyse(structure, loads)
         if structure.dofs != self.structure.dofs:
             raise InputError("reanalyse: the structure has other DOFs than the reduced one")
         t0 = time.perf_counter()
@@ -130,18 +134,24 @@ class RitzReduction:
         other.timings = {**self.timings, "reanalysis_s": time.perf_counter() - t0}
         return other
 
-    def with_change(self, dK: np.ndarray, dC: np.ndarray | None = None) -> "RitzReduction":
+    def with_change(self, dK: np.ndarray, dC: np.ndarray | None = None, structure=None) -> "RitzReduction":
         """The same Ritz vectors, surface data, loads and damping with the projected stiffness and damping changed
         by dK, dC (n x n in Ritz coordinates, N/m and N s/m; may be non-symmetric): a re-analysis whose projected
         change the caller already has (e.g. a few lumped elements' change, X_e^T dA_e X_e on their nodes' rows:
-        housingfe.runup.chain.follow_speeds), without any product with the coupled matrices.  `structure` stays
-        this reduction's, so it no longer holds the returned system's K and C."""
+        housingfe.runup.chain.follow_speeds), without any product with the coupled matrices.  No structure holds
+        the returned system's K and C: `structure` is what the result reports as its own (default this
+        reduction's; e.g. housingfe.runup.chain.SpeedInterior, which refuses the stale matrices).  The result
+        remembers this reduction and the change: its `reanalyse` starts from this one (the new structure's
+        matrices replace the change), its `with_damping` re-applies the change."""
         s = self.system
         if np.shape(dK) != s.Kr.shape or (dC is not None and np.shape(dC) != s.Cr.shape):
             raise InputError(f"with_change: dK, dC must be {s.Kr.shape[0]} x {s.Kr.shape[0]}")
         other = object.__new__(RitzReduction)
         other.__dict__.update(self.__dict__)
         other.__dict__.pop("_unit_memo", None)
+        other._changed_from = (self, dK, dC)
+        if structure is not None:
+            other.structure = structure
         matrices = (s.Kr + dK, s.Mr.copy(), s.Cr + dC if dC is not None else s.Cr.copy())
         other.system = other._project(self.structure, self.loads, matrices)
         return other
@@ -177,6 +187,9 @@ class RitzReduction:
 
     def with_damping(self, damping) -> "RitzReduction":
         """The same reduction with another damping (Damping or loss factor): only the small system changes."""
+        if "_changed_from" in self.__dict__:       # re-projecting `structure` would drop the change: re-apply it
+            parent, dK, dC = self._changed_from
+            return parent.with_damping(damping).with_change(dK, dC, self.structure)
         other = object.__new__(RitzReduction)
         other.__dict__.update(self.__dict__)
         other.damping = damping if isinstance(damping, harmonic.Damping) else loss_factor(damping)

@@ -86,6 +86,15 @@ class GearboxModel:
     # speed itself (a fluid film below its speed limit), and why (the first refusal's message)
     held_speeds: dict = field(default_factory=dict)
     held_reason: str = ""
+    # the reduction the speed models were made from (follow_speeds): another one here (dataclasses.replace of a
+    # model following the speeds) would leave them on the old one, silently: refused in __post_init__
+    followed_reduction: object = field(default=None, repr=False, compare=False)
+
+    def __post_init__(self):
+        if self.speed_models and self.followed_reduction is not self.reduction:
+            raise RuntimeError("GearboxModel: a model following the run-up's speeds (follow_speeds) got another "
+                               "reduction while its speed models keep the old one: use with_reduction(model, "
+                               "reduction), which follows the speeds again on it")
 
     def at_speed(self, speed_rpm: float) -> "GearboxModel":
         """The model at a pinion speed (rev/min): with the bearings following the run-up's speed
@@ -234,6 +243,62 @@ def _node_rows(structure, vectors, nodes) -> dict:
     return out
 
 
+class _SpeedSystem:
+    """The base's CoupledSystem (DOF layout, loads, node displacements, M: independent of the bearings' K, C)
+    without its K and C, which are the base speed's (`SpeedInterior`)."""
+
+    STALE = frozenset({"K", "C", "symmetric"})
+
+    def __init__(self, system, why):
+        self._system, self._why = system, why
+
+    def __getattr__(self, name):
+        if name.startswith("__") or name in ("_system", "_why"):
+            raise AttributeError(name)
+        if name in self.STALE:
+            raise RuntimeError(self._why(f"system.{name}"))
+        return getattr(self._system, name)
+
+
+class SpeedInterior:
+    """The `structure` of a model at one run-up speed (`follow_speeds`): its `spec` and `parts` are the speed's
+    (the bearing specs and elements at the speed, built anyway to project their change); geometry, DOF layout,
+    loads, M, node displacements, the housing are the base model's, which do not depend on the bearings' K, C;
+    the coupled K, C (and what depends on them: `symmetric`, the interior's modes on rigid bores `rigid`, the zero
+    modes, `basis_stiffness`) are refused with a RuntimeError, because the base model's are those of its own bearing
+    speed.
+
+    Why not the speed's own CoupledInterior: its K, C are matrices of the whole coupled model (66 k DOFs), to be
+    re-assembled or copied per speed: seconds and a matrix pair per speed, which is what `follow_speeds` exists to
+    avoid (the run-up needs only the projected change).  A caller that needs them builds the speed's structure:
+    `with_drivetrain(model, model.drivetrain)` on the speed's model (a re-analysis; seconds)."""
+
+    STALE = frozenset({"K", "C", "symmetric", "rigid", "basis_stiffness", "expected_zero_modes",
+                       "expected_mechanisms", "_basis_K"})
+
+    def __init__(self, base, spec, parts, speed_rpm: float, base_speed_rpm: float):
+        self._base = base
+        self.spec, self.parts = spec, parts
+        self.speed_rpm, self.base_speed_rpm = float(speed_rpm), float(base_speed_rpm)
+
+    def _why(self, name: str) -> str:
+        return (f"structure.{name} of the model at {self.speed_rpm:g} rev/min (follow_speeds, runup.bearing_speeds = "
+                f"\"follow\") would be that of the bearings at {self.base_speed_rpm:g} rev/min: only its reduction, "
+                f"spec and parts follow the speed; with_drivetrain(model, model.drivetrain) builds the structure at "
+                f"the speed")
+
+    @property
+    def system(self):
+        return _SpeedSystem(self._base.system, self._why)
+
+    def __getattr__(self, name):
+        if name.startswith("__") or name == "_base":
+            raise AttributeError(name)
+        if name in self.STALE:
+            raise RuntimeError(self._why(name))
+        return getattr(self._base, name)
+
+
 @single_thread
 def follow_speeds(model: GearboxModel, speeds_rpm) -> GearboxModel:
     """`model` with its speed-dependent bearings (fluid films: Drivetrain.speed_dependent_bearings) at each pinion
@@ -279,7 +344,8 @@ def follow_speeds(model: GearboxModel, speeds_rpm) -> GearboxModel:
         if s == float(dt.bearing_speed_rpm):
             models[s] = replace(base, drivetrain=at)
             continue
-        new = parts(spec, structure.centres).bearings
+        speed_parts = parts(spec, structure.centres)
+        new = speed_parts.bearings
         n = len(model.reduction.vectors)
         dK, dC = np.zeros((n, n)), np.zeros((n, n))
         for e_old, e_new in zip(old, new):
@@ -291,7 +357,11 @@ def follow_speeds(model: GearboxModel, speeds_rpm) -> GearboxModel:
                 c_old = np.zeros_like(e_new.K) if e_old.C is None else e_old.C
                 c_new = np.zeros_like(e_old.K) if e_new.C is None else e_new.C
                 dC += X.T @ (c_new - c_old) @ X
-        models[s] = replace(base, drivetrain=at, reduction=model.reduction.with_change(dK, dC))
+        # the structure: the speed's spec and bearing elements, the base's coupled K, C refused (SpeedInterior)
+        speed_structure = SpeedInterior(structure, spec, speed_parts, s, dt.bearing_speed_rpm)
+        models[s] = replace(base, drivetrain=at, structure=speed_structure,
+                            basis=replace(model.basis, structure=speed_structure),
+                            reduction=model.reduction.with_change(dK, dC, speed_structure))
     valid = np.array(sorted(models))
     held = {}
     for s in refused:
@@ -303,7 +373,18 @@ def follow_speeds(model: GearboxModel, speeds_rpm) -> GearboxModel:
     timings = {**model.timings, "speed_reanalysis_s": time.perf_counter() - t0, "bearing_matrices_s": t_matrices,
                "ritz_rows_s": t_rows, "speed_models": len(specs)}
     reason = next(iter(refused.values()), "")
-    return replace(model, speed_models=models, held_speeds=held, held_reason=reason, timings=timings)
+    return replace(model, speed_models=models, held_speeds=held, held_reason=reason, timings=timings,
+                   followed_reduction=model.reduction)
+
+
+def with_reduction(model: GearboxModel, reduction: RitzReduction) -> GearboxModel:
+    """`model` with another reduction of the same structure (another damping, a truncated basis, more kept
+    points); a model following the run-up's speeds (`follow_speeds`) follows the same speeds again on it, so the
+    per-speed models hold the new reduction too."""
+    speeds = sorted(model.speed_models)
+    out = replace(model, reduction=reduction, speed_models={}, held_speeds={}, held_reason="",
+                  followed_reduction=None)
+    return follow_speeds(out, speeds) if speeds else out
 
 
 def held_speed_note(model: GearboxModel, torque: float) -> str:

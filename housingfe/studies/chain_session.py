@@ -140,9 +140,11 @@ class ChainSession:
             self.housing_model, self.radiators = self.pool.housings[key]
         return self.housing_model
 
-    def model(self, drivetrain, label: str = ""):
+    def model(self, drivetrain, label: str = "", follow: bool = True):
         """The coupled GearboxModel of `drivetrain`: a new basis for the first drivetrain of its layout (or for
-        every drivetrain with fresh_basis), else a Rayleigh-Ritz re-analysis of that layout's model."""
+        every drivetrain with fresh_basis), else a Rayleigh-Ritz re-analysis of that layout's model.  follow: with
+        its bearings following the scene's speeds (`follow`); False for a model that is only re-analysed
+        (with_drivetrain drops the speed models), not run itself."""
         from housingfe.runup.chain import build_gearbox_model, with_drivetrain
 
         housing = self.housing()
@@ -161,7 +163,8 @@ class ChainSession:
         else:
             model = base if base.drivetrain is drivetrain else with_drivetrain(base, drivetrain)
             how = "re-analysed"
-        model = self.follow(model)
+        if follow:
+            model = self.follow(model)
         self.log.append(ModelEntry(label, key, how, time.perf_counter() - t0))
         return model
 

@@ -98,7 +98,7 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
     """Run the variants (module docstring) of a run-up scene at its highest torque; returns the result folder."""
     from housingfe.progress import Progress
     from housingfe.response.reduced import RitzReduction
-    from housingfe.runup.chain import unit_loads
+    from housingfe.runup.chain import unit_loads, with_reduction
 
     t0 = time.perf_counter()
     session = ChainSession.from_scene(scene_name, overrides)
@@ -128,7 +128,7 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
 
     for xi in (0.02, 0.08):
         damping = Damping(lambda f: np.zeros(np.shape(f)), modal_ratio=xi)
-        rows += _rows(f"damping xi {xi:g}", run(dataclasses.replace(gm, reduction=gm.reduction.with_damping(damping)),
+        rows += _rows(f"damping xi {xi:g}", run(with_reduction(gm, gm.reduction.with_damping(damping)),
                                                 f"damping xi {xi:g}"), torque, ref)
     loads, _, _ = unit_loads(gm.structure, gm.drivetrain)
     extra = {}
@@ -139,7 +139,7 @@ def run_study(scene_name: str = "test-gearbox-runup", out_dir: str | None = None
                             nodes=(gm.wheel_node,), extra_points=extra,
                             residual=False)
         rows += _rows(f"modes to {f_cut:g} Hz only, no static vectors",
-                      run(dataclasses.replace(gm, reduction=red), f"modes to {f_cut:g} Hz"), torque, ref)
+                      run(with_reduction(gm, red), f"modes to {f_cut:g} Hz"), torque, ref)
     rows += _rows("tooth frequency line only (harmonic 1)", _tooth_only(base), torque, ref)
     if scene.drivetrain.bearings == "ball":
         rows += _rows("ball bearings without moment stiffness (moment rows and columns zeroed, re-analysed)",

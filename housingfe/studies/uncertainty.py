@@ -259,7 +259,7 @@ _POOL: list = []       # per process: the one ModelPool its sessions share (the 
 @dataclass
 class _Base:
     session: object
-    model: object          # GearboxModel of the scene's drivetrain (set A, ball) at the highest torque
+    model: object          # GearboxModel of the scene's drivetrain at the highest torque (its bearings not following the speeds)
     surfaces: dict         # bearing -> housing bore (bore matching)
     setup_s: float
 
@@ -282,7 +282,9 @@ def _base(scene_name: str, overrides: tuple, comm) -> _Base:
             surfaces = match_bores(housing, dt, ref.bores, ref.match, ref.bore_tolerance)
         except InputError as exc:
             raise InputError(f"{session.scene_path}: {exc}") from None
-        model = session.model(dt.with_bores(surfaces), "uncertainty base")
+        # not followed: the samples only re-analyse it (`_runs`: with_drivetrain, then each follows the speeds on
+        # its own drivetrain), so fluid films followed here would be Reynolds solves for nothing
+        model = session.model(dt.with_bores(surfaces), "uncertainty base", follow=False)
         _STATE[key] = _Base(session, model, surfaces, time.perf_counter() - t0)
     return _STATE[key]
 

@@ -8,6 +8,9 @@ housingfe.runup.chain.follow_speeds), on the coarse coupled test gearbox with th
   from the films at 1500 rev/min (up to 1.3 dB per line at 800 rev/min);
 * against a fresh modal basis at the speed (a converged reference: `build_gearbox_model` with the bearings at that
   speed): L_WA within 0.02 dB (measured 0.0016 dB at 800 rev/min, both routes);
+* a model at one speed never gives the base speed's bearings silently: its bearing elements and spec are the
+  speed's, a re-analysis of it or another damping starts from the speed's matrices, the coupled K, C (the base
+  speed's) are a RuntimeError; another reduction of a following model (`with_reduction`) reaches every speed;
 * below the speed at which the film carries its load a speed holds the nearest carried speed's matrices, flagged;
   no carried speed at all is one InputError; rolling-element bearings are untouched (the model itself, no
   re-analysis); a bad setting names the key.
@@ -101,6 +104,71 @@ def test_follow_against_a_fresh_basis_at_the_speed(film):
     for route in a.routes:
         assert a.series(route, "erp", TORQUE, "LwA_dB")[1][0] == pytest.approx(
             b.series(route, "erp", TORQUE, "LwA_dB")[1][0], abs=0.02)
+
+
+@pytest.mark.slow
+def test_a_speed_model_never_gives_the_base_speeds_bearings(film):
+    """A model at one speed (`at_speed`) shares the base model's coupled matrices, whose bearings are those of 1500
+    rev/min.  What it gives must be the speed's or refused: its bearing elements (against the structure built with
+    the bearings at the speed), a re-analysis of it and another damping (against those of the model built at the
+    speed); the coupled K, C a RuntimeError naming follow_speeds; geometry and loads stay."""
+    from housingfe.response.harmonic import Load, harmonic_response
+    from housingfe.runup.chain import mesh_reference_stiffness, unit_loads
+    from housingfe.solvers import modal
+
+    gm, dt, _ = film
+    speed = 800.0
+    m = follow_speeds(gm, [speed, 1500.0]).at_speed(speed)
+    ref = with_drivetrain(gm, replace(dt, bearing_speed_rpm=speed))     # the coupled matrices at the speed
+    for a, b, base in zip(m.structure.parts.bearings, ref.structure.parts.bearings, gm.structure.parts.bearings):
+        np.testing.assert_allclose(a.K, b.K, rtol=1e-12)
+        np.testing.assert_allclose(a.C, b.C, rtol=1e-12)
+        assert np.max(np.abs(a.K - base.K)) > 0.1 * np.max(np.abs(base.K))     # the film at 800 is another one
+    assert m.structure.spec.bearings == ref.structure.spec.bearings
+    # re-analysing the speed's model on its own drivetrain is the model at the speed (on main before 2026-11-27 it
+    # added the speed's change twice: the base's projection plus the speed's change plus the coupled difference)
+    again = with_drivetrain(m, m.drivetrain)
+    for x, y in ((again.reduction.system.Kr, ref.reduction.system.Kr), (again.reduction.system.Cr,
+                                                                        ref.reduction.system.Cr)):
+        assert np.max(np.abs(x - y)) <= 1e-9 * np.max(np.abs(y))
+    # another damping keeps the speed's bearings (re-projecting the structure would drop them)
+    d = m.reduction.with_damping(0.02).system
+    r = ref.reduction.with_damping(0.02).system
+    assert np.max(np.abs(d.Kr - r.Kr)) <= 1e-9 * np.max(np.abs(r.Kr))
+    np.testing.assert_allclose(d.frequencies_hz, r.frequencies_hz, rtol=1e-9, atol=1e-6)
+    # what would be the base speed's is refused, loudly
+    mine, ours = unit_loads(m.structure, m.drivetrain)[0], unit_loads(gm.structure, gm.drivetrain)[0]
+    for get in (lambda: m.structure.K, lambda: m.structure.C, lambda: m.structure.system.K,
+                lambda: m.reduction.structure.K, lambda: m.basis.structure.K,
+                lambda: modal.modes(m.structure, 100.0),
+                lambda: harmonic_response(m.structure, Load("mesh", mine["mesh"]), 0.02, [100.0])):
+        with pytest.raises(RuntimeError, match=r"follow_speeds.*1500 rev/min"):
+            get()
+    # geometry and loads do not depend on the bearings
+    assert mesh_reference_stiffness(m) == mesh_reference_stiffness(gm)
+    assert m.structure.dofs == gm.structure.dofs and m.structure.spec.drive_lines == gm.structure.spec.drive_lines
+    for name in mine:
+        assert mine[name].equal(ours[name])
+
+
+@pytest.mark.slow
+def test_another_reduction_reaches_every_speed(film):
+    """A model following the speeds with another damping (housingfe runup-causes' variants): `with_reduction`
+    follows again, so every speed's model has it (the model at 800 rev/min with xi 0.02 is the re-analysis at 800
+    rev/min with xi 0.02); replacing the reduction alone, which would leave the speed models on the old one, is
+    refused."""
+    from housingfe.runup.chain import with_reduction
+
+    gm, dt, _ = film
+    following = follow_speeds(gm, SPEEDS)
+    other = with_reduction(following, following.reduction.with_damping(0.02))
+    ref = with_drivetrain(gm, replace(dt, bearing_speed_rpm=800.0)).reduction.with_damping(0.02)
+    mine = other.at_speed(800.0).reduction
+    assert mine.damping is other.reduction.damping
+    np.testing.assert_allclose(mine.frequencies_hz, ref.frequencies_hz, rtol=1e-9, atol=1e-6)
+    assert np.max(np.abs(mine.system.Kr - ref.system.Kr)) <= 1e-9 * np.max(np.abs(ref.system.Kr))
+    with pytest.raises(RuntimeError, match="with_reduction"):
+        replace(following, reduction=following.reduction.with_damping(0.02))
 
 
 @pytest.mark.slow
