@@ -171,6 +171,35 @@ def test_one_and_two_ranks_agree(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.mpi
+def test_one_and_two_ranks_agree_with_fluid_films_following_the_speed(tmp_path):
+    """The double helical set on fluid films following the speed (runup.bearing_speeds = "follow", the default):
+    every rank solves the films' Reynolds equation and projects their change itself, so 1 and 2 ranks must give
+    the same run-up, 100 rev/min (below the film limit at 2000 N m) held at the nearest carried speed on both."""
+    import json
+
+    if not shutil.which("mpirun"):
+        pytest.skip("mpirun not installed")
+    args = ["run", "test-gearbox-runup-double-helical", "--set", "drivetrain.bearings=fluid_film", "--set",
+            'housing.set=["mesh.size=0.06"]', "--set", "runup.f_max_hz=1500.0", "--set", "runup.torques_nm=[2000.0]",
+            "--set", "runup.speed_min_rpm=100.0", "--set", "runup.speed_step_rpm=600.0"]
+    one = housingfe(*args, "--out", str(tmp_path / "one"))
+    assert one.returncode == 0, one.stderr
+    two = housingfe(*args, "--out", str(tmp_path / "two"), mpi_ranks=2)
+    assert two.returncode == 0, two.stderr
+    a, b = _rows(tmp_path / "one/runup.csv"), _rows(tmp_path / "two/runup.csv")
+    assert len(a) == len(b) and {float(r["speed_rpm"]) for r in a} == {100.0, 700.0, 1300.0}
+    for ra, rb in zip(a, b):
+        assert (ra["route"], ra["radiation"], ra["speed_rpm"]) == (rb["route"], rb["radiation"], rb["speed_rpm"])
+        for key in ("Lv_dB", "LwA_dB", "L_omega_dB"):
+            assert float(ra[key]) == pytest.approx(float(rb[key]), abs=1e-6)
+    ja, jb = (json.loads((tmp_path / name / "runup.json").read_text())["bearing_speeds"] for name in ("one", "two"))
+    assert ja == jb
+    assert ja["setting"] == "follow" and ja["torques"]["2000"]["held"] == {"100": 700.0}
+    assert ja["torques"]["2000"]["models"] == 2
+
+
+@pytest.mark.slow
 def test_reanalysis_by_the_change_of_the_matrices_equals_a_full_projection(coarse):
     """The re-analysis projects only K, M, C's change (the interior rows) on the Ritz vectors: the reduced
     matrices must be those of projecting the new matrices whole (round-off of the largest entry), and the change
