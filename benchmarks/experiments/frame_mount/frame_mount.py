@@ -20,7 +20,8 @@ Usage (from the worktree, PYTHONPATH=$PWD):
   python benchmarks/experiments/frame_mount/frame_mount.py runs --mesh coarse            # all K_v, coarse mesh
   python benchmarks/experiments/frame_mount/frame_mount.py runs --mesh default --kv 3e8 1e9 fixed
   python benchmarks/experiments/frame_mount/frame_mount.py modes --mesh coarse
-  python benchmarks/experiments/frame_mount/frame_mount.py table     # CSV summary + PNG from what was run
+  python benchmarks/experiments/frame_mount/frame_mount.py bearings --kv fixed 1e9 3e8   # study bearings (set B)
+  python benchmarks/experiments/frame_mount/frame_mount.py plot --mesh default   # the PNGs from what was run
 Run folders: /tmp/frame-mount-runs/<mesh>_<case>/ (the CLI's output, kept for inspection).
 """
 from __future__ import annotations
@@ -111,6 +112,35 @@ def slope_rows(case: str, mesh: str) -> list[dict]:
     return out
 
 
+def run_bearings(case: str) -> list[dict]:
+    """`housingfe study bearings` (gear set B: ball, angular contact, self-aligning, tapered roller; default mesh)
+    with the case's housing overrides; its rows (Delta mean over 800-1500 rpm to ball, max L_WA) and rankings."""
+    out = RUNS / f"study_bearings_{case}"
+    cmd = [sys.executable, "-m", "housingfe", "study", "bearings", "--out", str(out),
+           "--set", f"housing.set={json.dumps(housing_sets(case, 'default'))}"]
+    print(" ".join(cmd), flush=True)
+    t0 = time.perf_counter()
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if res.returncode:
+        raise SystemExit(f"study bearings {case}: exit {res.returncode}\n{res.stderr[-2000:]}")
+    return study_rows(case, wall)
+
+
+def study_rows(case: str, wall: float | None = None) -> list[dict]:
+    data = json.loads((RUNS / f"study_bearings_{case}" / "study.json").read_text())
+    rows = [{"mesh": "default", "K_v_N_per_m": case, "route": r["route"], "variant": r["variant"],
+             "mean_diff_dB": r["mean_diff_dB"], "sd_diff_dB": r["sd_diff_dB"], "measured_mean_dB": r["measured_mean_dB"],
+             "LwA_max_dBA": r["LwA_max_dBA"], "at_rpm": r["at_rpm"], "measured_max_dBA": r["measured_max_dBA"],
+             "ranking": "", "wall_s": "" if wall is None else round(wall, 1)}
+            for r in data["rows"] if r["radiation"] == "erp"]
+    for k in data["rankings"]:
+        rows.append({"mesh": "default", "K_v_N_per_m": case, "route": k["route"], "variant": f"ranking: {k['measure']}",
+                     "ranking": f"{k['ours']} (measured {k['measured']}; quietest {k['quietest']}, loudest "
+                                f"{k['loudest']})"})
+    return rows
+
+
 # ------------------------------------------------------------------------------------------------ modes
 def coupled_model(case: str, mesh: str):
     """The run-up's coupled gearbox model of a case, built as `housingfe run` builds it."""
@@ -136,65 +166,98 @@ def coupled_model(case: str, mesh: str):
                                basis_factor=spec.basis_factor)
 
 
-def mode_rows(case: str, mesh: str, n_modes: int = 12) -> list[dict]:
-    """The lowest modes of the coupled gearbox with their rigid-body content, and the six-DOF rigid estimate."""
-    from housingfe.solvers import blocks
-
-    gm = coupled_model(case, mesh)
-    system = gm.structure.system
-    R = blocks.columns(system.rigid_body_vectors(gm.structure.model.V))
-    MR = blocks.mat_block(system.M, R)
-    KR = blocks.mat_block(system.K, R)
-    Mrr, Krr = R.T @ MR, R.T @ KR
-    Mrr, Krr = (Mrr + Mrr.T) / 2, (Krr + Krr.T) / 2
+def _about_centre(Mrr: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """(mass kg, centre of gravity m, T, Mc) of a rigid-body mass matrix about the origin (DOFs t, theta): T maps
+    origin coefficients to (t_c = t + theta x c, theta), Mc the mass matrix in those (m I, the inertia about c)."""
     mass = float(np.mean(np.diag(Mrr)[:3]))
-    c = np.array([Mrr[1, 5], Mrr[2, 3], Mrr[0, 4]]) / mass        # centre of gravity (rigid_body_mass_properties)
-    # rigid motions about the centre of gravity: translation t_c = t + theta x c, rotation theta
+    c = np.array([Mrr[1, 5], Mrr[2, 3], Mrr[0, 4]]) / mass        # as rigid_body_mass_properties
     T = np.eye(6)
     for j in range(3):
         T[0:3, 3 + j] = np.cross(np.eye(3)[j], c)
     Tinv = np.linalg.inv(T)
-    Mc = Tinv.T @ Mrr @ Tinv                                         # block diagonal: m I, inertia about c
-    rows = []
+    return mass, c, T, Tinv.T @ Mrr @ Tinv
+
+
+def _components(T: np.ndarray, Mc: np.ndarray, a: np.ndarray) -> np.ndarray:
+    """Shares of a rigid motion's kinetic energy per component about the centre of gravity (COMPONENTS)."""
+    ac = T @ a
+    energy = np.diag(Mc) * ac ** 2
+    return energy / max(energy.sum(), 1e-300)
+
+
+def _named(parts: np.ndarray) -> str:
+    order = np.argsort(parts)[::-1]
+    return " + ".join(f"{COMPONENTS[j]} {parts[j]:.0%}" for j in order[:2] if parts[j] > 0.1)
+
+
+def mode_rows(case: str, mesh: str, n_modes: int = 12) -> list[dict]:
+    """The lowest modes of the coupled gearbox: the share of the mode's strain energy in the mount's springs (a mode
+    "on the mount" when most of it is there: the gearbox moves as a body on the frame), the interior's share of the
+    kinetic energy (shafts and gears, also where carried along by the bores), and how much of the HOUSING's kinetic
+    energy is rigid-like motion (its field projected M-orthogonally on the housing's six exact rigid motions: also
+    high for a housing rocking on its own flexible feet and walls, so not by itself a mount mode) and which
+    motion about the housing's centre of gravity.
+    Then the six-DOF rigid estimate of the whole gearbox on the mount (Rayleigh-Ritz on the coupled model's six
+    rigid motions; elastic mounts only: on the fixed feet a rigid motion is not admissible)."""
+    from scipy.linalg import eigh
+
+    from housingfe.solvers import blocks
+
+    gm = coupled_model(case, mesh)
+    structure = gm.structure
+    housing = structure.model
+    Rh = blocks.columns(housing.rigid_body_vectors())
+    Mh = (Rh.T @ blocks.mat_block(housing.M, Rh))
+    Mh = (Mh + Mh.T) / 2
+    _, _, Th, Mch = _about_centre(Mh)
     basis = gm.basis
     n0 = basis.rigid_count
     freqs = basis.frequencies_hz[n0:]
-    Q = blocks.columns(basis.vectors[n0:n0 + n_modes])
-    share = gm.interior_share
-    for i in range(Q.shape[1]):
-        q = Q[:, i]
-        Mq = blocks.mat_block(system.M, q[:, None])[:, 0]
-        a = np.linalg.solve(Mrr, R.T @ Mq)                           # M-orthogonal projection on the rigid motions
-        total = float(q @ Mq)
-        rigid = float(a @ Mrr @ a) / total
-        ac = T @ a
-        energy = np.diag(Mc) * ac ** 2
-        parts = energy / max(energy.sum(), 1e-300)
-        order = np.argsort(parts)[::-1]
-        # the rigid motion named only where it is a real part of the mode (an elastic mode's few % are noise)
-        what = (" + ".join(f"{COMPONENTS[j]} {parts[j]:.0%}" for j in order[:2] if parts[j] > 0.1)
-                if rigid >= 0.2 else "")
-        kind = "rigid-body" if rigid >= 0.5 else "interior" if share[i] >= 0.5 else "housing elastic"
-        rows.append({"mesh": mesh, "K_v_N_per_m": case, "kind": "coupled_mode", "index": i + 1, "type": kind,
-                     "frequency_hz": round(float(freqs[i]), 1), "rigid_body_share": round(rigid, 3),
-                     "rigid_motion": what, "interior_share": round(float(share[i]), 3),
-                     **{COMPONENTS[j]: round(float(parts[j] * rigid), 3) for j in range(6)}})
-    # Rayleigh-Ritz on the six rigid motions: an upper bound of the six rigid-body frequencies of the mount
-    from scipy.linalg import eigh
+    vecs = basis.vectors[n0:n0 + n_modes]
+    U = blocks.columns([structure.fe_vector(q) for q in vecs])
+    MU = blocks.mat_block(housing.M, U)
+    mount = np.zeros(U.shape[1])
+    if case != "fixed":                 # strain energy in the springs: u^T K_f u / omega^2 (mass-normalised modes)
+        from dolfinx.fem.petsc import assemble_matrix
 
+        from housingfe.fe.model import foundation_forms
+
+        (form,) = foundation_forms(housing.scene.supports, housing.housing, housing.V)
+        Kf = assemble_matrix(form)
+        Kf.assemble()
+        KfU = blocks.mat_block(Kf, U)
+        w2 = (2 * np.pi * np.asarray(freqs[:U.shape[1]])) ** 2
+        mount = np.einsum("ij,ij->j", U, KfU) / w2
+    rows = []
+    for i in range(U.shape[1]):
+        u = U[:, i]
+        a = np.linalg.solve(Mh, Rh.T @ MU[:, i])
+        rigid = float(a @ Mh @ a) / float(u @ MU[:, i])
+        parts = _components(Th, Mch, a)
+        share = float(gm.interior_share[i])
+        kind = "on the mount" if mount[i] >= 0.5 else "interior" if share >= 0.5 else "housing elastic"
+        rows.append({"mesh": mesh, "K_v_N_per_m": case, "kind": "coupled_mode", "index": i + 1, "type": kind,
+                     "frequency_hz": round(float(freqs[i]), 1), "mount_energy_share": round(float(mount[i]), 3),
+                     "housing_rigid_share": round(rigid, 3),
+                     # the rigid motion named only where it is a real part of the housing's motion
+                     "rigid_motion": _named(parts) if rigid >= 0.2 else "", "interior_share": round(share, 3),
+                     **{COMPONENTS[j]: round(float(parts[j] * rigid), 3) for j in range(6)}})
+    if case == "fixed":
+        return rows
+    system = structure.system
+    R = blocks.columns(system.rigid_body_vectors(housing.V))
+    Mrr, Krr = R.T @ blocks.mat_block(system.M, R), R.T @ blocks.mat_block(system.K, R)
+    Mrr, Krr = (Mrr + Mrr.T) / 2, (Krr + Krr.T) / 2
+    mass, c, T, Mc = _about_centre(Mrr)
     w2, vec = eigh(Krr, Mrr)
     for i in range(6):
-        ac = T @ vec[:, i]
-        energy = np.diag(Mc) * ac ** 2
-        parts = energy / energy.sum()
-        order = np.argsort(parts)[::-1]
+        parts = _components(T, Mc, vec[:, i])
         rows.append({"mesh": mesh, "K_v_N_per_m": case, "kind": "rigid_estimate", "index": i + 1, "type": "",
-                     "frequency_hz": round(float(np.sqrt(max(w2[i], 0.0)) / 2 / np.pi), 1), "rigid_body_share": 1.0,
-                     "rigid_motion": " + ".join(f"{COMPONENTS[j]} {parts[j]:.0%}" for j in order[:2]
-                                                if parts[j] > 0.1),
-                     "interior_share": "", **{COMPONENTS[j]: round(float(parts[j]), 3) for j in range(6)}})
+                     "frequency_hz": round(float(np.sqrt(max(w2[i], 0.0)) / 2 / np.pi), 1),
+                     "mount_energy_share": "", "housing_rigid_share": 1.0, "rigid_motion": _named(parts), "interior_share": "",
+                     **{COMPONENTS[j]: round(float(parts[j]), 3) for j in range(6)}})
     rows.append({"mesh": mesh, "K_v_N_per_m": case, "kind": "mass", "index": 0, "type": "", "frequency_hz": "",
-                 "rigid_body_share": "", "rigid_motion": f"total {mass:.1f} kg, centre of gravity "
+                 "mount_energy_share": "", "housing_rigid_share": "", "rigid_motion": f"gearbox {mass:.1f} kg, centre of gravity "
                  f"({c[0]:.3f}, {c[1]:.3f}, {c[2]:.3f}) m", "interior_share": ""})
     return rows
 
@@ -235,7 +298,7 @@ def plot(mesh: str, cases: list[str]) -> None:
                     lw=2.2 if case == "fixed" else 1.2, color="k" if case == "fixed" else None)
         for lo, hi in ((450, 500), (850, 950), (1300, 1350)):
             ax.axvspan(lo, hi, color="0.85", zorder=0)
-        ax.plot([250, 500, 1000, 1500], [74, 80, 86, 89], "ks", label="measured (Fig. 5.10, thesis' reading)")
+        ax.plot([250, 500, 1000, 1500], [74, 80, 86, 89], "ks", label="thesis' 6 dB(A) speed-law line (Fig. 5.10)")
         ax.set_title(f"{route}, set A, ball, 2000 N m, sigma = 1 ({mesh} mesh)")
         ax.set_xlabel("pinion speed (rpm)")
         ax.set_ylim(30, 105)
@@ -247,9 +310,76 @@ def plot(mesh: str, cases: list[str]) -> None:
     plt.close(fig)
 
 
+def _read(path: Path, mesh: str) -> list[dict]:
+    if not path.is_file():
+        return []
+    with open(path, newline="") as fh:
+        return [r for r in csv.DictReader(fh) if r["mesh"] == mesh]
+
+
+def plot_trends(mesh: str) -> None:
+    """Modes, tooth-band transfer slope and speed law against K_v (fixed drawn at the right as 'fixed')."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    modes, slopes, checks = (_read(HERE / f"frame_mount_{n}.csv", mesh) for n in ("modes", "slopes", "checks"))
+    if not checks:
+        return
+    kvs = [c for c in KV_RANGE if any(r["K_v_N_per_m"] == c for r in checks)]
+    x = {c: (np.log10(float(c)) if c != "fixed" else 11.0) for c in kvs}
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    ax = axes[0]
+    styles = {"on the mount": ("o", "C3"), "interior": ("s", "C0"), "housing elastic": ("^", "C2")}
+    seen = set()
+    for r in modes:
+        if r["kind"] == "coupled_mode" and r["K_v_N_per_m"] in x:
+            m, col = styles[r["type"]]
+            ax.plot(x[r["K_v_N_per_m"]], float(r["frequency_hz"]), m, color=col, ms=5,
+                    label=r["type"] if r["type"] not in seen else None)
+            seen.add(r["type"])
+        elif r["kind"] == "rigid_estimate" and r["K_v_N_per_m"] in x:
+            ax.plot(x[r["K_v_N_per_m"]] + 0.12, float(r["frequency_hz"]), "_", color="k", ms=8,
+                    label="rigid estimate (6 DOF)" if "est" not in seen else None)
+            seen.add("est")
+    for f in (180, 340, 520):
+        ax.axhspan(f - 40, f + 40, color="0.85", zorder=0)
+    ax.set_ylim(0, 800)
+    ax.set_ylabel("frequency (Hz)")
+    ax.set_title("lowest 12 coupled modes (grey: measured peaks' f_z +- 100 rpm)", fontsize=9)
+    ax.legend(fontsize=7)
+    ax = axes[1]
+    for route, col in (("tf_omega", "C0"), ("mesh_force", "C1")):
+        pts = [(x[r["K_v_N_per_m"]], float(r["transfer"])) for r in slopes
+               if r["route"] == route and r["basis"] == "tooth_band" and r["K_v_N_per_m"] in x]
+        pts.sort()
+        ax.plot(*zip(*pts), "o-", color=col, label=route)
+    ax.axhline(-7, color="k", ls="--", label="implied by the measured (docs/runup.md)")
+    ax.set_title("tooth-band transfer slope (dB per doubling, 250-1500 rpm)")
+    ax.legend(fontsize=8)
+    ax = axes[2]
+    for route, col in (("tf_omega", "C0"), ("mesh_force", "C1")):
+        pts = sorted((x[r["K_v_N_per_m"]], float(r["ours"])) for r in checks
+                     if r["check_id"] == f"28.speed_law.{route}" and r["K_v_N_per_m"] in x)
+        ax.plot(*zip(*pts), "o-", color=col, label=route)
+    ax.axhspan(4, 8, color="0.85", zorder=0, label="measured 6 +- 2")
+    ax.set_title("speed law L_WA (dB(A) per doubling)")
+    ax.legend(fontsize=8)
+    for ax in axes:
+        ax.set_xticks(list(x.values()))
+        ax.set_xticklabels([c if c != "fixed" else "fixed" for c in kvs])
+        ax.set_xlabel("K_v (N/m), total vertical mount stiffness")
+        ax.grid(alpha=0.3)
+    fig.suptitle(f"test gearbox on an elastic frame, set A, ball, 2000 N m ({mesh} mesh)")
+    fig.tight_layout()
+    fig.savefig(HERE / f"frame_mount_trends_{mesh}.png", dpi=110)
+    plt.close(fig)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("runs", "modes", "plot"))
+    ap.add_argument("what", choices=("runs", "modes", "bearings", "plot"))
     ap.add_argument("--mesh", choices=tuple(MESHES), default="coarse")
     ap.add_argument("--kv", nargs="*", default=list(KV_RANGE), help="K_v in N/m, or 'fixed'")
     args = ap.parse_args()
@@ -264,14 +394,21 @@ def main() -> None:
             write_csv(HERE / "frame_mount_slopes.csv", slope_rows(case, args.mesh))
             print(f"{case}: {wall:.1f} s", flush=True)
         plot(args.mesh, list(KV_RANGE))
+        plot_trends(args.mesh)
     elif args.what == "modes":
         for case in args.kv:
             t0 = time.perf_counter()
             rows = mode_rows(case, args.mesh)
             write_csv(HERE / "frame_mount_modes.csv", rows)
             print(f"{case}: modes in {time.perf_counter() - t0:.1f} s", flush=True)
+    elif args.what == "bearings":       # default mesh; --kv as for runs (the study's folders are reused if there)
+        for case in args.kv:
+            done = (RUNS / f"study_bearings_{case}" / "study.json").is_file()
+            rows = study_rows(case) if done else run_bearings(case)
+            write_csv(HERE / "frame_mount_bearings.csv", rows)
     else:
         plot(args.mesh, list(KV_RANGE))
+        plot_trends(args.mesh)
 
 
 if __name__ == "__main__":
