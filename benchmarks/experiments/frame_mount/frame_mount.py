@@ -377,6 +377,36 @@ def plot_trends(mesh: str) -> None:
     plt.close(fig)
 
 
+def _compact(check_id: str, ours: str) -> str:
+    """A peaks cell 'speed (n = k, mode f Hz), ...' as 'speed/n ...; modes f ...'."""
+    import re
+
+    if ".peaks." not in check_id:
+        return ours
+    found = re.findall(r"(\d+) \(n = (\d+), mode (\d+) Hz\)", ours)
+    modes = " ".join(dict.fromkeys(m for _, _, m in found))
+    return f"{' '.join(f'{s}/{n}' for s, n, _ in found)}; modes {modes} Hz"
+
+
+def table(mesh: str) -> str:
+    """The issue-28 rows against K_v, markdown (ours, pass: y/n), softest mount first, fixed last."""
+    rows = _read(HERE / "frame_mount_checks.csv", mesh)
+    cases = [c for c in KV_RANGE if any(r["K_v_N_per_m"] == c for r in rows)]
+    ids = list(dict.fromkeys(r["check_id"] for r in rows))
+    head = ["check"] + [c if c == "fixed" else f"K_v {c}" for c in cases] + ["measured"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for i in ids:
+        cells = [i.removeprefix("28.")]
+        for c in cases:
+            r = next((x for x in rows if x["check_id"] == i and x["K_v_N_per_m"] == c), None)
+            cells.append("" if r is None else f"{_compact(i, r['ours'])} {'**y**' if r['passed'] == 'yes' else 'n'}")
+        cells.append(next(r["measured"] for r in rows if r["check_id"] == i))
+        lines.append("| " + " | ".join(cells) + " |")
+    passes = [sum(r["passed"] == "yes" for r in rows if r["K_v_N_per_m"] == c) for c in cases]
+    lines.append("| passed | " + " | ".join(f"{p} of {len(ids)}" for p in passes) + " | |")
+    return "\n".join(lines) + "\n"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("runs", "modes", "bearings", "plot"))
@@ -409,6 +439,7 @@ def main() -> None:
     else:
         plot(args.mesh, list(KV_RANGE))
         plot_trends(args.mesh)
+        (HERE / f"frame_mount_table_{args.mesh}.md").write_text(table(args.mesh))
 
 
 if __name__ == "__main__":
