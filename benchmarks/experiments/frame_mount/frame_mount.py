@@ -21,6 +21,7 @@ Usage (from the worktree, PYTHONPATH=$PWD):
   python benchmarks/experiments/frame_mount/frame_mount.py runs --mesh default --kv 3e8 1e9 fixed
   python benchmarks/experiments/frame_mount/frame_mount.py modes --mesh coarse
   python benchmarks/experiments/frame_mount/frame_mount.py bearings --kv fixed 1e9 3e8   # study bearings (set B)
+  python benchmarks/experiments/frame_mount/frame_mount.py radiation --kv fixed 1e9 3e8  # numerical sigma beside
   python benchmarks/experiments/frame_mount/frame_mount.py plot --mesh default   # the PNGs from what was run
 Run folders: /tmp/frame-mount-runs/<mesh>_<case>/ (the CLI's output, kept for inspection).
 """
@@ -138,6 +139,35 @@ def study_rows(case: str, wall: float | None = None) -> list[dict]:
         rows.append({"mesh": "default", "K_v_N_per_m": case, "route": k["route"], "variant": f"ranking: {k['measure']}",
                      "ranking": f"{k['ours']} (measured {k['measured']}; quietest {k['quietest']}, loudest "
                                 f"{k['loudest']})"})
+    return rows
+
+
+NUMERICAL = 'radiation.models=["erp","foller","numerical"]'
+
+
+def radiation_rows(case: str) -> list[dict]:
+    """The default run-up with the numerical sigma (Rayleigh integral plate by plate) beside sigma = 1 and Foller's:
+    max L_WA over the run-up and up to 700 rpm per route and model (how much of a mount's gain sigma = 1 credits
+    to a whole-box rocking).  The run's folder is reused if there."""
+    out = RUNS / f"numerical_{case}"
+    if not (out / "runup.csv").is_file():
+        cmd = [sys.executable, "-m", "housingfe", "run", "test-gearbox-runup", "--out", str(out), "--set",
+               f"housing.set={json.dumps(housing_sets(case, 'default'))}", "--set", NUMERICAL]
+        print(" ".join(cmd), flush=True)
+        res = subprocess.run(cmd, capture_output=True, text=True)
+        if res.returncode:
+            raise SystemExit(f"numerical {case}: exit {res.returncode}\n{res.stderr[-2000:]}")
+    with open(out / "runup.csv", newline="") as fh:
+        table = list(csv.DictReader(fh))
+    rows = []
+    for route in ("tf_omega", "mesh_force"):
+        for rad in ("erp", "foller", "numerical"):
+            sel = [r for r in table if r["route"] == route and r["radiation"] == rad]
+            top = max(sel, key=lambda r: float(r["LwA_dB"]))
+            low = max((r for r in sel if float(r["speed_rpm"]) <= 700), key=lambda r: float(r["LwA_dB"]))
+            rows.append({"mesh": "default", "K_v_N_per_m": case, "route": route, "radiation": rad,
+                         "LwA_max_dBA": round(float(top["LwA_dB"]), 1), "at_rpm": top["speed_rpm"],
+                         "LwA_max_to_700rpm_dBA": round(float(low["LwA_dB"]), 1), "at_rpm_to_700": low["speed_rpm"]})
     return rows
 
 
@@ -409,7 +439,7 @@ def table(mesh: str) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("runs", "modes", "bearings", "plot"))
+    ap.add_argument("what", choices=("runs", "modes", "bearings", "radiation", "plot"))
     ap.add_argument("--mesh", choices=tuple(MESHES), default="coarse")
     ap.add_argument("--kv", nargs="*", default=list(KV_RANGE), help="K_v in N/m, or 'fixed'")
     args = ap.parse_args()
@@ -431,6 +461,9 @@ def main() -> None:
             rows = mode_rows(case, args.mesh)
             write_csv(HERE / "frame_mount_modes.csv", rows)
             print(f"{case}: modes in {time.perf_counter() - t0:.1f} s", flush=True)
+    elif args.what == "radiation":      # default mesh; --kv as for runs
+        for case in args.kv:
+            write_csv(HERE / "frame_mount_radiation.csv", radiation_rows(case))
     elif args.what == "bearings":       # default mesh; --kv as for runs (the study's folders are reused if there)
         for case in args.kv:
             done = (RUNS / f"study_bearings_{case}" / "study.json").is_file()
