@@ -22,3 +22,22 @@ def coarse(comm):
     src = dt.source_model(stiffness_positions=32)     # coarse too (the run-up's default is 128): test speed
     lines, _ = source_lines(src, SPEEDS, [2000.0], F_LINES)
     return gm, src, lines, runup(gm, None, SPEEDS, [2000.0], lines=lines)
+
+
+@pytest.fixture(scope="session")
+def scene_run(tmp_path_factory):
+    """run(scene, settings) -> the output folder of `run_scene(scene, <folder>, settings)`, each distinct (scene,
+    settings) run once per session: test_as_made, test_as_made_totals and test_imported_runup assert different
+    things about the same coarse run-ups (the default one, and with runup.as_made = 5), which are deterministic, so
+    one run serves all of them.  The folders are read, never written, by the tests."""
+    from housingfe.runup.scene import run_scene
+
+    done = {}
+
+    def run(scene: str, settings: list[str]):
+        key = (scene, tuple(settings))
+        if key not in done:
+            done[key] = run_scene(scene, str(tmp_path_factory.mktemp("scene_run") / "out"), list(settings))
+        return done[key]
+
+    return run

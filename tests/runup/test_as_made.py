@@ -130,14 +130,12 @@ def _read(path):
         return list(csv.DictReader(fh))
 
 
-def test_run_scene_with_as_made_keeps_the_periodic_outputs_byte_identical(tmp_path):
+def test_run_scene_with_as_made_keeps_the_periodic_outputs_byte_identical(scene_run):
     """A coarse run-up with runup.as_made = 5 and without: runup.csv, runup_harmonics.csv, checks.csv and the
     spectra are byte-identical; runup_as_made.csv has a row per route, radiator and speed whose periodic columns
     are runup.csv's (tooth band = the n = 1 line, total = all lines) and whose as-made columns are not below them."""
-    from housingfe.runup.scene import run_scene
-
-    off = run_scene("test-gearbox-runup", str(tmp_path / "off"), SETTINGS)
-    on = run_scene("test-gearbox-runup", str(tmp_path / "on"), SETTINGS + ["runup.as_made=5"])
+    off = scene_run("test-gearbox-runup", SETTINGS)           # shared with test_imported_runup (conftest)
+    on = scene_run("test-gearbox-runup", SETTINGS + ["runup.as_made=5"])     # and with test_as_made_totals
     for name in ("runup.csv", "runup_harmonics.csv", "checks.csv", "spectra_500rpm.csv"):
         assert (off / name).read_bytes() == (on / name).read_bytes(), name
     assert not (off / am.CSV).exists()

@@ -100,14 +100,11 @@ def _read(path):
 
 
 @pytest.fixture(scope="module")
-def runs(tmp_path_factory):
-    """The coarse run-up with runup.as_made = 5, without and with runup.as_made_totals."""
-    from housingfe.runup.scene import run_scene
-
-    tmp = tmp_path_factory.mktemp("totals")
+def runs(scene_run):
+    """The coarse run-up with runup.as_made = 5, without (the run test_as_made makes too: one run, conftest) and with
+    runup.as_made_totals."""
     made = SETTINGS + ["runup.as_made=5"]
-    return (run_scene("test-gearbox-runup", str(tmp / "apart"), made),
-            run_scene("test-gearbox-runup", str(tmp / "totals"), made + ["runup.as_made_totals=true"]))
+    return scene_run("test-gearbox-runup", made), scene_run("test-gearbox-runup", made + ["runup.as_made_totals=true"])
 
 
 def test_totals_equal_the_as_made_columns_of_the_separate_file(runs):

@@ -32,12 +32,12 @@ def _result(folder):
     return facts, lwa
 
 
-def test_the_run_up_on_the_step_round_trip_equals_the_built_in_one(tmp_path):
+def test_the_run_up_on_the_step_round_trip_equals_the_built_in_one(tmp_path, scene_run):
     from housingfe.runup.scene import run_scene
 
     scene = write_imported_gearbox(tmp_path / "step")
     imported, lwa_imported = _result(run_scene(str(scene), str(tmp_path / "imported")))
-    built_in, lwa_built_in = _result(run_scene("test-gearbox-runup", str(tmp_path / "built-in"), SETTINGS))
+    built_in, lwa_built_in = _result(scene_run("test-gearbox-runup", SETTINGS))     # test_as_made's "off" run too
 
     assert [b["surface"] for b in imported["bores"]] == ["bore_A_front", "bore_A_back", "bore_B_front", "bore_B_back"]
     assert [b["surface"] for b in built_in["bores"]] == ["bore_pinion_front", "bore_pinion_back",
