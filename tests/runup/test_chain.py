@@ -134,6 +134,22 @@ def test_shuttle_load_ritz_matches_a_direct_solve(coarse):
     assert np.max(moment_only) > np.max(ours) - 20.0          # the moment is not negligible here
 
 
+# `housingfe run test-gearbox-runup` coarse (60 mm mesh, lines to 1.5 kHz, 1000-1500 rev/min), with the mesh moment
+# set explicitly to what it is by default (the face-width engagement's "shuttling")
+COARSE_CLI = ["run", "test-gearbox-runup", "--set", 'housing.set=["mesh.size=0.06"]', "--set",
+              "runup.f_max_hz=1500.0", "--set", "runup.speed_min_rpm=1000.0", "--set", "runup.speed_step_rpm=250.0"]
+SHUTTLING = ["--set", 'runup.mesh_moment="shuttling"']
+
+
+@pytest.fixture(scope="module")
+def coarse_cli_shuttling(tmp_path_factory):
+    """(CompletedProcess, output folder) of COARSE_CLI + SHUTTLING on one rank, run once for the module: the ranks
+    test compares it with two ranks, the mesh-moment test with mesh_moment = "none" and with friction (the same
+    deterministic run both made before)."""
+    folder = tmp_path_factory.mktemp("coarse_cli") / "shuttling"
+    return housingfe(*COARSE_CLI, *SHUTTLING, "--out", str(folder)), folder
+
+
 def _rows(path):
     with open(path) as fh:
         return list(csv.DictReader(fh))
@@ -141,16 +157,14 @@ def _rows(path):
 
 @pytest.mark.slow
 @pytest.mark.mpi
-def test_one_and_two_ranks_agree(tmp_path):
+def test_one_and_two_ranks_agree(tmp_path, coarse_cli_shuttling):
     if not shutil.which("mpirun"):
         pytest.skip("mpirun not installed")
-    args = ["run", "test-gearbox-runup", "--set", 'housing.set=["mesh.size=0.06"]', "--set",
-            "runup.f_max_hz=1500.0", "--set", "runup.speed_min_rpm=1000.0", "--set", "runup.speed_step_rpm=250.0"]
-    one = housingfe(*args, "--out", str(tmp_path / "one"))
+    one, one_dir = coarse_cli_shuttling        # the one-rank run test_cli_mesh_moment_changes_mesh_force_only reads
     assert one.returncode == 0, one.stderr
-    two = housingfe(*args, "--out", str(tmp_path / "two"), mpi_ranks=2)
+    two = housingfe(*COARSE_CLI, *SHUTTLING, "--out", str(tmp_path / "two"), mpi_ranks=2)
     assert two.returncode == 0, two.stderr
-    a, b = _rows(tmp_path / "one/runup.csv"), _rows(tmp_path / "two/runup.csv")
+    a, b = _rows(one_dir / "runup.csv"), _rows(tmp_path / "two/runup.csv")
     assert len(a) == len(b) == 2 * 2 * 3
     # progress (housingfe.progress): housing model, coupled model, the run-up at the one torque; rank 0 alone
     for proc in (one, two):
@@ -162,7 +176,7 @@ def test_one_and_two_ranks_agree(tmp_path):
         for key in ("Lv_dB", "LwA_dB", "L_omega_dB"):
             assert float(ra[key]) == pytest.approx(float(rb[key]), abs=1e-6)
     # the run-up with the envelope bound on the same models (set A's overlap note): the same on both, printed once
-    a, b = _rows(tmp_path / "one/runup_envelope_bound.csv"), _rows(tmp_path / "two/runup_envelope_bound.csv")
+    a, b = _rows(one_dir / "runup_envelope_bound.csv"), _rows(tmp_path / "two/runup_envelope_bound.csv")
     assert len(a) == len(b) == 2 * 2 * 3
     for ra, rb in zip(a, b):
         for key in ("Lv_dB", "LwA_dB", "L_omega_dB", "L_omega_coupled_dB"):
@@ -216,27 +230,30 @@ def test_reanalysis_by_the_change_of_the_matrices_equals_a_full_projection(coars
 
 
 @pytest.mark.slow
-def test_cli_mesh_moment_changes_mesh_force_only(tmp_path):
+def test_cli_mesh_moment_changes_mesh_force_only(tmp_path, coarse_cli_shuttling):
     """`housingfe run test-gearbox-runup --set runup.mesh_moment=...` as a user runs it (coarse): the shuttling moment
     raises the mesh_force route's tooth line, leaves tf_omega exactly as it was, and the result says it is on."""
     import json
 
-    args = ["run", "test-gearbox-runup", "--set", 'housing.set=["mesh.size=0.06"]', "--set",
-            "runup.f_max_hz=1500.0", "--set", "runup.speed_min_rpm=1000.0", "--set", "runup.speed_step_rpm=250.0"]
+    args = COARSE_CLI
     out = {}
     for moment in ("none", "shuttling"):
-        proc = housingfe(*args, "--set", f'runup.mesh_moment="{moment}"', "--out", str(tmp_path / moment))
+        if moment == "shuttling":       # the one-rank run test_one_and_two_ranks_agree compares with two ranks
+            proc, folder = coarse_cli_shuttling
+        else:
+            folder = tmp_path / moment
+            proc = housingfe(*args, "--set", f'runup.mesh_moment="{moment}"', "--out", str(folder))
         assert proc.returncode == 0, proc.stderr
         assert ("mesh moment: the shuttling moment" in proc.stdout) == (moment == "shuttling")
-        assert json.loads((tmp_path / moment / "runup.json").read_text())["mesh_moment"] == moment
-        out[moment] = _rows(tmp_path / moment / "runup.csv")
+        assert json.loads((folder / "runup.json").read_text())["mesh_moment"] == moment
+        out[moment] = _rows(folder / "runup.csv")
     for ra, rb in zip(out["none"], out["shuttling"]):
         if ra["route"] == "tf_omega":
             assert ra["Lv_dB"] == rb["Lv_dB"]
     tooth = [(float(ra["Lv_tooth_dB"]), float(rb["Lv_tooth_dB"])) for ra, rb in zip(out["none"], out["shuttling"])
              if ra["route"] == "mesh_force"]
     assert max(b - a for a, b in tooth) > 3.0          # set A: the moment is not a small correction
-    assert json.loads((tmp_path / "shuttling" / "runup.json").read_text())["mesh_friction"] == {
+    assert json.loads((coarse_cli_shuttling[1] / "runup.json").read_text())["mesh_friction"] == {
         "setting": "none", "applied": False, "mu": {}}
     # the sliding friction on top (runup.mesh_friction = 0.06): said and recorded; tf_omega moves only by the four
     # static vectors the Ritz space gains; mesh_force's total moves by up to a few dB (set A: about +-1 dB)
