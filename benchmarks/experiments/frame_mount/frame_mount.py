@@ -22,8 +22,9 @@ Usage (from the worktree, PYTHONPATH=$PWD):
   python benchmarks/experiments/frame_mount/frame_mount.py modes --mesh coarse
   python benchmarks/experiments/frame_mount/frame_mount.py bearings --kv fixed 1e9 3e8   # study bearings (set B)
   python benchmarks/experiments/frame_mount/frame_mount.py radiation --kv fixed 1e9 3e8  # numerical sigma beside
+  python benchmarks/experiments/frame_mount/frame_mount.py families --kv fixed 1e9 3e8   # profile corrections, double helical
   python benchmarks/experiments/frame_mount/frame_mount.py plot --mesh default   # the PNGs from what was run
-Run folders: /tmp/frame-mount-runs/<mesh>_<case>/ (the CLI's output, kept for inspection).
+Run folders: /tmp/frame-mount-runs/<mesh>_<case>/ (the CLI's output, kept for inspection; FRAME_MOUNT_RUNS moves them).
 """
 from __future__ import annotations
 
@@ -139,6 +140,54 @@ def study_rows(case: str, wall: float | None = None) -> list[dict]:
         rows.append({"mesh": "default", "K_v_N_per_m": case, "route": k["route"], "variant": f"ranking: {k['measure']}",
                      "ranking": f"{k['ours']} (measured {k['measured']}; quietest {k['quietest']}, loudest "
                                 f"{k['loudest']})"})
+    return rows
+
+
+FAMILIES = ("profile-corrections", "double-helical")
+
+
+def run_family(family: str, case: str) -> float:
+    """`housingfe study <family>` (default mesh, the family's own variants and scene) with the case's housing
+    overrides into RUNS/study_<family>_<case>/; wall time (s)."""
+    out = RUNS / f"study_{family}_{case}"
+    cmd = [sys.executable, "-m", "housingfe", "study", family, "--out", str(out),
+           "--set", f"housing.set={json.dumps(housing_sets(case, 'default'))}"]
+    print(" ".join(cmd), flush=True)
+    t0 = time.perf_counter()
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    (RUNS / f"study_{family}_{case}.log").write_text(res.stdout + res.stderr)
+    if res.returncode:
+        raise SystemExit(f"study {family} {case}: exit {res.returncode}\n{res.stderr[-2000:]}")
+    (out / "wall_s.txt").write_text(f"{wall:.1f}\n")
+    return wall
+
+
+def family_rows(family: str, case: str) -> list[dict]:
+    """A family study's result on a case: its variant rows (sigma = 1: Delta mean +- s.d. to the reference over
+    800-1500 rpm, max L_WA), its torque laws (kind torque_law) and the issue-28 check rows validate makes of it
+    (housingfe.verification.study_rows.study_rows, the same function: 28.variants.mean.<family>.*,
+    28.variants.correction_d.*, 28.variants.ranking.rollers_vs_fluid_films.*, 28.variants.torque_law.*)."""
+    from housingfe.verification import checks as ck
+    from housingfe.verification import study_rows as sr
+
+    f = RUNS / f"study_{family}_{case}"
+    data = json.loads((f / "study.json").read_text())
+    wall = (f / "wall_s.txt").read_text().strip() if (f / "wall_s.txt").is_file() else ""
+    base = {"mesh": "default", "K_v_N_per_m": case, "family": family}
+    rows = [{**base, "kind": "variant", "id": f"{r['variant']}.{r['route']}", "ours": r["mean_diff_dB"],
+             "sd": r["sd_diff_dB"], "measured": r["measured_mean_dB"], "passed": "",
+             "LwA_max_dBA": r["LwA_max_dBA"], "at_rpm": r["at_rpm"], "measured_max_dBA": r["measured_max_dBA"],
+             "why": "", "wall_s": wall}
+            for r in data["rows"] if r["radiation"] == data["radiation"]]
+    rows += [{**base, "kind": "torque_law", "id": f"{t['bearings']}.{t['route']}.step_{t['from_nm']:g}_to_"
+              f"{t['to_nm']:g}", "ours": t["step_mean_dB"], "sd": t["step_sd_dB"], "measured": t["measured_step_dBA"],
+              "passed": "", "why": f"slope {t['slope_dB_per_doubling']:+.2f} dB(A) per doubling over "
+              f"{t['torques_nm']} N m; at 1500 rpm {t['step_at_1500rpm_dB']:+.2f}", "wall_s": wall}
+             for t in data.get("torque_law", [])]
+    rows += [{**base, "kind": "check", "id": r["check_id"], "ours": r["ours"], "sd": "", "measured": r.get("measured"),
+              "passed": r.get("passed"), "why": r.get("why", ""), "wall_s": wall}
+             for r in ck.check_rows(sr.study_rows(data))]
     return rows
 
 
@@ -439,9 +488,10 @@ def table(mesh: str) -> str:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=("runs", "modes", "bearings", "radiation", "plot"))
+    ap.add_argument("what", choices=("runs", "modes", "bearings", "families", "radiation", "plot"))
     ap.add_argument("--mesh", choices=tuple(MESHES), default="coarse")
     ap.add_argument("--kv", nargs="*", default=list(KV_RANGE), help="K_v in N/m, or 'fixed'")
+    ap.add_argument("--family", nargs="*", choices=FAMILIES, default=list(FAMILIES), help="families (families only)")
     args = ap.parse_args()
     RUNS.mkdir(parents=True, exist_ok=True)
     if args.what == "runs":
@@ -469,6 +519,13 @@ def main() -> None:
             done = (RUNS / f"study_bearings_{case}" / "study.json").is_file()
             rows = study_rows(case) if done else run_bearings(case)
             write_csv(HERE / "frame_mount_bearings.csv", rows)
+    elif args.what == "families":       # default mesh; one study at a time (the folders are reused if there)
+        for family in args.family:
+            for case in args.kv:
+                if not (RUNS / f"study_{family}_{case}" / "study.json").is_file():
+                    run_family(family, case)
+                write_csv(HERE / "frame_mount_families.csv", family_rows(family, case),
+                          key=("mesh", "K_v_N_per_m", "family"))
     else:
         plot(args.mesh, list(KV_RANGE))
         plot_trends(args.mesh)
