@@ -186,7 +186,8 @@ def family_rows(family: str, case: str) -> list[dict]:
               f"{t['torques_nm']} N m; at 1500 rpm {t['step_at_1500rpm_dB']:+.2f}", "wall_s": wall}
              for t in data.get("torque_law", [])]
     rows += [{**base, "kind": "check", "id": r["check_id"], "ours": r["ours"], "sd": "", "measured": r.get("measured"),
-              "passed": r.get("passed"), "why": r.get("why", ""), "wall_s": wall}
+              "passed": r.get("passed"), "why": r.get("why", ""), "wall_s": wall,
+              "thesis_calculated": r.get("thesis_calculated")}
              for r in ck.check_rows(sr.study_rows(data))]
     return rows
 
@@ -486,6 +487,50 @@ def table(mesh: str) -> str:
     return "\n".join(lines) + "\n"
 
 
+def families_table() -> str:
+    """frame_mount_families.csv as markdown: Delta mean over 800-1500 rpm (tf_omega / mesh_force), the torque laws
+    (1000 -> 2000 N m), maxima and the issue-28 check rows passed, per case (fixed first)."""
+    rows = _read(HERE / "frame_mount_families.csv", "default")
+    cases = [c for c in ("fixed", "1e9", "3e8") if any(r["K_v_N_per_m"] == c for r in rows)]
+
+    def get(case, kind, ident, col="ours"):
+        r = next((x for x in rows if x["K_v_N_per_m"] == case and x["kind"] == kind and x["id"] == ident), None)
+        return None if r is None or r[col] in ("", None) else r[col]
+
+    def pair(case, kind, stem, col="ours", fmt="{:+.1f}"):
+        vals = [get(case, kind, f"{stem}.{route}", col) for route in ("tf_omega", "mesh_force")]
+        return " / ".join("–" if v is None else fmt.format(float(v)) for v in vals)
+
+    lines = ["| tf_omega / mesh_force | " + " | ".join("fixed" if c == "fixed" else f"K_v {c}" for c in cases)
+             + " | measured |", "|" + "---|" * (len(cases) + 2)]
+    for v, meas in (("B", "−0.9"), ("C", "+0.4"), ("D", "−0.3"), ("uncorrected", "– (calc. +3.5)")):
+        lines.append(f"| {v} − A, Δ mean dB | " + " | ".join(pair(c, "variant", v) for c in cases) + f" | {meas} |")
+    lines.append("| correction D: \\|ours − measured\\| dB (thesis' miss 4.8) | "
+                 + " | ".join(pair(c, "check", "28.variants.correction_d", fmt="{:.1f}") for c in cases) + " | < 4.8 |")
+    lines.append("| fluid films − rollers (2000 N m), Δ mean dB | "
+                 + " | ".join(pair(c, "variant", "fluid_film@2000") for c in cases) + " | −1.9 ± 3.0 |")
+    def law(case, bearings):
+        vals = [next((r["ours"] for r in rows if r["K_v_N_per_m"] == case and r["kind"] == "torque_law"
+                      and r["id"].startswith(f"{bearings}.{route}.")), None) for route in ("tf_omega", "mesh_force")]
+        return " / ".join("–" if v is None else f"{float(v):+.1f}" for v in vals)
+
+    for b, meas in (("cylindrical_roller", "+3.4"), ("fluid_film", "+2.7")):
+        lines.append(f"| torque law {b} 1000 → 2000 N m, dB(A) | " + " | ".join(law(c, b) for c in cases)
+                     + f" | {meas} |")
+    for v, label, meas in (("A", "max L_WA set A", "100.5"), ("cylindrical_roller@2000", "max L_WA rollers 2000 N m",
+                                                                "91.0"),
+                           ("fluid_film@2000", "max L_WA fluid films 2000 N m", "87.7")):
+        lines.append(f"| {label}, dB(A) | " + " | ".join(pair(c, "variant", v, "LwA_max_dBA", "{:.1f}") for c in cases)
+                     + f" | {meas} |")
+    for fam in FAMILIES:
+        cells = []
+        for c in cases:
+            chk = [r for r in rows if r["K_v_N_per_m"] == c and r["family"] == fam and r["kind"] == "check"]
+            cells.append(f"{sum(r['passed'] in ('True', 'yes', '1') for r in chk)} of {len(chk)}" if chk else "–")
+        lines.append(f"| {fam}: issue-28 check rows passed | " + " | ".join(cells) + " | |")
+    return "\n".join(lines) + "\n"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("what", choices=("runs", "modes", "bearings", "families", "radiation", "plot"))
@@ -526,6 +571,7 @@ def main() -> None:
                     run_family(family, case)
                 write_csv(HERE / "frame_mount_families.csv", family_rows(family, case),
                           key=("mesh", "K_v_N_per_m", "family"))
+        (HERE / "frame_mount_table_families.md").write_text(families_table())
     else:
         plot(args.mesh, list(KV_RANGE))
         plot_trends(args.mesh)
