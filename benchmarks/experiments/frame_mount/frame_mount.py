@@ -183,7 +183,8 @@ def family_rows(family: str, case: str) -> list[dict]:
     rows += [{**base, "kind": "torque_law", "id": f"{t['bearings']}.{t['route']}.step_{t['from_nm']:g}_to_"
               f"{t['to_nm']:g}", "ours": t["step_mean_dB"], "sd": t["step_sd_dB"], "measured": t["measured_step_dBA"],
               "passed": "", "why": f"slope {t['slope_dB_per_doubling']:+.2f} dB(A) per doubling over "
-              f"{t['torques_nm']} N m; at 1500 rpm {t['step_at_1500rpm_dB']:+.2f}", "wall_s": wall}
+              f"{t['torques_nm']} N m; at 1500 rpm {t['step_at_1500rpm_dB']:+.2f}", "wall_s": wall,
+              "slope_dB_per_doubling": round(t["slope_dB_per_doubling"], 2)}
              for t in data.get("torque_law", [])]
     rows += [{**base, "kind": "check", "id": r["check_id"], "ours": r["ours"], "sd": "", "measured": r.get("measured"),
               "passed": r.get("passed"), "why": r.get("why", ""), "wall_s": wall,
@@ -499,7 +500,7 @@ def families_table() -> str:
 
     def pair(case, kind, stem, col="ours", fmt="{:+.1f}"):
         vals = [get(case, kind, f"{stem}.{route}", col) for route in ("tf_omega", "mesh_force")]
-        return " / ".join("–" if v is None else fmt.format(float(v)) for v in vals)
+        return " / ".join("–" if v is None else fmt.format(float(v)).replace("-", "−") for v in vals)
 
     lines = ["| tf_omega / mesh_force | " + " | ".join("fixed" if c == "fixed" else f"K_v {c}" for c in cases)
              + " | measured |", "|" + "---|" * (len(cases) + 2)]
@@ -509,14 +510,25 @@ def families_table() -> str:
                  + " | ".join(pair(c, "check", "28.variants.correction_d", fmt="{:.1f}") for c in cases) + " | < 4.8 |")
     lines.append("| fluid films − rollers (2000 N m), Δ mean dB | "
                  + " | ".join(pair(c, "variant", "fluid_film@2000") for c in cases) + " | −1.9 ± 3.0 |")
-    def law(case, bearings):
-        vals = [next((r["ours"] for r in rows if r["K_v_N_per_m"] == case and r["kind"] == "torque_law"
+    def ranked(case, measure):
+        vals = [get(case, "check", f"28.variants.ranking.rollers_vs_fluid_films.{measure}.{route}", "passed")
+                for route in ("tf_omega", "mesh_force")]
+        return " / ".join("–" if v is None else "y" if v == "yes" else "n" for v in vals)
+
+    lines.append("| fluid films quieter than rollers (ranking check): by mean; by max | " + " | ".join(
+        f"{ranked(c, 'mean')}; {ranked(c, 'max')}" for c in cases) + " | y / y; y / y |")
+
+    def law(case, bearings, col="ours"):
+        vals = [next((r.get(col) or None for r in rows if r["K_v_N_per_m"] == case and r["kind"] == "torque_law"
                       and r["id"].startswith(f"{bearings}.{route}.")), None) for route in ("tf_omega", "mesh_force")]
-        return " / ".join("–" if v is None else f"{float(v):+.1f}" for v in vals)
+        return " / ".join("–" if v is None else f"{float(v):+.1f}".replace("-", "−") for v in vals)
 
     for b, meas in (("cylindrical_roller", "+3.4"), ("fluid_film", "+2.7")):
         lines.append(f"| torque law {b} 1000 → 2000 N m, dB(A) | " + " | ".join(law(c, b) for c in cases)
                      + f" | {meas} |")
+    for b in ("cylindrical_roller", "fluid_film"):
+        lines.append(f"| {b}: slope over 500–2000 N m, dB(A) per doubling | "
+                     + " | ".join(law(c, b, "slope_dB_per_doubling") for c in cases) + " | ≈ +3 |")
     for v, label, meas in (("A", "max L_WA set A", "100.5"), ("cylindrical_roller@2000", "max L_WA rollers 2000 N m",
                                                                 "91.0"),
                            ("fluid_film@2000", "max L_WA fluid films 2000 N m", "87.7")):
