@@ -73,13 +73,19 @@ def run_case(case: str, mesh: str) -> float:
     cmd = [sys.executable, "-m", "housingfe", "run", "test-gearbox-runup", "--out", str(out)]
     for s in runup_overrides(case, mesh):
         cmd += ["--set", s]
+    return timed_run(cmd, out, RUNS / f"{mesh}_{case}.log", f"{case}/{mesh}")
+
+
+def timed_run(cmd: list, out: Path, log: Path, label: str) -> float:
+    """Run `cmd` (a housingfe command writing `out`), keep its output in `log`, stop on failure; wall time (s),
+    also written to out/wall_s.txt."""
     print(" ".join(cmd), flush=True)
     t0 = time.perf_counter()
     res = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.perf_counter() - t0
-    (RUNS / f"{mesh}_{case}.log").write_text(res.stdout + res.stderr)
+    log.write_text(res.stdout + res.stderr)
     if res.returncode:
-        raise SystemExit(f"{case}/{mesh}: exit {res.returncode}\n{res.stderr[-2000:]}")
+        raise SystemExit(f"{label}: exit {res.returncode}\n{res.stderr[-2000:]}")
     (out / "wall_s.txt").write_text(f"{wall:.1f}\n")
     return wall
 
@@ -152,15 +158,7 @@ def run_family(family: str, case: str) -> float:
     out = RUNS / f"study_{family}_{case}"
     cmd = [sys.executable, "-m", "housingfe", "study", family, "--out", str(out),
            "--set", f"housing.set={json.dumps(housing_sets(case, 'default'))}"]
-    print(" ".join(cmd), flush=True)
-    t0 = time.perf_counter()
-    res = subprocess.run(cmd, capture_output=True, text=True)
-    wall = time.perf_counter() - t0
-    (RUNS / f"study_{family}_{case}.log").write_text(res.stdout + res.stderr)
-    if res.returncode:
-        raise SystemExit(f"study {family} {case}: exit {res.returncode}\n{res.stderr[-2000:]}")
-    (out / "wall_s.txt").write_text(f"{wall:.1f}\n")
-    return wall
+    return timed_run(cmd, out, RUNS / f"study_{family}_{case}.log", f"study {family} {case}")
 
 
 def family_rows(family: str, case: str) -> list[dict]:
