@@ -1,0 +1,451 @@
+"""Why the double helical set's fluid films lose their advantage over cylindrical rollers on an elastic frame.
+
+docs/design-variants.md / benchmarks/experiments/frame_mount (section d): fluid films - rollers (2000 N m, mean
+L_WA over 800-1500 rpm, sigma = 1, tf_omega / mesh_force) is -5.1 / -1.4 dB on the fixed feet and -0.6 / +1.4 dB
+on K_v = 1e9 N/m.  This experiment changes ONE thing per run to find which mechanism does it:
+
+  * bearings: cylindrical_roller or fluid_film (the real `housingfe run test-gearbox-runup-double-helical`);
+  * mount: fixed feet or K_v (the frame_mount `housing.set`, frame_mount.housing_sets);
+  * film damping scale c (films only): the films' 6x6 C multiplied by c (0: no film damping; 1: as computed).
+    No scene key does this, so the run goes through `housingfe.cli.main` in a process whose
+    housingfe.bearings.configurations._fluid_film_result is wrapped to scale C (and only C).  An experiment-only
+    control: nothing in the package changes;
+  * film stiffness: "films" (as computed), "sym" (K made symmetric, (K + K^T)/2: the thesis' own simplification),
+    or "roller" is not offered (the films' C on the rollers' K is not a bearing);
+  * radiation: sigma = 1 (the checks') or the numerical sigma beside it.
+
+Usage (PYTHONPATH=$PWD, from the worktree):
+  python benchmarks/experiments/film_mount/film_mount.py run --case fixed --bearings fluid_film --c-scale 0
+  python benchmarks/experiments/film_mount/film_mount.py table        # film_mount.csv from the run folders
+  python benchmarks/experiments/film_mount/film_mount.py plot
+Run folders: /tmp/film-mount-runs/<label>/ (FILM_MOUNT_RUNS moves them).
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent / "frame_mount"))
+import frame_mount as fm  # noqa: E402  (housing_sets: the mount's overrides, one definition)
+
+RUNS = Path(os.environ.get("FILM_MOUNT_RUNS", "/tmp/film-mount-runs"))
+SCENE = "test-gearbox-runup-double-helical"
+MEAN_RPM = (800.0, 1500.0)
+
+
+def label(case, bearings, mesh, c_scale=1.0, k_mode="films", radiation="erp", moment="shuttling") -> str:
+    s = f"{mesh}_{case}_{bearings}"
+    if bearings == "fluid_film":
+        s += f"_c{c_scale:g}" + ("" if k_mode == "films" else f"_{k_mode}")
+    s += "" if moment == "shuttling" else f"_moment-{moment}"
+    return s + ("" if radiation == "erp" else f"_{radiation}")
+
+
+def patch(c_scale: float, k_mode: str) -> None:
+    """Wrap the fluid-film position result: C -> c_scale C, K -> (K + K^T)/2 with k_mode "sym"."""
+    from housingfe.bearings import configurations as cfg
+
+    original = cfg._fluid_film_result
+
+    def scaled(*args, **kwargs):
+        res = original(*args, **kwargs)
+        res.C = c_scale * res.C
+        if k_mode == "sym":
+            res.K = 0.5 * (res.K + res.K.T)
+        return res
+
+    cfg._fluid_film_result = scaled
+
+
+def child(argv) -> int:
+    """In the run's own process: patch, then `housingfe` with the given arguments."""
+    c_scale, k_mode = float(argv[0]), argv[1]
+    if c_scale != 1.0 or k_mode != "films":
+        patch(c_scale, k_mode)
+    from housingfe.cli import main
+
+    return main(argv[2:])
+
+
+def run(case, bearings, mesh, c_scale=1.0, k_mode="films", radiation="erp", moment="shuttling",
+        speed_min=800.0) -> Path:
+    out = RUNS / label(case, bearings, mesh, c_scale, k_mode, radiation, moment)
+    args = ["run", SCENE, "--out", str(out), "--set", f"drivetrain.bearings={bearings}",
+            "--set", "runup.torques_nm=[2000.0]", "--set", f"runup.speed_min_rpm={speed_min}"]
+    for s in fm.runup_overrides(case, mesh):
+        args += ["--set", s]
+    if moment != "shuttling":
+        args += ["--set", f'runup.mesh_moment="{moment}"']
+    if radiation == "numerical":
+        args += ["--set", 'radiation.models=["erp","foller","numerical"]']
+    cmd = [sys.executable, str(Path(__file__).resolve()), "_child", str(c_scale), k_mode] + args
+    RUNS.mkdir(parents=True, exist_ok=True)
+    fm.timed_run(cmd, out, RUNS / f"{out.name}.log", out.name)
+    return out
+
+
+# ------------------------------------------------------------------------------------------------ reading
+def curve(folder: Path, route: str, col: str = "LwA_dB", radiation: str = "erp") -> dict:
+    """{speed rpm: value} of runup.csv's column for a route and radiation model."""
+    with open(folder / "runup.csv") as fh:
+        return {float(r["speed_rpm"]): float(r[col]) for r in csv.DictReader(fh)
+                if r["route"] == route and r["radiation"] == radiation and r[col] != ""}
+
+
+def diff_stats(a: dict, b: dict) -> tuple[float, float]:
+    """Mean and s.d. over MEAN_RPM of b - a speed by speed (dB), the thesis' (and the study's) measure."""
+    s = [k for k in sorted(a) if MEAN_RPM[0] <= k <= MEAN_RPM[1]]
+    d = np.array([b[k] - a[k] for k in s])
+    return float(d.mean()), float(d.std())
+
+
+def harmonics(folder: Path, route: str, col: str, radiation: str = "erp") -> dict:
+    """{(speed, harmonic): value} of runup_harmonics.csv."""
+    with open(folder / "runup_harmonics.csv") as fh:
+        return {(float(r["speed_rpm"]), int(r["harmonic"])): float(r[col]) for r in csv.DictReader(fh)
+                if r["route"] == route and r["radiation"] == radiation and r[col] != ""}
+
+
+def parse(name: str) -> dict:
+    """The run's settings from its folder name (label)."""
+    parts = name.split("_")
+    out = {"mesh": parts[0], "case": parts[1], "c_scale": "", "k_mode": "", "moment": "shuttling",
+           "radiation": "erp"}
+    rest = "_".join(parts[2:])
+    out["bearings"] = "fluid_film" if rest.startswith("fluid_film") else "cylindrical_roller"
+    tail = rest[len(out["bearings"]):].strip("_").split("_") if rest[len(out["bearings"]):] else []
+    for t in tail:
+        if t.startswith("c") and out["bearings"] == "fluid_film":
+            out["c_scale"] = float(t[1:])
+        elif t == "sym":
+            out["k_mode"] = "sym"
+        elif t.startswith("moment-"):
+            out["moment"] = t[len("moment-"):]
+        elif t == "numerical":
+            out["radiation"] = "numerical"
+    if out["bearings"] == "fluid_film" and not out["k_mode"]:
+        out["k_mode"] = "films"
+    return out
+
+
+def reference_of(name: str) -> str:
+    """The rollers' run on the same mesh, mount, mesh moment and radiation setting."""
+    p = parse(name)
+    return label(p["case"], "cylindrical_roller", p["mesh"], moment=p["moment"], radiation=p["radiation"])
+
+
+def table_rows() -> list[dict]:
+    """Per run and route: fluid films (or rollers) - rollers of the same setting, mean +- s.d. over 800-1500 rpm
+    of L_WA and, split, of the route's source line level and of L_v (the transfer's share), max L_WA."""
+    rows = []
+    for f in sorted(p for p in RUNS.iterdir() if p.is_dir() and (p / "runup.csv").is_file()):
+        p = parse(f.name)
+        ref = RUNS / reference_of(f.name)
+        if not (ref / "runup.csv").is_file():
+            continue
+        wall = (f / "wall_s.txt").read_text().strip() if (f / "wall_s.txt").is_file() else ""
+        rads = [p["radiation"]] if p["radiation"] == "erp" else ["erp", "numerical"]
+        for rad in rads:
+            for route in ("tf_omega", "mesh_force"):
+                a, b = curve(ref, route, radiation=rad), curve(f, route, radiation=rad)
+                m, sd = diff_stats(a, b)
+                src = "L_omega_dB" if route == "tf_omega" else "L_omega_coupled_dB"
+                ms, _ = diff_stats(curve(ref, route, src, rad), curve(f, route, src, rad))
+                mv, _ = diff_stats(curve(ref, route, "Lv_dB", rad), curve(f, route, "Lv_dB", rad))
+                kmax = max(b, key=b.get)
+                rows.append({"run": f.name, **p, "sigma": rad, "route": route, "reference": ref.name,
+                             "dLwA_mean_dB": round(m, 2), "dLwA_sd_dB": round(sd, 2),
+                             "dL_omega_mean_dB": round(ms, 2), "dLv_mean_dB": round(mv, 2),
+                             "LwA_max_dBA": round(b[kmax], 1), "at_rpm": kmax,
+                             "ref_LwA_max_dBA": round(max(a.values()), 1), "wall_s": wall})
+    return rows
+
+
+def energy_db(values) -> float:
+    return float(10 * np.log10(np.sum(10 ** (np.asarray(list(values)) / 10))))
+
+
+def harmonic_rows(n_max: int = 6) -> list[dict]:
+    """Per run, route and harmonic n: the L_WA of line n summed (energy) over the run-up speeds 800-1500 rpm, the
+    reference's (rollers of the same setting), and the share of the run's total L_WA energy that line carries:
+    which lines make the mean, and which the films change."""
+    rows = []
+    for f in sorted(p for p in RUNS.iterdir() if p.is_dir() and (p / "runup_harmonics.csv").is_file()):
+        p = parse(f.name)
+        ref = RUNS / reference_of(f.name)
+        if p["radiation"] != "erp" or not (ref / "runup_harmonics.csv").is_file():
+            continue
+        for route in ("tf_omega", "mesh_force"):
+            a, b = harmonics(ref, route, "LwA_dB"), harmonics(f, route, "LwA_dB")
+            sel = lambda h, n: [v for (k, m), v in h.items() if m == n and MEAN_RPM[0] <= k <= MEAN_RPM[1]]  # noqa: E731
+            tot_a = energy_db(v for (k, _), v in a.items() if MEAN_RPM[0] <= k <= MEAN_RPM[1])
+            tot_b = energy_db(v for (k, _), v in b.items() if MEAN_RPM[0] <= k <= MEAN_RPM[1])
+            for n in range(1, n_max + 1):
+                if not sel(a, n):
+                    continue
+                la, lb = energy_db(sel(a, n)), energy_db(sel(b, n))
+                rows.append({"run": f.name, **p, "route": route, "harmonic": n, "LwA_energy_ref_dB": round(la, 2),
+                             "LwA_energy_dB": round(lb, 2), "delta_dB": round(lb - la, 2),
+                             "share_ref": round(10 ** ((la - tot_a) / 10), 3),
+                             "share": round(10 ** ((lb - tot_b) / 10), 3)})
+    return rows
+
+
+def write_table() -> list[dict]:
+    rows = table_rows()
+    with open(HERE / "film_mount.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    hrows = harmonic_rows()
+    with open(HERE / "film_mount_harmonics.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(hrows[0]))
+        w.writeheader()
+        w.writerows(hrows)
+    for r in rows:
+        print(f"{r['run']:48s} {r['sigma']:9s} {r['route']:10s} d {r['dLwA_mean_dB']:+6.2f} +- {r['dLwA_sd_dB']:4.2f}"
+              f"  src {r['dL_omega_mean_dB']:+6.2f}  Lv {r['dLv_mean_dB']:+6.2f}  max {r['LwA_max_dBA']:5.1f}"
+              f" @{r['at_rpm']:g} (ref {r['ref_LwA_max_dBA']:5.1f})  {r['wall_s']} s")
+    return rows
+
+
+# ------------------------------------------------------------------------------------------------ modes
+def gearbox_model(case: str, bearings: str, mesh: str):
+    """The run-up's coupled gearbox model (2000 N m, bearings at drivetrain.bearing_speed_rpm = 1500 rpm), built as
+    `housingfe run` builds it (frame_mount.coupled_model on the double helical scene)."""
+    from mpi4py import MPI
+
+    from housingfe.runup.chain import build_gearbox_model
+    from housingfe.runup.scene import drivetrain_of, housing_model_for, load_runup_scene, matched_drivetrains
+    from housingfe.scene import load_housing_scene
+
+    over = fm.runup_overrides(case, mesh) + [f"drivetrain.bearings={bearings}", "runup.torques_nm=[2000.0]"]
+    scene, path = load_runup_scene(SCENE, over)
+    spec = scene.runup
+    hs, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
+    dts = {2000.0: drivetrain_of(scene.drivetrain, 2000.0, spec.drive_line_model)}
+    model = housing_model_for(hs, spec.f_max_hz, MPI.COMM_WORLD)
+    dts, _ = matched_drivetrains(scene.housing, model, dts, path)
+    return build_gearbox_model(model, dts[2000.0], spec.f_max_hz, damping_ratio=spec.damping_ratio,
+                               basis_factor=spec.basis_factor)
+
+
+def mode_rows(case: str, mesh: str, f_top: float = 1100.0) -> list[dict]:
+    """Per bearing configuration the coupled modes up to f_top (Hz): frequency, interior share of the kinetic
+    energy, share of the strain energy in the mount's springs (u^T K_f u / omega^2), and the damping ratio the
+    films' C alone gives the (undamped, symmetric-K) mode, zeta_film = phi^T C phi / (2 omega phi^T M phi): what
+    the films add to the modal 4 %."""
+    from housingfe.solvers import blocks
+    from housingfe.solvers.harmonic import project
+
+    rows = []
+    for bearings in ("cylindrical_roller", "fluid_film"):
+        gm = gearbox_model(case, bearings, mesh)
+        st, basis = gm.structure, gm.basis
+        n0 = basis.rigid_count
+        freqs = np.asarray(basis.frequencies_hz[n0:])
+        keep = int(np.sum(freqs <= f_top))
+        vecs = list(basis.vectors[n0:n0 + keep])
+        _, Mm, Cm = project(vecs, st.K, st.M, st.C) if st.C is not None else (None, project(vecs, st.K, st.M)[1],
+                                                                               None)
+        omega = 2 * np.pi * freqs[:keep]
+        zeta = np.zeros(keep) if Cm is None else np.diag(Cm) / (2 * omega * np.diag(Mm))
+        mount = np.zeros(keep)
+        if case != "fixed":
+            from dolfinx.fem.petsc import assemble_matrix
+
+            from housingfe.fe.model import foundation_forms
+
+            housing = st.model
+            (form,) = foundation_forms(housing.scene.supports, housing.housing, housing.V)
+            Kf = assemble_matrix(form)
+            Kf.assemble()
+            U = blocks.columns([st.fe_vector(q) for q in vecs])
+            mount = np.einsum("ij,ij->j", U, blocks.mat_block(Kf, U)) / (omega ** 2 * np.diag(Mm))
+        if bearings == "fluid_film":
+            rows += stability_rows(gm, case, mesh)
+        for i in range(keep):
+            share = float(gm.interior_share[i])
+            kind = "on the mount" if mount[i] >= 0.5 else "interior" if share >= 0.5 else "housing"
+            rows.append({"mesh": mesh, "case": case, "bearings": bearings, "index": i + 1,
+                         "frequency_hz": round(float(freqs[i]), 1), "type": kind,
+                         "interior_share": round(share, 3), "mount_energy_share": round(float(mount[i]), 3),
+                         "zeta_film": round(float(zeta[i]), 4)})
+    return rows
+
+
+def stability_rows(gm, case: str, mesh: str, f_top: float = 1100.0) -> list[dict]:
+    """The films' model at 1500 rpm on its Ritz space with the films' C scaled by 0 and 1 (and K as computed or
+    made symmetric), modal 4 % on top: the complex modes up to f_top, their damping ratio -Re(s)/|s|; a mode with
+    Re(s) > 0 is self-excited (oil whirl): a harmonic response of it has no physical meaning."""
+    sysr = gm.reduction.system
+    n = sysr.Kr.shape[0]
+    rows = []
+    for k_mode in ("films", "sym"):
+        K = sysr.Kr if k_mode == "films" else 0.5 * (sysr.Kr + sysr.Kr.T)
+        for c in (0.0, 1.0):
+            C = c * sysr.Cr + (sysr.D if sysr.D is not None else 0.0)
+            Minv = np.linalg.inv(sysr.Mr)
+            A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+            lam = np.linalg.eigvals(A)
+            lam = lam[(lam.imag > 0) & (lam.imag / (2 * np.pi) <= f_top)]
+            lam = lam[np.argsort(lam.imag)]
+            for i, s_ in enumerate(lam):
+                rows.append({"mesh": mesh, "case": case, "bearings": f"fluid_film c{c:g} {k_mode}",
+                             "index": i + 1, "frequency_hz": round(float(abs(s_)) / (2 * np.pi), 1),
+                             "type": "complex mode" + (" UNSTABLE" if s_.real > 0 else ""), "interior_share": "",
+                             "mount_energy_share": "", "zeta_film": round(float(-s_.real / abs(s_)), 4)})
+    return rows
+
+
+def write_modes(cases, mesh) -> None:
+    path = HERE / "film_mount_modes.csv"
+    old = []
+    if path.is_file():
+        with open(path) as fh:
+            old = [r for r in csv.DictReader(fh) if not (r["mesh"] == mesh and r["case"] in cases)]
+    rows = old + [r for c in cases for r in mode_rows(c, mesh)]
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[-1]))
+        w.writeheader()
+        w.writerows(rows)
+    for r in rows:
+        print(r)
+
+
+# ------------------------------------------------------------------------------------------------ plot
+DECOMPOSITION = (("stiffness: the films' K (made symmetric), no C", "c0_sym", None),
+                 ("film damping C (on the symmetric K)", "c1_sym", "c0_sym"),
+                 ("cross-coupled K (with C)", "c1", "c1_sym"))
+
+
+def decomposition(rows: list[dict], mesh: str, case: str, route: str) -> list[tuple[str, float]]:
+    """Fluid films - rollers split into the steps rollers -> the films' symmetric K without C -> with the films' C
+    -> the films as computed (non-symmetric K): (step, Delta mean dB) each, from film_mount.csv's rows (sigma = 1,
+    shuttling moment)."""
+    def d(tag):
+        if tag is None:
+            return 0.0
+        hit = [r for r in rows if r["run"] == f"{mesh}_{case}_fluid_film_{tag}" and r["route"] == route
+               and r["sigma"] == "erp"]
+        return float(hit[0]["dLwA_mean_dB"]) if hit else float("nan")
+    return [(lab, d(a) - d(b)) for lab, a, b in DECOMPOSITION]
+
+
+def plot(mesh: str = "default") -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    with open(HERE / "film_mount.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    with open(HERE / "film_mount_harmonics.csv") as fh:
+        hrows = list(csv.DictReader(fh))
+    fig, ax = plt.subplots(2, 2, figsize=(12, 8.5))
+    styles = {("fixed", "cylindrical_roller"): ("k", "-"), ("fixed", "fluid_film_c1"): ("k", "--"),
+              ("1e9", "cylindrical_roller"): ("tab:red", "-"), ("1e9", "fluid_film_c1"): ("tab:red", "--"),
+              ("fixed", "fluid_film_c0_sym"): ("k", ":"), ("1e9", "fluid_film_c0_sym"): ("tab:red", ":")}
+    for j, route in enumerate(("tf_omega", "mesh_force")):
+        a = ax[0, j]
+        for (case, b), (col, ls) in styles.items():
+            f = RUNS / f"{mesh}_{case}_{b}"
+            if not (f / "runup.csv").is_file():
+                continue
+            c = curve(f, route)
+            k = sorted(c)
+            name = {"cylindrical_roller": "rollers", "fluid_film_c1": "fluid films",
+                    "fluid_film_c0_sym": "fluid films without C (K symmetric)"}[b]
+            a.plot(k, [c[x] for x in k], color=col, ls=ls, label=f"{'fixed feet' if case == 'fixed' else 'K_v 1e9 N/m'}: {name}")
+        a.set_title(f"{route}: double helical, 2000 N m ({mesh} mesh, sigma = 1)", fontsize=10)
+        a.set_xlabel("pinion speed (rev/min)")
+        a.set_ylabel("L_WA (dB(A))")
+        a.grid(alpha=0.3)
+        a.legend(fontsize=7)
+    a = ax[1, 0]
+    width = 0.2
+    for i, (case, route, col) in enumerate((("fixed", "tf_omega", "0.4"), ("1e9", "tf_omega", "tab:red"),
+                                            ("fixed", "mesh_force", "0.75"), ("1e9", "mesh_force", "salmon"))):
+        hs = [r for r in hrows if r["run"] == f"{mesh}_{case}_fluid_film_c1" and r["route"] == route]
+        n = np.array([int(r["harmonic"]) for r in hs])
+        a.bar(n + (i - 1.5) * width, [float(r["delta_dB"]) for r in hs], width, color=col,
+              label=f"{route}, {'fixed' if case == 'fixed' else '1e9'}")
+        for x, r in zip(n, hs):
+            if float(r["share_ref"]) >= 0.2:
+                a.text(x + (i - 1.5) * width, 0.3 if float(r["delta_dB"]) < 0 else float(r["delta_dB"]) + 0.3,
+                       f"{float(r['share_ref']):.0%}", ha="center", fontsize=6, rotation=90)
+    a.axhline(0, color="k", lw=0.5)
+    a.set_xlabel("harmonic n of the tooth frequency (800-1500 rpm: n x 320-600 Hz)")
+    a.set_ylabel("films - rollers, line energy 800-1500 rpm (dB)")
+    a.set_title("which lines the films change (labels: the rollers' share of L_WA >= 20 %)", fontsize=9)
+    a.legend(fontsize=7)
+    a.grid(alpha=0.3)
+    a = ax[1, 1]
+    groups = [(c, r) for r in ("tf_omega", "mesh_force") for c in ("fixed", "1e9")]
+    for i, (case, route) in enumerate(groups):
+        parts = decomposition(rows, mesh, case, route)
+        bottom_pos = bottom_neg = 0.0
+        for (lab, v), col in zip(parts, ("tab:blue", "tab:orange", "tab:green")):
+            if not np.isfinite(v):
+                continue
+            b0 = bottom_pos if v >= 0 else bottom_neg
+            a.bar(i, v, 0.6, bottom=b0, color=col, label=lab if i == 0 else None)
+            if v >= 0:
+                bottom_pos += v
+            else:
+                bottom_neg += v
+        total = sum(v for _, v in parts)
+        a.plot(i, total, "kD")
+        a.text(i + 0.33, total, f"{total:+.1f}", va="center", fontsize=8)
+    a.set_xticks(range(len(groups)), [f"{r}\n{'fixed' if c == 'fixed' else 'K_v 1e9'}" for c, r in groups], fontsize=8)
+    a.axhline(0, color="k", lw=0.5)
+    a.set_ylabel("fluid films - rollers, mean 800-1500 rpm (dB)")
+    a.set_ylim(-6.0, 2.5)
+    a.set_xlim(-0.5, len(groups) - 0.2)
+    a.set_title("the films' difference, one change at a time (diamond: total)", fontsize=9)
+    a.legend(fontsize=7)
+    a.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    fig.savefig(HERE / "film_mount.png", dpi=110)
+    print(HERE / "film_mount.png")
+
+
+def main() -> None:
+    if len(sys.argv) > 1 and sys.argv[1] == "_child":
+        raise SystemExit(child(sys.argv[2:]))
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("--case", default="fixed")
+    r.add_argument("--bearings", default="fluid_film")
+    r.add_argument("--mesh", default="coarse", choices=tuple(fm.MESHES))
+    r.add_argument("--c-scale", type=float, default=1.0)
+    r.add_argument("--k-mode", default="films", choices=("films", "sym"))
+    r.add_argument("--radiation", default="erp", choices=("erp", "numerical"))
+    r.add_argument("--moment", default="shuttling", choices=("shuttling", "none"))
+    r.add_argument("--speed-min", type=float, default=800.0)
+    sub.add_parser("table")
+    pl = sub.add_parser("plot")
+    pl.add_argument("--mesh", default="default", choices=tuple(fm.MESHES))
+    m = sub.add_parser("modes")
+    m.add_argument("--case", nargs="+", default=["fixed", "1e9"])
+    m.add_argument("--mesh", default="coarse", choices=tuple(fm.MESHES))
+    a = ap.parse_args()
+    if a.cmd == "table":
+        write_table()
+    elif a.cmd == "plot":
+        plot(a.mesh)
+    elif a.cmd == "modes":
+        write_modes(a.case, a.mesh)
+    if a.cmd == "run":
+        run(a.case, a.bearings, a.mesh, a.c_scale, a.k_mode, a.radiation, a.moment, a.speed_min)
+
+
+if __name__ == "__main__":
+    main()
