@@ -280,7 +280,7 @@ def mode_rows(case: str, mesh: str, f_top: float = 1100.0) -> list[dict]:
     return rows
 
 
-def stability_rows(gm, case: str, mesh: str, f_top: float = 1100.0) -> list[dict]:
+def stability_rows(gm, case: str, mesh: str, f_top: float = 3000.0) -> list[dict]:
     """The films' model at 1500 rpm on its Ritz space with the films' C scaled by 0 and 1 (and K as computed or
     made symmetric), modal 4 % on top: the complex modes up to f_top, their damping ratio -Re(s)/|s|; a mode with
     Re(s) > 0 is self-excited (oil whirl): a harmonic response of it has no physical meaning."""
