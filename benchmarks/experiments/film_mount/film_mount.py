@@ -7,17 +7,20 @@ on K_v = 1e9 N/m.  This experiment changes ONE thing per run to find which mecha
   * bearings: cylindrical_roller or fluid_film (the real `housingfe run test-gearbox-runup-double-helical`);
   * mount: fixed feet or K_v (the frame_mount `housing.set`, frame_mount.housing_sets);
   * film damping scale c (films only): the films' 6x6 C multiplied by c (0: no film damping; 1: as computed).
-    No scene key does this, so the run goes through `housingfe.cli.main` in a process whose
-    housingfe.bearings.configurations._fluid_film_result is wrapped to scale C (and only C).  An experiment-only
-    control: nothing in the package changes;
-  * film stiffness: "films" (as computed), "sym" (K made symmetric, (K + K^T)/2: the thesis' own simplification),
-    or "roller" is not offered (the films' C on the rollers' K is not a bearing);
+    No scene key does this, so the run goes through `housingfe.cli.main` in a child process whose
+    housingfe.bearings.configurations._fluid_film_result is wrapped (`patch`).  An experiment-only control:
+    nothing in the package changes;
+  * film stiffness: "films" (as computed) or "sym" (K made symmetric, (K + K^T)/2: the thesis' own simplification);
+  * mesh moment: "shuttling" (default) or "none" (runup.mesh_moment);
   * radiation: sigma = 1 (the checks') or the numerical sigma beside it.
+Each run is compared speed by speed with the rollers' run of the same mesh, mount, moment and radiation.
 
-Usage (PYTHONPATH=$PWD, from the worktree):
-  python benchmarks/experiments/film_mount/film_mount.py run --case fixed --bearings fluid_film --c-scale 0
-  python benchmarks/experiments/film_mount/film_mount.py table        # film_mount.csv from the run folders
-  python benchmarks/experiments/film_mount/film_mount.py plot
+Usage (PYTHONPATH=$PWD, from the worktree; README.md has the runs made):
+  python benchmarks/experiments/film_mount/film_mount.py run --mesh default --case 1e9 --bearings fluid_film \
+      --c-scale 0 --k-mode sym
+  python benchmarks/experiments/film_mount/film_mount.py table        # film_mount.csv, film_mount_harmonics.csv
+  python benchmarks/experiments/film_mount/film_mount.py modes --mesh default   # film_mount_modes.csv
+  python benchmarks/experiments/film_mount/film_mount.py plot         # film_mount.png
 Run folders: /tmp/film-mount-runs/<label>/ (FILM_MOUNT_RUNS moves them).
 """
 from __future__ import annotations
