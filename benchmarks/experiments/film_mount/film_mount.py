@@ -64,6 +64,17 @@ def patch(c_scale: float, k_mode: str) -> None:
         return res
 
     cfg._fluid_film_result = scaled
+    # the control must act on what the run-up takes (Drivetrain.configuration_matrices -> bearing_matrices ->
+    # evaluate): checked here on the configuration's representative load case, not assumed
+    loads = cfg.representative_loads("double_helical")
+    raw = {p: (original(ch, np.asarray(loads[p], float), cfg.REPRESENTATIVE_SPEEDS_RPM, "reynolds"))
+           for p, ch in cfg.configurations()["fluid_film"].positions.items()}
+    for p, (K, C) in cfg.bearing_matrices("fluid_film", loads, cfg.REPRESENTATIVE_SPEEDS_RPM).items():
+        K_raw = raw[p].K
+        K_want = 0.5 * (K_raw + K_raw.T) if k_mode == "sym" else K_raw
+        if not (np.allclose(C, c_scale * raw[p].C, rtol=1e-12, atol=0.0)
+                and np.allclose(K[:2, :2], K_want[:2, :2], rtol=1e-12, atol=0.0)):
+            raise SystemExit(f"film_mount: the patch of _fluid_film_result does not reach bearing_matrices ({p})")
 
 
 def child(argv) -> int:
