@@ -44,6 +44,7 @@ UNIT_BY_NAME = {
                      "z_min", "z_max", "points", "seed", "machines", "boxes", "elements_per_section", "speeds"],
                     "-"),
     "density": "kg/m^3", "youngs_modulus": "Pa", "normal_stiffness": "N/m^3", "tangential_stiffness": "N/m^3",
+    "total_normal_stiffness": "N/m", "total_tangential_stiffness": "N/m",
 }
 _CONSTRAINTS = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
 
@@ -521,7 +522,9 @@ def describe(name_or_path: str, overrides: list[str] | None = None, mesh_f_max: 
                     for b in model.bores]
     if scene.supports:
         out += ["", "supports:"] + [f"  {s.kind} on {s.surface}" + (
-            f" (normal {s.normal_stiffness:g} N/m^3)" if s.normal_stiffness else "") for s in scene.supports]
+            f" (normal {s.normal_stiffness:g} N/m^3)" if s.normal_stiffness else
+            f" (normal {s.total_normal_stiffness:g} N/m in total)" if s.total_normal_stiffness else "")
+            for s in scene.supports]
     else:
         out += ["", "supports: none (free: six rigid-body modes at 0 Hz)"]
     if scene.loads:

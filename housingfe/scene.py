@@ -306,18 +306,31 @@ class SupportSpec(_Strict):
     """A support on a named surface group of the geometry.
 
     fixed: all displacement components zero.  normal: zero displacement normal to a plane, axis-aligned
-    surface.  elastic: distributed springs, normal_stiffness and tangential_stiffness per unit area (N/m^3).
+    surface.  elastic: distributed springs, normal_stiffness and tangential_stiffness per unit area (N/m^3), or
+    total_normal_stiffness and total_tangential_stiffness of the whole surface (N/m: what a frame's or an
+    isolator's data sheet gives), spread evenly over the surface's area on the mesh.
     """
 
     surface: str
     kind: Literal["fixed", "normal", "elastic"]
     normal_stiffness: Optional[PositiveFloat] = None
     tangential_stiffness: Optional[float] = Field(None, ge=0.0)
+    total_normal_stiffness: Optional[PositiveFloat] = None
+    total_tangential_stiffness: Optional[float] = Field(None, ge=0.0)
 
     @model_validator(mode="after")
     def _check(self):
-        if self.kind == "elastic" and self.normal_stiffness is None:
-            raise ValueError("normal_stiffness: required for an elastic support (N/m^3)")
+        given = [k for k in ("normal_stiffness", "tangential_stiffness", "total_normal_stiffness",
+                             "total_tangential_stiffness") if getattr(self, k) is not None]
+        if self.kind != "elastic" and given:
+            raise ValueError(f"{given[0]}: only for an elastic support (this one is kind = {self.kind!r})")
+        if self.kind == "elastic":
+            if (self.normal_stiffness is None) == (self.total_normal_stiffness is None):
+                raise ValueError("normal_stiffness: an elastic support needs exactly one of normal_stiffness "
+                                 "(N/m^3) or total_normal_stiffness (N/m)")
+            if self.tangential_stiffness is not None and self.total_tangential_stiffness is not None:
+                raise ValueError("tangential_stiffness: give tangential_stiffness (N/m^3) or "
+                                 "total_tangential_stiffness (N/m), not both")
         return self
 
 

@@ -396,6 +396,28 @@ def material_field(regions: dict, housing: HousingMesh, default: Material):
     return MaterialField(housing.mesh, default, housing.cell_tags, groups)
 
 
+def support_stiffness_per_area(support, area_m2: float) -> tuple[float, float]:
+    """(normal, tangential) spring stiffness per unit area (N/m^3) of an elastic support whose surface has the
+    area `area_m2` (m^2): the per-area keys as given, a total stiffness (N/m) spread evenly over the area."""
+    normal = (support.normal_stiffness if support.normal_stiffness is not None
+              else support.total_normal_stiffness / area_m2)
+    tangential = (support.tangential_stiffness if support.tangential_stiffness is not None
+                  else (support.total_tangential_stiffness or 0.0) / area_m2)
+    return normal, tangential
+
+
+def surface_area(housing: HousingMesh, name: str, key: str = "surface") -> float:
+    """Area (m^2) of the named surface group on the mesh, summed over all ranks."""
+    import ufl
+    from dolfinx import fem
+    from mpi4py import MPI
+
+    ds = ufl.Measure("ds", domain=housing.mesh, subdomain_data=housing.facet_tags)
+    one = fem.Constant(housing.mesh, 1.0)
+    local = fem.assemble_scalar(fem.form(one * ds(_surface_tags(housing, name, key))))
+    return float(housing.mesh.comm.allreduce(local, op=MPI.SUM))
+
+
 def foundation_forms(supports, housing: HousingMesh, V) -> list:
     """Stiffness forms of the elastic supports."""
     import ufl
@@ -406,8 +428,14 @@ def foundation_forms(supports, housing: HousingMesh, V) -> list:
     ds = ufl.Measure("ds", domain=housing.mesh, subdomain_data=housing.facet_tags)
     for i, support in enumerate(supports):
         if support.kind == "elastic":
-            tags = _surface_tags(housing, support.surface, f"supports[{i}].surface")
-            forms.append(foundation_form(V, ds(tags), support.normal_stiffness, support.tangential_stiffness or 0.0))
+            key = f"supports[{i}].surface"
+            tags = _surface_tags(housing, support.surface, key)
+            needs_area = support.normal_stiffness is None or support.total_tangential_stiffness is not None
+            area = surface_area(housing, support.surface, key) if needs_area else 1.0
+            if area <= 0.0:
+                raise InputError(f"{key}: surface {support.surface!r} has no area on the mesh: a total "
+                                 f"stiffness cannot be spread over it")
+            forms.append(foundation_form(V, ds(tags), *support_stiffness_per_area(support, area)))
     return forms
 
 

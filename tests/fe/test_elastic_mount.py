@@ -67,3 +67,53 @@ def test_soft_mount_modes_are_the_rigid_block_on_springs(soft_mount):
     # coupling (the centre of gravity is 8 mm off the feet's centre along x)
     bounce = np.sqrt(K_V / M_rb[0, 0]) / (2 * np.pi)
     assert np.min(np.abs(fe[:6] / bounce - 1)) < 0.02
+
+
+def test_a_total_stiffness_in_newtons_per_metre_is_spread_over_the_feet(comm):
+    """`total_normal_stiffness` / `total_tangential_stiffness` (N/m, a frame's data) on the feet: the model spreads
+    them over foot_bottom's area measured on the mesh, so the six modes are the rigid block on the analytic spring
+    bed K_V / A with the feet's drawn area A = 0.49 m x 2 x 0.075 m = 0.0735 m^2 (a wrong area, e.g. the housing's
+    whole bottom, moves them by the square root of the area ratio, >= 10 %)."""
+    from housingfe.fe.model import surface_area
+
+    area = (FOOT_X[1] - FOOT_X[0]) * sum(b - a for a, b in FOOT_Y)
+    scene, _ = load_housing_scene("test-gearbox", [
+        "mesh.size=0.06", "supports.0.kind=elastic", f"supports.0.total_normal_stiffness={K_V!r}",
+        f"supports.0.total_tangential_stiffness={K_V / 3!r}"])
+    model = build_model_from_scene(scene, comm)
+    assert surface_area(model.housing, "foot_bottom") == pytest.approx(area, rel=1e-9)
+    R = blocks.columns(model.rigid_body_vectors())
+    M_rb = R.T @ blocks.mat_block(model.M, R)
+    M_rb = (M_rb + M_rb.T) / 2
+    k_n = K_V / area
+    expected = np.sqrt(eigh(spring_bed_stiffness(k_n, k_n / 3), M_rb, eigvals_only=True)) / (2 * np.pi)
+    fe = modal.solve_modes(model.K, model.M, 1.5 * expected.max()).frequencies_hz
+    assert np.allclose(fe[:6], expected, rtol=2e-3), (fe[:6], expected)
+
+
+@pytest.mark.parametrize("sets, key", [
+    (["supports.0.kind=elastic"], "normal_stiffness"),
+    (["supports.0.kind=elastic", "supports.0.normal_stiffness=1e10", "supports.0.total_normal_stiffness=1e9"],
+     "normal_stiffness"),
+    (["supports.0.kind=elastic", "supports.0.total_normal_stiffness=1e9", "supports.0.tangential_stiffness=1e9",
+      "supports.0.total_tangential_stiffness=1e8"], "tangential_stiffness"),
+    (["supports.0.total_normal_stiffness=1e9"], "total_normal_stiffness"),
+    (["supports.0.kind=elastic", "supports.0.total_normal_stiffness=-1e9"], "total_normal_stiffness"),
+])
+def test_an_elastic_support_given_twice_or_not_at_all_is_one_error_naming_the_key(sets, key, tmp_path):
+    """Neither or both of the per-area and the total normal stiffness, both tangential stiffnesses, a stiffness on a
+    fixed support (it would be ignored silently), a negative total: one line naming the key, exit 2, nothing
+    written."""
+    import os
+    import subprocess
+    import sys
+
+    cmd = [sys.executable, "-m", "housingfe", "run", "test-gearbox", "--out", str(tmp_path / "out")]
+    for s in sets:
+        cmd += ["--set", s]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env={**os.environ, "OPENBLAS_NUM_THREADS": "1"},
+                          cwd=tmp_path, timeout=300)
+    assert proc.returncode == 2, proc.stdout + proc.stderr
+    assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert key in proc.stderr, proc.stderr
+    assert not (tmp_path / "out").exists()
