@@ -26,6 +26,12 @@ source's lead gap.  So each process computes ONE modal basis per layout (the sce
 with the double-helical family that gearbox's too) and every configuration of every sample is a Rayleigh-Ritz
 re-analysis on it (housingfe.runup.chain.with_drivetrain).
 
+The one exception is opt-in: `mount_stiffness_N_per_m` (only with --range; `OPT_IN`, drawn from a stream of its own
+so that every seed's other inputs stay as without it) stands the housing on an elastic frame.  The fixed feet's
+Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its own on
+the elastic feet (`mount_overrides`), every family of the sample runs on them, and a process drops them when the
+next sample brings another mount (`_mount_pool`).
+
 Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
 concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A sample's answer
 does not depend on the process that computed it (each builds the same basis): 1 and 2 workers give the same
@@ -391,10 +397,19 @@ def _mount_pool(stiffness: float, comm):
 
             from housingfe.drivetrain.coupling import release_petsc_garbage
 
+            # PETSc parks dropped objects per communicator (release_petsc_garbage) and the housing's matrices live
+            # on its mesh's own (duplicated) communicator, which the next mount's coupling never cleans: without
+            # this every mount left its housing model and bases behind (~200 MB per sample, coarse mesh)
+            comms = []
             for key in _MOUNT["keys"]:
-                _STATE.pop(key, None)
+                base = _STATE.pop(key, None)
+                if base is not None and base.session.housing_model is not None:
+                    comms.append(base.session.housing_model.K.getComm())
+                del base
             _MOUNT.clear()
             gc.collect()
+            for c in comms:
+                release_petsc_garbage(c)
             release_petsc_garbage(comm)
         _MOUNT.update({"value": stiffness, "pool": ModelPool(), "keys": set()})
     return _MOUNT["pool"]
