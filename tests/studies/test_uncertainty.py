@@ -137,7 +137,9 @@ def test_a_mount_drops_the_previous_mounts_bases():
     try:
         unc._MOUNT.clear()
         pool = unc._mount_pool(1e9, MPI.COMM_SELF)
-        unc._STATE["mount-1e9"] = "base"
+        from types import SimpleNamespace
+
+        unc._STATE["mount-1e9"] = SimpleNamespace(session=SimpleNamespace(housing_model=None))   # not built
         unc._MOUNT["keys"].add("mount-1e9")
         assert unc._mount_pool(1e9, MPI.COMM_SELF) is pool and "mount-1e9" in unc._STATE      # same mount: kept
         other = unc._mount_pool(3e8, MPI.COMM_SELF)
