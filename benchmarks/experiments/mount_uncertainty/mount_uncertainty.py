@@ -31,7 +31,7 @@ COARSE = ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500", "runup.speed_
           "runup.speed_step_rpm=250"]
 CASES = {
     "cost": {"args": ["--samples", "4", "--seed", "1", "--workers", "1", "--family", "bearings"], "sets": COARSE},
-    # concurrent.futures: the mpi4py.futures spawn hung here (2026-11-27, orted up, no worker after 6 min)
+    # concurrent.futures: the mpi4py.futures spawn hung here once (2026-11-27, orted up, no worker after 6 min)
     "bands": {"args": ["--samples", "8", "--seed", "1", "--workers", "2", "--engine", "processes", "--family",
                        "bearings"], "sets": []},
 }
