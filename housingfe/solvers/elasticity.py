@@ -124,7 +124,11 @@ def foundation_form(V, ds, normal_stiffness: float, tangential_stiffness: float)
     n = ufl.FacetNormal(V.mesh)
     un, vn = ufl.dot(u, n), ufl.dot(v, n)
     ut, vt = u - un * n, v - vn * n
-    return fem.form((normal_stiffness * un * vn + tangential_stiffness * ufl.inner(ut, vt)) * ds)
+    # constants, not floats: a float is compiled into the form, so every other stiffness (a sampled frame,
+    # housingfe uncertainty) was a C compile of its own
+    kn = fem.Constant(V.mesh, PETSc.ScalarType(normal_stiffness))
+    kt = fem.Constant(V.mesh, PETSc.ScalarType(tangential_stiffness))
+    return fem.form((kn * un * vn + kt * ufl.inner(ut, vt)) * ds)
 
 
 def clamp_bc(V, facets: np.ndarray, components: tuple[int, ...] | None = None) -> list:

@@ -26,6 +26,12 @@ source's lead gap.  So each process computes ONE modal basis per layout (the sce
 with the double-helical family that gearbox's too) and every configuration of every sample is a Rayleigh-Ritz
 re-analysis on it (housingfe.runup.chain.with_drivetrain).
 
+The one exception is opt-in: `mount_stiffness_N_per_m` (only with --range; `OPT_IN`, drawn from a stream of its own
+so that every seed's other inputs stay as without it) stands the housing on an elastic frame.  The fixed feet's
+Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its own on
+the elastic feet (`mount_overrides`), every family of the sample runs on them, and a process drops them when the
+next sample brings another mount (`_mount_pool`).
+
 Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
 concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A sample's answer
 does not depend on the process that computed it (each builds the same basis): 1 and 2 workers give the same
@@ -41,6 +47,7 @@ Python API (the quantity names are those of `UncertaintyResult.quantities`, docs
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import math
 import os
@@ -139,7 +146,22 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
     Parameter("helix_deviation_wheel", "uniform", -1.0, 1.0, 0.0, "f_Hbeta",
               "source: the wheel's helix slope deviation, added to the lead gap",
               "DIN 3962 quality 5 (App. F): ±f_Hbeta"),
+    Parameter("mount_stiffness_N_per_m", "loguniform", 1e8, 1e10, None, "N/m",
+              "housing: total vertical stiffness K_v of an elastic frame under the feet (the housing's supports.0 "
+              "made elastic, k_n = K_v / its area, k_t = k_n / 3); opt-in: drawn only with --range, else the "
+              "scene's fixed feet (each sample then builds its own housing model and basis)",
+              "estimate: the thesis says only 'the gearbox stands on a frame' (Ch. 5), stiffness not given; a "
+              "steel frame under the 169 kg gearbox: 1e8 N/m puts its six mount modes at 48-146 Hz, 1e9 at "
+              "130-382 Hz, from 3e9 they mix with the housing's (benchmarks/experiments/frame_mount)"),
 )}
+
+# Inputs drawn only when --range names them: the nominal of the mount is a model choice (the fixed feet), not a
+# value in the range, and each of its samples needs a housing model and basis of its own.  They are drawn from a
+# stream of their own (`_OPT_IN_STREAM`), so every other column of a seed is the same with or without them.
+MOUNT = "mount_stiffness_N_per_m"
+OPT_IN = (MOUNT,)
+_OPT_IN_STREAM = 0x6D6F756E74            # "mount": the seed sequence (seed, stream + k) of the k-th opt-in input
+MOUNT_TANGENTIAL_RATIO = 1.0 / 3.0       # k_t / k_n, as the built-in scene box-supported-elastic (assumed)
 
 
 # What each input can physically be (lower, lower included, upper, upper included, what it is): a --range outside
@@ -165,6 +187,7 @@ PHYSICAL_LIMITS: dict[str, tuple] = {
                                f"at most ±{HELIX_QUALITY_12:.3g} f_Hbeta (quality 12, the coarsest class)"),
     "helix_deviation_wheel": (-HELIX_QUALITY_12, True, HELIX_QUALITY_12, True,
                               f"at most ±{HELIX_QUALITY_12:.3g} f_Hbeta (quality 12, the coarsest class)"),
+    "mount_stiffness_N_per_m": (0.0, False, math.inf, False, "a stiffness > 0 N/m"),
 }
 
 
@@ -209,6 +232,8 @@ def nominal_ranges(scene) -> dict[str, tuple]:
     """Every range at the value the chain uses (zero width): the deterministic run as an uncertainty run."""
     out = {}
     for p in PARAMETERS.values():
+        if p.name in OPT_IN:               # not drawn: the scene as it is (the fixed feet)
+            continue
         if p.name == "radiation":
             out[p.name] = (scene.radiation.models[0],)
         elif p.name == "damping_ratio":
@@ -220,11 +245,14 @@ def nominal_ranges(scene) -> dict[str, tuple]:
 
 def draw_samples(scene, n_samples: int, seed: int, ranges: dict | None = None) -> list[dict]:
     """n_samples Latin-hypercube samples {parameter: value} (scipy.stats.qmc.LatinHypercube, `seed`) over the
-    PARAMETERS' ranges with `ranges` overriding some ({name: (low, high)}; radiation: (models...))."""
+    PARAMETERS' ranges with `ranges` overriding some ({name: (low, high)}; radiation: (models...)).  An OPT_IN
+    input (the mount stiffness) is None (the scene's fixed feet) unless `ranges` names it; then it is drawn from a
+    one-dimensional Latin hypercube of its own seeded stream, so every other input's values are those of the seed
+    without it."""
     from scipy.stats import qmc
 
     ranges = dict(ranges or {})
-    names = list(PARAMETERS)
+    names = [n for n in PARAMETERS if n not in OPT_IN]
     u = qmc.LatinHypercube(d=len(names), seed=int(seed)).random(int(n_samples))
     models = list(scene.radiation.models)
     samples = [{} for _ in range(int(n_samples))]
@@ -241,14 +269,27 @@ def draw_samples(scene, n_samples: int, seed: int, ranges: dict | None = None) -
             continue
         lo, hi = ranges.get(name, (p.low, p.high))
         for i in range(len(samples)):
-            if lo == hi:
-                v = lo
-            elif p.distribution == "loguniform":
-                v = lo * (hi / lo) ** u[i, j]
-            else:
-                v = lo + (hi - lo) * u[i, j]
-            samples[i][name] = float(v)
+            samples[i][name] = _value(p, lo, hi, u[i, j])
+    for k, name in enumerate(OPT_IN):
+        if name not in ranges:
+            for s in samples:
+                s[name] = None
+            continue
+        lo, hi = ranges[name]
+        stream = np.random.default_rng([int(seed), _OPT_IN_STREAM + k])
+        w = qmc.LatinHypercube(d=1, seed=stream).random(int(n_samples))[:, 0]
+        for i in range(len(samples)):
+            samples[i][name] = _value(PARAMETERS[name], lo, hi, w[i])
     return samples
+
+
+def _value(p: Parameter, lo: float, hi: float, u: float) -> float:
+    """The value of a numeric parameter at the unit-interval point u of its range [lo, hi]."""
+    if lo == hi:
+        return float(lo)
+    if p.distribution == "loguniform":
+        return float(lo * (hi / lo) ** u)
+    return float(lo + (hi - lo) * u)
 
 
 # ------------------------------------------------------------------------------------------------ one sample
@@ -264,16 +305,20 @@ class _Base:
     setup_s: float
 
 
-def _base(scene_name: str, overrides: tuple, comm) -> _Base:
+def _base(scene_name: str, overrides: tuple, comm, pool=None) -> _Base:
+    """The process's base of a scene with --set `overrides` (built on first use): its ChainSession and the coupled
+    model at the highest torque.  pool: the ModelPool its session shares (default the process's one, _POOL)."""
     key = json.dumps([scene_name, list(overrides)])
     if key not in _STATE:
         from housingfe.drivetrain.bore_matching import match_bores
         from housingfe.studies.chain_session import ChainSession, ModelPool
 
-        if not _POOL:
-            _POOL.append(ModelPool())
+        if pool is None:
+            if not _POOL:
+                _POOL.append(ModelPool())
+            pool = _POOL[0]
         t0 = time.perf_counter()
-        session = ChainSession.from_scene(scene_name, list(overrides), comm=comm, pool=_POOL[0])
+        session = ChainSession.from_scene(scene_name, list(overrides), comm=comm, pool=pool)
         spec = session.scene.drivetrain
         dt = session.drivetrain(spec.gear_set, spec.bearings, max(session.spec.torques_nm))
         housing = session.housing()
@@ -287,6 +332,104 @@ def _base(scene_name: str, overrides: tuple, comm) -> _Base:
         model = session.model(dt.with_bores(surfaces), "uncertainty base", follow=False)
         _STATE[key] = _Base(session, model, surfaces, time.perf_counter() - t0)
     return _STATE[key]
+
+
+# per process: the one mount whose bases _STATE holds now ({"value": K_v N/m, "pool": its ModelPool, "keys": its
+# _STATE keys}).  A sample of another mount drops them before building its own, so a process holds at most one
+# mount's housing model and bases beside the fixed feet's (a zero-width mount range reuses them from sample to sample).
+_MOUNT: dict = {}
+
+
+@functools.lru_cache(maxsize=16)
+def _support_of(scene_name: str, overrides: tuple) -> tuple:
+    """(the run-up scene's housing.set, the housing's supports.0 surface, its area m^2) of a scene with --set
+    `overrides`; InputError naming the housing scene when it has no support or no block model."""
+    from housingfe.geometry.registry import block_model_for, own_mesh_kind
+    from housingfe.geometry.surfaces import named_surfaces
+    from housingfe.runup.scene import load_runup_scene
+    from housingfe.scene import load_housing_scene
+
+    scene, _ = load_runup_scene(scene_name, list(overrides))
+    housing, hpath = load_housing_scene(scene.housing.scene, list(scene.housing.set))
+    if not housing.supports:
+        raise InputError(f"{hpath}: supports: none; --range {MOUNT} puts supports.0 on an elastic frame")
+    surface = housing.supports[0].surface
+    if own_mesh_kind(housing.geometry) is not None:
+        raise InputError(f"{hpath}: geometry.kind {housing.geometry.kind!r}: --range {MOUNT} needs the area of "
+                         f"supports.0 ({surface}) from a block model")
+    area = named_surfaces(block_model_for(housing.geometry)).get(surface)
+    if area is None or area.area <= 0.0:
+        raise InputError(f"{hpath}: supports.0.surface {surface!r}: not a named surface with an area (--range {MOUNT})")
+    return tuple(scene.housing.set), surface, float(area.area)
+
+
+def mount_overrides(scene_name: str, overrides: tuple, stiffness: float) -> tuple:
+    """The run-up scene's --set `overrides` plus one `housing.set` that stands the housing on an elastic frame of
+    total vertical stiffness `stiffness` (N/m): the housing's supports.0 (test-gearbox: foot_bottom, 0.0735 m^2)
+    made elastic with k_n = stiffness / its area (N/m^3) and k_t = k_n / 3 (MOUNT_TANGENTIAL_RATIO), appended to
+    the scene's own housing.set so that e.g. a coarser mesh given there stays.  As `housing_sets` of
+    benchmarks/experiments/frame_mount/frame_mount.py.  InputError (one line) when the housing has no support or
+    its area is not known without meshing."""
+    own, _, area = _support_of(scene_name, tuple(overrides))
+    kn = float(stiffness) / area
+    sets = list(own) + ["supports.0.kind=elastic", f"supports.0.normal_stiffness={kn!r}",
+                        f"supports.0.tangential_stiffness={kn * MOUNT_TANGENTIAL_RATIO!r}"]
+    return tuple(overrides) + (f"housing.set={json.dumps(sets)}",)
+
+
+def check_mount(scene_name: str, overrides, ranges: dict | None, families: tuple) -> None:
+    """InputError (one line) when --range names the mount but a scene of the run cannot stand on a frame."""
+    if ranges and MOUNT in ranges:
+        from housingfe.studies.design_variants import family_of
+
+        scenes = [scene_name] + ([family_of("double-helical").scene] if "double-helical" in families else [])
+        for name in scenes:
+            mount_overrides(name, tuple(overrides), ranges[MOUNT][1])
+
+
+def _mount_pool(stiffness: float, comm):
+    """The ModelPool of the mount `stiffness` (N/m) in this process; the previous mount's bases are dropped first."""
+    from housingfe.studies.chain_session import ModelPool
+
+    if _MOUNT.get("value") != stiffness:
+        if _MOUNT:
+            import gc
+
+            from housingfe.drivetrain.coupling import release_petsc_garbage
+
+            # PETSc parks dropped objects per communicator (release_petsc_garbage) and the housing's matrices live
+            # on its mesh's own (duplicated) communicator, which the next mount's coupling never cleans: without
+            # this every mount left its housing model and bases behind (~200 MB per sample, coarse mesh)
+            comms = []
+            for key in _MOUNT["keys"]:
+                base = _STATE.pop(key, None)
+                if base is not None and base.session.housing_model is not None:
+                    comms.append(base.session.housing_model.K.getComm())
+                del base
+            _MOUNT.clear()
+            gc.collect()
+            for c in comms:
+                release_petsc_garbage(c)
+            release_petsc_garbage(comm)
+        _MOUNT.update({"value": stiffness, "pool": ModelPool(), "keys": set()})
+    return _MOUNT["pool"]
+
+
+def _sample_base(scene_name: str, overrides: tuple, values: dict, comm) -> tuple:
+    """(base, setup wall s, setup CPU s) of a scene for one sample: the shared base (fixed feet) or, with a mount
+    value, the base of the housing on that mount (its own housing model and basis)."""
+    mount = values.get(MOUNT)
+    pool = None
+    if mount is not None:
+        pool = _mount_pool(mount, comm)
+        overrides = mount_overrides(scene_name, tuple(overrides), mount)
+    key = json.dumps([scene_name, list(overrides)])
+    fresh = key not in _STATE
+    c0 = time.process_time()
+    base = _base(scene_name, tuple(overrides), comm, pool)
+    if mount is not None:
+        _MOUNT["keys"].add(key)
+    return base, (base.setup_s if fresh else 0.0), (time.process_time() - c0 if fresh else 0.0)
 
 
 def perturbed_drivetrain(base: _Base, values: dict, gear_set: str, bearings: str, torque: float):
@@ -563,15 +706,14 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
                     worker: bool = False) -> dict:
     """The metrics of one sample (see the module docstring), {"route/quantity": value}, "checks" (the issue-28
     check rows of this sample's runs, check_values: {check_id: {"ours", "passed"}}), "seconds" (its wall time,
-    without the process's bases), "setup_s" (the bases, when this sample built them) and "rss_mb" (the process's
-    resident memory after the sample).  worker: the call runs in a pool process (its FE on MPI.COMM_SELF)."""
+    without the process's bases), "setup_s" and "setup_cpu_s" (the bases, wall and CPU, when this sample built
+    them: with a mount value (`MOUNT`) every new mount's housing model and bases), "mount" (whether the sample
+    stands on a frame) and "rss_mb" (the process's resident memory after the sample).  A sample with a mount value
+    runs every configuration of every family on the housing on that frame (`mount_overrides`).  worker: the call runs in a pool process (its FE on MPI.COMM_SELF)."""
     from mpi4py import MPI
 
     comm = MPI.COMM_SELF if worker else MPI.COMM_WORLD
-    setup = 0.0
-    fresh = json.dumps([scene_name, list(overrides)]) not in _STATE
-    base = _base(scene_name, tuple(overrides), comm)
-    setup += base.setup_s if fresh else 0.0
+    base, setup, setup_cpu = _sample_base(scene_name, tuple(overrides), values, comm)
     t0, c0 = time.perf_counter(), time.process_time()
     scene = base.session.scene
     rad = values["radiation"]
@@ -638,12 +780,13 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
         from housingfe.studies.design_variants import family_of
 
         dh_scene = family_of("double-helical").scene
-        fresh = json.dumps([dh_scene, list(overrides)]) not in _STATE
-        t1 = time.perf_counter()
-        dh = _base(dh_scene, tuple(overrides), comm)
-        if fresh:                       # its basis is setup, not the sample's cost
-            setup += dh.setup_s
+        t1, c1 = time.perf_counter(), time.process_time()
+        dh, dh_setup, dh_cpu = _sample_base(dh_scene, tuple(overrides), values, comm)
+        if dh_setup:                    # its basis is setup, not the sample's cost
+            setup += dh_setup
+            setup_cpu += dh_cpu
             t0 += time.perf_counter() - t1
+            c0 += time.process_time() - c1
         t2 = time.perf_counter()
         checks.update(_family_checks("double-helical", dh, runs))
         out["seconds_double-helical"] = time.perf_counter() - t2
@@ -653,6 +796,8 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
     out["seconds"] = time.perf_counter() - t0
     out["cpu_s"] = time.process_time() - c0          # the machine is shared: CPU time is the steadier measure
     out["setup_s"] = setup
+    out["setup_cpu_s"] = setup_cpu
+    out["mount"] = values.get(MOUNT) is not None
     out["rss_mb"] = _rss_mb()
     out["pid"] = os.getpid()
     return out
@@ -819,7 +964,9 @@ class UncertaintyResult:
         best = ("", float("nan"))
         if keep.sum() >= 5 and np.ptp(v[keep]) > 0:
             for name in PARAMETERS:
-                x = np.array([s[name] for s in self.samples], dtype=object)[keep]
+                x = np.array([s.get(name) for s in self.samples], dtype=object)[keep]
+                if any(a is None for a in x):         # an opt-in input not drawn (or an older run's samples)
+                    continue
                 if name == "radiation":
                     x = np.array([str(a) == str(x[0]) for a in x], float)
                 x = x.astype(float)
@@ -910,7 +1057,8 @@ def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 
                                 & (scene_obj.runup.speeds <= MEAN_RANGE_RPM[1])):
         raise InputError(f"{path}: runup speeds: none inside {MEAN_RANGE_RPM[0]:g}-{MEAN_RANGE_RPM[1]:g} rev/min "
                          "(the bearings family's mean differences)")
-    full = {**{k: v for k, v in ((p.name, (p.low, p.high)) for p in PARAMETERS.values())}, **(ranges or {})}
+    check_mount(scene, overrides, ranges, families)
+    full = {**{p.name: (p.low, p.high) for p in PARAMETERS.values() if p.name not in OPT_IN}, **(ranges or {})}
     samples = draw_samples(scene_obj, n_samples, seed, ranges)
     say = progress or (lambda text: None)
     t0 = time.perf_counter()
@@ -947,10 +1095,17 @@ def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 
                         metrics.append(m)
                         say(f"sample {len(metrics)}/{n_samples}: {m['seconds']:.1f} s (process {m['pid']})")
     wall = time.perf_counter() - t0
-    setups = [m["setup_s"] for m in metrics if m["setup_s"] > 0]     # one per process that built a basis
+    # the fixed feet: one basis per process that built one; a mount: the bases of each new mount value
+    setups = [m["setup_s"] for m in metrics if m["setup_s"] > 0 and not m.get("mount")]
+    mounts = [m for m in metrics if m.get("mount") and m["setup_s"] > 0]
     timings = {"wall_s": wall, "per_sample_s": float(np.mean([m["seconds"] for m in metrics])),
                "per_sample_cpu_s": float(np.mean([m["cpu_s"] for m in metrics])),
-               "basis_per_process_s": float(np.mean(setups)) if setups else 0.0, "processes": len(setups)}
+               "basis_per_process_s": float(np.mean(setups)) if setups else 0.0,
+               "processes": len({m["pid"] for m in metrics})}
+    if mounts:
+        timings["mount_bases_s"] = float(np.mean([m["setup_s"] for m in mounts]))
+        timings["mount_bases_cpu_s"] = float(np.mean([m["setup_cpu_s"] for m in mounts]))
+        timings["mount_bases_built"] = len(mounts)
     return UncertaintyResult(scene, int(seed), samples, metrics, tuple(scene_obj.runup.routes),
                              scene_obj.runup.speeds, families, full, used, int(workers), timings)
 
@@ -970,8 +1125,13 @@ def summary_text(result: UncertaintyResult) -> str:
     head = (f"uncertainty {result.scene}: {len(result.samples)} Latin-hypercube samples, seed {result.seed}, "
             f"{result.workers} worker(s) ({result.engine}); families: {', '.join(result.families) or 'set A only'}")
     what = "set A" + (f" + families {', '.join(result.families)}" if result.families else "")
-    cost = (f"cost: {t['per_sample_s']:.1f} s per sample (CPU {t['per_sample_cpu_s']:.1f} s) ({what}), "
-            f"{t['basis_per_process_s']:.1f} s for the modal bases per process ({t['processes']} process(es)); "
+    if t.get("mount_bases_built"):
+        bases = (f"{t['mount_bases_s']:.1f} s (CPU {t['mount_bases_cpu_s']:.1f} s) for the housing model and "
+                 f"bases of each sample's mount ({t['mount_bases_built']} built, {t['processes']} process(es))")
+    else:
+        bases = (f"{t['basis_per_process_s']:.1f} s for the modal bases per process ({t['processes']} "
+                 "process(es))")
+    cost = (f"cost: {t['per_sample_s']:.1f} s per sample (CPU {t['per_sample_cpu_s']:.1f} s) ({what}), {bases}; "
             f"wall time {t['wall_s']:.1f} s")
     parts = [(k.removeprefix("seconds_"), [m[k] for m in result.metrics if k in m])
              for k in ("seconds_set_a", *(f"seconds_{f}" for f in FAMILIES))]
@@ -1011,12 +1171,12 @@ def write(folder: Path, result: UncertaintyResult) -> None:
     from housingfe.outputs import write_csv, write_json
 
     names = list(PARAMETERS)
-    skip = {"pid", "setup_s", "checks"}
+    skip = {"pid", "setup_s", "setup_cpu_s", "checks"}
     keys = [k for k in result.metrics[0] if not k.endswith("lwa_curve_dBA") and k not in skip]
     keys += sorted({k for m in result.metrics for k in m} - set(keys) - skip
                    - {k for k in result.metrics[0] if k.endswith("lwa_curve_dBA")})
     write_csv(folder / "samples.csv", ["sample", *names, *keys],
-              ([i, *(s[n] for n in names), *(m.get(k, "") for k in keys)]
+              ([i, *("" if s.get(n) is None else s[n] for n in names), *(m.get(k, "") for k in keys)]
                for i, (s, m) in enumerate(zip(result.samples, result.metrics))))
     write_csv(folder / "sample_checks.csv", ["sample", "check_id", "ours", "passed"],
               ([i, c, v["ours"], v["passed"]] for i, m in enumerate(result.metrics)
@@ -1105,6 +1265,7 @@ def run_command(scene: str, n_samples: int, seed: int, workers: int, out_dir: st
     ranges = parse_ranges(ranges_items)
     scene_obj, path = load_runup_scene(scene, list(overrides))
     draw_samples(scene_obj, 1, seed, ranges)                 # a bad radiation choice stops here
+    check_mount(scene, overrides, ranges, families)          # a housing that cannot stand on a frame too
     out = Path(out_dir or f"results/uncertainty-{scene_obj.scene.name}")
     comm = MPI.COMM_WORLD
     outputs.reserve_output(out, comm, inputs=[path])

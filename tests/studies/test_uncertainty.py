@@ -41,6 +41,9 @@ def test_latin_hypercube_samples():
     assert a == unc.draw_samples(scene, 10, seed=3)
     assert a != unc.draw_samples(scene, 10, seed=4)
     for name, p in unc.PARAMETERS.items():
+        if name in unc.OPT_IN:                     # not drawn without --range (test_the_mount_is_opt_in)
+            assert {s[name] for s in a} == {None}, name
+            continue
         if p.distribution == "uniform":            # one sample in each tenth of the range
             strata = sorted(int((s[name] - p.low) / (p.high - p.low) * 10) for s in a)
             assert strata == list(range(10)), name
@@ -71,6 +74,126 @@ def test_every_range_lies_within_what_its_input_can_be():
                  "spherical_contact_angle_deg=0:90", "quill_diameter_scale=0:1"):
         with pytest.raises(InputError, match=f"--range {item.split('=')[0]}: .*must be"):
             unc.parse_ranges([item])
+
+
+# The parameter list before the mount (2026-11-27): name, distribution, low, high.  What `draw_samples` gave for a
+# seed then is u = LatinHypercube(d=15, seed).random(n), column j mapped onto the j-th range (radiation: one of the
+# scene's models, equally likely) - the draws docs/runup.md quotes (`--samples 24 --seed 1`).
+OLD_PARAMETERS = (
+    ("damping_ratio", "loguniform", 0.02, 0.08), ("radiation", "choice", 0.0, 1.0),
+    ("clearance_position", "uniform", 0.0, 1.0), ("groove_inner", "uniform", 0.51, 0.53),
+    ("groove_outer", "uniform", 0.52, 0.54), ("spherical_contact_angle_deg", "uniform", 7.0, 11.0),
+    ("tapered_e_scale", "uniform", 0.85, 1.15), ("quill_diameter_scale", "uniform", 0.8, 1.25),
+    ("quill_length_scale", "loguniform", 0.5, 2.0), ("coupling_inertia_scale", "loguniform", 0.5, 2.0),
+    ("lumped_bearing_span_m", "uniform", 0.045, 0.075), ("appendix_c_bearing_scale", "loguniform", 0.7, 1.4),
+    ("source_loss_factor", "loguniform", 0.05, 0.2), ("helix_deviation_pinion", "uniform", -1.0, 1.0),
+    ("helix_deviation_wheel", "uniform", -1.0, 1.0))
+
+
+def old_draws(models, n, seed):
+    from scipy.stats import qmc
+
+    u = qmc.LatinHypercube(d=len(OLD_PARAMETERS), seed=seed).random(n)
+    out = [{} for _ in range(n)]
+    for j, (name, dist, lo, hi) in enumerate(OLD_PARAMETERS):
+        for i in range(n):
+            out[i][name] = (models[min(int(u[i, j] * len(models)), len(models) - 1)] if dist == "choice"
+                            else lo * (hi / lo) ** u[i, j] if dist == "loguniform" else lo + (hi - lo) * u[i, j])
+    return out
+
+
+def test_the_mount_is_opt_in():
+    """Without --range mount_stiffness_N_per_m every seed draws what it drew before the mount existed (the fixed
+    feet: None); with it, the other inputs are still those draws and the mount is a log-uniform Latin hypercube of
+    its own (one sample per tenth of log K_v over 1e8 ... 1e10 N/m)."""
+    from housingfe.runup.scene import load_runup_scene
+
+    scene, _ = load_runup_scene("test-gearbox-runup")
+    models = list(scene.radiation.models)
+    mount = unc.parse_ranges(["mount_stiffness_N_per_m=1e8:1e10"])
+    for seed, n in ((1, 24), (0, 8), (7, 10)):
+        old = old_draws(models, n, seed)
+        for ranges in (None, mount):
+            new = unc.draw_samples(scene, n, seed, ranges)
+            assert [set(s) - {unc.MOUNT} for s in new] == [set(s) for s in old]
+            for a, b in zip(new, old):
+                b = dict(b)
+                assert a["radiation"] == b.pop("radiation")
+                assert {k: a[k] for k in b} == pytest.approx(b, rel=1e-15, abs=1e-15), (seed, ranges)
+        assert {s[unc.MOUNT] for s in unc.draw_samples(scene, n, seed)} == {None}
+        kv = [s[unc.MOUNT] for s in unc.draw_samples(scene, n, seed, mount)]
+        assert sorted(int(math.log10(k / 1e8) / 2.0 * n) for k in kv) == list(range(n))
+    assert unc.nominal_ranges(scene).keys().isdisjoint(unc.OPT_IN)        # the deterministic run: the fixed feet
+    fixed = unc.draw_samples(scene, 3, 1, unc.parse_ranges(["mount_stiffness_N_per_m=3e8"]))
+    assert [s[unc.MOUNT] for s in fixed] == [3e8] * 3
+
+
+def test_a_mount_drops_the_previous_mounts_bases():
+    """A process holds the bases of one mount at a time: a sample of another mount value drops them first (no
+    FE here: the state is the process's cache)."""
+    from mpi4py import MPI
+
+    saved_state, saved_mount = dict(unc._STATE), dict(unc._MOUNT)
+    try:
+        unc._MOUNT.clear()
+        pool = unc._mount_pool(1e9, MPI.COMM_SELF)
+        from types import SimpleNamespace
+
+        unc._STATE["mount-1e9"] = SimpleNamespace(session=SimpleNamespace(housing_model=None))   # not built
+        unc._MOUNT["keys"].add("mount-1e9")
+        assert unc._mount_pool(1e9, MPI.COMM_SELF) is pool and "mount-1e9" in unc._STATE      # same mount: kept
+        other = unc._mount_pool(3e8, MPI.COMM_SELF)
+        assert other is not pool and "mount-1e9" not in unc._STATE and unc._MOUNT["keys"] == set()
+    finally:
+        unc._STATE.clear()
+        unc._STATE.update(saved_state)
+        unc._MOUNT.clear()
+        unc._MOUNT.update(saved_mount)
+
+
+def test_a_sample_with_a_mount_runs_on_the_housing_on_that_frame():
+    """A sample with K_v = 1e8 N/m runs on a housing model and basis of its own whose lowest modes are the
+    gearbox's six rigid-body modes on the frame: below 160 Hz (frame_mount, default mesh: 48-146 Hz; the fixed
+    feet's lowest mode apart from the drive line's torsion at 76 Hz is 212 Hz), the bounce within 10 % of the
+    rigid mass on a spring, sqrt(K_v / m) / 2 pi with m = 169.4 kg (the coupled gearbox, frame_mount README);
+    k_n = K_v / 0.0735 m^2, the two feet of 0.075 x 0.490 m.  Coarsest mesh (80 mm), lines to 600 Hz."""
+    from housingfe.runup.scene import load_runup_scene
+
+    overrides = ('housing.set=["mesh.size=0.08"]', "runup.f_max_hz=600", "runup.speed_min_rpm=250",
+                 "runup.speed_step_rpm=250")
+    kv = 1e8
+    scene, _ = load_runup_scene("test-gearbox-runup", list(overrides))
+    values = unc.draw_samples(scene, 1, 2, unc.parse_ranges([f"mount_stiffness_N_per_m={kv:g}"]))[0]
+    mounted = unc.mount_overrides("test-gearbox-runup", overrides, kv)
+    sets = json_list(mounted[-1])            # the scene's own housing.set stays, then supports.0 on the bed
+    assert sets[:2] == ["mesh.size=0.08", "supports.0.kind=elastic"]
+    kn = kv / (2 * 0.075 * 0.490)
+    assert float(sets[2].removeprefix("supports.0.normal_stiffness=")) == pytest.approx(kn, rel=1e-12)
+    assert float(sets[3].removeprefix("supports.0.tangential_stiffness=")) == pytest.approx(kn / 3, rel=1e-12)
+    saved_state, saved_mount = dict(unc._STATE), dict(unc._MOUNT)
+    try:
+        m = unc.evaluate_sample("test-gearbox-runup", overrides, values, ())
+        assert m["mount"] and m["setup_s"] > 0                   # its own base, built for the sample
+        assert len(unc._MOUNT["keys"]) == 1
+        base = unc._STATE[next(iter(unc._MOUNT["keys"]))]
+        assert base.session.scene.housing.set == list(json_list(mounted[-1]))
+        f = np.asarray(base.model.basis.frequencies_hz)
+        below = f[f < 160.0]
+        assert len(below) == 7 and below[0] < 60.0              # six mount modes and the drive line's torsion
+        bounce = math.sqrt(kv / 169.4) / (2 * math.pi)
+        assert np.min(np.abs(below / bounce - 1.0)) < 0.10
+        assert np.isfinite(m["mesh_force/max_lwa_dBA"]) and m["checks"]
+    finally:
+        unc._STATE.clear()
+        unc._STATE.update(saved_state)
+        unc._MOUNT.clear()
+        unc._MOUNT.update(saved_mount)
+
+
+def json_list(override):
+    import json
+
+    return json.loads(override.split("=", 1)[1])
 
 
 @pytest.fixture(scope="module")
@@ -121,6 +244,8 @@ def test_zero_width_ranges_give_the_deterministic_run(serial, tmp_path):
     (["--family", "gears"], "--family gears: unknown"),
     (["--samples-per-process", "0"], "--samples-per-process: 0: must be >= 1"),
     (["--range", "radiation=numerical"], "--range radiation: numerical: not a radiation model of the scene"),
+    (["--range", "mount_stiffness_N_per_m=0:1e9"], "--range mount_stiffness_N_per_m: 0: must be > 0"),
+    (["--range", "mount_stiffness_N_per_m=-1e9"], "--range mount_stiffness_N_per_m: -1e+09: must be > 0"),
 ])
 def test_bad_input_is_one_line_and_no_folder(tmp_path, args, message):
     out = tmp_path / "u"
