@@ -342,10 +342,8 @@ _MOUNT: dict = {}
 
 @functools.lru_cache(maxsize=16)
 def _support_of(scene_name: str, overrides: tuple) -> tuple:
-    """(the run-up scene's housing.set, the housing's supports.0 surface, its area m^2) of a scene with --set
-    `overrides`; InputError naming the housing scene when it has no support or no block model."""
-    from housingfe.geometry.registry import block_model_for, own_mesh_kind
-    from housingfe.geometry.surfaces import named_surfaces
+    """(the run-up scene's housing.set, the housing's supports.0 surface) of a scene with --set `overrides`;
+    InputError naming the housing scene when it has no support."""
     from housingfe.runup.scene import load_runup_scene
     from housingfe.scene import load_housing_scene
 
@@ -353,27 +351,21 @@ def _support_of(scene_name: str, overrides: tuple) -> tuple:
     housing, hpath = load_housing_scene(scene.housing.scene, list(scene.housing.set))
     if not housing.supports:
         raise InputError(f"{hpath}: supports: none; --range {MOUNT} puts supports.0 on an elastic frame")
-    surface = housing.supports[0].surface
-    if own_mesh_kind(housing.geometry) is not None:
-        raise InputError(f"{hpath}: geometry.kind {housing.geometry.kind!r}: --range {MOUNT} needs the area of "
-                         f"supports.0 ({surface}) from a block model")
-    area = named_surfaces(block_model_for(housing.geometry)).get(surface)
-    if area is None or area.area <= 0.0:
-        raise InputError(f"{hpath}: supports.0.surface {surface!r}: not a named surface with an area (--range {MOUNT})")
-    return tuple(scene.housing.set), surface, float(area.area)
+    return tuple(scene.housing.set), housing.supports[0].surface
 
 
 def mount_overrides(scene_name: str, overrides: tuple, stiffness: float) -> tuple:
     """The run-up scene's --set `overrides` plus one `housing.set` that stands the housing on an elastic frame of
     total vertical stiffness `stiffness` (N/m): the housing's supports.0 (test-gearbox: foot_bottom, 0.0735 m^2)
-    made elastic with k_n = stiffness / its area (N/m^3) and k_t = k_n / 3 (MOUNT_TANGENTIAL_RATIO), appended to
-    the scene's own housing.set so that e.g. a coarser mesh given there stays.  As `housing_sets` of
-    benchmarks/experiments/frame_mount/frame_mount.py.  InputError (one line) when the housing has no support or
-    its area is not known without meshing."""
-    own, _, area = _support_of(scene_name, tuple(overrides))
-    kn = float(stiffness) / area
-    sets = list(own) + ["supports.0.kind=elastic", f"supports.0.normal_stiffness={kn!r}",
-                        f"supports.0.tangential_stiffness={kn * MOUNT_TANGENTIAL_RATIO!r}"]
+    made elastic with total_normal_stiffness = stiffness and total_tangential_stiffness = stiffness / 3
+    (MOUNT_TANGENTIAL_RATIO), which the model spreads over the surface's area on the mesh (so an imported housing
+    stands on a frame too), appended to the scene's own housing.set so that e.g. a coarser mesh given there stays.
+    The same springs as `housing_sets` of benchmarks/experiments/frame_mount/frame_mount.py (there per unit area,
+    K_v / 0.0735 m^2).  InputError (one line) when the housing has no support."""
+    own, _ = _support_of(scene_name, tuple(overrides))
+    kv = float(stiffness)
+    sets = list(own) + ["supports.0.kind=elastic", f"supports.0.total_normal_stiffness={kv!r}",
+                        f"supports.0.total_tangential_stiffness={kv * MOUNT_TANGENTIAL_RATIO!r}"]
     return tuple(overrides) + (f"housing.set={json.dumps(sets)}",)
 
 

@@ -156,7 +156,7 @@ def test_a_sample_with_a_mount_runs_on_the_housing_on_that_frame():
     gearbox's six rigid-body modes on the frame: below 160 Hz (frame_mount, default mesh: 48-146 Hz; the fixed
     feet's lowest mode apart from the drive line's torsion at 76 Hz is 212 Hz), the bounce within 10 % of the
     rigid mass on a spring, sqrt(K_v / m) / 2 pi with m = 169.4 kg (the coupled gearbox, frame_mount README);
-    k_n = K_v / 0.0735 m^2, the two feet of 0.075 x 0.490 m.  Coarsest mesh (80 mm), lines to 600 Hz."""
+    K_v spread by the model over the two feet of 0.075 x 0.490 m.  Coarsest mesh (80 mm), lines to 600 Hz."""
     from housingfe.runup.scene import load_runup_scene
 
     overrides = ('housing.set=["mesh.size=0.08"]', "runup.f_max_hz=600", "runup.speed_min_rpm=250",
@@ -167,9 +167,8 @@ def test_a_sample_with_a_mount_runs_on_the_housing_on_that_frame():
     mounted = unc.mount_overrides("test-gearbox-runup", overrides, kv)
     sets = json_list(mounted[-1])            # the scene's own housing.set stays, then supports.0 on the bed
     assert sets[:2] == ["mesh.size=0.08", "supports.0.kind=elastic"]
-    kn = kv / (2 * 0.075 * 0.490)
-    assert float(sets[2].removeprefix("supports.0.normal_stiffness=")) == pytest.approx(kn, rel=1e-12)
-    assert float(sets[3].removeprefix("supports.0.tangential_stiffness=")) == pytest.approx(kn / 3, rel=1e-12)
+    assert float(sets[2].removeprefix("supports.0.total_normal_stiffness=")) == pytest.approx(kv, rel=1e-12)
+    assert float(sets[3].removeprefix("supports.0.total_tangential_stiffness=")) == pytest.approx(kv / 3, rel=1e-12)
     saved_state, saved_mount = dict(unc._STATE), dict(unc._MOUNT)
     try:
         m = unc.evaluate_sample("test-gearbox-runup", overrides, values, ())
