@@ -387,22 +387,28 @@ def _mount_pool(stiffness: float, comm):
         if _MOUNT:
             import gc
 
-            from housingfe.drivetrain.coupling import release_petsc_garbage
+            from housingfe.drivetrain.coupling import release_fe_garbage, release_petsc_garbage
 
             # PETSc parks dropped objects per communicator (release_petsc_garbage) and the housing's matrices live
             # on its mesh's own (duplicated) communicator, which the next mount's coupling never cleans: without
-            # this every mount left its housing model and bases behind (~200 MB per sample, coarse mesh)
-            comms = []
+            # this every mount left its housing model and bases behind (~200 MB per sample, coarse mesh); its
+            # housing fields on yet another one, its function space's (release_fe_garbage: ~6-12 MB per basis)
+            comms, spaces = [], []
             for key in _MOUNT["keys"]:
                 base = _STATE.pop(key, None)
                 if base is not None and base.session.housing_model is not None:
                     comms.append(base.session.housing_model.K.getComm())
+                    spaces.append(base.session.housing_model.V)
                 del base
             _MOUNT.clear()
             gc.collect()
             for c in comms:
                 release_petsc_garbage(c)
             release_petsc_garbage(comm)
+            for V in spaces:
+                release_fe_garbage(V)
+            del spaces
+            gc.collect()
         _MOUNT.update({"value": stiffness, "pool": ModelPool(), "keys": set()})
     return _MOUNT["pool"]
 
