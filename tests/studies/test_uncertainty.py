@@ -128,30 +128,34 @@ def test_the_mount_is_opt_in():
     assert [s[unc.MOUNT] for s in fixed] == [3e8] * 3
 
 
-def test_a_mount_drops_the_previous_mounts_bases():
+@pytest.fixture
+def process_cache():
+    """The process's cache of bases (`_STATE`) and of the current mount (`_MOUNT`), restored after the test."""
+    saved_state, saved_mount = dict(unc._STATE), dict(unc._MOUNT)
+    yield
+    unc._STATE.clear()
+    unc._STATE.update(saved_state)
+    unc._MOUNT.clear()
+    unc._MOUNT.update(saved_mount)
+
+
+def test_a_mount_drops_the_previous_mounts_bases(process_cache):
     """A process holds the bases of one mount at a time: a sample of another mount value drops them first (no
     FE here: the state is the process's cache)."""
+    from types import SimpleNamespace
+
     from mpi4py import MPI
 
-    saved_state, saved_mount = dict(unc._STATE), dict(unc._MOUNT)
-    try:
-        unc._MOUNT.clear()
-        pool = unc._mount_pool(1e9, MPI.COMM_SELF)
-        from types import SimpleNamespace
-
-        unc._STATE["mount-1e9"] = SimpleNamespace(session=SimpleNamespace(housing_model=None))   # not built
-        unc._MOUNT["keys"].add("mount-1e9")
-        assert unc._mount_pool(1e9, MPI.COMM_SELF) is pool and "mount-1e9" in unc._STATE      # same mount: kept
-        other = unc._mount_pool(3e8, MPI.COMM_SELF)
-        assert other is not pool and "mount-1e9" not in unc._STATE and unc._MOUNT["keys"] == set()
-    finally:
-        unc._STATE.clear()
-        unc._STATE.update(saved_state)
-        unc._MOUNT.clear()
-        unc._MOUNT.update(saved_mount)
+    unc._MOUNT.clear()
+    pool = unc._mount_pool(1e9, MPI.COMM_SELF)
+    unc._STATE["mount-1e9"] = SimpleNamespace(session=SimpleNamespace(housing_model=None))   # not built
+    unc._MOUNT["keys"].add("mount-1e9")
+    assert unc._mount_pool(1e9, MPI.COMM_SELF) is pool and "mount-1e9" in unc._STATE      # same mount: kept
+    other = unc._mount_pool(3e8, MPI.COMM_SELF)
+    assert other is not pool and "mount-1e9" not in unc._STATE and unc._MOUNT["keys"] == set()
 
 
-def test_a_mount_frees_its_dropped_housing_fields(capfd):
+def test_a_mount_frees_its_dropped_housing_fields(capfd, process_cache):
     """Dropping a mount's bases frees the housing fields they dropped last (release_fe_garbage): dolfinx 0.5.2
     makes them on its IndexMap's own communicator, which no other cleanup reaches; before, each rebuilt base left
     them (~12 MB per base on the 80 mm test gearbox mesh).  A small block's field stands in for a basis'."""
@@ -172,7 +176,6 @@ def test_a_mount_frees_its_dropped_housing_fields(capfd):
     del field_vector
     gc.collect()
     assert garbage_entries(comm, capfd) == 1
-    saved_state, saved_mount = dict(unc._STATE), dict(unc._MOUNT)
     try:
         unc._MOUNT.clear()
         unc._mount_pool(1e9, MPI.COMM_SELF)
@@ -182,14 +185,10 @@ def test_a_mount_frees_its_dropped_housing_fields(capfd):
         unc._mount_pool(3e8, MPI.COMM_SELF)          # another mount: drops the bases and frees their fields
         assert garbage_entries(comm, capfd) == 0
     finally:
-        unc._STATE.clear()
-        unc._STATE.update(saved_state)
-        unc._MOUNT.clear()
-        unc._MOUNT.update(saved_mount)
         held.destroy()
 
 
-def test_a_sample_with_a_mount_runs_on_the_housing_on_that_frame():
+def test_a_sample_with_a_mount_runs_on_the_housing_on_that_frame(process_cache):
     """A sample with K_v = 1e8 N/m runs on a housing model and basis of its own whose lowest modes are the
     gearbox's six rigid-body modes on the frame: below 160 Hz (frame_mount, default mesh: 48-146 Hz; the fixed
     feet's lowest mode apart from the drive line's torsion at 76 Hz is 212 Hz), the bounce within 10 % of the
@@ -207,24 +206,17 @@ def test_a_sample_with_a_mount_runs_on_the_housing_on_that_frame():
     assert sets[:2] == ["mesh.size=0.08", "supports.0.kind=elastic"]
     assert float(sets[2].removeprefix("supports.0.total_normal_stiffness=")) == pytest.approx(kv, rel=1e-12)
     assert float(sets[3].removeprefix("supports.0.total_tangential_stiffness=")) == pytest.approx(kv / 3, rel=1e-12)
-    saved_state, saved_mount = dict(unc._STATE), dict(unc._MOUNT)
-    try:
-        m = unc.evaluate_sample("test-gearbox-runup", overrides, values, ())
-        assert m["mount"] and m["setup_s"] > 0                   # its own base, built for the sample
-        assert len(unc._MOUNT["keys"]) == 1
-        base = unc._STATE[next(iter(unc._MOUNT["keys"]))]
-        assert base.session.scene.housing.set == list(json_list(mounted[-1]))
-        f = np.asarray(base.model.basis.frequencies_hz)
-        below = f[f < 160.0]
-        assert len(below) == 7 and below[0] < 60.0              # six mount modes and the drive line's torsion
-        bounce = math.sqrt(kv / 169.4) / (2 * math.pi)
-        assert np.min(np.abs(below / bounce - 1.0)) < 0.10
-        assert np.isfinite(m["mesh_force/max_lwa_dBA"]) and m["checks"]
-    finally:
-        unc._STATE.clear()
-        unc._STATE.update(saved_state)
-        unc._MOUNT.clear()
-        unc._MOUNT.update(saved_mount)
+    m = unc.evaluate_sample("test-gearbox-runup", overrides, values, ())
+    assert m["mount"] and m["setup_s"] > 0                   # its own base, built for the sample
+    assert len(unc._MOUNT["keys"]) == 1
+    base = unc._STATE[next(iter(unc._MOUNT["keys"]))]
+    assert base.session.scene.housing.set == list(json_list(mounted[-1]))
+    f = np.asarray(base.model.basis.frequencies_hz)
+    below = f[f < 160.0]
+    assert len(below) == 7 and below[0] < 60.0              # six mount modes and the drive line's torsion
+    bounce = math.sqrt(kv / 169.4) / (2 * math.pi)
+    assert np.min(np.abs(below / bounce - 1.0)) < 0.10
+    assert np.isfinite(m["mesh_force/max_lwa_dBA"]) and m["checks"]
 
 
 def json_list(override):
