@@ -333,6 +333,247 @@ def write_modes(cases, mesh) -> None:
         print(r)
 
 
+# ------------------------------------------------------------------------------------------------ probe (why C raises
+# the higher harmonics on the mount): the run-up's own model, the films' C changed on the reduced system only
+def probe_model(case: str, mesh: str):
+    """(scene spec, the run-up's coupled model following the speeds, the source) of the films' run (K made
+    symmetric, C as computed: `patch(1, "sym")`), built as `housingfe run` builds it (housingfe.runup.scene
+    .run_scene: one torque, 2000 N m)."""
+    from mpi4py import MPI
+
+    from housingfe.runup.chain import build_gearbox_model, follow_speeds
+    from housingfe.runup.scene import (
+        _source,
+        drivetrain_of,
+        housing_model_for,
+        load_runup_scene,
+        matched_drivetrains,
+    )
+    from housingfe.scene import load_housing_scene
+
+    patch(1.0, "sym")
+    over = fm.runup_overrides(case, mesh) + ["drivetrain.bearings=fluid_film", "runup.torques_nm=[2000.0]",
+                                             "runup.speed_min_rpm=800.0"]
+    scene, path = load_runup_scene(SCENE, over)
+    spec = scene.runup
+    hs, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
+    dts = {2000.0: drivetrain_of(scene.drivetrain, 2000.0, spec.drive_line_model)}
+    model = housing_model_for(hs, spec.f_max_hz, MPI.COMM_WORLD)
+    dts, _ = matched_drivetrains(scene.housing, model, dts, path)
+    gm = build_gearbox_model(model, dts[2000.0], spec.f_max_hz, damping_ratio=spec.damping_ratio,
+                             basis_factor=spec.basis_factor)
+    source = _source(dts[2000.0], spec, spec.misalignment_model)
+    source.adopt(source.prepared(spec.torques_nm))
+    return spec, follow_speeds(gm, spec.speeds), source
+
+
+def film_damping(m, select=None) -> np.ndarray:
+    """The films' C projected on the Ritz vectors of speed model m: sum over the bearings of X_e^T C_e X_e (N s/m
+    in Ritz coordinates; X_e the vectors' rows at the element's nodes).  select(element, i, j) -> bool keeps
+    entry (i, j) of C_e (default all)."""
+    from housingfe.runup.chain import _node_rows
+
+    els = m.structure.parts.bearings
+    rows = _node_rows(m.structure, m.reduction.vectors, sorted({n for e in els for n in e.nodes}))
+    n = len(m.reduction.vectors)
+    out = np.zeros((n, n))
+    for e in els:
+        if e.C is None:
+            continue
+        X = np.vstack([rows[node] for node in e.nodes])
+        Ce = np.array(e.C, float)
+        if select is not None:
+            Ce = Ce * np.array([[select(e, i, j) for j in range(Ce.shape[1])] for i in range(Ce.shape[0])], float)
+        out += X.T @ Ce @ X
+    return out
+
+
+def variant(m, change):
+    """The model following the speeds with each speed model's reduced C replaced: change(speed model, Cr) -> new
+    Cr (N s/m in Ritz coordinates; Cr the film's C as the run has it, the modal D stays)."""
+    from dataclasses import replace
+
+    done = {}
+    sm = {}
+    for s, mv in m.speed_models.items():
+        if id(mv) not in done:
+            Cr = mv.reduction.system.Cr
+            done[id(mv)] = replace(mv, reduction=mv.reduction.with_change(np.zeros_like(Cr), change(mv, Cr) - Cr))
+        sm[s] = done[id(mv)]
+    return replace(m, speed_models=sm)
+
+
+def solve_lines(m, lines, make) -> dict:
+    """Both routes on every line of `lines`, each line solved on its speed's reduced system with (K, C) =
+    make(speed model, omega rad/s, its ReducedSystem) in place of (Kr, Cr) (the modal D stays):
+    (Kr' + i omega (Cr' + D) - omega^2 Mr) c = Fr.  Returns per line (dB): Lv_tf = the source's L_omega + TF_omega
+    (eq. 5.5), Lv_unit and Lw_unit (housing L_v and the wheel's L_omega under the route's 1 N m: TF_omega =
+    Lv_unit - Lw_unit), Lv_mf (the mesh_force route: lines' mesh excitation and shuttling moment)."""
+    import math
+
+    from housingfe.runup.chain import _wheel_omega_level
+
+    red = m.reduction
+    f, sp = lines.frequency, lines.speed
+    amps = lines.mesh_amplitudes()
+    n = len(red.vectors)
+    cu, cm = np.zeros((n, len(f)), complex), np.zeros((n, len(f)), complex)
+    for i in range(len(f)):
+        mv = m.at_speed(sp[i])
+        s, names = mv.reduction.system, mv.reduction.names
+        w = 2 * math.pi * f[i]
+        K, C = make(mv, w, s)
+        Z = K + 1j * w * (C + s.D) - w * w * s.Mr
+        F = sum(s.Fr[:, names.index(k)] * (a[i] if np.ndim(a) else a) for k, a in amps.items())
+        sol = np.linalg.solve(Z, np.column_stack([s.Fr[:, names.index("wheel_torque")], F]))
+        cu[:, i], cm[:, i] = sol[:, 0], sol[:, 1]
+    ru, rm = red.response_of(f, cu), red.response_of(f, cm)
+    Lvu, Lwu = ru.velocity_level_db, _wheel_omega_level(m, ru, f)
+    return {"Lv_tf": lines.L_omega + Lvu - Lwu, "Lv_unit": Lvu, "Lw_unit": Lwu, "Lv_mf": rm.velocity_level_db}
+
+
+def line_energy(lines, values, n) -> float:
+    """10 lg sum over 800-1500 rpm of 10^((value + A(f))/10) on harmonic n: for L_v the line's L_WA energy up to
+    the constant L_S (sigma = 1), the measure of film_mount_harmonics.csv (dB)."""
+    from housingfe import levels
+
+    sel = (lines.harmonic == n) & (lines.speed >= MEAN_RPM[0]) & (lines.speed <= MEAN_RPM[1])
+    return energy_db(np.asarray(values)[sel] + levels.a_weighting_db(lines.frequency[sel]))
+
+
+def _is_pinion(e, i, j):
+    return e.nodes[0].startswith("pinion")
+
+
+def _is_wheel(e, i, j):
+    return e.nodes[0].startswith("wheel")
+
+
+def _translations(e, i, j):
+    return i % 6 < 3 and j % 6 < 3
+
+
+def _tilts(e, i, j):
+    return i % 6 >= 3 and j % 6 >= 3
+
+
+def _modal_diagonal(mv, w, s):
+    """The films' C as a proportional damping: only the diagonal of Y^T Cr Y on the reduced system's undamped modes
+    Y (mass-normalised), back in Ritz coordinates: Ms Y diag(Y^T Cr Y) Y^T Ms."""
+    MY = 0.5 * (s.Mr + s.Mr.T) @ s.Y
+    return s.Kr, (MY * np.diag(s.Y.T @ s.Cr @ s.Y)) @ MY.T
+
+
+def probe_variants() -> dict:
+    """{name: make(speed model, omega, ReducedSystem) -> (K, C)}: the films' C (Cr, the films only: checked in
+    `probe`) changed on the reduced system, one change each; "c0" is the reference."""
+    import math
+
+    memo = {}
+
+    def part(select):
+        def make(mv, w, s):
+            key = (id(mv), select.__name__)
+            if key not in memo:
+                memo[key] = film_damping(mv, select)
+            return s.Kr, memo[key]
+        return make
+
+    return {
+        "c1 (C as computed)": lambda mv, w, s: (s.Kr, s.Cr),
+        "c0 (no C)": lambda mv, w, s: (s.Kr, 0 * s.Cr),
+        "C replaced by the stiffness omega C (no loss)": lambda mv, w, s: (s.Kr + w * s.Cr, 0 * s.Cr),
+        "C x 0.25": lambda mv, w, s: (s.Kr, 0.25 * s.Cr),
+        "C x 4": lambda mv, w, s: (s.Kr, 4 * s.Cr),
+        "C x 20": lambda mv, w, s: (s.Kr, 20 * s.Cr),
+        "C only on lines below 1 kHz": lambda mv, w, s: (s.Kr, s.Cr if w < 2 * math.pi * 1000 else 0 * s.Cr),
+        "C only on lines above 1 kHz": lambda mv, w, s: (s.Kr, s.Cr if w >= 2 * math.pi * 1000 else 0 * s.Cr),
+        "C diagonal on the undamped modes (no modal coupling)": _modal_diagonal,
+        "C translations only": part(_translations),
+        "C tilts only": part(_tilts),
+        "C pinion bearings only": part(_is_pinion),
+        "C wheel bearings only": part(_is_wheel),
+    }
+
+
+def probe_rows(case: str, mesh: str) -> list[dict]:
+    """Why C raises the higher harmonics on the mount: per variant (`probe_variants`; plus the excitation of the
+    no-C model on the C model, and the films held at 1500 rpm for every line), route and harmonic n the line's
+    L_WA energy 800-1500 rpm (sigma = 1, up to the constant L_S) and its change against no C; for tf_omega also the
+    changes of TF_omega's parts (housing L_v and wheel L_omega under 1 N m), for mesh_force of L_F."""
+    import time
+    from dataclasses import replace
+
+    from housingfe import levels
+    from housingfe.runup.chain import run_source
+
+    t0 = time.perf_counter()
+    spec, m, source = probe_model(case, mesh)
+    mv = m.at_speed(1500.0)
+    err = np.linalg.norm(mv.reduction.system.Cr - film_damping(mv)) / np.linalg.norm(mv.reduction.system.Cr)
+    if err > 1e-10:
+        raise SystemExit(f"film_mount probe: the reduced C is not the films' alone (rel. difference {err:.1e})")
+    t_build = time.perf_counter() - t0
+
+    def source_lines(model):
+        return run_source(model, source, spec.speeds, [2000.0], spec.f_max_hz, spec.source_receptance,
+                          spec.mesh_moment_model, spec.mesh_friction)[0]
+
+    variants = probe_variants()
+    m0 = variant(m, lambda mv, Cr: 0 * Cr)
+    lines1, lines0 = source_lines(m), source_lines(m0)
+    res = {k: (lines1, solve_lines(m, lines1, make)) for k, make in variants.items()}
+    res["c1 with the excitation of c0 (coupled source without C)"] = (lines0, solve_lines(
+        m, lines0, variants["c1 (C as computed)"]))
+    fixed = replace(m, speed_models={s: m.at_speed(1500.0) for s in m.speed_models})
+    lf = source_lines(fixed)
+    for c in (1, 0):
+        res[f"c{c}, films at 1500 rpm for every line"] = (lf, solve_lines(fixed, lf, variants[
+            "c1 (C as computed)" if c else "c0 (no C)"]))
+    L_F = {1: levels.level(np.abs(lines1.mesh_excitation) ** 2, levels.F0),
+           0: levels.level(np.abs(lines0.mesh_excitation) ** 2, levels.F0)}
+    rows = []
+    for name, (ln, q) in res.items():
+        ref_ln, ref = res["c0, films at 1500 rpm for every line" if "1500 rpm" in name else "c0 (no C)"]
+        for route, key in (("tf_omega", "Lv_tf"), ("mesh_force", "Lv_mf")):
+            for n in range(1, 6):
+                e, e0 = line_energy(ln, q[key], n), line_energy(ref_ln, ref[key], n)
+                row = {"mesh": mesh, "case": case, "variant": name, "route": route, "harmonic": n,
+                       "LwA_energy_minus_LS_dB": round(e, 2), "delta_vs_no_C_dB": round(e - e0, 2)}
+                if route == "tf_omega":
+                    for k in ("Lv_unit", "Lw_unit"):
+                        row[f"d_{k}_dB"] = round(line_energy(ln, q[k], n) - line_energy(ref_ln, ref[k], n), 2)
+                    row["d_L_F_dB"] = ""
+                else:
+                    row["d_Lv_unit_dB"] = row["d_Lw_unit_dB"] = ""
+                    row["d_L_F_dB"] = (round(line_energy(lines1, L_F[1], n) - line_energy(lines0, L_F[0], n), 2)
+                                       if name == "c1 (C as computed)" else "")
+                rows.append(row)
+    wall = time.perf_counter() - t0
+    print(f"probe {case} {mesh}: model {t_build:.1f} s, total {wall:.1f} s")
+    return rows
+
+
+def write_probe(cases, mesh) -> None:
+    path = HERE / "film_mount_probe.csv"
+    old = []
+    if path.is_file():
+        with open(path) as fh:
+            old = [r for r in csv.DictReader(fh) if not (r["mesh"] == mesh and r["case"] in cases)]
+    rows = old + [r for c in cases for r in probe_rows(c, mesh)]
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[-1]))
+        w.writeheader()
+        w.writerows(rows)
+    for c in cases:
+        for route in ("tf_omega", "mesh_force"):
+            print(f"{c} {route}: change against no C, n = 1..5 (dB)")
+            for v in dict.fromkeys(r["variant"] for r in rows):
+                d = [r["delta_vs_no_C_dB"] for r in rows if r["case"] == c and r["route"] == route
+                     and r["variant"] == v and r["mesh"] == mesh]
+                print(f"  {v:58s} " + " ".join(f"{float(x):+6.2f}" for x in d))
+
+
 # ------------------------------------------------------------------------------------------------ plot
 DECOMPOSITION = (("stiffness: the films' K (made symmetric), no C", "c0_sym", None),
                  ("film damping C (on the symmetric K)", "c1_sym", "c0_sym"),
@@ -451,6 +692,9 @@ def main() -> None:
     sub.add_parser("table")
     pl = sub.add_parser("plot")
     pl.add_argument("--mesh", default="default", choices=tuple(fm.MESHES))
+    pr = sub.add_parser("probe")
+    pr.add_argument("--case", nargs="+", default=["fixed", "1e9"])
+    pr.add_argument("--mesh", default="default", choices=tuple(fm.MESHES))
     m = sub.add_parser("modes")
     m.add_argument("--case", nargs="+", default=["fixed", "1e9"])
     m.add_argument("--mesh", default="coarse", choices=tuple(fm.MESHES))
@@ -461,6 +705,8 @@ def main() -> None:
         plot(a.mesh)
     elif a.cmd == "modes":
         write_modes(a.case, a.mesh)
+    elif a.cmd == "probe":
+        write_probe(a.case, a.mesh)
     if a.cmd == "run":
         run(a.case, a.bearings, a.mesh, a.c_scale, a.k_mode, a.radiation, a.moment, a.speed_min)
 
