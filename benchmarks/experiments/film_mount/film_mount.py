@@ -21,6 +21,8 @@ Usage (PYTHONPATH=$PWD, from the worktree; README.md has the runs made):
   python benchmarks/experiments/film_mount/film_mount.py table        # film_mount.csv, film_mount_harmonics.csv
   python benchmarks/experiments/film_mount/film_mount.py modes --mesh default   # film_mount_modes.csv
   python benchmarks/experiments/film_mount/film_mount.py plot         # film_mount.png
+  python benchmarks/experiments/film_mount/film_mount.py probe --case 1e9 fixed   # film_mount_probe.csv: C changed
+      per line on the run-up's own reduced systems (why C raises the higher harmonics on the mount)
 Run folders: /tmp/film-mount-runs/<label>/ (FILM_MOUNT_RUNS moves them).
 """
 from __future__ import annotations
