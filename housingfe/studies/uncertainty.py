@@ -387,26 +387,34 @@ def _mount_pool(stiffness: float, comm):
         if _MOUNT:
             import gc
 
-            from housingfe.drivetrain.coupling import release_fe_garbage, release_petsc_garbage
+            from housingfe.drivetrain import coupling
 
             # PETSc parks dropped objects per communicator (release_petsc_garbage) and the housing's matrices live
             # on its mesh's own (duplicated) communicator, which the next mount's coupling never cleans: without
             # this every mount left its housing model and bases behind (~200 MB per sample, coarse mesh); its
-            # housing fields on yet another one, its function space's (release_fe_garbage: ~6-12 MB per basis)
-            comms, spaces = [], []
-            for key in _MOUNT["keys"]:
+            # housing fields on yet another one, its function space's (release_fe_garbage: ~6-12 MB per basis).
+            # Two scenes of a mount (--family all) share one housing model (ModelPool): each model is cleaned once,
+            # through a probe that keeps its communicator alive (the K's own handle dangles once the cleanup has
+            # freed the last object on it: cleaning through it twice segfaulted), in the same order on every rank
+            # (the cleanups are collective; a set's order is not).
+            probes, spaces, seen = [], [], set()
+            for key in sorted(_MOUNT["keys"]):
                 base = _STATE.pop(key, None)
-                if base is not None and base.session.housing_model is not None:
-                    comms.append(base.session.housing_model.K.getComm())
-                    spaces.append(base.session.housing_model.V)
-                del base
+                model = None if base is None else base.session.housing_model
+                if model is not None and id(model) not in seen:
+                    seen.add(id(model))
+                    probes.append(coupling.hold_petsc_comm(model.K.getComm()))
+                    spaces.append(model.V)
+                del base, model
             _MOUNT.clear()
             gc.collect()
-            for c in comms:
-                release_petsc_garbage(c)
-            release_petsc_garbage(comm)
+            for probe in probes:
+                coupling.release_petsc_garbage(probe.getComm())
+                probe.destroy()
+            del probes
+            coupling.release_petsc_garbage(comm)
             for V in spaces:
-                release_fe_garbage(V)
+                coupling.release_fe_garbage(V)
             del spaces
             gc.collect()
         _MOUNT.update({"value": stiffness, "pool": ModelPool(), "keys": set()})
