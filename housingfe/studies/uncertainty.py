@@ -1014,16 +1014,39 @@ class UncertaintyResult:
         return rows
 
 
+# s an mpi4py.futures pool may take to start its workers (spawned Python processes importing mpi4py: ~1-2 s here)
+POOL_START_S = 120.0
+
+
 def _executor(engine: str, workers: int):
     if engine == "mpi":
         from mpi4py.futures import MPIPoolExecutor
 
         # a singleton MPI process has one slot: spawning more needs oversubscription (Open MPI 4)
-        return MPIPoolExecutor(max_workers=workers, mpi_info={"map_by": ":OVERSUBSCRIBE"})
+        return _started(MPIPoolExecutor(max_workers=workers, mpi_info={"map_by": ":OVERSUBSCRIBE"}), workers)
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+
+
+def _started(ex, workers: int):
+    """The mpi4py.futures pool `ex` once its workers answer (they are spawned together, so one answer means all
+    are up); PoolStartError if they do not within POOL_START_S.  A worker that cannot be executed, exits at once
+    or never calls MPI_Init left the command waiting for ever (2026-11-27: mpi4py 3.1.4, Open MPI 4), the pool's
+    thread blocked in MPI_Comm_spawn; one such hang was seen at spawn (docs/uncertainty.md)."""
+    import concurrent.futures
+    import os
+
+    from housingfe.errors import PoolStartError
+
+    try:
+        ex.submit(os.getpid).result(timeout=POOL_START_S)
+    except concurrent.futures.TimeoutError:
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise PoolStartError(f"uncertainty: the mpi4py.futures pool of {workers} worker(s) did not start within "
+                             f"{POOL_START_S:g} s (MPI_Comm_spawn); try --engine processes") from None
+    return ex
 
 
 def check_request(n_samples, seed, workers, families, engine) -> None:

@@ -459,3 +459,50 @@ def test_all_families_give_every_check_row_a_band(tmp_path):
     assert texts["28.variants.ranking.rollers_vs_fluid_films.mean.tf_omega"] in (
         "passes in 0/1 samples", "passes in 1/1 samples")
     assert texts["28.excitation.envelope.A"].startswith("no sampled input acts on this")
+
+
+NEVER_STARTS = """
+import sys
+
+from mpi4py.futures import MPIPoolExecutor
+
+from housingfe.cli import main
+from housingfe.studies import uncertainty as unc
+
+# workers that never call MPI_Init (a "python" that sleeps): the spawn never returns
+unc.POOL_START_S = 3.0
+started = unc._started
+unc._executor = lambda engine, workers: started(
+    MPIPoolExecutor(max_workers=workers, python_exe=sys.argv[1], mpi_info={"map_by": ":OVERSUBSCRIBE"}), workers)
+raise SystemExit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.mpi
+def test_a_pool_that_never_starts_stops_with_one_line(tmp_path):
+    """An mpi4py.futures pool whose workers never start (here a worker "python" that only sleeps) left the command
+    waiting for ever, and even past a time-out the process could not end (its pool thread blocked in
+    MPI_Comm_spawn; 2026-11-27).  Now: after POOL_START_S one error line, exit 2, no result folder, the process
+    gone within seconds."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    fake = tmp_path / "sleeping-python"
+    fake.write_text("#!/bin/sh\nexec sleep 20\n")
+    fake.chmod(0o755)
+    out = tmp_path / "never"
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    t0 = time.monotonic()
+    proc = subprocess.run([sys.executable, "-c", NEVER_STARTS, str(fake), "uncertainty", "--samples", "2",
+                           "--workers", "2", "--family", "none", "--set", 'housing.set=["mesh.size=0.08"]',
+                           "--out", str(out)], capture_output=True, text=True, env=env, timeout=120)
+    wall = time.monotonic() - t0
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert proc.returncode == 2, proc.stderr
+    assert lines == ["housingfe: error: uncertainty: the mpi4py.futures pool of 2 worker(s) did not start within "
+                     "3 s (MPI_Comm_spawn); try --engine processes"]
+    assert not out.exists()
+    assert wall < 60.0                      # not the sleeping workers' 20 s twice over, nor for ever
