@@ -8,3 +8,8 @@ class InputError(Exception):
 
 class SolverError(Exception):
     """A numerical failure the user must know about (incomplete eigen-solution, singular system)."""
+
+
+class PoolStartError(InputError):
+    """A pool of worker processes that did not start in time (e.g. MPI_Comm_spawn that never returns).  A thread
+    of the pool stays blocked, so the process cannot end normally: the CLI prints the line and ends it at once."""

@@ -395,6 +395,15 @@ def release_petsc_garbage(comm) -> None:
     PETSc.garbage_cleanup(comm)
 
 
+def hold_petsc_comm(comm):
+    """A one-entry-per-rank PETSc vector on `comm` (collective): while it lives, so does PETSc's communicator, and
+    release_petsc_garbage(probe.getComm()) is safe however often it runs; destroy() it after (at once, not parked).
+
+    A handle from obj.getComm() does not keep the communicator: once a garbage cleanup has freed the last object on
+    it PETSc frees the communicator too, and cleaning through the handle again segfaulted (petsc4py 3.18)."""
+    return PETSc.Vec().createMPI((1, PETSc.DECIDE), comm=comm)
+
+
 def release_fe_garbage(V) -> None:
     """Free the dropped PETSc vectors of the FE space V (dolfinx la.create_petsc_vector, fem.Function.vector;
     collective on V's mesh).

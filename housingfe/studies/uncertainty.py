@@ -387,26 +387,34 @@ def _mount_pool(stiffness: float, comm):
         if _MOUNT:
             import gc
 
-            from housingfe.drivetrain.coupling import release_fe_garbage, release_petsc_garbage
+            from housingfe.drivetrain import coupling
 
             # PETSc parks dropped objects per communicator (release_petsc_garbage) and the housing's matrices live
             # on its mesh's own (duplicated) communicator, which the next mount's coupling never cleans: without
             # this every mount left its housing model and bases behind (~200 MB per sample, coarse mesh); its
-            # housing fields on yet another one, its function space's (release_fe_garbage: ~6-12 MB per basis)
-            comms, spaces = [], []
-            for key in _MOUNT["keys"]:
+            # housing fields on yet another one, its function space's (release_fe_garbage: ~6-12 MB per basis).
+            # Two scenes of a mount (--family all) share one housing model (ModelPool): each model is cleaned once,
+            # through a probe that keeps its communicator alive (the K's own handle dangles once the cleanup has
+            # freed the last object on it: cleaning through it twice segfaulted), in the same order on every rank
+            # (the cleanups are collective; a set's order is not).
+            probes, spaces, seen = [], [], set()
+            for key in sorted(_MOUNT["keys"]):
                 base = _STATE.pop(key, None)
-                if base is not None and base.session.housing_model is not None:
-                    comms.append(base.session.housing_model.K.getComm())
-                    spaces.append(base.session.housing_model.V)
-                del base
+                model = None if base is None else base.session.housing_model
+                if model is not None and id(model) not in seen:
+                    seen.add(id(model))
+                    probes.append(coupling.hold_petsc_comm(model.K.getComm()))
+                    spaces.append(model.V)
+                del base, model
             _MOUNT.clear()
             gc.collect()
-            for c in comms:
-                release_petsc_garbage(c)
-            release_petsc_garbage(comm)
+            for probe in probes:
+                coupling.release_petsc_garbage(probe.getComm())
+                probe.destroy()
+            del probes
+            coupling.release_petsc_garbage(comm)
             for V in spaces:
-                release_fe_garbage(V)
+                coupling.release_fe_garbage(V)
             del spaces
             gc.collect()
         _MOUNT.update({"value": stiffness, "pool": ModelPool(), "keys": set()})
@@ -1006,16 +1014,39 @@ class UncertaintyResult:
         return rows
 
 
+# s an mpi4py.futures pool may take to start its workers (spawned Python processes importing mpi4py: ~1-2 s here)
+POOL_START_S = 120.0
+
+
 def _executor(engine: str, workers: int):
     if engine == "mpi":
         from mpi4py.futures import MPIPoolExecutor
 
         # a singleton MPI process has one slot: spawning more needs oversubscription (Open MPI 4)
-        return MPIPoolExecutor(max_workers=workers, mpi_info={"map_by": ":OVERSUBSCRIBE"})
+        return _started(MPIPoolExecutor(max_workers=workers, mpi_info={"map_by": ":OVERSUBSCRIBE"}), workers)
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+
+
+def _started(ex, workers: int):
+    """The mpi4py.futures pool `ex` once its workers answer (they are spawned together, so one answer means all
+    are up); PoolStartError if they do not within POOL_START_S.  A worker that cannot be executed, exits at once
+    or never calls MPI_Init left the command waiting for ever (2026-11-27: mpi4py 3.1.4, Open MPI 4), the pool's
+    thread blocked in MPI_Comm_spawn; one such hang was seen at spawn (docs/uncertainty.md)."""
+    import concurrent.futures
+    import os
+
+    from housingfe.errors import PoolStartError
+
+    try:
+        ex.submit(os.getpid).result(timeout=POOL_START_S)
+    except concurrent.futures.TimeoutError:
+        ex.shutdown(wait=False, cancel_futures=True)
+        raise PoolStartError(f"uncertainty: the mpi4py.futures pool of {workers} worker(s) did not start within "
+                             f"{POOL_START_S:g} s (MPI_Comm_spawn); try --engine processes") from None
+    return ex
 
 
 def check_request(n_samples, seed, workers, families, engine) -> None:

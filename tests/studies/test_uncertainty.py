@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 
 import numpy as np
 import pytest
@@ -186,6 +187,67 @@ def test_a_mount_frees_its_dropped_housing_fields(capfd, process_cache):
         assert garbage_entries(comm, capfd) == 0
     finally:
         held.destroy()
+
+
+TWO_SCENES_DROP = """
+import gc
+from types import SimpleNamespace
+
+from dolfinx import fem, la
+from mpi4py import MPI
+from petsc4py import PETSc
+
+from housingfe.scene import build_model_from_scene
+from housingfe.studies import uncertainty as unc
+from tests.drivetrain.test_coupling import block_scene
+
+unc._mount_pool(1e9, MPI.COMM_WORLD)
+for round in range(3):
+    shared, other = (build_model_from_scene(block_scene(E), MPI.COMM_WORLD) for E in (2.1e11, 1.0e11))
+    held = [la.create_petsc_vector(m.V.dofmap.index_map, m.V.dofmap.index_map_bs) for m in (shared, other)]
+    fields = [fem.Function(m.V).vector for m in (shared, other)]
+    del fields
+    gc.collect()
+    for h in held:
+        PETSc.garbage_view(h.getComm())
+    for key, m in (("single helical", shared), ("double helical", shared), ("other", other)):
+        unc._STATE[key] = SimpleNamespace(session=SimpleNamespace(housing_model=m))
+        unc._MOUNT["keys"].add(key)
+    del shared, other, m
+    unc._mount_pool(3e8 + round, MPI.COMM_WORLD)          # the next mount: drops the three bases, two models
+    for h in held:
+        PETSc.garbage_view(h.getComm())
+        h.destroy()
+print("dropped", flush=True)
+"""
+
+
+@pytest.mark.parametrize("ranks", [None, pytest.param(2, marks=pytest.mark.mpi)])
+def test_a_mount_of_two_scenes_sharing_a_housing_model_is_dropped_safely(ranks):
+    """--family all: the single and the double helical scene of a mount share one housing model (ModelPool), so the
+    drop meets it twice.  Cleaning its communicator's garbage twice through K's handle segfaulted at the first drop
+    (2026-11-27: the handle dangles once the first cleanup freed the last object on it); now each model is cleaned
+    once through a probe that keeps the communicator, in the same order on every rank.  Three drops, a subprocess
+    (a segfault must fail this test, not end the session); the housing fields dropped before are freed (garbage
+    list: 1 entry before, 0 after, for each model)."""
+    import os
+    import shutil
+    import subprocess
+    import sys
+
+    cmd = [sys.executable, "-c", TWO_SCENES_DROP]
+    if ranks:
+        if not shutil.which("mpirun"):
+            pytest.skip("mpirun not installed")
+        cmd = [shutil.which("mpirun"), "-n", str(ranks), *cmd]
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
+    assert proc.stdout.count("dropped") == (ranks or 1)
+    entries = [int(n) for n in re.findall(r"Total entries: (\d+)", proc.stdout)]
+    n = 2 * (ranks or 1)                    # garbage_view prints each rank's list of the two models' communicators
+    assert entries == ([1] * n + [0] * n) * 3
 
 
 def test_a_sample_with_a_mount_runs_on_the_housing_on_that_frame(process_cache):
@@ -397,3 +459,50 @@ def test_all_families_give_every_check_row_a_band(tmp_path):
     assert texts["28.variants.ranking.rollers_vs_fluid_films.mean.tf_omega"] in (
         "passes in 0/1 samples", "passes in 1/1 samples")
     assert texts["28.excitation.envelope.A"].startswith("no sampled input acts on this")
+
+
+NEVER_STARTS = """
+import sys
+
+from mpi4py.futures import MPIPoolExecutor
+
+from housingfe.cli import main
+from housingfe.studies import uncertainty as unc
+
+# workers that never call MPI_Init (a "python" that sleeps): the spawn never returns
+unc.POOL_START_S = 3.0
+started = unc._started
+unc._executor = lambda engine, workers: started(
+    MPIPoolExecutor(max_workers=workers, python_exe=sys.argv[1], mpi_info={"map_by": ":OVERSUBSCRIBE"}), workers)
+raise SystemExit(main(sys.argv[2:]))
+"""
+
+
+@pytest.mark.mpi
+def test_a_pool_that_never_starts_stops_with_one_line(tmp_path):
+    """An mpi4py.futures pool whose workers never start (here a worker "python" that only sleeps) left the command
+    waiting for ever, and even past a time-out the process could not end (its pool thread blocked in
+    MPI_Comm_spawn; 2026-11-27).  Now: after POOL_START_S one error line, exit 2, no result folder, the process
+    gone within seconds."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    fake = tmp_path / "sleeping-python"
+    fake.write_text("#!/bin/sh\nexec sleep 20\n")
+    fake.chmod(0o755)
+    out = tmp_path / "never"
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    t0 = time.monotonic()
+    proc = subprocess.run([sys.executable, "-c", NEVER_STARTS, str(fake), "uncertainty", "--samples", "2",
+                           "--workers", "2", "--family", "none", "--set", 'housing.set=["mesh.size=0.08"]',
+                           "--out", str(out)], capture_output=True, text=True, env=env, timeout=120)
+    wall = time.monotonic() - t0
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert proc.returncode == 2, proc.stderr
+    assert lines == ["housingfe: error: uncertainty: the mpi4py.futures pool of 2 worker(s) did not start within "
+                     "3 s (MPI_Comm_spawn); try --engine processes"]
+    assert not out.exists()
+    assert wall < 60.0                      # not the sleeping workers' 20 s twice over, nor for ever
