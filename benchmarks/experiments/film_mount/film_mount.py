@@ -232,24 +232,26 @@ def write_table() -> list[dict]:
 
 
 # ------------------------------------------------------------------------------------------------ modes
-def gearbox_model(case: str, bearings: str, mesh: str):
+def gearbox_model(case: str, bearings: str, mesh: str, extra: tuple = ()):
     """The run-up's coupled gearbox model (2000 N m, bearings at drivetrain.bearing_speed_rpm = 1500 rpm), built as
-    `housingfe run` builds it (frame_mount.coupled_model on the double helical scene)."""
+    `housingfe run` builds it (frame_mount.coupled_model on the double helical scene); with `extra` overrides.
+    Returns (model, scene spec, drivetrain)."""
     from mpi4py import MPI
 
     from housingfe.runup.chain import build_gearbox_model
     from housingfe.runup.scene import drivetrain_of, housing_model_for, load_runup_scene, matched_drivetrains
     from housingfe.scene import load_housing_scene
 
-    over = fm.runup_overrides(case, mesh) + [f"drivetrain.bearings={bearings}", "runup.torques_nm=[2000.0]"]
+    over = fm.runup_overrides(case, mesh) + [f"drivetrain.bearings={bearings}", "runup.torques_nm=[2000.0]", *extra]
     scene, path = load_runup_scene(SCENE, over)
     spec = scene.runup
     hs, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
     dts = {2000.0: drivetrain_of(scene.drivetrain, 2000.0, spec.drive_line_model)}
     model = housing_model_for(hs, spec.f_max_hz, MPI.COMM_WORLD)
     dts, _ = matched_drivetrains(scene.housing, model, dts, path)
-    return build_gearbox_model(model, dts[2000.0], spec.f_max_hz, damping_ratio=spec.damping_ratio,
-                               basis_factor=spec.basis_factor)
+    gm = build_gearbox_model(model, dts[2000.0], spec.f_max_hz, damping_ratio=spec.damping_ratio,
+                             basis_factor=spec.basis_factor)
+    return gm, spec, dts[2000.0]
 
 
 def mode_rows(case: str, mesh: str, f_top: float = 1100.0) -> list[dict]:
@@ -262,7 +264,7 @@ def mode_rows(case: str, mesh: str, f_top: float = 1100.0) -> list[dict]:
 
     rows = []
     for bearings in ("cylindrical_roller", "fluid_film"):
-        gm = gearbox_model(case, bearings, mesh)
+        gm = gearbox_model(case, bearings, mesh)[0]
         st, basis = gm.structure, gm.basis
         n0 = basis.rigid_count
         freqs = np.asarray(basis.frequencies_hz[n0:])
@@ -320,17 +322,22 @@ def stability_rows(gm, case: str, mesh: str, f_top: float = 3000.0) -> list[dict
     return rows
 
 
-def write_modes(cases, mesh) -> None:
-    path = HERE / "film_mount_modes.csv"
+def merge_rows(path: Path, cases, mesh, compute) -> list[dict]:
+    """Rows of `path` for other meshes/cases kept, those of (mesh, cases) computed anew by compute(case, mesh)."""
     old = []
     if path.is_file():
         with open(path) as fh:
             old = [r for r in csv.DictReader(fh) if not (r["mesh"] == mesh and r["case"] in cases)]
-    rows = old + [r for c in cases for r in mode_rows(c, mesh)]
+    rows = old + [r for c in cases for r in compute(c, mesh)]
     with open(path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[-1]))
         w.writeheader()
         w.writerows(rows)
+    return rows
+
+
+def write_modes(cases, mesh) -> None:
+    rows = merge_rows(HERE / "film_mount_modes.csv", cases, mesh, mode_rows)
     for r in rows:
         print(r)
 
@@ -341,30 +348,12 @@ def probe_model(case: str, mesh: str):
     """(scene spec, the run-up's coupled model following the speeds, the source) of the films' run (K made
     symmetric, C as computed: `patch(1, "sym")`), built as `housingfe run` builds it (housingfe.runup.scene
     .run_scene: one torque, 2000 N m)."""
-    from mpi4py import MPI
-
-    from housingfe.runup.chain import build_gearbox_model, follow_speeds
-    from housingfe.runup.scene import (
-        _source,
-        drivetrain_of,
-        housing_model_for,
-        load_runup_scene,
-        matched_drivetrains,
-    )
-    from housingfe.scene import load_housing_scene
+    from housingfe.runup.chain import follow_speeds
+    from housingfe.runup.scene import _source
 
     patch(1.0, "sym")
-    over = fm.runup_overrides(case, mesh) + ["drivetrain.bearings=fluid_film", "runup.torques_nm=[2000.0]",
-                                             "runup.speed_min_rpm=800.0"]
-    scene, path = load_runup_scene(SCENE, over)
-    spec = scene.runup
-    hs, _ = load_housing_scene(scene.housing.scene, list(scene.housing.set))
-    dts = {2000.0: drivetrain_of(scene.drivetrain, 2000.0, spec.drive_line_model)}
-    model = housing_model_for(hs, spec.f_max_hz, MPI.COMM_WORLD)
-    dts, _ = matched_drivetrains(scene.housing, model, dts, path)
-    gm = build_gearbox_model(model, dts[2000.0], spec.f_max_hz, damping_ratio=spec.damping_ratio,
-                             basis_factor=spec.basis_factor)
-    source = _source(dts[2000.0], spec, spec.misalignment_model)
+    gm, spec, dt = gearbox_model(case, "fluid_film", mesh, ("runup.speed_min_rpm=800.0",))
+    source = _source(dt, spec, spec.misalignment_model)
     source.adopt(source.prepared(spec.torques_nm))
     return spec, follow_speeds(gm, spec.speeds), source
 
@@ -557,16 +546,7 @@ def probe_rows(case: str, mesh: str) -> list[dict]:
 
 
 def write_probe(cases, mesh) -> None:
-    path = HERE / "film_mount_probe.csv"
-    old = []
-    if path.is_file():
-        with open(path) as fh:
-            old = [r for r in csv.DictReader(fh) if not (r["mesh"] == mesh and r["case"] in cases)]
-    rows = old + [r for c in cases for r in probe_rows(c, mesh)]
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[-1]))
-        w.writeheader()
-        w.writerows(rows)
+    rows = merge_rows(HERE / "film_mount_probe.csv", cases, mesh, probe_rows)
     for c in cases:
         for route in ("tf_omega", "mesh_force"):
             print(f"{c} {route}: change against no C, n = 1..5 (dB)")
