@@ -23,6 +23,8 @@ Usage (PYTHONPATH=$PWD, from the worktree; README.md has the runs made):
   python benchmarks/experiments/film_mount/film_mount.py plot         # film_mount.png
   python benchmarks/experiments/film_mount/film_mount.py probe --case 1e9 fixed   # film_mount_probe.csv: C changed
       per line on the run-up's own reduced systems (why C raises the higher harmonics on the mount)
+  python benchmarks/experiments/film_mount/film_mount.py stiff --case fixed 1e10 3e9 1e9 3e8   # film_mount_stiff.csv:
+      C as the lossless stiffness omega C per line: rigid-body / elastic split, bore forces, modes near n = 3-5
 Run folders: /tmp/film-mount-runs/<label>/ (FILM_MOUNT_RUNS moves them).
 """
 from __future__ import annotations
@@ -556,6 +558,180 @@ def write_probe(cases, mesh) -> None:
                 print(f"  {v:58s} " + " ".join(f"{float(x):+6.2f}" for x in d))
 
 
+# ------------------------------------------------------------------------------------------------ stiff (why a stiff
+# shaft-bore link raises the lines on the mount and lowers them on the fixed feet)
+STIFF_VARIANTS = ("c0 (no C)", "C replaced by the stiffness omega C (no loss)", "c1 (C as computed)")
+STIFF_BAND_HZ = (900.0, 3100.0)     # the n = 3-5 lines over 800-1500 rpm: 0.96-3.0 kHz
+
+
+def _stiff_make(name):
+    return probe_variants()[name]
+
+
+def rigid_projector(m):
+    """(P, Q) of the housing's surface normal velocity and its six rigid-body motions: P = X^T W R (vectors x 6),
+    Q = R^T W R (6 x 6); X the Ritz vectors' housing fields, R the coupled structure's exact rigid-body motions'
+    housing fields, W the observed surface's normal Gram form (m^2).  The rigid part of a response c is the
+    W-orthogonal projection a = Q^-1 P^T c, its <v_n^2> share a^H Q a / c^H G c."""
+    from housingfe.solvers import blocks
+
+    st, red = m.structure, m.reduction
+    W = red.observer.W
+    R = blocks.columns([st.fe_vector(r) for r in st.rigid_body_vectors()])
+    X = blocks.columns([st.fe_vector(q) for q in red.vectors])
+    WR = blocks.mat_block(W, R)
+    return blocks.gram(X, WR, W.getComm()), blocks.gram(R, WR, W.getComm())
+
+
+def _rigid_share(c, G, P, Q):
+    a = np.linalg.solve(Q, P.T @ c)
+    return float(np.real(np.conj(a) @ Q @ a) / np.real(np.conj(c) @ G @ c))
+
+
+def _bore_force(mv, memo, w, vname, c) -> float:
+    """Sum over the bearings of |f|^2 (N^2, rms) of the three force components the films put on the bore masters
+    at Ritz solution c: f = bore rows of (K_e + i omega C_e) X_e c, with the variant's C (none; as the stiffness
+    omega C; as computed)."""
+    from housingfe.runup.chain import _node_rows
+
+    key = id(mv)
+    if key not in memo:
+        els = mv.structure.parts.bearings
+        rows = _node_rows(mv.structure, mv.reduction.vectors, sorted({n for e in els for n in e.nodes}))
+        memo[key] = [(np.array(e.K, float), np.zeros((12, 12)) if e.C is None else np.array(e.C, float),
+                      np.vstack([rows[node] for node in e.nodes])) for e in els]
+    total = 0.0
+    for K, C, X in memo[key]:
+        Z = K if vname.startswith("c0") else K + w * C if "stiffness" in vname else K + 1j * w * C
+        total += float(np.sum(np.abs((Z @ (X @ c))[6:9]) ** 2))
+    return total
+
+
+def stiff_rows(case: str, mesh: str) -> list[dict]:
+    """Per variant of STIFF_VARIANTS (no C, C as the lossless stiffness omega C, C as computed), route (tf_omega:
+    housing L_v under the wheel's 1 N m; mesh_force) and harmonic n = 1..5, over 800-1500 rpm (line energies with
+    A(f), sigma = 1, as `probe`): the housing's L_v energy, its split into the surface's rigid-body part and its
+    elastic rest (W-orthogonal, `rigid_projector`), and the changes against no C; for n = 3-5 the modal picture:
+    each line's Ritz solution on the undamped modes of (Ks + omega Cs [stiff variant] or Ks, Ms) at that line's
+    speed model, z = Y^T Ms c, shares Re(z_i^* (Y^T G Y z)_i) / c^H G c (sum 1), the energy-weighted share per
+    50 Hz bin of mode frequency; `diag_share` = sum_i |z_i|^2 (Y^T G Y)_ii / c^H G c (1 without cross terms)."""
+    import math
+    import time
+
+    import scipy.linalg
+
+    from housingfe import levels
+    from housingfe.runup.chain import _wheel_omega_level, run_source
+
+    t0 = time.perf_counter()
+    spec, m, source = probe_model(case, mesh)
+    lines = run_source(m, source, spec.speeds, [2000.0], spec.f_max_hz, spec.source_receptance,
+                       spec.mesh_moment_model, spec.mesh_friction)[0]
+    P, Q = rigid_projector(m)
+    red = m.reduction
+    G = red.reduced.gram
+    t_build = time.perf_counter() - t0
+    f, sp = lines.frequency, lines.speed
+    amps = lines.mesh_amplitudes()
+    A = levels.a_weighting_db(f)
+    band = (sp >= MEAN_RPM[0]) & (sp <= MEAN_RPM[1])
+    out, memo = {}, {}
+    els = m.at_speed(1500.0).structure.parts.bearings
+    if any(len(e.nodes) != 2 or np.shape(e.K) != (12, 12) for e in els):
+        raise SystemExit("film_mount stiff: a bearing element is not a 12x12 shaft-node/bore pair")
+    for vname in STIFF_VARIANTS:
+        make = _stiff_make(vname)
+        n = len(red.vectors)
+        cu, cm = np.zeros((n, len(f)), complex), np.zeros((n, len(f)), complex)
+        modal = {"tf_omega": {}, "mesh_force": {}}
+        fb = {"tf_omega": np.zeros(len(f)), "mesh_force": np.zeros(len(f))}
+        for i in range(len(f)):
+            mv = m.at_speed(sp[i])
+            s, names = mv.reduction.system, mv.reduction.names
+            w = 2 * math.pi * f[i]
+            K, C = make(mv, w, s)
+            Z = K + 1j * w * (C + s.D) - w * w * s.Mr
+            F = sum(s.Fr[:, names.index(k)] * (a[i] if np.ndim(a) else a) for k, a in amps.items())
+            sol = np.linalg.solve(Z, np.column_stack([s.Fr[:, names.index("wheel_torque")], F]))
+            cu[:, i], cm[:, i] = sol[:, 0], sol[:, 1]
+            for route, c in (("tf_omega", cu[:, i]), ("mesh_force", cm[:, i])):
+                fb[route][i] = _bore_force(mv, memo, w, vname, c)
+            if band[i] and lines.harmonic[i] in (3, 4, 5):
+                Ms = 0.5 * (s.Mr + s.Mr.T)
+                lam, Y = scipy.linalg.eigh(0.5 * (K + K.T), Ms)
+                fy = np.sqrt(np.clip(lam, 0, None)) / (2 * math.pi)
+                GY = Y.T @ G @ Y
+                for route, c in (("tf_omega", cu[:, i]), ("mesh_force", cm[:, i])):
+                    z = Y.T @ Ms @ c
+                    tot = np.real(np.conj(c) @ G @ c)
+                    part = np.real(np.conj(z) * (GY @ z)) / tot
+                    modal[route][i] = (fy, part, float(np.sum(np.abs(z) ** 2 * np.diag(GY)) / tot))
+        ru = red.response_of(f, cu)
+        out[(vname, "tf_line")] = lines.L_omega + ru.velocity_level_db - _wheel_omega_level(m, ru, f)
+        for route, c in (("tf_omega", cu), ("mesh_force", cm)):
+            Lv = red.response_of(f, c).velocity_level_db
+            rb = np.array([_rigid_share(c[:, i], G, P, Q) for i in range(len(f))])
+            out[(vname, route)] = (Lv, rb, modal[route], levels.level(fb[route], levels.F0))
+    rows = []
+    for (vname, route), value in out.items():
+        if route == "tf_line":
+            continue
+        Lv, rb, modal, LF = value
+        Lv0, rb0, _, LF0 = out[(STIFF_VARIANTS[0], route)]
+        tf, tf0 = out[(vname, "tf_line")], out[(STIFF_VARIANTS[0], "tf_line")]
+        for nh in range(1, 6):
+            def e(values):
+                return line_energy(lines, values, nh)
+            tot, rig = e(Lv), e(Lv + 10 * np.log10(np.clip(rb, 1e-30, None)))
+            ela = e(Lv + 10 * np.log10(np.clip(1 - rb, 1e-30, None)))
+            tot0, rig0 = e(Lv0), e(Lv0 + 10 * np.log10(np.clip(rb0, 1e-30, None)))
+            ela0 = e(Lv0 + 10 * np.log10(np.clip(1 - rb0, 1e-30, None)))
+            row = {"mesh": mesh, "case": case, "variant": vname, "route": route, "harmonic": nh,
+                   "Lv_energy_dB": round(tot, 2), "rigid_share": round(10 ** ((rig - tot) / 10), 3),
+                   "d_Lv_vs_no_C_dB": round(tot - tot0, 2), "d_rigid_vs_no_C_dB": round(rig - rig0, 2),
+                   "d_elastic_vs_no_C_dB": round(ela - ela0, 2),
+                   "d_bore_force_vs_no_C_dB": round(e(LF) - e(LF0), 2),
+                   "d_tf_line_vs_no_C_dB": round(e(tf) - e(tf0), 2) if route == "tf_omega" else "",
+                   "diag_share": "", "top_modes": ""}
+            sel = [i for i in modal if lines.harmonic[i] == nh]
+            if sel:
+                wts = np.array([10 ** ((Lv[i] + A[i]) / 10) for i in sel])
+                wts /= wts.sum()
+                bins = {}
+                for wgt, i in zip(wts, sel):
+                    fy, part, _ = modal[i]
+                    for fb, p in zip(np.round(fy / 50) * 50, part):
+                        bins[fb] = bins.get(fb, 0.0) + wgt * p
+                top = sorted(bins.items(), key=lambda kv: -kv[1])[:5]
+                row["diag_share"] = round(float(sum(wgt * modal[i][2] for wgt, i in zip(wts, sel))), 3)
+                row["top_modes"] = " ".join(f"{fb:.0f}Hz:{p:.2f}" for fb, p in top)
+            rows.append(row)
+    # the modes in the n = 3-5 band of the 1500 rpm speed model: undamped Ks, and Ks + omega Cs at 1.2 / 2 / 3 kHz
+    mv = m.at_speed(1500.0)
+    s = mv.reduction.system
+    Ms = 0.5 * (s.Mr + s.Mr.T)
+    for tag, Kx in [("Ks", s.Kr)] + [(f"Ks + omega C at {fk:g} Hz", s.Kr + 2 * math.pi * fk * s.Cr)
+                                      for fk in (1200.0, 2000.0, 3000.0)]:
+        lam, Y = scipy.linalg.eigh(0.5 * (Kx + Kx.T), Ms)
+        fy = np.sqrt(np.clip(lam, 0, None)) / (2 * math.pi)
+        inb = np.flatnonzero((fy >= STIFF_BAND_HZ[0]) & (fy <= STIFF_BAND_HZ[1]))
+        rs = [_rigid_share(Y[:, k], G, P, Q) for k in inb]
+        rows.append({"mesh": mesh, "case": case, "variant": f"modes 1500 rpm: {tag}", "route": "", "harmonic": "",
+                     "Lv_energy_dB": "", "rigid_share": "", "d_Lv_vs_no_C_dB": "", "d_rigid_vs_no_C_dB": "",
+                     "d_elastic_vs_no_C_dB": "", "d_bore_force_vs_no_C_dB": "", "d_tf_line_vs_no_C_dB": "",
+                     "diag_share": len(inb),
+                     "top_modes": " ".join(f"{fy[k]:.0f}Hz(rb{r:.2f})" for k, r in zip(inb, rs))})
+    print(f"stiff {case} {mesh}: model {t_build:.1f} s, total {time.perf_counter() - t0:.1f} s", flush=True)
+    return rows
+
+
+def write_stiff(cases, mesh) -> None:
+    rows = merge_rows(HERE / "film_mount_stiff.csv", cases, mesh, stiff_rows)
+    for r in rows:
+        if r["mesh"] == mesh and r["case"] in cases:
+            print({k: v for k, v in r.items() if k != "mesh"})
+
+
 # ------------------------------------------------------------------------------------------------ plot
 DECOMPOSITION = (("stiffness: the films' K (made symmetric), no C", "c0_sym", None),
                  ("film damping C (on the symmetric K)", "c1_sym", "c0_sym"),
@@ -677,6 +853,9 @@ def main() -> None:
     pr = sub.add_parser("probe")
     pr.add_argument("--case", nargs="+", default=["fixed", "1e9"])
     pr.add_argument("--mesh", default="default", choices=tuple(fm.MESHES))
+    st = sub.add_parser("stiff")
+    st.add_argument("--case", nargs="+", default=["fixed", "1e10", "3e9", "1e9", "3e8"])
+    st.add_argument("--mesh", default="default", choices=tuple(fm.MESHES))
     m = sub.add_parser("modes")
     m.add_argument("--case", nargs="+", default=["fixed", "1e9"])
     m.add_argument("--mesh", default="coarse", choices=tuple(fm.MESHES))
@@ -689,6 +868,8 @@ def main() -> None:
         write_modes(a.case, a.mesh)
     elif a.cmd == "probe":
         write_probe(a.case, a.mesh)
+    elif a.cmd == "stiff":
+        write_stiff(a.case, a.mesh)
     if a.cmd == "run":
         run(a.case, a.bearings, a.mesh, a.c_scale, a.k_mode, a.radiation, a.moment, a.speed_min)
 
