@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import math
 import os
 import sys
 from pathlib import Path
@@ -396,13 +397,26 @@ def variant(m, change):
     return replace(m, speed_models=sm)
 
 
+def solve_line(m, speed: float, frequency: float, make, amps: dict, i: int):
+    """One line on its speed's reduced system with (K, C) = make(speed model, omega, system): the coordinates under
+    the route's 1 N m wheel torque (tf_omega) and under the line's mesh excitation (mesh_force, amplitudes `amps`
+    indexed by line i), and the speed model, its ReducedSystem, omega (rad/s) and the K used."""
+    mv = m.at_speed(speed)
+    s, names = mv.reduction.system, mv.reduction.names
+    w = 2 * math.pi * frequency
+    K, C = make(mv, w, s)
+    Z = K + 1j * w * (C + s.D) - w * w * s.Mr
+    F = sum(s.Fr[:, names.index(k)] * (a[i] if np.ndim(a) else a) for k, a in amps.items())
+    sol = np.linalg.solve(Z, np.column_stack([s.Fr[:, names.index("wheel_torque")], F]))
+    return sol[:, 0], sol[:, 1], mv, s, w, K
+
+
 def solve_lines(m, lines, make) -> dict:
     """Both routes on every line of `lines`, each line solved on its speed's reduced system with (K, C) =
     make(speed model, omega rad/s, its ReducedSystem) in place of (Kr, Cr) (the modal D stays):
     (Kr' + i omega (Cr' + D) - omega^2 Mr) c = Fr.  Returns per line (dB): Lv_tf = the source's L_omega + TF_omega
     (eq. 5.5), Lv_unit and Lw_unit (housing L_v and the wheel's L_omega under the route's 1 N m: TF_omega =
     Lv_unit - Lw_unit), Lv_mf (the mesh_force route: lines' mesh excitation and shuttling moment)."""
-    import math
 
     from housingfe.runup.chain import _wheel_omega_level
 
@@ -412,14 +426,7 @@ def solve_lines(m, lines, make) -> dict:
     n = len(red.vectors)
     cu, cm = np.zeros((n, len(f)), complex), np.zeros((n, len(f)), complex)
     for i in range(len(f)):
-        mv = m.at_speed(sp[i])
-        s, names = mv.reduction.system, mv.reduction.names
-        w = 2 * math.pi * f[i]
-        K, C = make(mv, w, s)
-        Z = K + 1j * w * (C + s.D) - w * w * s.Mr
-        F = sum(s.Fr[:, names.index(k)] * (a[i] if np.ndim(a) else a) for k, a in amps.items())
-        sol = np.linalg.solve(Z, np.column_stack([s.Fr[:, names.index("wheel_torque")], F]))
-        cu[:, i], cm[:, i] = sol[:, 0], sol[:, 1]
+        cu[:, i], cm[:, i] = solve_line(m, sp[i], f[i], make, amps, i)[:2]
     ru, rm = red.response_of(f, cu), red.response_of(f, cm)
     Lvu, Lwu = ru.velocity_level_db, _wheel_omega_level(m, ru, f)
     return {"Lv_tf": lines.L_omega + Lvu - Lwu, "Lv_unit": Lvu, "Lw_unit": Lwu, "Lv_mf": rm.velocity_level_db}
@@ -460,7 +467,6 @@ def _modal_diagonal(mv, w, s):
 def probe_variants() -> dict:
     """{name: make(speed model, omega, ReducedSystem) -> (K, C)}: the films' C (Cr, the films only: checked in
     `probe`) changed on the reduced system, one change each; "c0" is the reference."""
-    import math
 
     memo = {}
 
@@ -615,7 +621,6 @@ def stiff_rows(case: str, mesh: str) -> list[dict]:
     each line's Ritz solution on the undamped modes of (Ks + omega Cs [stiff variant] or Ks, Ms) at that line's
     speed model, z = Y^T Ms c, shares Re(z_i^* (Y^T G Y z)_i) / c^H G c (sum 1), the energy-weighted share per
     50 Hz bin of mode frequency; `diag_share` = sum_i |z_i|^2 (Y^T G Y)_ii / c^H G c (1 without cross terms)."""
-    import math
     import time
 
     import scipy.linalg
@@ -646,14 +651,7 @@ def stiff_rows(case: str, mesh: str) -> list[dict]:
         modal = {"tf_omega": {}, "mesh_force": {}}
         fb = {"tf_omega": np.zeros(len(f)), "mesh_force": np.zeros(len(f))}
         for i in range(len(f)):
-            mv = m.at_speed(sp[i])
-            s, names = mv.reduction.system, mv.reduction.names
-            w = 2 * math.pi * f[i]
-            K, C = make(mv, w, s)
-            Z = K + 1j * w * (C + s.D) - w * w * s.Mr
-            F = sum(s.Fr[:, names.index(k)] * (a[i] if np.ndim(a) else a) for k, a in amps.items())
-            sol = np.linalg.solve(Z, np.column_stack([s.Fr[:, names.index("wheel_torque")], F]))
-            cu[:, i], cm[:, i] = sol[:, 0], sol[:, 1]
+            cu[:, i], cm[:, i], mv, s, w, K = solve_line(m, sp[i], f[i], make, amps, i)
             for route, c in (("tf_omega", cu[:, i]), ("mesh_force", cm[:, i])):
                 fb[route][i] = _bore_force(mv, memo, w, vname, c)
             if band[i] and lines.harmonic[i] in (3, 4, 5):
