@@ -397,6 +397,11 @@ def variant(m, change):
     return replace(m, speed_models=sm)
 
 
+def line_matrix(s, w: float, K, C):
+    """The reduced dynamic stiffness K + i omega (C + D) - omega^2 Mr (N/m in Ritz coordinates) at omega (rad/s)."""
+    return K + 1j * w * (C + s.D) - w * w * s.Mr
+
+
 def solve_line(m, speed: float, frequency: float, make, amps: dict, i: int):
     """One line on its speed's reduced system with (K, C) = make(speed model, omega, system): the coordinates under
     the route's 1 N m wheel torque (tf_omega) and under the line's mesh excitation (mesh_force, amplitudes `amps`
@@ -405,7 +410,7 @@ def solve_line(m, speed: float, frequency: float, make, amps: dict, i: int):
     s, names = mv.reduction.system, mv.reduction.names
     w = 2 * math.pi * frequency
     K, C = make(mv, w, s)
-    Z = K + 1j * w * (C + s.D) - w * w * s.Mr
+    Z = line_matrix(s, w, K, C)
     F = sum(s.Fr[:, names.index(k)] * (a[i] if np.ndim(a) else a) for k, a in amps.items())
     sol = np.linalg.solve(Z, np.column_stack([s.Fr[:, names.index("wheel_torque")], F]))
     return sol[:, 0], sol[:, 1], mv, s, w, K
@@ -435,10 +440,9 @@ def solve_lines(m, lines, make) -> dict:
 def line_energy(lines, values, n) -> float:
     """10 lg sum over 800-1500 rpm of 10^((value + A(f))/10) on harmonic n: for L_v the line's L_WA energy up to
     the constant L_S (sigma = 1), the measure of film_mount_harmonics.csv (dB)."""
-    from housingfe import levels
 
-    sel = (lines.harmonic == n) & (lines.speed >= MEAN_RPM[0]) & (lines.speed <= MEAN_RPM[1])
-    return energy_db(np.asarray(values)[sel] + levels.a_weighting_db(lines.frequency[sel]))
+    sel = np.flatnonzero((lines.harmonic == n) & (lines.speed >= MEAN_RPM[0]) & (lines.speed <= MEAN_RPM[1]))
+    return line_energy_at(lines, sel, np.asarray(values)[sel])
 
 
 def _is_pinion(e, i, j):
@@ -598,6 +602,22 @@ def _bore_force(mv, memo, w, vname, c) -> float:
     """Sum over the bearings of |f|^2 (N^2, rms) of the three force components the films put on the bore masters
     at Ritz solution c: f = bore rows of (K_e + i omega C_e) X_e c, with the variant's C (none; as the stiffness
     omega C; as computed)."""
+    return float(np.sum(np.abs(bore_loads(mv, memo, w, vname, c).reshape(-1, 6)[:, :3]) ** 2))
+
+
+def bore_loads(mv, memo, w, vname, c) -> np.ndarray:
+    """The loads the films put on the bore masters at Ritz solution(s) c, bore by bore (Fx Fy Fz Mx My Mz: N, N m):
+    bore rows of -(K_e + i omega C_e) X_e c with the variant's C (none; as the stiffness omega C; as computed)."""
+    out = []
+    for K, C, X in _bore_elements(mv, memo):
+        Z = K if vname.startswith("c0") else K + w * C if "stiffness" in vname else K + 1j * w * C
+        out.append(-(Z @ (X @ c))[6:12])
+    return np.concatenate(out)
+
+
+def _bore_elements(mv, memo) -> list:
+    """[(K_e, C_e, X_e)] of the speed model's bearing elements (12x12 shaft node, bore master), X_e the Ritz
+    vectors' rows at the two nodes; memoised per speed model."""
     from housingfe.runup.chain import _node_rows
 
     key = id(mv)
@@ -606,11 +626,7 @@ def _bore_force(mv, memo, w, vname, c) -> float:
         rows = _node_rows(mv.structure, mv.reduction.vectors, sorted({n for e in els for n in e.nodes}))
         memo[key] = [(np.array(e.K, float), np.zeros((12, 12)) if e.C is None else np.array(e.C, float),
                       np.vstack([rows[node] for node in e.nodes])) for e in els]
-    total = 0.0
-    for K, C, X in memo[key]:
-        Z = K if vname.startswith("c0") else K + w * C if "stiffness" in vname else K + 1j * w * C
-        total += float(np.sum(np.abs((Z @ (X @ c))[6:9]) ** 2))
-    return total
+    return memo[key]
 
 
 def stiff_rows(case: str, mesh: str) -> list[dict]:
@@ -725,6 +741,124 @@ def stiff_rows(case: str, mesh: str) -> list[dict]:
 
 def write_stiff(cases, mesh) -> None:
     rows = merge_rows(HERE / "film_mount_stiff.csv", cases, mesh, stiff_rows)
+    for r in rows:
+        if r["mesh"] == mesh and r["case"] in cases:
+            print({k: v for k, v in r.items() if k != "mesh"})
+
+
+# ------------------------------------------------------------------------------------------------ bores (why the
+# clamped housing answers the stiff link's bore forces with less L_v)
+BORE_VARIANTS = STIFF_VARIANTS[:2]      # no C, C as omega C: both C-free, so one dynamic stiffness per line
+BORE_QUANTITIES = ("Lv", "Lv_from_bore_loads", "F2", "M2", "resultant_F2", "resp_forces", "resp_moments",
+                   "resp_forces_incoherent")
+
+
+def bore_line(mv, memo, s, w, K, G, c_lines, vname) -> tuple[list[dict], float]:
+    """One line: the housing's own transfer from the bore loads to the surface, A = H^H G H (6 per bore), and per
+    Ritz solution in c_lines the energies of BORE_QUANTITIES (<v_n^2>-proportional c^H G c for responses, N^2 and
+    (N m)^2 for loads) and the bore-by-bore sum |f|^2.  H comes from the coupled model itself: unit loads e_j on the
+    bore masters give solutions V and total bore loads E = I + (film loads of V); the surface sees only the bore
+    loads, so H = V E^-1 (checked: Lv_from_bore_loads = h^H A h against c^H G c).  Also returns A."""
+    B = np.vstack([X[6:12] for _, _, X in _bore_elements(mv, memo)])
+    V = np.linalg.solve(line_matrix(s, w, K, 0 * K), B.T)
+    H = V @ np.linalg.inv(np.eye(B.shape[0]) + bore_loads(mv, memo, w, vname, V))
+    A = np.conj(H.T) @ G @ H
+    tr = np.tile(np.arange(6) < 3, B.shape[0] // 6)
+    out = []
+    for c in c_lines:
+        h = bore_loads(mv, memo, w, vname, c)
+        f, mo = h[tr], h[~tr]
+        out.append({"Lv": np.real(np.conj(c) @ G @ c), "Lv_from_bore_loads": np.real(np.conj(h) @ A @ h),
+                    "F2": np.sum(np.abs(f) ** 2), "M2": np.sum(np.abs(mo) ** 2),
+                    "resultant_F2": np.sum(np.abs(f.reshape(-1, 3).sum(axis=0)) ** 2),
+                    "resp_forces": np.real(np.conj(f) @ A[np.ix_(tr, tr)] @ f),
+                    "resp_moments": np.real(np.conj(mo) @ A[np.ix_(~tr, ~tr)] @ mo),
+                    "resp_forces_incoherent": np.real(np.sum(np.abs(f) ** 2 * np.diag(A)[tr])),
+                    "per_bore_F2": np.sum(np.abs(f.reshape(-1, 3)) ** 2, axis=1)})
+    return out, A
+
+
+def bores_rows(case: str, mesh: str) -> list[dict]:
+    """Per variant of BORE_VARIANTS, route and harmonic n = 3-5 over 800-1500 rpm (line energies with A(f), sigma
+    = 1, as `stiff`): the housing's L_v, the same rebuilt from the bore loads (check), Sigma|f|^2, Sigma|m|^2, the
+    bores' resultant force |Sigma_b f_b|^2 (on the fixed feet it goes into the feet), and the L_v the forces alone,
+    the moments alone and the forces without their phases (Sigma_j |f_j|^2 A_jj) give through the housing's
+    transfer A (`bore_line`); the bores' shares of Sigma|f|^2; the change of A between the variants (should be 0:
+    it is the housing's own).  A last row per route and n: omega C - no C (dB)."""
+    import time
+
+    from housingfe import levels
+    from housingfe.runup.chain import run_source
+
+    t0 = time.perf_counter()
+    spec, m, source = probe_model(case, mesh)
+    lines = run_source(m, source, spec.speeds, [2000.0], spec.f_max_hz, spec.source_receptance,
+                       spec.mesh_moment_model, spec.mesh_friction)[0]
+    G = m.reduction.reduced.gram
+    f, sp, amps = lines.frequency, lines.speed, lines.mesh_amplitudes()
+    sel = np.flatnonzero((sp >= MEAN_RPM[0]) & (sp <= MEAN_RPM[1]) & np.isin(lines.harmonic, (3, 4, 5)))
+    Lv = {}
+    for vname in BORE_VARIANTS:
+        make = _stiff_make(vname)
+        n = len(m.reduction.vectors)
+        cu, cm = np.zeros((n, len(f)), complex), np.zeros((n, len(f)), complex)
+        for i in range(len(f)):
+            cu[:, i], cm[:, i] = solve_line(m, sp[i], f[i], make, amps, i)[:2]
+        Lv[vname] = {"tf_omega": m.reduction.response_of(f, cu).velocity_level_db,
+                     "mesh_force": m.reduction.response_of(f, cm).velocity_level_db, "cu": cu, "cm": cm}
+    res, memo, A0, dA = {}, {}, {}, {}
+    bore_names = [e.nodes[1] for e in m.at_speed(1500.0).structure.parts.bearings]
+    for vname in BORE_VARIANTS:
+        make = _stiff_make(vname)
+        for i in sel:
+            mv = m.at_speed(sp[i])
+            s, w = mv.reduction.system, 2 * math.pi * f[i]
+            K = make(mv, w, s)[0]
+            q, A = bore_line(mv, memo, s, w, K, G, (Lv[vname]["cu"][:, i], Lv[vname]["cm"][:, i]), vname)
+            if vname == BORE_VARIANTS[0]:
+                A0[i] = A
+            else:
+                dA[i] = np.linalg.norm(A - A0[i]) / np.linalg.norm(A0[i])
+            for route, qq in zip(("tf_omega", "mesh_force"), q):
+                res[(vname, route, i)] = qq
+    rows = []
+    for route in ("tf_omega", "mesh_force"):
+        for nh in (3, 4, 5):
+            idx = [i for i in sel if lines.harmonic[i] == nh]
+            vals = {}
+            for vname in BORE_VARIANTS:
+                L = Lv[vname][route]
+                r = {"mesh": mesh, "case": case, "variant": vname, "route": route, "harmonic": nh}
+                for k in BORE_QUANTITIES:
+                    x = np.array([res[(vname, route, i)][k] for i in idx])
+                    if k.startswith(("Lv_", "resp_")):      # a response: the line's L_v scaled by its energy ratio
+                        x = L[idx] + 10 * np.log10(x / np.array([res[(vname, route, i)]["Lv"] for i in idx]))
+                    elif k == "Lv":
+                        x = L[idx]
+                    else:
+                        x = levels.level(x, levels.F0)
+                    r[k + "_dB"] = vals.setdefault(vname, {})[k] = round(line_energy_at(lines, idx, x), 2)
+                pb = np.sum([res[(vname, route, i)]["per_bore_F2"] for i in idx], axis=0)
+                r["bore_F2_shares"] = " ".join(f"{b}:{v:.2f}" for b, v in zip(bore_names, pb / pb.sum()))
+                r["A_change"] = round(float(np.mean([dA[i] for i in idx])), 4) if vname != BORE_VARIANTS[0] else ""
+                rows.append(r)
+            d = {"mesh": mesh, "case": case, "variant": "omega C - no C", "route": route, "harmonic": nh}
+            d.update({k + "_dB": round(vals[BORE_VARIANTS[1]][k] - vals[BORE_VARIANTS[0]][k], 2)
+                      for k in BORE_QUANTITIES})
+            rows.append({**d, "bore_F2_shares": "", "A_change": ""})
+    print(f"bores {case} {mesh}: {time.perf_counter() - t0:.1f} s", flush=True)
+    return rows
+
+
+def line_energy_at(lines, idx, values) -> float:
+    """10 lg sum over the lines idx of 10^((value + A(f))/10) (dB): `line_energy` on a chosen set of lines."""
+    from housingfe import levels
+
+    return energy_db(np.asarray(values) + levels.a_weighting_db(lines.frequency[idx]))
+
+
+def write_bores(cases, mesh) -> None:
+    rows = merge_rows(HERE / "film_mount_bores.csv", cases, mesh, bores_rows)
     for r in rows:
         if r["mesh"] == mesh and r["case"] in cases:
             print({k: v for k, v in r.items() if k != "mesh"})
@@ -854,6 +988,9 @@ def main() -> None:
     st = sub.add_parser("stiff")
     st.add_argument("--case", nargs="+", default=["fixed", "1e10", "3e9", "1e9", "3e8"])
     st.add_argument("--mesh", default="default", choices=tuple(fm.MESHES))
+    bo = sub.add_parser("bores")
+    bo.add_argument("--case", nargs="+", default=["fixed", "1e9"])
+    bo.add_argument("--mesh", default="default", choices=tuple(fm.MESHES))
     m = sub.add_parser("modes")
     m.add_argument("--case", nargs="+", default=["fixed", "1e9"])
     m.add_argument("--mesh", default="coarse", choices=tuple(fm.MESHES))
@@ -868,6 +1005,8 @@ def main() -> None:
         write_probe(a.case, a.mesh)
     elif a.cmd == "stiff":
         write_stiff(a.case, a.mesh)
+    elif a.cmd == "bores":
+        write_bores(a.case, a.mesh)
     if a.cmd == "run":
         run(a.case, a.bearings, a.mesh, a.c_scale, a.k_mode, a.radiation, a.moment, a.speed_min)
 
