@@ -25,6 +25,8 @@ Usage (PYTHONPATH=$PWD, from the worktree; README.md has the runs made):
       per line on the run-up's own reduced systems (why C raises the higher harmonics on the mount)
   python benchmarks/experiments/film_mount/film_mount.py stiff --case fixed 1e10 3e9 1e9 3e8   # film_mount_stiff.csv:
       C as the lossless stiffness omega C per line: rigid-body / elastic split, bore forces, modes near n = 3-5
+  python benchmarks/experiments/film_mount/film_mount.py bores --case fixed 1e9   # film_mount_bores.csv: the bore
+      forces and moments of no C and omega C through the housing's own transfer from the bore loads
 Run folders: /tmp/film-mount-runs/<label>/ (FILM_MOUNT_RUNS moves them).
 """
 from __future__ import annotations
