@@ -576,8 +576,17 @@ STIFF_VARIANTS = ("c0 (no C)", "C replaced by the stiffness omega C (no loss)", 
 STIFF_BAND_HZ = (900.0, 3100.0)     # the n = 3-5 lines over 800-1500 rpm: 0.96-3.0 kHz
 
 
+BORE_TRANSLATIONS = "C translations only, as the stiffness omega C"
+
+
 def _stiff_make(name):
-    return probe_variants()[name]
+    """make(speed model, omega, ReducedSystem) -> (K, C) of a `probe_variants` entry, or of BORE_TRANSLATIONS (C's
+    translation block as the lossless stiffness omega C, for `bores`)."""
+    variants = probe_variants()
+    if name == BORE_TRANSLATIONS:
+        part = variants["C translations only"]
+        return lambda mv, w, s: (s.Kr + w * part(mv, w, s)[1], 0 * s.Cr)
+    return variants[name]
 
 
 def rigid_projector(m):
@@ -612,6 +621,8 @@ def bore_loads(mv, memo, w, vname, c) -> np.ndarray:
     bore rows of -(K_e + i omega C_e) X_e c with the variant's C (none; as the stiffness omega C; as computed)."""
     out = []
     for K, C, X in _bore_elements(mv, memo):
+        if vname == BORE_TRANSLATIONS:
+            C = C * np.array([[_translations(None, i, j) for j in range(12)] for i in range(12)], float)
         Z = K if vname.startswith("c0") else K + w * C if "stiffness" in vname else K + 1j * w * C
         out.append(-(Z @ (X @ c))[6:12])
     return np.concatenate(out)
@@ -750,7 +761,8 @@ def write_stiff(cases, mesh) -> None:
 
 # ------------------------------------------------------------------------------------------------ bores (why the
 # clamped housing answers the stiff link's bore forces with less L_v)
-BORE_VARIANTS = STIFF_VARIANTS[:2]      # no C, C as omega C: both C-free, so one dynamic stiffness per line
+# no C, C as omega C (all of it; its translation block only): all C-free, so one dynamic stiffness per line
+BORE_VARIANTS = STIFF_VARIANTS[:2] + (BORE_TRANSLATIONS,)
 BORE_QUANTITIES = ("Lv", "Lv_from_bore_loads", "F2", "M2", "resultant_F2", "resp_forces", "resp_moments",
                    "resp_forces_incoherent")
 
@@ -786,7 +798,7 @@ def bores_rows(case: str, mesh: str) -> list[dict]:
     bores' resultant force |Sigma_b f_b|^2 (on the fixed feet it goes into the feet), and the L_v the forces alone,
     the moments alone and the forces without their phases (Sigma_j |f_j|^2 A_jj) give through the housing's
     transfer A (`bore_line`); the bores' shares of Sigma|f|^2; the change of A between the variants (should be 0:
-    it is the housing's own).  A last row per route and n: omega C - no C (dB)."""
+    it is the housing's own).  Last rows per route and n: each variant - no C (dB)."""
     import time
 
     from housingfe import levels
@@ -820,7 +832,7 @@ def bores_rows(case: str, mesh: str) -> list[dict]:
             if vname == BORE_VARIANTS[0]:
                 A0[i] = A
             else:
-                dA[i] = np.linalg.norm(A - A0[i]) / np.linalg.norm(A0[i])
+                dA[(vname, i)] = np.linalg.norm(A - A0[i]) / np.linalg.norm(A0[i])
             for route, qq in zip(("tf_omega", "mesh_force"), q):
                 res[(vname, route, i)] = qq
     rows = []
@@ -842,12 +854,12 @@ def bores_rows(case: str, mesh: str) -> list[dict]:
                     r[k + "_dB"] = vals.setdefault(vname, {})[k] = round(line_energy_at(lines, idx, x), 2)
                 pb = np.sum([res[(vname, route, i)]["per_bore_F2"] for i in idx], axis=0)
                 r["bore_F2_shares"] = " ".join(f"{b}:{v:.2f}" for b, v in zip(bore_names, pb / pb.sum()))
-                r["A_change"] = round(float(np.mean([dA[i] for i in idx])), 4) if vname != BORE_VARIANTS[0] else ""
+                r["A_change"] = round(float(np.mean([dA[(vname, i)] for i in idx])), 4) if vname != BORE_VARIANTS[0] else ""
                 rows.append(r)
-            d = {"mesh": mesh, "case": case, "variant": "omega C - no C", "route": route, "harmonic": nh}
-            d.update({k + "_dB": round(vals[BORE_VARIANTS[1]][k] - vals[BORE_VARIANTS[0]][k], 2)
-                      for k in BORE_QUANTITIES})
-            rows.append({**d, "bore_F2_shares": "", "A_change": ""})
+            for vname in BORE_VARIANTS[1:]:
+                d = {"mesh": mesh, "case": case, "variant": f"{vname} - no C", "route": route, "harmonic": nh}
+                d.update({k + "_dB": round(vals[vname][k] - vals[BORE_VARIANTS[0]][k], 2) for k in BORE_QUANTITIES})
+                rows.append({**d, "bore_F2_shares": "", "A_change": ""})
     print(f"bores {case} {mesh}: {time.perf_counter() - t0:.1f} s", flush=True)
     return rows
 
