@@ -279,17 +279,59 @@ def draw_deviations(rng: np.random.Generator, teeth: int, tolerances: dict, kind
     return dev
 
 
-def order_amplitudes(signal: np.ndarray, revolutions_per_record: int = 1) -> tuple[np.ndarray, np.ndarray]:
-    """One-sided amplitudes of a periodic record (one full period): orders [cycles per record / revolutions] and
-    amplitudes (order 0: the mean).  Parseval: mean(x^2) = a_0^2 + sum_{0 < q < N/2} a_q^2 / 2 (+ a_{N/2}^2 for an
-    even length N: the Nyquist line is a cosine sampled at its extremes)."""
+def order_lines(signal: np.ndarray, revolutions_per_record: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided complex amplitudes of a periodic record (one full period of N samples): orders [cycles per record /
+    revolutions] and c_q with x[n] = Re sum_q c_q exp(2 pi i q n / N) (order 0: the mean; the Nyquist line of an
+    even N not doubled), same unit as the signal."""
     x = np.asarray(signal, float)
-    c = np.fft.rfft(x) / x.size
-    a = 2 * np.abs(c)
-    a[0] = abs(c[0])
+    c = 2 * np.fft.rfft(x) / x.size
+    c[0] /= 2
     if x.size % 2 == 0:
-        a[-1] = abs(c[-1])          # the Nyquist line is not doubled
-    return np.arange(a.size) / revolutions_per_record, a
+        c[-1] /= 2                  # the Nyquist line is a cosine sampled at its extremes
+    return np.arange(c.size) / revolutions_per_record, c
+
+
+def order_amplitudes(signal: np.ndarray, revolutions_per_record: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided amplitudes |c_q| of a periodic record (`order_lines`): orders and amplitudes (order 0: |mean|).
+    Parseval: mean(x^2) = a_0^2 + sum_{0 < q < N/2} a_q^2 / 2 (+ a_{N/2}^2 for an even length N)."""
+    orders, c = order_lines(signal, revolutions_per_record)
+    return orders, np.abs(c)
+
+
+# ------------------------------------------------------------------------------------------------ pinion re-indexed
+def turned(deviations: ToothDeviations, shift: int) -> ToothDeviations:
+    """The same gear re-assembled turned by `shift` teeth against its mate: the tooth that meets the mate's
+    tooth m + k at mesh period m (first_order_te's indexing, tooth m + k before) is now tooth m + k + shift, so
+    the deviations seen at mesh index t are those of physical tooth (t + shift) mod z.  Every deviation stays on
+    its tooth (a runout turns with the gear: it belongs to the gear on its shaft)."""
+    z = deviations.position.size
+    idx = (np.arange(z) + int(shift)) % z
+    return ToothDeviations(deviations.position[idx], deviations.profile_slope[idx], deviations.helix_slope[idx],
+                           deviations.twist[idx], deviations.form[idx])
+
+
+def reindexed_order_lines(pair: GearPair, weights: ContactWeights, pinion: ToothDeviations, wheel: ToothDeviations,
+                          shift: int, aligned_te: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Wheel orders and complex one-sided amplitudes c_q [m] (`order_lines`) of the loaded TE over one hunting period
+    with the pinion turned by `shift` teeth against the wheel (`turned`; the thesis' Sec. 5.6 test: 8 and 16 of
+    24): the first-order TE of the deviations (`first_order_te`) plus the aligned pair's periodic TE (aligned_te: one
+    mesh period of weights.n_positions samples [m], or None).  The TE is linear in the deviations, so turning the
+    pinion multiplies its share at wheel order q = (z2/z1) j by exp(2 pi i j shift / z1) and leaves the wheel's and
+    the aligned share: a line's power changes only at the orders both gears reach, and never at the tooth
+    harmonics (j = 0 mod z1)."""
+    periods = hunting_mesh_periods(pair)
+    te = first_order_te(pair, weights, turned(pinion, shift), wheel, periods)
+    if aligned_te is not None:
+        te = te + _aligned_record(aligned_te, weights.n_positions, periods)
+    return order_lines(te, periods // int(pair.teeth[1]))
+
+
+def _aligned_record(aligned_te, positions: int, periods: int) -> np.ndarray:
+    """The aligned pair's TE of one mesh period (`positions` samples [m]) repeated over `periods` mesh periods."""
+    d = np.asarray(aligned_te, float)
+    if d.size != positions:
+        raise InputError(f"as_made: the aligned TE needs {positions} samples per mesh period, got {d.size}")
+    return np.tile(d, periods)
 
 
 def band_rms_amplitude(frequencies: np.ndarray, amplitudes: np.ndarray, lower: float, upper: float) -> float:
@@ -495,9 +537,5 @@ def expected_order_spectrum(pair: GearPair, weights: ContactWeights, pinion: Dev
         dev[q] += power / (P * z) ** 2
     aligned = np.zeros(q_all.size)
     if aligned_te is not None:
-        d = np.asarray(aligned_te, float)
-        if d.size != P:
-            raise InputError(f"as_made: the aligned TE needs {P} samples per mesh period, got {d.size}")
-        _, a = order_amplitudes(np.tile(d, periods))
-        aligned = a**2
+        aligned = order_amplitudes(_aligned_record(aligned_te, P, periods))[1] ** 2
     return ExpectedOrderSpectrum(q_all / (periods // z2), aligned, dev * one_sided)

@@ -316,3 +316,95 @@ def test_pitch_model_is_checked_and_independent_stays_the_default():
     assert not np.any(am.deviation_statistics(72, tol, am.DEVIATION_KINDS, 1.0, 1.0, pitch_model="none").pitch_spectrum)
     d2 = am.draw_deviations(np.random.default_rng(5), 72, tol, am.DEVIATION_KINDS, 1.0, 1.0, pitch_model="none")
     assert not np.any(d2.position) and np.any(d2.profile_slope)
+
+
+# ------------------------------------------------------------------------ pinion re-indexed (thesis Sec. 5.6)
+def _draw_pair(rng, pair, kinds, pitch_model):
+    tol = [am.iso1328_tolerances(0.004, d, 0.040) for d in pair.pitch_diameter]
+    return [am.draw_deviations(rng, int(z), t, kinds, 0.94, 1.0, pitch_model=pitch_model)
+            for z, t in zip(pair.teeth, tol)]
+
+
+def test_turning_the_pinion_moves_only_the_lines_both_gears_reach(spur):
+    """The first-order TE is linear in the deviations, so turning the pinion by s teeth against the wheel multiplies
+    the pinion's share at wheel order q = 3 j by exp(2 pi i j s / 24): a full pinion revolution (s = 24, 48) is the
+    identity; the tooth harmonics (q = 72 n, j = 0 mod 24) do not move; the pinion's own spectrum keeps its
+    magnitudes and Parseval; the orders only the wheel reaches (q not a multiple of 3) keep theirs; and the whole
+    spectrum's energy changes only by the cross terms at the shared orders."""
+    pair, model, w = spur
+    z1, z2 = (int(z) for z in pair.teeth)
+    rng = np.random.default_rng(56)
+    pin, whl = _draw_pair(rng, pair, am.DEVIATION_KINDS, "independent")
+    aligned = 1e-6 * np.cos(2 * math.pi * np.arange(w.n_positions) / w.n_positions) + 0.3e-6
+    orders, c0 = am.reindexed_order_lines(pair, w, pin, whl, 0, aligned)
+    q = np.arange(orders.size)
+    assert np.array_equal(orders, q)                               # one wheel revolution per hunting period
+    for s in (24, 48, -24):
+        assert np.allclose(am.reindexed_order_lines(pair, w, pin, whl, s, aligned)[1], c0, rtol=0, atol=1e-18)
+    zero = (am.ToothDeviations.zeros(z1), am.ToothDeviations.zeros(z2))
+    _, p0 = am.reindexed_order_lines(pair, w, pin, zero[1], 0)
+    _, w0 = am.reindexed_order_lines(pair, w, zero[0], whl, 0, aligned)
+    assert np.allclose(p0 + w0, c0, rtol=0, atol=1e-18)            # linear: pinion share + wheel share
+    tooth = q % z2 == 0
+    shared = (q % (z2 // z1) == 0) & ~tooth
+    assert np.max(np.abs(p0[q % (z2 // z1) != 0])) < 1e-12 * np.max(np.abs(p0))
+    for s in (8, 16, 5):
+        _, cs = am.reindexed_order_lines(pair, w, pin, whl, s, aligned)
+        _, ps = am.reindexed_order_lines(pair, w, pin, zero[1], s)
+        assert np.allclose(cs[tooth], c0[tooth], rtol=0, atol=1e-18)
+        assert np.allclose(np.abs(cs[~shared]), np.abs(c0[~shared]), rtol=0, atol=1e-18)
+        assert np.allclose(np.abs(ps), np.abs(p0), rtol=0, atol=1e-18)
+        assert np.sum(np.abs(ps) ** 2) == pytest.approx(np.sum(np.abs(p0) ** 2), rel=1e-12)
+        j = q[shared] // (z2 // z1)
+        assert np.allclose(ps[shared], p0[shared] * np.exp(2j * math.pi * j * s / z1), rtol=0, atol=1e-18)
+        cross = 2 * np.real(w0[shared] * np.conj(ps[shared] - p0[shared]))
+        assert np.sum(np.abs(cs) ** 2 - np.abs(c0) ** 2) == pytest.approx(np.sum(cross), rel=1e-9)
+        assert abs(np.sum(cross)) > 1e-6 * np.sum(np.abs(c0[1:]) ** 2)      # the shared lines do move
+
+
+def test_runout_pitch_alone_keeps_every_lines_magnitude_when_the_pinion_turns(spur):
+    """"runout" pitch without flank deviations: the pinion's lines lie at 72 n +- 3, the wheel's at 72 n +- 1 and
+    the aligned pair's at 72 n; no order is shared, so no line's magnitude can change whatever the shift."""
+    pair, model, w = spur
+    rng = np.random.default_rng(57)
+    pin, whl = _draw_pair(rng, pair, ["pitch"], "runout")
+    aligned = 1e-6 * np.cos(2 * math.pi * np.arange(w.n_positions) / w.n_positions)
+    _, c0 = am.reindexed_order_lines(pair, w, pin, whl, 0, aligned)
+    for s in (8, 16, 3):
+        _, cs = am.reindexed_order_lines(pair, w, pin, whl, s, aligned)
+        assert np.allclose(np.abs(cs), np.abs(c0), rtol=1e-9, atol=1e-15 * np.max(np.abs(c0)))
+        assert not np.allclose(cs, c0, rtol=0, atol=1e-3 * np.max(np.abs(c0[1:])))   # the phases do move
+
+
+def test_one_displaced_pinion_tooth_and_one_wheel_tooth_interfere_at_the_shared_orders():
+    """Analytic case.  One contact point per mesh position, weight 1 (one tooth pair carries the load), pinion
+    tooth t_p displaced by d1, wheel tooth t_w by d2: TE[m, p] = d1 [(m + s) = t_p mod 24] + d2 [m = t_w mod 72]
+    over M = 72 mesh periods of P samples.  Its line at wheel order q (N = M P, G(q) = (2/N) sum_p exp(-2 pi i q p /
+    N)) is G(q) [d1 sum_{m = t_p - s mod 24} exp(-2 pi i q m / M) + d2 exp(-2 pi i q t_w / M)], the first sum
+    3 exp(-2 pi i q (t_p - s) / M) at q = 0 mod 3 and 0 elsewhere, so
+    |c_q|^2 = |G|^2 [9 d1^2 + d2^2 + 6 d1 d2 cos(2 pi q (t_p - s - t_w) / M)] at q = 0 mod 3: turning the pinion by s
+    moves the cross term's phase by 2 pi q s / 72 = 2 pi j s / 24."""
+    pair = GearPair.from_table(dict(module_mm=4.0, teeth=[24, 72], pressure_angle_deg=20.0, helix_angle_deg=0.0,
+                                    addendum_modification=[0.0, 0.0], face_width_mm=[40.0, 40.0],
+                                    centre_distance_mm=192.0, kind="spur"))
+    P, M = 4, 72
+    one = [np.zeros(1)] * P
+    w = am.ContactWeights(s=one, w_local=one, pair=[np.zeros(1, int)] * P, weight=[np.ones(1)] * P,
+                          stiffness=np.ones(P))
+    d1, d2, tp, tw = 3e-6, 2e-6, 5, 40
+    pin, whl = am.ToothDeviations.zeros(24), am.ToothDeviations.zeros(72)
+    pin.position[tp], whl.position[tw] = d1, d2
+    N = M * P
+    q = np.arange(N // 2 + 1)
+    G = 2 / N * np.sum(np.exp(-2j * math.pi * np.outer(q, np.arange(P)) / N), axis=1)
+    G[0] /= 2
+    G[-1] /= 2
+    for s in (0, 8, 16):
+        _, c = am.reindexed_order_lines(pair, w, pin, whl, s)
+        expected = G * (d1 * np.where(q % 3 == 0, 3.0, 0.0) * np.exp(-2j * math.pi * q * (tp - s) / M)
+                        + d2 * np.exp(-2j * math.pi * q * tw / M))
+        assert np.allclose(c, expected, rtol=0, atol=1e-15)
+        shared = q % 3 == 0
+        power = np.abs(G[shared]) ** 2 * (9 * d1**2 + d2**2 + 6 * d1 * d2 * np.cos(
+            2 * math.pi * q[shared] * (tp - s - tw) / M))
+        assert np.allclose(np.abs(c[shared]) ** 2, power, rtol=1e-9, atol=1e-30)
