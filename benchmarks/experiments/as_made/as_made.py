@@ -57,14 +57,13 @@ def band_of(f: float):
     return float(bands.nominal[i]), float(bands.lower[i]), float(bands.upper[i])
 
 
-def coupled_receptances(orders, f_tooth, z2, bands):
-    """|Omega_wheel / e| [(rad/s)/m] of the coupled gearbox of `test-gearbox-runup` (housing, ball bearings, shafts,
-    gear bodies; its Ritz reduction loaded by k_ref e at the gear mesh: the receptance of lomega_budget's coupled part)
-    at the wheel orders inside the bands of each speed (NaN elsewhere)."""
+def coupled_te_receptance():
+    """f [Hz] -> |Omega_wheel / e| [(rad/s)/m] of the coupled gearbox of `test-gearbox-runup` at TORQUE (housing,
+    ball bearings, shafts, gear bodies; its Ritz reduction loaded by k_ref e at the gear mesh: the receptance of
+    lomega_budget's coupled part).  Building it takes 10-60 s; each frequency about 1 ms."""
     from housingfe.response.observers import node_key
     from housingfe.studies.chain_session import ChainSession
 
-    t0 = time.perf_counter()
     session = ChainSession.from_scene("test-gearbox-runup")
     dspec = session.scene.drivetrain
     model = session.model(session.drivetrain(dspec.gear_set, dspec.bearings, TORQUE))
@@ -72,15 +71,26 @@ def coupled_receptances(orders, f_tooth, z2, bands):
     k_ref = float(model.structure.spec.gear_meshes[0].stiffness)
     node = red.reduced.points[node_key(model.wheel_node)]
     axis = model.wheel_axis / np.linalg.norm(model.wheel_axis)
+
+    def receptance(f):
+        f = np.asarray(f, float)
+        c = red.coefficients(f, {"mesh": np.full(f.size, k_ref, complex)})
+        return np.abs(2 * math.pi * f * (axis @ (node[3:6] @ c)))
+    return receptance
+
+
+def coupled_receptances(orders, f_tooth, z2, bands):
+    """`coupled_te_receptance` at the wheel orders inside the bands of each speed (NaN elsewhere)."""
+    t0 = time.perf_counter()
+    receptance = coupled_te_receptance()
     out = {}
     for v in SPEEDS:
         f = orders * f_tooth[v] / z2
         sel = np.zeros(f.size, bool)
         for _, lo, hi in bands[v]:
             sel |= (f >= lo) & (f < hi)
-        c = red.coefficients(f[sel], {"mesh": np.full(int(sel.sum()), k_ref, complex)})
         out[v] = np.full(f.size, np.nan)
-        out[v][sel] = np.abs(2 * math.pi * f[sel] * (axis @ (node[3:6] @ c)))
+        out[v][sel] = receptance(f[sel])
     print(f"coupled gearbox (test-gearbox-runup, ball bearings): receptance at {sum(np.isfinite(r).sum() for r in out.values())}"
           f" lines in {time.perf_counter() - t0:.1f} s")
     return out
@@ -98,8 +108,10 @@ def draw_case(rng, case, pair, tolerances, pitch_factor, flank_factor):
             for g, z in enumerate(pair.teeth)]
 
 
-def main(draws: int, seed: int, positions: int, exact: bool, out_dir: Path = HERE, with_coupled: bool = True):
-    t0 = time.perf_counter()
+def set_a(positions: int):
+    """Set A at TORQUE (scene gearset-A, rigid-bore lumped source, face-width engagement): pair, mesh model,
+    operating point, normal force [N], the aligned d_qs at `positions` samples per mesh period [m], contact weights,
+    grade-5 tolerances per gear, the pitch and flank factors to the mesh normal."""
     data, path = read_scene_dict("gearset-A")
     table = rs.parse(data, str(path))
     pair, corr, _, interior, model = rs.build(table, str(path))
@@ -109,15 +121,19 @@ def main(draws: int, seed: int, positions: int, exact: bool, out_dir: Path = HER
     step = d_qs.size // positions
     if step * positions != d_qs.size:
         raise SystemExit(f"--positions must divide {d_qs.size}")
-    d_qs = d_qs[::step]
-    weights = am.contact_weights(model, F, positions)
+    beta_b = pair.base_helix_angle
+    alpha_t = pair.transverse_pressure_angle
+    tolerances = [am.iso1328_tolerances(pair.module, pair.pitch_diameter[g], FACE_WIDTHS[g]) for g in range(2)]
+    return (pair, model, op, F, d_qs[::step], am.contact_weights(model, F, positions), tolerances,
+            math.cos(alpha_t) * math.cos(beta_b), math.cos(beta_b))
+
+
+def main(draws: int, seed: int, positions: int, exact: bool, out_dir: Path = HERE, with_coupled: bool = True):
+    t0 = time.perf_counter()
+    pair, model, op, F, d_qs, weights, tolerances, pitch_factor, flank_factor = set_a(positions)
     z1, z2 = (int(z) for z in pair.teeth)
     periods = am.hunting_mesh_periods(pair)
     wheel_revs = periods // z2
-    beta_b = pair.base_helix_angle
-    alpha_t = pair.transverse_pressure_angle
-    pitch_factor, flank_factor = math.cos(alpha_t) * math.cos(beta_b), math.cos(beta_b)
-    tolerances = [am.iso1328_tolerances(pair.module, pair.pitch_diameter[g], FACE_WIDTHS[g]) for g in range(2)]
     deflection = float(op.curve.deflection.mean())
     print(f"set A: z = {z1}/{z2}, m_n = {pair.module * 1e3:.1f} mm, d = {pair.pitch_diameter[0] * 1e3:.1f} / "
           f"{pair.pitch_diameter[1] * 1e3:.1f} mm, b = 66 / 62 mm, eps_alpha = {pair.transverse_contact_ratio:.3f}, "
