@@ -92,18 +92,27 @@ def main(draws: int, seed: int, positions: int, out_dir: Path = HERE, with_coupl
           f"({time.perf_counter() - t0:.1f} s set-up)")
 
     rows, per_speed = [], {}
+    q = np.arange(orders.size)
+    near_tooth = np.where((q > 0) & (q < orders.size // 2), np.minimum(q % z2, (-q) % z2), 0)  # distance to 72 n
     for mi, model in enumerate(am.PITCH_MODELS):
         rng = np.random.default_rng([seed, mi])
         diffs = np.zeros((draws, len(SHIFTS), len(metrics), SPEEDS.size))
         base = np.zeros((draws, len(metrics), SPEEDS.size))
+        low = np.zeros(draws)
         for d in range(draws):
             pin, whl = (am.draw_deviations(rng, z, tolerances[g], am.DEVIATION_KINDS, pitch_factor, flank_factor,
                                            pitch_model=model) for g, z in enumerate((z1, z2)))
             power = [np.abs(am.reindexed_order_lines(pair, weights, pin, whl, s, d_qs)[1]) ** 2 for s in (0,) + SHIFTS]
             L = [10 * np.log10(W @ p / levels.OMEGA0**2) for p in power]      # (metric, speed) each
             base[d] = L[0]
+            for p in power[1:]:                 # where the power moves: |change| at wheel orders 72 n +- 3, +- 6
+                change = np.abs(p - power[0])[near_tooth > 0]
+                low[d] += np.sum(change[np.isin(near_tooth[near_tooth > 0], (3, 6))]) / np.sum(change) / len(SHIFTS)
             diffs[d] = np.array(L[1:]) - L[0]
         per_speed[model] = (base, diffs)
+        print(f"{model}: share of the lines' |power change| (orders 1..{orders.size // 2 - 1}, 2 shifts) at wheel "
+              f"orders {z2} n +- 3 and +- 6 (pinion pitch orders 1, 2 x wheel orders 3, 6): median "
+              f"{np.median(low) * 100:.0f} % [p5 {np.percentile(low, 5) * 100:.0f} %] over the draws")
         for d in range(draws):
             for ki, metric in enumerate(metrics):
                 row = {"pitch_model": model, "draw": d, "metric": metric}
