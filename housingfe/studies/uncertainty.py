@@ -33,7 +33,8 @@ the elastic feet (`mount_overrides`), every family of the sample runs on them, a
 next sample brings another mount (`_mount_pool`).
 
 Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
-concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A sample's answer
+concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A worker that dies
+stops the run with one line (`_pool`, `_results`: the pool's workers on this host are watched).  A sample's answer
 does not depend on the process that computed it (each builds the same basis): 1 and 2 workers give the same
 numbers (tests/studies/test_uncertainty.py).
 
@@ -1090,9 +1091,11 @@ def _note(folder: str, numbers) -> None:
 
 
 def _task(folder: str, numbers, batch) -> list[dict]:
-    """One pool task: note the samples `numbers` of `batch`, then evaluate_batch."""
+    """One pool task: note the samples `numbers` of `batch`, evaluate_batch, note that none runs."""
     _note(folder, numbers)
-    return evaluate_batch(batch, worker=True)
+    done = evaluate_batch(batch, worker=True)
+    _note(folder, ())
+    return done
 
 
 def _local_workers(folder: str) -> dict:
