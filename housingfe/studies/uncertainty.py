@@ -1026,8 +1026,8 @@ POLL_S = 0.5
 def _pool(engine: str, workers: int):
     """A started pool of `workers` processes (engine "mpi": mpi4py.futures; "processes": concurrent.futures) whose
     workers note their pid, host and current samples in a folder (_note), so that `_results` can tell a worker
-    that died.  On an error the pool's local workers are ended and the pool is not waited for (a dead mpi4py.futures
-    worker leaves the pool's thread waiting for ever: the CLI ends the process, see PoolError)."""
+    that died.  On an error the pool is not waited for here (a dead mpi4py.futures worker leaves the pool's thread
+    waiting for ever: the CLI ends the process, see PoolError)."""
     import shutil
     import tempfile
 
@@ -1037,8 +1037,6 @@ def _pool(engine: str, workers: int):
         try:
             yield ex, folder
         except BaseException:
-            for pid in _local_workers(folder):
-                _end(pid)
             ex.shutdown(wait=False, cancel_futures=True)
             raise
         ex.shutdown(wait=True)
@@ -1052,12 +1050,12 @@ def _executor(engine: str, workers: int, folder: str):
 
         # a singleton MPI process has one slot: spawning more needs oversubscription (Open MPI 4)
         return _started(MPIPoolExecutor(max_workers=workers, mpi_info={"map_by": ":OVERSUBSCRIBE"},
-                                        initializer=_note, initargs=(folder, ())), workers)
+                                        initializer=_worker_start, initargs=(folder,)), workers)
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
     return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
-                               initializer=_note, initargs=(folder, ()))
+                               initializer=_worker_start, initargs=(folder,))
 
 
 def _started(ex, workers: int):
@@ -1077,6 +1075,15 @@ def _started(ex, workers: int):
         raise PoolError(f"uncertainty: the mpi4py.futures pool of {workers} worker(s) did not start within "
                         f"{POOL_START_S:g} s (MPI_Comm_spawn); try --engine processes") from None
     return ex
+
+
+def _worker_start(folder: str) -> None:
+    """A pool worker's initializer: start PETSc and note the worker (_note).  PETSc starts collectively on the
+    mpi4py.futures workers' COMM_WORLD: when it started in the first sample, a worker whose sample failed before
+    it left the others blocked in PetscInitialize, and the command waiting for ever (2026-11-27)."""
+    from petsc4py import PETSc  # noqa: F401
+
+    _note(folder, ())
 
 
 def _note(folder: str, numbers) -> None:
@@ -1151,12 +1158,15 @@ def _results(futures, ex, folder: str, engine: str):
 
 
 def _check_mpi_workers(folder: str) -> None:
-    """PoolError naming the pool's workers on this host that are gone (Open MPI then ends the others)."""
+    """PoolError naming the pool's workers on this host that are gone, once the others are ended (Open MPI aborts
+    their job, but they stayed up for seconds)."""
     from housingfe.errors import PoolError
 
     workers = _local_workers(folder)
     dead = {pid: "" for pid in workers if not _alive(pid)}
     if dead:
+        for pid in workers:
+            _end(pid)
         raise PoolError(_died("mpi4py.futures", dead, workers))
 
 

@@ -593,3 +593,45 @@ def test_a_worker_that_dies_mid_sample_stops_with_one_line(tmp_path, engine, poo
         left = _processes_with(tag)
     assert left == []
     assert wall < 30.0                              # ~4.3 s here: spawn, imports, 1 s into sample 2, 0.2 s poll
+
+
+RAISES_EARLY = """
+import sys
+
+from housingfe.cli import main
+from housingfe.studies import uncertainty as unc
+
+
+def task(folder, numbers, batch):
+    if 2 in numbers:                    # fails before anything of its own starts PETSc
+        raise RuntimeError("sample 2 failed early")
+    from petsc4py import PETSc          # what every sample does first (dolfinx)
+    return [{"pid": PETSc.COMM_WORLD.getRank(), "seconds": 0.0}]
+
+
+unc._task = task
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
+"""
+
+
+@pytest.mark.mpi
+def test_a_sample_failing_before_petsc_does_not_block_the_others(tmp_path):
+    """PETSc starts collectively on the mpi4py.futures workers' COMM_WORLD: when it started in a worker's first
+    sample, a sample that failed before it left the other workers blocked in PetscInitialize and the command
+    waiting for ever (> 200 s, 2026-11-27).  The pool's initializer now starts it in every worker: the failure comes
+    back (a traceback: a bug, not an input; exit 1) in seconds."""
+    import os
+    import subprocess
+    import sys
+
+    script = tmp_path / "raises.py"
+    script.write_text(RAISES_EARLY)
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    proc = subprocess.run([sys.executable, str(script), "uncertainty", "--samples", "2", "--workers", "2",
+                           "--family", "none", "--set", 'housing.set=["mesh.size=0.08"]',
+                           "--out", str(tmp_path / "r")], capture_output=True, text=True, env=env, timeout=60)
+    assert proc.returncode == 1, proc.stderr
+    assert proc.stderr.strip().endswith("RuntimeError: sample 2 failed early")
+    assert not (tmp_path / "r").exists()
