@@ -11,7 +11,7 @@ import importlib
 import re
 import sys
 
-from housingfe.errors import InputError, PoolStartError, SolverError
+from housingfe.errors import InputError, PoolError, SolverError
 
 # Modules that contribute sub-commands (each defines register_cli(subparsers)).
 _EXTENSIONS = (
@@ -247,8 +247,9 @@ def main(argv: list[str] | None = None) -> int:
         if comm is not None and mode == "serial":
             return ranks.on_rank_zero(lambda: _serial(args, comm), comm)
         return int(args.func(args) or 0)
-    except PoolStartError as exc:
-        # the pool's thread is blocked in MPI_Comm_spawn: a normal exit would join it (and MPI_Finalize) for ever
+    except PoolError as exc:
+        # the pool's thread is blocked (in MPI_Comm_spawn, or on a dead worker's answer): a normal exit would join it
+        # (and MPI_Finalize) for ever
         from housingfe import outputs
 
         outputs.release_all()

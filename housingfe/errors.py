@@ -10,6 +10,7 @@ class SolverError(Exception):
     """A numerical failure the user must know about (incomplete eigen-solution, singular system)."""
 
 
-class PoolStartError(InputError):
-    """A pool of worker processes that did not start in time (e.g. MPI_Comm_spawn that never returns).  A thread
-    of the pool stays blocked, so the process cannot end normally: the CLI prints the line and ends it at once."""
+class PoolError(InputError):
+    """A pool of worker processes that did not start in time (e.g. MPI_Comm_spawn that never returns) or whose
+    worker died while the command waited on it.  A thread of the pool stays blocked, so the process cannot end
+    normally: the CLI prints the line and ends it at once."""

@@ -33,7 +33,8 @@ the elastic feet (`mount_overrides`), every family of the sample runs on them, a
 next sample brings another mount (`_mount_pool`).
 
 Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
-concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A sample's answer
+concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A worker that dies
+stops the run with one line (`_pool`, `_results`: the pool's workers on this host are watched).  A sample's answer
 does not depend on the process that computed it (each builds the same basis): 1 and 2 workers give the same
 numbers (tests/studies/test_uncertainty.py).
 
@@ -47,6 +48,7 @@ Python API (the quantity names are those of `UncertaintyResult.quantities`, docs
 from __future__ import annotations
 
 import argparse
+import contextlib
 import functools
 import json
 import math
@@ -1016,37 +1018,182 @@ class UncertaintyResult:
 
 # s an mpi4py.futures pool may take to start its workers (spawned Python processes importing mpi4py: ~1-2 s here)
 POOL_START_S = 120.0
+# s between checks, while waiting on a pool's samples, that its workers on this host are still alive
+POLL_S = 0.5
 
 
-def _executor(engine: str, workers: int):
+@contextlib.contextmanager
+def _pool(engine: str, workers: int):
+    """A started pool of `workers` processes (engine "mpi": mpi4py.futures; "processes": concurrent.futures) whose
+    workers note their pid, host and current samples in a folder (_note), so that `_results` can tell a worker
+    that died.  On an error the pool is not waited for here (a dead mpi4py.futures worker leaves the pool's thread
+    waiting for ever: the CLI ends the process, see PoolError)."""
+    import shutil
+    import tempfile
+
+    folder = tempfile.mkdtemp(prefix="housingfe-pool-")
+    try:
+        ex = _executor(engine, workers, folder)
+        try:
+            yield ex, folder
+        except BaseException:
+            ex.shutdown(wait=False, cancel_futures=True)
+            raise
+        ex.shutdown(wait=True)
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _executor(engine: str, workers: int, folder: str):
     if engine == "mpi":
         from mpi4py.futures import MPIPoolExecutor
 
         # a singleton MPI process has one slot: spawning more needs oversubscription (Open MPI 4)
-        return _started(MPIPoolExecutor(max_workers=workers, mpi_info={"map_by": ":OVERSUBSCRIBE"}), workers)
+        return _started(MPIPoolExecutor(max_workers=workers, mpi_info={"map_by": ":OVERSUBSCRIBE"},
+                                        initializer=_worker_start, initargs=(folder,)), workers)
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+    return ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_worker_start, initargs=(folder,))
 
 
 def _started(ex, workers: int):
-    """The mpi4py.futures pool `ex` once its workers answer (they are spawned together, so one answer means all
-    are up); PoolStartError if they do not within POOL_START_S.  A worker that cannot be executed, exits at once
-    or never calls MPI_Init left the command waiting for ever (2026-11-27: mpi4py 3.1.4, Open MPI 4), the pool's
-    thread blocked in MPI_Comm_spawn; one such hang was seen at spawn (docs/uncertainty.md)."""
+    """The mpi4py.futures pool `ex` once its workers answer (they are spawned together, and every worker has run
+    its initializer before the first task runs: one answer means all are up); PoolError if they do not within
+    POOL_START_S.  A worker that cannot be executed, exits at once or never calls MPI_Init left the command
+    waiting for ever (2026-11-27: mpi4py 3.1.4, Open MPI 4), the pool's thread blocked in MPI_Comm_spawn; one
+    such hang was seen at spawn (docs/uncertainty.md)."""
     import concurrent.futures
-    import os
 
-    from housingfe.errors import PoolStartError
+    from housingfe.errors import PoolError
 
     try:
         ex.submit(os.getpid).result(timeout=POOL_START_S)
     except concurrent.futures.TimeoutError:
         ex.shutdown(wait=False, cancel_futures=True)
-        raise PoolStartError(f"uncertainty: the mpi4py.futures pool of {workers} worker(s) did not start within "
-                             f"{POOL_START_S:g} s (MPI_Comm_spawn); try --engine processes") from None
+        raise PoolError(f"uncertainty: the mpi4py.futures pool of {workers} worker(s) did not start within "
+                        f"{POOL_START_S:g} s (MPI_Comm_spawn); try --engine processes") from None
     return ex
+
+
+def _worker_start(folder: str) -> None:
+    """A pool worker's initializer: start PETSc and note the worker (_note).  PETSc starts collectively on the
+    mpi4py.futures workers' COMM_WORLD: when it started in the first sample, a worker whose sample failed before
+    it left the others blocked in PetscInitialize, and the command waiting for ever (2026-11-27)."""
+    from petsc4py import PETSc  # noqa: F401
+
+    _note(folder, ())
+
+
+def _note(folder: str, numbers) -> None:
+    """In a worker: write `folder/<pid>` = this host and the sample numbers (1-based) it runs now.  A worker on
+    another host has no such folder (or another machine's): it is not watched."""
+    import socket
+
+    try:
+        Path(folder, str(os.getpid())).write_text(f"{socket.gethostname()}\n{' '.join(map(str, numbers))}\n")
+    except OSError:
+        pass
+
+
+def _task(folder: str, numbers, batch) -> list[dict]:
+    """One pool task: note the samples `numbers` of `batch`, evaluate_batch, note that none runs."""
+    _note(folder, numbers)
+    done = evaluate_batch(batch, worker=True)
+    _note(folder, ())
+    return done
+
+
+def _local_workers(folder: str) -> dict:
+    """{pid: sample numbers it runs (text)} of the workers on this host that noted themselves in `folder`."""
+    import socket
+
+    host, found = socket.gethostname(), {}
+    for f in Path(folder).iterdir():
+        try:
+            where, numbers = (f.read_text().split("\n") + [""])[:2]
+        except OSError:
+            continue
+        if where == host:
+            found[int(f.name)] = numbers.split()
+    return found
+
+
+def _alive(pid: int) -> bool:
+    """Process `pid` exists and is not a zombie (a dead child of this process not yet reaped)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return False
+
+
+def _end(pid: int) -> None:
+    import signal
+
+    try:
+        os.kill(pid, signal.SIGKILL)
+    except OSError:
+        pass
+
+
+def _results(futures, ex, folder: str, engine: str):
+    """Each future's result, in order; PoolError (one line) when a worker of the pool died: engine "mpi" checks
+    every POLL_S that its workers on this host are alive (mpi4py.futures never notices a dead worker and waits for
+    ever), engine "processes" learns it from concurrent.futures (BrokenProcessPool)."""
+    import concurrent.futures
+    from concurrent.futures.process import BrokenProcessPool
+
+    for fut in futures:
+        while True:
+            try:
+                yield fut.result(timeout=POLL_S if engine == "mpi" else None)
+                break
+            except concurrent.futures.TimeoutError:
+                _check_mpi_workers(folder)
+            except BrokenProcessPool:
+                _broken_processes(ex, folder)
+    if engine == "mpi":
+        _check_mpi_workers(folder)                  # one that died idle would hang the pool's shutdown
+
+
+def _check_mpi_workers(folder: str) -> None:
+    """PoolError naming the pool's workers on this host that are gone, once the others are ended (Open MPI aborts
+    their job, but they stayed up for seconds)."""
+    from housingfe.errors import PoolError
+
+    workers = _local_workers(folder)
+    dead = {pid: "" for pid in workers if not _alive(pid)}
+    if dead:
+        for pid in workers:
+            _end(pid)
+        raise PoolError(_died("mpi4py.futures", dead, workers))
+
+
+def _broken_processes(ex, folder: str) -> None:
+    """InputError naming the worker(s) of the broken concurrent.futures pool `ex` that died of themselves: the
+    pool ends the others with SIGTERM once it notices (its process objects: private, read if there)."""
+    import signal
+
+    procs = dict(getattr(ex, "_processes", None) or {})
+    ex.shutdown(wait=True)                          # bounded: the broken pool joins its ended processes
+    codes = {pid: p.exitcode for pid, p in procs.items() if p.exitcode is not None}
+    own = {pid: c for pid, c in codes.items() if c != -signal.SIGTERM} or codes
+    dead = {pid: f" (signal {-c})" if c < 0 else f" (exit code {c})" for pid, c in own.items()}
+    # an ordinary exit: the pool is broken, not blocked (os._exit would leak its semaphores)
+    if not dead:
+        raise InputError("uncertainty: a worker of the concurrent.futures pool died (BrokenProcessPool); the run "
+                         "stopped, nothing written")
+    raise InputError(_died("concurrent.futures", dead, _local_workers(folder)))
+
+
+def _died(pool: str, dead: dict, workers: dict) -> str:
+    """The one line for the dead workers {pid: " (how)"} of `pool`, with the samples they ran (`workers`)."""
+    what = [f"pid {pid}{' of the ' + pool + ' pool' if i == 0 else ''} died{how} "
+            + (f"while running sample {', '.join(workers[pid])}" if workers.get(pid) else "between samples")
+            for i, (pid, how) in enumerate(sorted(dead.items()))]
+    return (f"uncertainty: worker {'; worker '.join(what)}; the run stopped, nothing written (killed for memory? "
+            "try fewer --workers)")
 
 
 def check_request(n_samples, seed, workers, families, engine) -> None:
@@ -1103,24 +1250,26 @@ def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 
         # task, and its resident memory stays flat (release_petsc_garbage; docs/uncertainty.md)
         used = "mpi4py.futures" if engine == "mpi" else "concurrent.futures"
         metrics = []
-        with _executor(engine, min(workers, n_samples)) as ex:
-            futures = [ex.submit(evaluate_batch, [a], worker=True) for a in args]
-            for fut in futures:                     # in sample order: the answer does not depend on the pool
-                metrics += fut.result()
+        with _pool(engine, min(workers, n_samples)) as (ex, folder):
+            futures = [ex.submit(_task, folder, [i + 1], [a]) for i, a in enumerate(args)]
+            for batch in _results(futures, ex, folder, engine):   # in sample order: the answer does not depend on the pool
+                metrics += batch
                 m = metrics[-1]
                 say(f"sample {len(metrics)}/{n_samples}: {m['seconds']:.1f} s (process {m['pid']})")
     else:
         # batches of samples_per_process samples, at most `workers` batches per pool: the pool's processes end
         # after them and new ones build their bases again
         used = "mpi4py.futures" if engine == "mpi" else "concurrent.futures"
-        batches = [args[i:i + samples_per_process] for i in range(0, len(args), samples_per_process)]
+        numbers = list(range(1, len(args) + 1))
+        batches = [(numbers[i:i + samples_per_process], args[i:i + samples_per_process])
+                   for i in range(0, len(args), samples_per_process)]
         metrics = []
         for first in range(0, len(batches), workers):
             group = batches[first:first + workers]
-            with _executor(engine, len(group)) as ex:
-                futures = [ex.submit(evaluate_batch, batch, worker=True) for batch in group]
-                for fut in futures:                 # in sample order: the answer does not depend on the pool
-                    for m in fut.result():
+            with _pool(engine, len(group)) as (ex, folder):
+                futures = [ex.submit(_task, folder, nums, batch) for nums, batch in group]
+                for batch in _results(futures, ex, folder, engine):   # in sample order
+                    for m in batch:
                         metrics.append(m)
                         say(f"sample {len(metrics)}/{n_samples}: {m['seconds']:.1f} s (process {m['pid']})")
     wall = time.perf_counter() - t0

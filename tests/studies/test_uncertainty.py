@@ -472,7 +472,7 @@ from housingfe.studies import uncertainty as unc
 # workers that never call MPI_Init (a "python" that sleeps): the spawn never returns
 unc.POOL_START_S = 3.0
 started = unc._started
-unc._executor = lambda engine, workers: started(
+unc._executor = lambda engine, workers, folder: started(
     MPIPoolExecutor(max_workers=workers, python_exe=sys.argv[1], mpi_info={"map_by": ":OVERSUBSCRIBE"}), workers)
 raise SystemExit(main(sys.argv[2:]))
 """
@@ -506,3 +506,132 @@ def test_a_pool_that_never_starts_stops_with_one_line(tmp_path):
                      "3 s (MPI_Comm_spawn); try --engine processes"]
     assert not out.exists()
     assert wall < 60.0                      # not the sleeping workers' 20 s twice over, nor for ever
+
+
+DIES = """
+import os
+import signal
+import sys
+import time
+
+from housingfe.cli import main
+from housingfe.studies import uncertainty as unc
+
+# runs in the parent and, imported as the main module, in every worker: the worker given sample 2 kills itself
+unc.POLL_S = 0.2
+real_task = unc._task
+
+
+def dying_task(folder, numbers, batch):
+    if 2 in numbers:
+        unc._note(folder, numbers)
+        time.sleep(1.0)
+        os.kill(os.getpid(), signal.SIGKILL)
+    return real_task(folder, numbers, batch)
+
+
+unc._task = dying_task
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
+"""
+
+
+def _processes_with(tag: str) -> list[int]:
+    """pids of the processes whose environment holds `tag` (this test's run and its workers)."""
+    import os
+
+    found = []
+    for d in os.listdir("/proc"):
+        try:
+            with open(f"/proc/{d}/environ", "rb") as fh:
+                if tag.encode() in fh.read():
+                    found.append(int(d))
+        except (OSError, ValueError):
+            pass
+    return found
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("engine, pool", [("mpi", "mpi4py.futures"), ("processes", "concurrent.futures")])
+def test_a_worker_that_dies_mid_sample_stops_with_one_line(tmp_path, engine, pool):
+    """A worker killed (SIGKILL) while running its sample left engine "mpi" waiting for ever (mpi4py.futures never
+    notices; 2026-11-27) and engine "processes" ending in a BrokenProcessPool traceback.  Now: within a few poll
+    intervals one "housingfe: error:" line naming the dead worker's pid and its sample, exit 2, no result folder,
+    no worker process left."""
+    import os
+    import re
+    import subprocess
+    import sys
+    import time
+    import uuid
+
+    script = tmp_path / "dies.py"
+    script.write_text(DIES)
+    out = tmp_path / "dead"
+    tag = f"HOUSINGFE_TEST_TAG={uuid.uuid4().hex}"
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1", tag.split("=")[0]: tag.split("=")[1]}
+    t0 = time.monotonic()
+    proc = subprocess.run([sys.executable, str(script), "uncertainty", "--samples", "2", "--workers", "2",
+                           "--engine", engine, "--family", "none", "--set", 'housing.set=["mesh.size=0.08"]',
+                           "--out", str(out)], capture_output=True, text=True, env=env, timeout=120)
+    wall = time.monotonic() - t0
+    ours = [ln for ln in proc.stderr.splitlines() if ln.startswith("housingfe")]
+    assert proc.returncode == 2, proc.stderr
+    assert len(ours) == 1 and "Traceback" not in proc.stderr, proc.stderr
+    assert re.fullmatch(rf"housingfe: error: uncertainty: worker pid \d+ of the {pool} pool died"
+                        rf"{' [(]signal 9[)]' if engine == 'processes' else ''} while running sample 2; the run "
+                        r"stopped, nothing written \(killed for memory\? try fewer --workers\)", ours[0]), ours[0]
+    if engine == "processes":                       # Open MPI adds its own report of the dead worker
+        assert proc.stderr.strip() == ours[0]
+    assert not out.exists()
+    left = _processes_with(tag)
+    for _ in range(50):                             # Open MPI's daemon ends the spawned workers it still holds
+        if not left:
+            break
+        time.sleep(0.1)
+        left = _processes_with(tag)
+    assert left == []
+    assert wall < 30.0                              # ~4.3 s here: spawn, imports, 1 s into sample 2, 0.2 s poll
+
+
+RAISES_EARLY = """
+import sys
+
+from housingfe.cli import main
+from housingfe.studies import uncertainty as unc
+
+
+def task(folder, numbers, batch):
+    if 2 in numbers:                    # fails before anything of its own starts PETSc
+        raise RuntimeError("sample 2 failed early")
+    from petsc4py import PETSc          # what every sample does first (dolfinx)
+    return [{"pid": PETSc.COMM_WORLD.getRank(), "seconds": 0.0}]
+
+
+unc._task = task
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
+"""
+
+
+@pytest.mark.mpi
+def test_a_sample_failing_before_petsc_does_not_block_the_others(tmp_path):
+    """PETSc starts collectively on the mpi4py.futures workers' COMM_WORLD: when it started in a worker's first
+    sample, a sample that failed before it left the other workers blocked in PetscInitialize and the command
+    waiting for ever (> 200 s, 2026-11-27).  The pool's initializer now starts it in every worker: the failure comes
+    back (a traceback: a bug, not an input; exit 1) in seconds."""
+    import os
+    import subprocess
+    import sys
+
+    script = tmp_path / "raises.py"
+    script.write_text(RAISES_EARLY)
+    env = {**os.environ, "OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OPENBLAS_NUM_THREADS": "1"}
+    proc = subprocess.run([sys.executable, str(script), "uncertainty", "--samples", "2", "--workers", "2",
+                           "--family", "none", "--set", 'housing.set=["mesh.size=0.08"]',
+                           "--out", str(tmp_path / "r")], capture_output=True, text=True, env=env, timeout=60)
+    assert proc.returncode == 1, proc.stderr
+    assert proc.stderr.strip().endswith("RuntimeError: sample 2 failed early")
+    assert not (tmp_path / "r").exists()
