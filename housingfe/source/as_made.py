@@ -179,22 +179,33 @@ def first_order_te(pair: GearPair, weights: ContactWeights, pinion: ToothDeviati
     wheel's the other way round), the face coordinate over the contact width.  with_spread: also return the largest
     range (max - min) [m] of the deviations over the points in contact at one instant (the first-order validity:
     it must stay small against the mesh deflection)."""
+    te_pinion, te_wheel, spread = _te_terms(pair, weights, pinion, wheel, periods)
+    te = te_pinion + te_wheel
+    return (te, spread) if with_spread else te
+
+
+def _te_terms(pair: GearPair, weights: ContactWeights, pinion: ToothDeviations, wheel: ToothDeviations,
+              periods: int | None = None) -> tuple[np.ndarray, np.ndarray, float]:
+    """`first_order_te`'s two terms apart, the pinion's deviations' and the wheel's [m] (the TE is their sum), and
+    the largest spread of the deviations in contact [m]."""
     z1, z2 = (int(z) for z in pair.teeth)
     periods = hunting_mesh_periods(pair) if periods is None else periods
     A, E = pair.path_of_contact
     b = pair.contact_width
     n_pos = weights.n_positions
-    te = np.zeros((periods, n_pos))
+    te = np.zeros((2, periods, n_pos))
     spread = 0.0
     m = np.arange(periods)[:, None]
     for p in range(n_pos):
         xi = (weights.s[p] - 0.5 * (A + E)) / (E - A)
         eta = weights.w_local[p] / b - 0.5
         k = weights.pair[p][None, :]
-        e = pinion.gap((m + k) % z1, xi[None, :], eta[None, :]) + wheel.gap((m + k) % z2, -xi[None, :], eta[None, :])
-        te[:, p] = e @ weights.weight[p]
-        spread = max(spread, float(np.max(np.ptp(e, axis=1))))
-    return (te.ravel(), spread) if with_spread else te.ravel()
+        e_pinion = pinion.gap((m + k) % z1, xi[None, :], eta[None, :])
+        e_wheel = wheel.gap((m + k) % z2, -xi[None, :], eta[None, :])
+        te[0, :, p] = e_pinion @ weights.weight[p]
+        te[1, :, p] = e_wheel @ weights.weight[p]
+        spread = max(spread, float(np.max(np.ptp(e_pinion + e_wheel, axis=1))))
+    return te[0].ravel(), te[1].ravel(), spread
 
 
 def exact_deviation_te(model: MeshModel, total_force: float, pinion: ToothDeviations, wheel: ToothDeviations,
@@ -324,6 +335,26 @@ def reindexed_order_lines(pair: GearPair, weights: ContactWeights, pinion: Tooth
     if aligned_te is not None:
         te = te + _aligned_record(aligned_te, weights.n_positions, periods)
     return order_lines(te, periods // int(pair.teeth[1]))
+
+
+def turned_pinion_lines(pair: GearPair, weights: ContactWeights, pinion: ToothDeviations, wheel: ToothDeviations,
+                        shifts, aligned_te: np.ndarray | None = None) -> tuple[np.ndarray, list[np.ndarray]]:
+    """`reindexed_order_lines` for several shifts from one evaluation of the deviations: wheel orders and, per shift,
+    the complex one-sided amplitudes c_q [m].  Turning the pinion by s teeth shows at mesh period m the deviations
+    it showed at period m + s, so its share of the hunting record (`_te_terms`) is the unturned one advanced by s
+    mesh periods (a circular shift: the hunting period is a multiple of z1); the wheel's and the aligned share stay.
+    Equal to `reindexed_order_lines` shift by shift to rounding (tests/source/test_as_made.py), a third of its cost
+    for three shifts."""
+    periods = hunting_mesh_periods(pair)
+    te_pinion, te_wheel, _ = _te_terms(pair, weights, pinion, wheel, periods)
+    if aligned_te is not None:
+        te_wheel = te_wheel + _aligned_record(aligned_te, weights.n_positions, periods)
+    per_wheel_revolution = periods // int(pair.teeth[1])
+    lines = [order_lines(np.roll(te_pinion, -int(s) * weights.n_positions) + te_wheel, per_wheel_revolution)
+             for s in shifts]
+    if not lines:
+        raise ValueError("turned_pinion_lines: no shifts")
+    return lines[0][0], [c for _, c in lines]
 
 
 def _aligned_record(aligned_te, positions: int, periods: int) -> np.ndarray:

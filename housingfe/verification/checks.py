@@ -11,7 +11,8 @@ unit, source, note) with these fields added (`tag`):
   as made (`as_made_row`; runup.as_made, docs/runup.md), and "28.as_made.<pitch>.<the check's id after 28.>", the
   default chain's checks on a run with the sidebands in its totals (`as_made_check`; runup.as_made_totals), reported,
   never judged, without a band and counted apart as well (the count line says how many of those the checks would
-  pass); and in the variants group the double helical set against single helical set A and self-aligning B
+  pass), and "28.as_made.reindex.<pitch>", the thesis' turned-pinion measurement (Sec. 5.6) against drawn grade-5
+  gears per pitch model (AS_MADE_REINDEX; housingfe.verification.turned_pinion_rows); and in the variants group the double helical set against single helical set A and self-aligning B
   (VS_SINGLE, "28.variants.double_helical_vs_single.<roller|fluid_film>.<A|B_self_aligning>.<mean|max_reduction>.
   <route>", study_rows.double_helical_vs_single_rows): the issue's checks do not name this comparison, so these are
   reported beside them, never judged, without a band and counted apart;
@@ -53,6 +54,10 @@ AS_MADE_GROUP = "as_made"
 AS_MADE_GRADE = 5
 AS_MADE_OVERRIDE = f"runup.as_made={AS_MADE_GRADE}"     # validate's runs of gears as made (run-up, studies)
 AS_MADE_VARIANTS = f"28.{AS_MADE_GROUP}.variants."      # the design variants' rows as made (study_rows.as_made_rows)
+# the pinion turned against the wheel (thesis Sec. 5.6, Fig. 5.12; housingfe.runup.reindex): per pitch model
+AS_MADE_REINDEX = f"28.{AS_MADE_GROUP}.reindex."
+AS_MADE_REINDEX_WHY = (f"gears as made (drawn ISO 1328-1 grade-{AS_MADE_GRADE} deviations standing in for the thesis' "
+                       "DIN 5; the pinion turned against the wheel): reported, not a check; docs/source.md")
 AS_MADE_WHY = (f"gears as made (runup.as_made = {AS_MADE_GRADE}, ISO 1328-1 grade {AS_MADE_GRADE} standing in for the "
                "thesis' DIN 5): reported, not a check; docs/runup.md")
 CHECK_COLUMNS = ("check_id", "quantity", "ours", "measured", "thesis_calculated", "tolerance", "passed", "band", "why",
@@ -183,13 +188,13 @@ def as_made_check(row: dict, pitch: str, periodic: dict | None = None) -> dict:
 
 
 def as_made_row(check_id: str, scene: str, quantity: str, ours, unit: str, source: str, *, measured=None,
-                thesis_calculated=None, why: str = "") -> dict:
+                thesis_calculated=None, why: str = "", prefix: str = AS_MADE_WHY) -> dict:
     """A row of gears as made: check_id 28.as_made.<the check's id after "28.">, ours with the expected sidebands,
     measured / thesis calculated as the check's, passed "" (reported), no tolerance, no band, `why` starting with
-    AS_MADE_WHY."""
+    `prefix` (AS_MADE_WHY; the turned pinion's rows AS_MADE_REINDEX_WHY)."""
     if not check_id.startswith(f"28.{AS_MADE_GROUP}."):
         raise ValueError(f"as_made_row: {check_id!r} is not 28.{AS_MADE_GROUP}.<...>")
-    why = f"{AS_MADE_WHY}; {why}" if why else AS_MADE_WHY
+    why = f"{prefix}; {why}" if why else prefix
     r = check_row(check_id, scene, quantity, ours, unit, source, measured=measured,
                   thesis_calculated=thesis_calculated, why=why)
     r["note"] = f"reported, not judged: {why}"
@@ -335,6 +340,7 @@ def checks_markdown(rows) -> str:
     bound = sum(is_bound(r) for r in found)
     made = sum(is_as_made(r) for r in found)
     variants = sum(is_as_made(r) and r["check_id"].startswith(AS_MADE_VARIANTS) for r in found)
+    reindex = sum(is_as_made(r) and r["check_id"].startswith(AS_MADE_REINDEX) for r in found)
     chain = {p: [r for r in found if is_as_made_check(r) and r["check_id"].split(".")[2] == p]
              for p in AS_MADE_PITCHES}
     n_chain = sum(len(v) for v in chain.values())
@@ -342,7 +348,7 @@ def checks_markdown(rows) -> str:
     checks = len(found) - bound - made - vs_single
     passed = sum(r.get("passed") == "yes" for r in found)
     failed = sum(r.get("passed") == "no" for r in found)
-    parts = [f"{made - variants - n_chain} of the default run-up"]
+    parts = [f"{made - variants - n_chain - reindex} of the default run-up"]
     if n_chain:
         would = ", ".join(f"{p} {sum(r.get('as_made_passes') == 'yes' for r in v)} of "
                           f"{sum(bool(r.get('as_made_passes')) for r in v)}" for p, v in chain.items() if v)
@@ -350,7 +356,9 @@ def checks_markdown(rows) -> str:
                      f"pass: {would})")
     if variants:
         parts.append(f"{variants} of the design variants {AS_MADE_VARIANTS}*")
-    detail = f": {', '.join(parts)}" if (variants or n_chain) else ""
+    if reindex:
+        parts.append(f"{reindex} of the pinion turned against the wheel {AS_MADE_REINDEX}* (Sec. 5.6)")
+    detail = f": {', '.join(parts)}" if (variants or n_chain or reindex) else ""
     lines += ["", f"{checks} checks: {passed} passed, {failed} failed, {checks - passed - failed} reported"
               + (f"; and {bound} rows of the envelope bound (28.bound.*), reported: a bound, not the model" if bound
                  else "")

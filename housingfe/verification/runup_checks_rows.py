@@ -118,9 +118,10 @@ def only_rows(results: Path, quick: bool = False, failures: list[str] | None = N
     """The check rows of issue 28 alone (`housingfe validate --only runup-checks`): the default run-up's tagged rows,
     the design-variant study's (study_rows), the quasi-static excitation's (source_rows.excitation_rows) and the
     checks no other provider makes (runup_checks_rows), each from the same cached computation the full validate
-    uses, and after them the reported rows 28.bound.* and 28.as_made.* (not checks: checks.as_bound, as_made_row).  A failed
+    uses, and after them the reported rows 28.bound.* and 28.as_made.* (not checks: checks.as_bound, as_made_row; the
+    turned pinion's 28.as_made.reindex.* computed as in the full validate, turned_pinion_rows, ~10 s).  A failed
     computation is appended to failures (its rows are missing)."""
-    from housingfe.verification import source_rows, study_rows, validate
+    from housingfe.verification import source_rows, study_rows, turned_pinion_rows, validate
     from housingfe.verification.checks import check_rows
 
     failures = [] if failures is None else failures
@@ -129,7 +130,8 @@ def only_rows(results: Path, quick: bool = False, failures: list[str] | None = N
     for what, make in ((validate.DEFAULT_RUNUP, lambda: validate.runup_rows(validate.DEFAULT_RUNUP, (), results, quick)),
                        ("runup_checks_rows", lambda: published_rows(results, quick, failures)),
                        ("quasi-static excitation", source_rows.excitation_rows),
-                       ("study rows", lambda: study_rows.published_rows(results, quick))):
+                       ("study rows", lambda: study_rows.published_rows(results, quick)),
+                       ("turned pinion (28.as_made.reindex.*)", turned_pinion_rows.published_rows)):
         try:
             rows += make()
         except validate.ComputationFailed as exc:

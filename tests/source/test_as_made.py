@@ -408,3 +408,23 @@ def test_one_displaced_pinion_tooth_and_one_wheel_tooth_interfere_at_the_shared_
         power = np.abs(G[shared]) ** 2 * (9 * d1**2 + d2**2 + 6 * d1 * d2 * np.cos(
             2 * math.pi * q[shared] * (tp - s - tw) / M))
         assert np.allclose(np.abs(c[shared]) ** 2, power, rtol=1e-9, atol=1e-30)
+
+
+def test_turned_pinion_lines_are_reindexed_order_lines_from_one_evaluation(spur):
+    """The fast path (the pinion's share of the hunting record advanced by s mesh periods) gives, shift by shift,
+    the lines of re-assembling the gears with the pinion turned (`reindexed_order_lines`, via `turned`), negative and
+    full-revolution shifts included; and first_order_te is still the sum of the two gears' terms."""
+    pair, model, w = spur
+    rng = np.random.default_rng(7)
+    pin, whl = _draw_pair(rng, pair, am.DEVIATION_KINDS, "independent")
+    aligned = 0.5e-6 * np.sin(2 * math.pi * np.arange(w.n_positions) / w.n_positions)
+    shifts = (0, 8, 16, 5, -3, 24)
+    orders, lines = am.turned_pinion_lines(pair, w, pin, whl, shifts, aligned)
+    scale = np.max(np.abs(lines[0]))
+    for s, c in zip(shifts, lines):
+        ref_orders, ref = am.reindexed_order_lines(pair, w, pin, whl, s, aligned)
+        assert np.array_equal(orders, ref_orders)
+        assert np.max(np.abs(c - ref)) < 1e-12 * scale, s
+    assert np.max(np.abs(lines[1] - lines[0])) > 1e-3 * scale          # a turn does move the shared orders
+    with pytest.raises(ValueError, match="no shifts"):
+        am.turned_pinion_lines(pair, w, pin, whl, ())

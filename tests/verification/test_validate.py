@@ -177,7 +177,7 @@ def test_row_providers_are_the_rows_modules_and_no_other_module_has_rows():
 
     assert validate.ROW_PROVIDERS == ("housingfe.verification.bearing_rows", "housingfe.verification.radiation_rows",
                                       "housingfe.verification.runup_checks_rows", "housingfe.verification.source_rows",
-                                      "housingfe.verification.study_rows")
+                                      "housingfe.verification.study_rows", "housingfe.verification.turned_pinion_rows")
     for m in pkgutil.iter_modules(package.__path__):
         name = f"housingfe.verification.{m.name}"
         assert hasattr(importlib.import_module(name), "published_rows") == (name in validate.ROW_PROVIDERS), name

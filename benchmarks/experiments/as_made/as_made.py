@@ -29,15 +29,11 @@ import numpy as np
 
 from housingfe import levels
 from housingfe.outputs import write_csv
-from housingfe.scenefile import read_scene_dict
 from housingfe.source import as_made as am
-from housingfe.source.roosmalen import dynamics as dyn
-from housingfe.source.roosmalen import run as rs
 
 TORQUE = 2000.0
 SPEEDS = (500.0, 1000.0, 1500.0)
 MEASURED = {500.0: 109.9, 1000.0: 111.2, 1500.0: 120.8}    # Fig. 5.4, tooth 1/3-octave band, set A, 2000 N m
-FACE_WIDTHS = (0.066, 0.062)                                 # set A: pinion, wheel [m]
 CASES = {"pitch": ["pitch"], "profile slope": ["profile_slope"], "profile form": ["profile_form"],
          "helix slope": ["helix_slope"], "twist": ["twist"], "all": list(am.DEVIATION_KINDS),
          "twist common to all teeth": "common-twist"}
@@ -109,23 +105,18 @@ def draw_case(rng, case, pair, tolerances, pitch_factor, flank_factor):
 
 
 def set_a(positions: int):
-    """Set A at TORQUE (scene gearset-A, rigid-bore lumped source, face-width engagement): pair, mesh model,
-    operating point, normal force [N], the aligned d_qs at `positions` samples per mesh period [m], contact weights,
-    grade-5 tolerances per gear, the pitch and flank factors to the mesh normal."""
-    data, path = read_scene_dict("gearset-A")
-    table = rs.parse(data, str(path))
-    pair, corr, _, interior, model = rs.build(table, str(path))
-    op = rs.OperatingPoint(pair, corr, interior, model, TORQUE, positions, engagement="face-width")
-    F = op.normal_force
-    d_qs = dyn.quasi_static_compression(op.S, op.shock, F)
-    step = d_qs.size // positions
-    if step * positions != d_qs.size:
-        raise SystemExit(f"--positions must divide {d_qs.size}")
-    beta_b = pair.base_helix_angle
-    alpha_t = pair.transverse_pressure_angle
-    tolerances = [am.iso1328_tolerances(pair.module, pair.pitch_diameter[g], FACE_WIDTHS[g]) for g in range(2)]
-    return (pair, model, op, F, d_qs[::step], am.contact_weights(model, F, positions), tolerances,
-            math.cos(alpha_t) * math.cos(beta_b), math.cos(beta_b))
+    """Set A at TORQUE (housingfe.runup.reindex.set_a: scene gearset-A, rigid-bore lumped source, face-width
+    engagement): pair, mesh model, operating point, normal force [N], the aligned d_qs at `positions` samples per mesh
+    period [m], contact weights, grade-5 tolerances per gear, the pitch and flank factors to the mesh normal."""
+    from housingfe.errors import InputError
+    from housingfe.runup.reindex import set_a as package_set_a
+
+    try:
+        a = package_set_a(positions, TORQUE)
+    except InputError as exc:
+        raise SystemExit(f"--positions: {exc}") from None
+    return (a.pair, a.model, a.op, a.normal_force, a.aligned_te, a.weights, a.tolerances, a.pitch_factor,
+            a.flank_factor)
 
 
 def main(draws: int, seed: int, positions: int, exact: bool, out_dir: Path = HERE, with_coupled: bool = True):

@@ -29,14 +29,14 @@ import numpy as np
 
 from housingfe import levels
 from housingfe.outputs import write_csv
-from housingfe.runup.as_made import band_of, te_receptance_rigid_bores
+from housingfe.runup.as_made import te_receptance_rigid_bores
+from housingfe.runup.reindex import KINDS, weights_per_speed
 from housingfe.source import as_made as am
 
 HERE = Path(__file__).parent
 SHIFTS = (8, 16)                     # pinion teeth turned against the wheel (1/3 and 2/3 of a pinion revolution)
 SPEEDS = np.arange(50.0, 1501.0, 50.0)
 HARMONICS = range(1, 9)
-KINDS = ("tooth", "bands 1-8", "bands 1-8, A")
 RANGES = {"50-1500": SPEEDS >= 50, "800-1500": SPEEDS >= 800}
 # thesis Sec. 5.6 (seed 004, line 2032): re-indexed pinion, mean and s.d. of the L_W differences over speed, dB;
 # the repeatability (Fig. 5.11) is reference/roosmalen1994.toml test_gearbox.repeatability_mean_dB / _sd_dB
@@ -51,28 +51,6 @@ def _as_made_experiment():
     return module
 
 
-def weights_per_speed(orders, f_tooth_per_rpm, z2, receptance):
-    """(KINDS, speed, order) weights: the mean square of L_omega per unit a_q^2 [1/s^2 per m^2] of the lines each
-    metric sums at each speed (receptance: f [Hz] -> |Omega_wheel / e| [(rad/s)/m]; A-weighting on the last)."""
-    W = np.zeros((len(KINDS), SPEEDS.size, orders.size))
-    for i, v in enumerate(SPEEDS):
-        f_t = f_tooth_per_rpm * v
-        f = orders * f_t / z2
-        lo, hi = band_of(f_t)
-        tooth = (f >= lo) & (f < hi)
-        bands = np.zeros(f.size, bool)
-        for n in HARMONICS:
-            lo, hi = band_of(n * f_t)
-            bands |= (f >= lo) & (f < hi)
-        bands &= orders > 0
-        r2 = np.zeros(f.size)
-        r2[bands | tooth] = receptance(f[bands | tooth]) ** 2 / 2
-        W[0, i] = r2 * tooth
-        W[1, i] = r2 * bands
-        W[2, i] = r2 * bands * 10 ** (levels.a_weighting_db(np.maximum(f, 1e-9)) / 10)
-    return W
-
-
 def main(draws: int, seed: int, positions: int, out_dir: Path = HERE, with_coupled: bool = True) -> None:
     t0 = time.perf_counter()
     exp = _as_made_experiment()
@@ -85,7 +63,8 @@ def main(draws: int, seed: int, positions: int, out_dir: Path = HERE, with_coupl
         t1 = time.perf_counter()
         routes["coupled"] = exp.coupled_te_receptance()
         print(f"coupled gearbox (test-gearbox-runup, ball bearings) built in {time.perf_counter() - t1:.1f} s")
-    W = np.concatenate([weights_per_speed(orders, pair.tooth_frequency(1.0), z2, r) for r in routes.values()])
+    W = np.concatenate([weights_per_speed(orders, pair.tooth_frequency(1.0), z2, r, SPEEDS, HARMONICS)
+                        for r in routes.values()])
     metrics = tuple(f"{route}: {kind}" for route in routes for kind in KINDS)
     print(f"set A, {exp.TORQUE:g} N m, ISO 1328-1 grade 5 (all kinds), {positions} positions per mesh period, "
           f"{SPEEDS.size} speeds {SPEEDS[0]:g}-{SPEEDS[-1]:g} rpm; aligned tooth line {abs(c_aligned[z2]) * 1e6:.3f} um "
