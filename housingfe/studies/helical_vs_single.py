@@ -80,6 +80,26 @@ def difference(speeds, levels_db, ref_speeds, ref_db, speed_range=MEAN_RANGE_RPM
             "ref_at_rpm": float(common[j]), "reduction_dB": float(b[j] - a[i])}
 
 
+def speed_law(speeds, levels_db, speed_range=None) -> dict:
+    """The speed law of one run-up curve (speeds rev/min, L_WA dB(A)) over speed_range (inclusive; default the
+    set-A check's 250-1500 rev/min, housingfe.runup.slopes.SPEED_LAW_RANGE_RPM): slope_dB (least squares against
+    log2 of the speed: dB(A) per doubling), residual_sd_dB (population s.d. of L_WA about that line, dB: how
+    smooth the curve is), n and the lowest / highest speed used.  InputError when fewer than three speeds or less
+    than a doubling of speed lie in the range."""
+    from housingfe.runup.slopes import SPEED_LAW_RANGE_RPM
+
+    lo, hi = SPEED_LAW_RANGE_RPM if speed_range is None else speed_range
+    s, v = np.asarray(speeds, float), np.asarray(levels_db, float)
+    keep = (s >= lo) & (s <= hi) & np.isfinite(v)
+    if keep.sum() < 3 or s[keep].max() < 2 * s[keep].min():
+        raise InputError(f"speed law: less than a doubling of speed (or fewer than three speeds) inside "
+                         f"{lo:g}-{hi:g} rev/min")
+    x, y = np.log2(s[keep]), v[keep]
+    slope, intercept = np.polyfit(x, y, 1)
+    return {"slope_dB": float(slope), "residual_sd_dB": float(np.std(y - (intercept + slope * x))),
+            "n": int(keep.sum()), "from_rpm": float(s[keep].min()), "to_rpm": float(s[keep].max())}
+
+
 def read_runup_table(path: Path) -> dict:
     """{column: values} of a family's run-up table (<family>_runup.csv: speed_rpm, LwA_<route>_<variant>_dBA, ...);
     InputError naming the file when it is missing or unreadable."""

@@ -14,8 +14,11 @@ unit, source, note) with these fields added (`tag`):
   pass), and "28.as_made.reindex.<pitch>", the thesis' turned-pinion measurement (Sec. 5.6) against drawn grade-5
   gears per pitch model (AS_MADE_REINDEX; housingfe.verification.turned_pinion_rows); and in the variants group the double helical set against single helical set A and self-aligning B
   (VS_SINGLE, "28.variants.double_helical_vs_single.<roller|fluid_film>.<A|B_self_aligning>.<mean|max_reduction>.
-  <route>", study_rows.double_helical_vs_single_rows): the issue's checks do not name this comparison, so these are
-  reported beside them, never judged, without a band and counted apart;
+  <route>", study_rows.double_helical_vs_single_rows) and the double helical set's speed law and smoothness
+  (DH_SPEED_LAW, DH_SMOOTHNESS: "28.variants.double_helical_speed_law.<cylindrical_roller|fluid_film>.<route>",
+  "28.variants.double_helical_smoothness.<cylindrical_roller|fluid_film|set_A>.<route>",
+  study_rows.double_helical_speed_law_rows): the issue's checks do not name these, so they are reported beside them,
+  never judged, without a band and counted apart;
 * measured, thesis_calculated — the published numbers beside ours (either may be None);
 * tolerance — the goal as text ("3 dB", "n <= 2", ">= 80 % of the speeds", "report");
 * passed — "yes", "no" or "" (a report row: nothing to pass);
@@ -142,10 +145,22 @@ def is_vs_single(row: dict) -> bool:
     return is_check(row) and row["check_id"].startswith(VS_SINGLE)
 
 
+# the double helical set's speed law and smoothness over speed (Sec. 5.9, Fig. 5.19: "very smooth curves", the
+# 6 dB(A) per doubling "seen clearly"; study_rows.double_helical_speed_law_rows): reported beside the checks, never
+# judged, no band, counted apart (the speed-law check of issue 28 is set A's, 28.speed_law.<route>)
+DH_SPEED_LAW = "28.variants.double_helical_speed_law."
+DH_SMOOTHNESS = "28.variants.double_helical_smoothness."
+
+
+def is_dh_speed_law(row: dict) -> bool:
+    """A row of the double helical set's speed law or smoothness (DH_SPEED_LAW*, DH_SMOOTHNESS*): reported."""
+    return is_check(row) and row["check_id"].startswith((DH_SPEED_LAW, DH_SMOOTHNESS))
+
+
 def is_reported_beside(row: dict) -> bool:
     """A row shown beside the checks but not one of them (the envelope bound's, gears as made, the double helical
-    set against single helical)."""
-    return is_bound(row) or is_as_made(row) or is_vs_single(row)
+    set against single helical, its speed law and smoothness)."""
+    return is_bound(row) or is_as_made(row) or is_vs_single(row) or is_dh_speed_law(row)
 
 
 # the default chain's checks evaluated on gears as made (runup.as_made = AS_MADE_GRADE with runup.as_made_totals:
@@ -332,8 +347,8 @@ def _cells(r: dict) -> list[str]:
 def checks_markdown(rows) -> str:
     """The check rows of `rows` as a Markdown table (the columns of CHECK_COLUMNS) and a count line; the envelope
     bound's rows (28.bound.*), those of gears as made (28.as_made.*; those of the design variants,
-    28.as_made.variants.*, named apart) and those of the double helical set against single helical (VS_SINGLE) are
-    counted apart: they are not checks."""
+    28.as_made.variants.*, named apart), those of the double helical set against single helical (VS_SINGLE) and
+    those of its speed law and smoothness (DH_SPEED_LAW, DH_SMOOTHNESS) are counted apart: they are not checks."""
     found = check_rows(rows)
     lines = ["| " + " | ".join(CHECK_COLUMNS) + " |", "|" + "---|" * len(CHECK_COLUMNS)]
     lines += ["| " + " | ".join(c.replace("|", "\\|").replace("\n", " ") for c in _cells(r)) + " |" for r in found]
@@ -345,7 +360,8 @@ def checks_markdown(rows) -> str:
              for p in AS_MADE_PITCHES}
     n_chain = sum(len(v) for v in chain.values())
     vs_single = sum(is_vs_single(r) for r in found)
-    checks = len(found) - bound - made - vs_single
+    dh_law = sum(is_dh_speed_law(r) for r in found)
+    checks = len(found) - bound - made - vs_single - dh_law
     passed = sum(r.get("passed") == "yes" for r in found)
     failed = sum(r.get("passed") == "no" for r in found)
     parts = [f"{made - variants - n_chain - reindex} of the default run-up"]
@@ -365,7 +381,9 @@ def checks_markdown(rows) -> str:
               + (f"; and {made} rows of gears as made (28.as_made.*, ISO grade {AS_MADE_GRADE} sidebands{detail}), "
                  "reported: not checks" if made else "")
               + (f"; and {vs_single} rows of the double helical set against single helical ({VS_SINGLE}*), "
-                 "reported: not checks" if vs_single else "")]
+                 "reported: not checks" if vs_single else "")
+              + (f"; and {dh_law} rows of the double helical set's speed law and smoothness ({DH_SPEED_LAW}*, "
+                 f"{DH_SMOOTHNESS}*), reported: not checks" if dh_law else "")]
     return "\n".join(lines) + "\n"
 
 

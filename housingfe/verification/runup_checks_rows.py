@@ -22,6 +22,12 @@ and from the design-variant study's cached result (<results>/study-validate/, ho
   the double helical set against single helical set A (ball) and set B on self-aligning bearings, all 2000 N m,
   from the study's run-up tables (study_rows.double_helical_vs_single_rows): reported beside the checks, not
   checks (checks.VS_SINGLE); a missing run costs these rows alone (a failure line).
+* 28.variants.double_helical_speed_law.<cylindrical_roller|fluid_film>.<route> and
+  28.variants.double_helical_smoothness.<cylindrical_roller|fluid_film|set_A>.<route> — the double helical set's
+  L_WA slope per doubling of speed at 2000 N m (250-1500 rpm) beside the measured 6, and the s.d. of L_WA about its
+  speed-law line beside set A's (Fig. 5.19: smooth against fluctuating), from the same tables
+  (study_rows.double_helical_speed_law_rows): reported, not checks (checks.DH_SPEED_LAW, DH_SMOOTHNESS); a missing
+  run costs these rows alone (a failure line).
 
 and, where the default run-up also ran the envelope bound (set A's overlap ratio near an integer: runup_envelope_bound.csv,
 runup_envelope_bound_harmonics.csv and runup.json "envelope_bound"), the rows of the envelope bound (`bound_chain_rows`,
@@ -86,6 +92,15 @@ def published_rows(results: Path | None = None, quick: bool = False, failures: l
             out += study_rows.double_helical_vs_single_rows(folder)
         except InputError as exc:
             message = f"double helical vs single helical ({ck.VS_SINGLE}* left out): {exc}"
+            if failures is None:
+                print(f"validate: {message}", flush=True)
+            else:
+                failures.append(message)
+        try:
+            out += study_rows.double_helical_speed_law_rows(folder)
+        except InputError as exc:
+            message = (f"double helical speed law and smoothness ({ck.DH_SPEED_LAW}*, {ck.DH_SMOOTHNESS}* left "
+                       f"out): {exc}")
             if failures is None:
                 print(f"validate: {message}", flush=True)
             else:

@@ -132,3 +132,18 @@ def test_families_run_together_are_compared_with_the_same_shock(tmp_path):
         assert [r["single_helical"] for r in csv.DictReader(fh)] == ["A"] * 4
     assert "| roller | A | tf_omega | -4.3 (2.5) | -5.3 | +5.0 (90.0 / 95.0) | +9.5 |" in \
         (tmp_path / "double-helical_vs_single.md").read_text()
+
+
+def test_speed_law_fits_over_the_set_a_range():
+    # 70 + 6 log2(s/250) with +3 dB at 500 rpm and -1.5 dB at 250 and 1000 rpm (mean zero, orthogonal to log2 s):
+    # slope 6 exactly, residual population s.d. sqrt((9 + 2 * 2.25) / 26) over the 26 speeds of 250-1500 rpm
+    levels = 70.0 + 6.0 * np.log2(SPEEDS / 250.0)
+    levels[SPEEDS == 500.0] += 3.0
+    levels[(SPEEDS == 250.0) | (SPEEDS == 1000.0)] -= 1.5
+    levels[SPEEDS < 250.0] = -50.0                   # outside the range: takes part in nothing
+    law = hvs.speed_law(SPEEDS, levels)
+    assert law["slope_dB"] == pytest.approx(6.0, abs=1e-9)
+    assert law["residual_sd_dB"] == pytest.approx(np.sqrt(13.5 / 26), abs=1e-9)
+    assert (law["n"], law["from_rpm"], law["to_rpm"]) == (26, 250.0, 1500.0)
+    with pytest.raises(InputError, match="doubling"):
+        hvs.speed_law([800.0, 1000.0, 1200.0], [1.0, 2.0, 3.0])
