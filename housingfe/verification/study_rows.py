@@ -279,6 +279,16 @@ VS_SINGLE_WHAT = {"mean": ("mean L_WA difference 800-1500 rpm", "dB"),
                   "max_reduction": ("reduction of the maximum L_WA, max(single) - max(double helical)", "dB(A)")}
 
 
+def default_engagement_folders(folder: Path, families) -> dict:
+    """{family: the folder of its default-engagement job in the study folder} (the first job of each of `families`
+    in JOBS without an engagement override), where `housingfe study` wrote its <family>_runup.csv."""
+    subs = {}
+    for family, overrides, sub in JOBS:
+        if family in families and family not in subs and not any("engagement" in o for o in overrides):
+            subs[family] = Path(folder) / sub
+    return subs
+
+
 def double_helical_vs_single_rows(folder: Path) -> list[dict]:
     """The double helical set (rollers, fluid films; 2000 N m) against single helical set A (ball bearings) and set B
     on self-aligning roller bearings (2000 N m), per route, from the run-up tables of the study's default-engagement
@@ -291,11 +301,7 @@ def double_helical_vs_single_rows(folder: Path) -> list[dict]:
     from housingfe.verification.checks import VS_SINGLE, check_row
     from housingfe.verification.published import thesis_source
 
-    subs = {}
-    for family, overrides, sub in JOBS:
-        if family in VS_SINGLE_FAMILIES and family not in subs and not any("engagement" in o for o in overrides):
-            subs[family] = Path(folder) / sub
-    rows = hvs.compare(hvs.tables_of(subs))
+    rows = hvs.compare(hvs.tables_of(default_engagement_folders(folder, VS_SINGLE_FAMILIES)))
     src = thesis_source("test_gearbox.double_helical", "Sec. 5.9, thesis lines 2157-2185")
     out = []
     for r in rows:
@@ -345,12 +351,7 @@ def double_helical_speed_law_rows(folder: Path) -> list[dict]:
     from housingfe.verification.checks import DH_SMOOTHNESS, DH_SPEED_LAW, check_row
     from housingfe.verification.published import thesis_source
 
-    subs = {}
-    for family, overrides, sub in JOBS:
-        if family in ("double-helical", "profile-corrections") and family not in subs and \
-                not any("engagement" in o for o in overrides):
-            subs[family] = Path(folder) / sub
-    tables = hvs.tables_of(subs)
+    tables = hvs.tables_of(default_engagement_folders(folder, ("double-helical", "profile-corrections")))
     dh_table, dh_path = tables["double-helical"]
     laws = {name: {route: hvs.speed_law(s, lv) for route, (s, lv) in hvs.curves(dh_table, key, dh_path).items()}
             for name, key in DH_SPEED_LAW_VARIANTS}
