@@ -398,7 +398,10 @@ def folded_result(model, periodic: RunupResult, sidebands: RunupResult) -> Runup
             _cat(rp.L_omega_coupled, rs.L_omega_coupled, order),
             None if rp.tf_omega is None else _cat(rp.tf_omega, rs.tf_omega, order),
             None if rp.excitation_db is None else _cat(rp.excitation_db, rs.excitation_db, order),
-            rp.excitation_name, rp.transfer_name)
+            rp.excitation_name, rp.transfer_name,
+            *((None, None, None) if rp.bore_loads is None or rs.bore_loads is None else
+              (_cat(rp.bore_loads, rs.bore_loads, order), _cat(rp.bore_force_db, rs.bore_force_db, order),
+               _cat(rp.bore_moment_db, rs.bore_moment_db, order))))
     L_sigma = {k: _cat(v, sidebands.L_sigma[k], order) for k, v in periodic.L_sigma.items()}
     L_W = {k: _cat(v, sidebands.L_W[k], order) for k, v in periodic.L_W.items()}
     totals = folded_totals(lines, routes, L_W, periodic.radiators)

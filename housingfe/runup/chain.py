@@ -37,6 +37,8 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from housingfe import levels
+from housingfe.drivetrain.bore_loads import bore_loads, force_level_db, moment_level_db, structure_bearing_elements
+from housingfe.drivetrain.bore_loads import node_rows as _node_rows
 from housingfe.drivetrain.description import FRICTION_LOADS
 from housingfe.errors import InputError
 from housingfe.radiation.power import area_level_db
@@ -232,15 +234,6 @@ def with_drivetrain(model: GearboxModel, drivetrain) -> GearboxModel:
 # runup.bearing_speeds): "fixed" = at the one pinion speed drivetrain.bearing_speed_rpm for the whole run-up;
 # "follow" = at each run-up speed (`follow_speeds`; the default).  Rolling-element bearings are the same either way
 BEARING_SPEEDS = ("fixed", "follow")
-
-
-def _node_rows(structure, vectors, nodes) -> dict:
-    """{node name: (6, vectors) displacements of an extra node in each coupled vector} (m, rad)."""
-    out = {n: np.empty((6, len(vectors))) for n in nodes}
-    for j, q in enumerate(vectors):
-        for n in nodes:
-            out[n][:, j] = structure.system.node_displacement(q, n)
-    return out
 
 
 class _SpeedSystem:
@@ -757,6 +750,45 @@ class RouteResult:
     excitation_db: np.ndarray | None = None
     excitation_name: str = ""
     transfer_name: str = ""
+    # the loads the bearings put on the bore masters per line (`route_bore_loads`, set by `runup`): complex rms
+    # (lines, bearings, 6) of `coefficients` (N, N m); and their force / moment levels scaled as L_v is (dB re 1 N,
+    # 1 N m: tf_omega's coefficients are the response to 1 N m, its L_v scaled to the source's L_omega), which split
+    # the transfer into the path (mesh -> bores) and the housing (bores -> surface), housingfe.runup.slopes
+    bore_loads: np.ndarray | None = None
+    bore_force_db: np.ndarray | None = None
+    bore_moment_db: np.ndarray | None = None
+
+
+def route_bore_loads(model: GearboxModel, frequency, speed, coefficients, elements: dict | None = None) -> np.ndarray:
+    """The loads the bearings put on their bore masters at a route's Ritz solutions (RouteResult.coefficients,
+    (vectors, lines)) at the lines' frequencies (Hz) and pinion speeds (rev/min): complex (lines, bearings, 6) in
+    the coefficients' convention (rms), Fx Fy Fz (N), Mx My Mz (N m) about the master, bearings in the order of
+    structure.parts.bearings (those to ground left out); housingfe.drivetrain.bore_loads.bore_loads per line, on the
+    bearings of the line's speed model (GearboxModel.at_speed: the films following the run-up's speed).
+    elements: {speed model id: BearingElement list} to reuse between routes (filled here)."""
+    f = np.asarray(frequency, float)
+    c = np.asarray(coefficients)
+    memo = {} if elements is None else elements
+    rows = memo.get("rows")
+    if rows is None:        # the Ritz vectors' rows at the bearings' nodes: the same for every speed model
+        rows = memo["rows"] = structure_bearing_elements(model.structure, model.reduction.vectors)
+
+    def elements_at(m):
+        if id(m) not in memo:
+            memo[id(m)] = [replace(r, K=np.asarray(e.K, float), C=(np.zeros((12, 12)) if e.C is None
+                                                                    else np.asarray(e.C, float)))
+                           for r, e in zip(rows, [e for e in m.structure.parts.bearings
+                                                   if len(e.nodes) == 2 and None not in e.nodes])]
+        return memo[id(m)]
+
+    if not model.speed_models:
+        return bore_loads(elements_at(model), f, c)
+    speed = np.broadcast_to(np.asarray(speed, float), f.shape)
+    out = np.zeros((len(f), len(rows), 6), complex)
+    for s in np.unique(speed):
+        at = np.flatnonzero(speed == s)
+        out[at] = bore_loads(elements_at(model.at_speed(s)), f[at], c[:, at])
+    return out
 
 
 def _wheel_omega_level(model: GearboxModel, response, frequency) -> np.ndarray:
@@ -863,6 +895,14 @@ def runup(model: GearboxModel, source, speeds_rpm, torques_nm, *, routes=("tf_om
     t0 = time.perf_counter()
     results = {name: ROUTES[name](model, lines) for name in routes}
     timings["response_s"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    elements = {}
+    for rr in results.values():     # the bearings' loads on the bores, scaled as the route's L_v is
+        rr.bore_loads = route_bore_loads(model, lines.frequency, lines.speed, rr.coefficients, elements)
+        shift = rr.L_v - rr.response.velocity_level_db
+        rr.bore_force_db = force_level_db(rr.bore_loads) + shift
+        rr.bore_moment_db = moment_level_db(rr.bore_loads) + shift
+    timings["bore_loads_s"] = time.perf_counter() - t0
     L_S = area_level_db(model.area)
     f = lines.frequency
     a_w = levels.a_weighting_db(f)

@@ -26,6 +26,20 @@ Two choices of what "the level at a speed" is:
   shift of power between harmonics as the lines move through the A-curve).  The residual of the sum is then
   round-off; it is reported (`sum_residual_db`), not assumed.
 
+The transfer split into PATH and HOUSING (where the run-up holds the bearings' loads on the bores,
+RouteResult.bore_force_db: housingfe.runup.chain.route_bore_loads):
+
+    T = T_path + T_housing,   T_path = L_bore - L_exc,   T_housing = L_v - L_bore
+
+with L_bore = 10 lg(sum over the bearings of |F|^2 of the three force components / 1 N^2) (rms, dB re 1 N) of the
+loads the bearings put on the bore masters: T_path is what the mesh force, shafts, gear bodies and bearings make
+of the excitation at the bores, T_housing what the housing makes of the bore forces at its surface.  Same two bases:
+on the tooth band line by line, on the total with L_bore,tot = 10 lg sum 10^(L_bore/10) (telescoping as above:
+T_path,tot = L_bore,tot - L_exc,tot, T_housing,tot = L_v,tot - L_bore,tot).  The split is of the transfer only: the
+five terms and their sum are untouched; its residual slope(T_path) + slope(T_housing) - slope(T) is reported
+(`split_residual_db`).  The bore moments are not in L_bore (their own level L_bore_moment, dB re 1 N m, is kept
+beside it): T_housing holds the housing's answer to the moments too.
+
 The slope is the least-squares fit of the level against log2(speed) over SPEED_LAW_RANGE_RPM (dB per doubling
 of speed), the fit of the speed-law check (housingfe.runup.checks).  The term "that makes" the slope is the one
 with the largest positive slope; the one "that holds it back" the most negative one.
@@ -41,9 +55,15 @@ from housingfe import levels
 SPEED_LAW_RANGE_RPM = (250.0, 1500.0)
 TERMS = ("excitation", "transfer", "L_S", "L_sigma", "A_weighting")      # their sum is L_WA
 SUMS = ("L_v", "L_W", "L_WA")
+SPLIT = ("transfer_path", "transfer_housing")     # their sum is the transfer (where the bore loads are known)
+BORE_LEVELS = ("L_bore", "L_bore_moment")
 BASES = ("total", "tooth_band")
 TERM_LABELS = {"excitation": "excitation", "transfer": "transfer (L_v - excitation)", "L_S": "L_S (area)",
-               "L_sigma": "L_sigma (radiation index)", "A_weighting": "A-weighting"}
+               "L_sigma": "L_sigma (radiation index)", "A_weighting": "A-weighting",
+               "transfer_path": "T_path = L_bore - excitation (mesh, shafts, gears, bearings -> bore forces)",
+               "transfer_housing": "T_housing = L_v - L_bore (bore forces -> surface velocity)",
+               "L_bore": "L_bore, bearing forces on the bores (dB re 1 N)",
+               "L_bore_moment": "L_bore_moment, bearing moments on the bores (dB re 1 N m)"}
 
 
 def slope_per_doubling(speeds, values, speed_range=SPEED_LAW_RANGE_RPM) -> float:
@@ -66,10 +86,36 @@ def _energy_sum(values_db, groups, n_groups) -> np.ndarray:
 
 
 def term_levels(point, n_points: int, harmonic, frequency, excitation_db, L_v_db, L_sigma_db, area_level_db: float,
-                basis: str = "total") -> dict[str, np.ndarray]:
+                basis: str = "total", bore_db=None, bore_moment_db=None) -> dict[str, np.ndarray]:
     """The terms (TERMS) and sums (SUMS) of L_WA per operating point (dB), from per-line arrays: point (index of the
     operating point, 0..n_points-1), harmonic number, frequency (Hz), excitation level, L_v (dB re 5e-8 m/s) and
-    L_sigma (dB); area_level_db = L_S.  basis "tooth_band" (harmonic 1 only) or "total" (module docstring)."""
+    L_sigma (dB); area_level_db = L_S.  basis "tooth_band" (harmonic 1 only) or "total" (module docstring).
+    bore_db (per line, dB re 1 N: L_bore) adds the transfer's split SPLIT and "L_bore"; bore_moment_db (dB re
+    1 N m) adds "L_bore_moment"."""
+    out = _term_levels(point, n_points, harmonic, frequency, excitation_db, L_v_db, L_sigma_db, area_level_db, basis)
+    for key, values in (("L_bore", bore_db), ("L_bore_moment", bore_moment_db)):
+        if values is not None:
+            out[key] = _basis_level(point, n_points, harmonic, values, basis)
+    if bore_db is not None:
+        with np.errstate(invalid="ignore"):
+            out["transfer_path"] = out["L_bore"] - out["excitation"]
+            out["transfer_housing"] = out["L_v"] - out["L_bore"]
+    return out
+
+
+def _basis_level(point, n_points: int, harmonic, values_db, basis: str) -> np.ndarray:
+    """A per-line level on a basis: the tooth line's (or the energy sum of the tooth band's lines), or the energy
+    sum of every line of the operating point."""
+    point = np.asarray(point, int)
+    values_db = np.asarray(values_db, float)
+    if basis == "total":
+        return _energy_sum(values_db, point, n_points)
+    tooth = np.flatnonzero(np.asarray(harmonic) == 1)
+    return _energy_sum(values_db[tooth], point[tooth], n_points)
+
+
+def _term_levels(point, n_points: int, harmonic, frequency, excitation_db, L_v_db, L_sigma_db, area_level_db: float,
+                 basis: str) -> dict[str, np.ndarray]:
     point = np.asarray(point, int)
     exc = np.asarray(excitation_db, float)
     L_v = np.asarray(L_v_db, float)
@@ -136,6 +182,18 @@ class SlopeDecomposition:
         return self.term_sum - self.slopes["L_WA"]
 
     @property
+    def has_split(self) -> bool:
+        """Whether the transfer is split into path and housing (the run-up held the bore loads)."""
+        return all(k in self.slopes for k in SPLIT)
+
+    @property
+    def split_residual_db(self) -> float:
+        """slope(T_path) + slope(T_housing) - slope(T) (dB per doubling; round-off), NaN without the split."""
+        if not self.has_split:
+            return float("nan")
+        return self.slopes["transfer_path"] + self.slopes["transfer_housing"] - self.slopes["transfer"]
+
+    @property
     def made_by(self) -> str:
         terms = [t for t in TERMS if t != "L_S" and np.isfinite(self.slopes[t])]
         return max(terms, key=lambda t: self.slopes[t]) if terms else ""
@@ -159,8 +217,11 @@ class SlopeDecomposition:
         terms = " + ".join(f"{t} {s[t]:+.2f}" for t in TERMS if t != "L_S")
         held = (f", held back by {self.held_back_by} ({s[self.held_back_by]:+.2f})" if self.held_back_by
                 else ", no term falls with speed")
+        split = (f"; transfer {s['transfer']:+.2f} = path {s['transfer_path']:+.2f} (L_bore - excitation) + housing "
+                 f"{s['transfer_housing']:+.2f} (L_v - L_bore) (residual {self.split_residual_db:.1e})"
+                 if self.has_split and np.isfinite(self.split_residual_db) else "")
         return (f"{where}: L_WA {s['L_WA']:+.2f} dB(A)/doubling = {terms} (residual {self.sum_residual_db:.1e}); made by "
-                f"{self.made_by} ({s[self.made_by]:+.2f}){held}")
+                f"{self.made_by} ({s[self.made_by]:+.2f}){held}{split}")
 
     def to_json(self) -> dict:
         def num(x):
@@ -172,6 +233,7 @@ class SlopeDecomposition:
                 "slopes_dB_per_doubling": {k: num(v) for k, v in self.slopes.items()},
                 "term_sum_dB_per_doubling": num(self.term_sum), "sum_residual_dB": num(self.sum_residual_db),
                 "made_by": self.made_by, "held_back_by": self.held_back_by,
+                "split_residual_dB": num(self.split_residual_db) if self.has_split else None,
                 "speeds_rpm": [float(x) for x in self.speeds_rpm],
                 "levels_dB": {k: [num(x) for x in v] for k, v in self.levels.items()}}
 
@@ -184,8 +246,11 @@ def decompose(result, route: str, radiation: str, torque: float, basis: str = "t
     renumber = np.full(len(ln.points), -1)
     renumber[pts] = np.arange(len(pts))
     sel = np.flatnonzero(renumber[ln.point] >= 0)
+    bore = getattr(rr, "bore_force_db", None)
+    moment = getattr(rr, "bore_moment_db", None)
     lv = term_levels(renumber[ln.point[sel]], len(pts), ln.harmonic[sel], ln.frequency[sel], rr.excitation_db[sel],
-                     rr.L_v[sel], result.L_sigma[route, radiation][sel], result.area_level_db, basis)
+                     rr.L_v[sel], result.L_sigma[route, radiation][sel], result.area_level_db, basis,
+                     None if bore is None else bore[sel], None if moment is None else moment[sel])
     speeds = np.array([ln.points[p][1] for p in pts])
     return SlopeDecomposition(route, radiation, float(torque), basis, rr.excitation_name, rr.transfer_name, speeds,
                               lv)
@@ -203,15 +268,21 @@ SLOPE_COLUMNS = ("route", "radiation", "torque_nm", "basis", "term", "meaning", 
 
 
 def slope_rows(decompositions) -> list[dict]:
-    """One row per decomposition and term/sum (slope_terms.csv); the row 'sum of terms' is the check."""
+    """One row per decomposition and term/sum (slope_terms.csv); the row 'sum of terms' is the check.  With the
+    bore loads also the transfer's split (SPLIT), its check 'path + housing' and the bore levels (BORE_LEVELS)."""
     rows = []
     for d in decompositions:
-        for key in (*TERMS, "sum of terms", *SUMS):
+        extra = ((*SPLIT, "path + housing", *(k for k in BORE_LEVELS if k in d.levels)) if d.has_split else ())
+        for key in (*TERMS, "sum of terms", *SUMS, *extra):
             if key == "sum of terms":
                 slope, meaning, lv = d.term_sum, f"residual to L_WA {d.sum_residual_db:.2e} dB", None
+            elif key == "path + housing":
+                slope = d.slopes["transfer_path"] + d.slopes["transfer_housing"]
+                meaning, lv = f"residual to the transfer {d.split_residual_db:.2e} dB", None
             else:
                 slope = d.slopes[key]
-                meaning = d.label(key) if key in TERMS else {"L_v": "L_v", "L_W": "L_W", "L_WA": "L_WA"}[key]
+                meaning = (d.label(key) if key in TERMS or key in TERM_LABELS
+                           else {"L_v": "L_v", "L_W": "L_W", "L_WA": "L_WA"}[key])
                 lv = d.levels[key]
 
             def at(s):
@@ -229,12 +300,15 @@ def table(decompositions) -> str:
     """The slopes as a text table (one row per curve and basis, one column per term)."""
     from housingfe.outputs import format_table
 
+    split = any(d.has_split for d in decompositions)
     head = ["route", "radiation", "N m", "basis", *(t for t in TERMS if t != "L_S"), "sum", "L_W", "L_WA",
-            "made by", "held back by"]
+            "made by", "held back by", *(("T path", "T housing") if split else ())]
     rows = [[d.route, d.radiation, f"{d.torque_nm:g}", d.basis, *(round(d.slopes[t], 2) for t in TERMS if t != "L_S"),
-             round(d.term_sum, 2), round(d.slopes["L_W"], 2), round(d.slopes["L_WA"], 2), d.made_by, d.held_back_by or "-"]
+             round(d.term_sum, 2), round(d.slopes["L_W"], 2), round(d.slopes["L_WA"], 2), d.made_by, d.held_back_by or "-",
+             *((round(d.slopes[k], 2) if d.has_split else "-" for k in SPLIT) if split else ())]
             for d in decompositions]
-    return ("slope over speed, dB per doubling, 250-1500 rpm (terms add up to L_WA; L_S is constant):\n"
+    return ("slope over speed, dB per doubling, 250-1500 rpm (terms add up to L_WA; L_S is constant"
+            + ("; T path + T housing = transfer: L_bore - excitation, L_v - L_bore" if split else "") + "):\n"
             + format_table(head, rows))
 
 
@@ -273,12 +347,14 @@ def plot(path, decompositions) -> None:
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=7)
         ax = axes[row, 2]
-        x = np.arange(len(names))
+        bars = names + (SPLIT if all(by_basis[b].has_split for b in BASES) else ())
+        x = np.arange(len(bars))
         for j, basis in enumerate(BASES):
             d = by_basis[basis]
-            ax.bar(x + (j - 0.5) * 0.38, [d.slopes[t] for t in names], 0.38, label=basis.replace("_", " "))
+            ax.bar(x + (j - 0.5) * 0.38, [d.slopes[t] for t in bars], 0.38, label=basis.replace("_", " "))
         ax.axhline(6.0, color="r", ls="--", lw=0.8, label="measured L_WA speed law, 6 dB(A)")
-        ax.set_xticks(x, names, rotation=20, fontsize=8)
+        ax.set_xticks(x, [{"transfer_path": "T path", "transfer_housing": "T housing"}.get(t, t) for t in bars],
+                      rotation=20, fontsize=8)
         ax.set_ylabel("slope (dB per doubling)")
         ax.set_title(f"{route}, {torque:g} N m: slopes, 250-1500 rpm", fontsize=9)
         ax.grid(True, axis="y", alpha=0.3)
