@@ -37,7 +37,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from housingfe import levels
-from housingfe.drivetrain.bore_loads import bore_loads, force_level_db, moment_level_db, structure_bearing_elements
+from housingfe.drivetrain.bore_loads import (
+    bore_loads,
+    force_level_db,
+    moment_level_db,
+    structure_bearing_elements,
+)
 from housingfe.drivetrain.bore_loads import node_rows as _node_rows
 from housingfe.drivetrain.description import FRICTION_LOADS
 from housingfe.errors import InputError

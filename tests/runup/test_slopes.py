@@ -133,8 +133,9 @@ def test_cli_writes_the_slope_terms(tmp_path):
     assert proc.returncode == 0, proc.stderr
     with open(out / "slope_terms.csv") as fh:
         rows = list(csv.DictReader(fh))
-    # 2 routes x 2 radiators (the scene's erp and foller) x 2 bases x (5 terms + sum + 3 levels)
-    assert len(rows) == 2 * 2 * 2 * 9
+    # 2 routes x 2 radiators (the scene's erp and foller) x 2 bases x (5 terms + sum + 3 levels + the transfer's
+    # split: path, housing, their sum, L_bore, L_bore_moment)
+    assert len(rows) == 2 * 2 * 2 * 14
     for route in ("tf_omega", "mesh_force"):
         for basis in ("tooth_band", "total"):
             sel = {r["term"]: float(r["slope_dB_per_doubling"]) for r in rows
@@ -142,9 +143,14 @@ def test_cli_writes_the_slope_terms(tmp_path):
             assert sel["sum of terms"] == pytest.approx(sel["L_WA"], abs=1e-6)
             # the CSV keeps 6 significant digits: five rounded terms sum to L_WA within their rounding
             assert sum(sel[t] for t in TERMS) == pytest.approx(sel["L_WA"], abs=5e-4)
+            assert sel["path + housing"] == pytest.approx(sel["transfer"], abs=5e-4)
+            assert sel["transfer_path"] + sel["transfer_housing"] == pytest.approx(sel["transfer"], abs=5e-4)
+    split = json.loads((out / "runup.json").read_text())["slope_terms"]
+    assert all(abs(s["split_residual_dB"]) < 1e-9 for s in split)
     assert (out / "slope_terms.png").stat().st_size > 10_000
     summary = (out / "summary.txt").read_text()
     assert "made by" in summary and "tf_omega (erp, 2000 N m, total): L_WA" in summary
+    assert "= path" in summary and "T housing" in summary
     with open(out / "checks.csv") as fh:
         law = [r for r in csv.DictReader(fh) if r["check"] == "speed_law"]
     assert len(law) == 2 and all("made by" in r["note"] for r in law)

@@ -367,10 +367,10 @@ def film_damping(m, select=None) -> np.ndarray:
     """The films' C projected on the Ritz vectors of speed model m: sum over the bearings of X_e^T C_e X_e (N s/m
     in Ritz coordinates; X_e the vectors' rows at the element's nodes).  select(element, i, j) -> bool keeps
     entry (i, j) of C_e (default all)."""
-    from housingfe.runup.chain import _node_rows
+    from housingfe.drivetrain.bore_loads import node_rows
 
     els = m.structure.parts.bearings
-    rows = _node_rows(m.structure, m.reduction.vectors, sorted({n for e in els for n in e.nodes}))
+    rows = node_rows(m.structure, m.reduction.vectors, sorted({n for e in els for n in e.nodes}))
     n = len(m.reduction.vectors)
     out = np.zeros((n, n))
     for e in els:
@@ -617,28 +617,35 @@ def _bore_force(mv, memo, w, vname, c) -> float:
 
 
 def bore_loads(mv, memo, w, vname, c) -> np.ndarray:
-    """The loads the films put on the bore masters at Ritz solution(s) c, bore by bore (Fx Fy Fz Mx My Mz: N, N m):
-    bore rows of -(K_e + i omega C_e) X_e c with the variant's C (none; as the stiffness omega C; as computed)."""
-    out = []
-    for K, C, X in _bore_elements(mv, memo):
-        if vname == BORE_TRANSLATIONS:
-            C = C * np.array([[_translations(None, i, j) for j in range(12)] for i in range(12)], float)
-        Z = K if vname.startswith("c0") else K + w * C if "stiffness" in vname else K + 1j * w * C
-        out.append(-(Z @ (X @ c))[6:12])
-    return np.concatenate(out)
+    """The loads the films put on the bore masters at Ritz solution(s) c, bore by bore (Fx Fy Fz Mx My Mz: N, N m;
+    (6 bearings,) for one solution, (6 bearings, k) for k columns): housingfe.drivetrain.bore_loads.bore_loads,
+    bore rows of -(K_e + s C_e) X_e c, with the variant's C (none; as the stiffness omega C, s = omega; as computed,
+    s = i omega)."""
+    from dataclasses import replace
+
+    from housingfe.drivetrain.bore_loads import bore_loads as library_bore_loads
+
+    els = _bore_elements(mv, memo)
+    if vname == BORE_TRANSLATIONS:
+        mask = np.array([[_translations(None, i, j) for j in range(12)] for i in range(12)], float)
+        els = [replace(e, C=e.C * mask) for e in els]
+    if vname.startswith("c0"):
+        els = [replace(e, C=0 * e.C) for e in els]
+    c = np.asarray(c)
+    n = 1 if c.ndim == 1 else c.shape[1]
+    s = w if "stiffness" in vname else 1j * w
+    out = library_bore_loads(els, w / (2 * math.pi), c, c_factor=np.full(n, s))
+    return out.reshape(-1) if c.ndim == 1 else out.reshape(n, -1).T
 
 
 def _bore_elements(mv, memo) -> list:
-    """[(K_e, C_e, X_e)] of the speed model's bearing elements (12x12 shaft node, bore master), X_e the Ritz
-    vectors' rows at the two nodes; memoised per speed model."""
-    from housingfe.runup.chain import _node_rows
+    """The speed model's bearing elements (housingfe.drivetrain.bore_loads.BearingElement: 12x12 K_e, C_e at the
+    shaft node and bore master, X_e the Ritz vectors' rows at the two nodes); memoised per speed model."""
+    from housingfe.drivetrain.bore_loads import structure_bearing_elements
 
     key = id(mv)
     if key not in memo:
-        els = mv.structure.parts.bearings
-        rows = _node_rows(mv.structure, mv.reduction.vectors, sorted({n for e in els for n in e.nodes}))
-        memo[key] = [(np.array(e.K, float), np.zeros((12, 12)) if e.C is None else np.array(e.C, float),
-                      np.vstack([rows[node] for node in e.nodes])) for e in els]
+        memo[key] = structure_bearing_elements(mv.structure, mv.reduction.vectors)
     return memo[key]
 
 
@@ -773,7 +780,7 @@ def bore_line(mv, memo, s, w, K, G, c_lines, vname) -> tuple[list[dict], float]:
     (N m)^2 for loads) and the bore-by-bore sum |f|^2.  H comes from the coupled model itself: unit loads e_j on the
     bore masters give solutions V and total bore loads E = I + (film loads of V); the surface sees only the bore
     loads, so H = V E^-1 (checked: Lv_from_bore_loads = h^H A h against c^H G c).  Also returns A."""
-    B = np.vstack([X[6:12] for _, _, X in _bore_elements(mv, memo)])
+    B = np.vstack([e.X[6:12] for e in _bore_elements(mv, memo)])
     V = np.linalg.solve(line_matrix(s, w, K, 0 * K), B.T)
     H = V @ np.linalg.inv(np.eye(B.shape[0]) + bore_loads(mv, memo, w, vname, V))
     A = np.conj(H.T) @ G @ H
