@@ -63,12 +63,19 @@ def speed_law_row(total, tooth_band) -> dict:
     def terms(d):
         return ", ".join(f"{t} {d.slopes[t]:+.2f}" for t in ("excitation", "transfer", "L_sigma", "A_weighting"))
 
+    def split(d):
+        if not (d.has_split and np.isfinite(d.split_residual_db)):
+            return ""
+        # path: the bearings' loads on the bores over the excitation; housing: L_v over those loads (slopes.py)
+        return f" = path {d.slopes['transfer_path']:+.2f} + housing {d.slopes['transfer_housing']:+.2f}"
+
     s = total.slopes["L_WA"]
     held = (f"held back by {total.held_back_by} ({total.slopes[total.held_back_by]:+.2f})" if total.held_back_by
             else "no term falls with speed")
     return _row("speed_law", f"{total.route}: speed law 6 +- 2 dB(A) per doubling (250-1500 rpm), with the term "
                 "that made it named", round(s, 2), 6.0, None, "within 2 dB of 6, term named", abs(s - 6.0) <= 2.0,
-                f"made by {total.made_by} ({total.slopes[total.made_by]:+.2f}), {held}; total: {terms(total)} "
+                f"made by {total.made_by} ({total.slopes[total.made_by]:+.2f})"
+                f"{split(total) if total.made_by == 'transfer' else ''}, {held}; total: {terms(total)} "
                 f"(sum {total.term_sum:+.2f}, "
                 f"residual {total.sum_residual_db:.1e}); tooth band: L_WA {tooth_band.slopes['L_WA']:+.2f} = "
                 f"{terms(tooth_band)}, made by {tooth_band.made_by}; excitation = {total.excitation_name}; "

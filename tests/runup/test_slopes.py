@@ -154,6 +154,16 @@ def test_cli_writes_the_slope_terms(tmp_path):
     with open(out / "checks.csv") as fh:
         law = [r for r in csv.DictReader(fh) if r["check"] == "speed_law"]
     assert len(law) == 2 and all("made by" in r["note"] for r in law)
+    # a speed law made by the transfer says whether its path or the housing makes it, with the split's slopes
+    for r in law:
+        route = r["quantity"].split(":")[0]
+        sel = {t["term"]: float(t["slope_dB_per_doubling"]) for t in rows
+               if t["route"] == route and t["basis"] == "total" and t["radiation"] == "erp"}
+        if r["note"].startswith("made by transfer"):
+            assert (f"= path {sel['transfer_path']:+.2f} + housing {sel['transfer_housing']:+.2f}, "
+                    in r["note"].split(";")[0])
+        else:
+            assert "= path" not in r["note"].split(";")[0]
     assert "made by" in proc.stdout
     # set A (eps_beta 1.026) with the default face-width engagement: the overlap note, once (issue 28)
     notes = [ln for ln in summary.splitlines() if ln.startswith("NOTE: overlap ratio 1.026")]
