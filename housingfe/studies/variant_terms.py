@@ -98,7 +98,7 @@ def csv_cells(row: dict) -> list:
 
 
 def _cell(x: float) -> str:
-    return "-" if not np.isfinite(x) else f"{x:+.2f}"
+    return "-" if not np.isfinite(x) else f"{round(x, 2) + 0.0:+.2f}"        # + 0.0: no "-0.00"
 
 
 def markdown(rows: list[dict]) -> list[str]:
