@@ -35,7 +35,9 @@ BESIDE the periodic one, labelled "as made, ISO grade g": extra columns *_as_mad
 The periodic tables stay as with the option off ("none", the default: nothing changes).
 
 Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route),
-<family>_torque_law.csv and <family>_torque_law.png (where there is a torque law; plot_torque_law) and study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
+<family>_torque_law.csv and <family>_torque_law.png (where there is a torque law; plot_torque_law), variant_terms.csv
+(per route and variant the mean difference of each term of L_WA: excitation, T_path, T_housing, L_sigma,
+A-weighting; housingfe.studies.variant_terms; also a table in <family>.md and the summary) and study.json (everything, with per-variant timings and how each model's basis was obtained) to the result folder
 (default results/study-<family>-<engagement>); several families in one command share the housing model and the
 bases that fit (profile-corrections and bearings are one layout) and go to <out>/<family>/.
 """
@@ -50,7 +52,7 @@ from pathlib import Path
 import numpy as np
 
 from housingfe.errors import InputError
-from housingfe.studies import helical_vs_single
+from housingfe.studies import helical_vs_single, variant_terms
 from housingfe.studies.chain_session import (
     MEAN_RANGE_RPM,
     ChainSession,
@@ -188,7 +190,9 @@ class VariantRun:
     """A variant's run-up: per route the speeds (rev/min) and L_WA (dB(A)) of the total; how its basis was
     obtained ("built" / "re-analysed"); wall times (s): the coupled model, the run-up (source lines + routes); with
     runup.as_made on, per route (speeds, L_WA dB(A)) with the expected sidebands of gears as made and the seconds
-    they took (housingfe.runup.as_made)."""
+    they took (housingfe.runup.as_made); per route the per-speed term levels of the periodic L_WA on the total
+    basis (speeds, {term: dB}; housingfe.studies.variant_terms.term_curves, None for a route without an excitation
+    level; empty when not kept)."""
 
     variant: Variant
     curves: dict
@@ -197,6 +201,7 @@ class VariantRun:
     runup_s: float
     curves_as_made: dict = field(default_factory=dict)
     as_made_s: float = 0.0
+    terms: dict = field(default_factory=dict)
 
     def curves_of(self, kind: str) -> dict:
         """The curves per route of the periodic model (PERIODIC) or of gears as made (AS_MADE)."""
@@ -222,6 +227,7 @@ class StudyResult:
     as_made_grade: object = "none"
     as_made: dict = field(default_factory=dict)
     as_made_pitch: str = "independent"
+    terms: list = field(default_factory=list)     # housingfe.studies.variant_terms.variant_terms (periodic)
 
     @property
     def as_made_label(self) -> str:
@@ -277,7 +283,8 @@ def run_family(family: Family, session: ChainSession, progress=print) -> StudyRe
         res = session.runup(model, v.torque)
         t2 = time.perf_counter()
         how = session.log[-1].how
-        runs[v.key] = VariantRun(v, {r: lwa_curve(res, r, rad, v.torque) for r in routes}, how, t1 - t0, t2 - t1)
+        runs[v.key] = VariantRun(v, {r: lwa_curve(res, r, rad, v.torque) for r in routes}, how, t1 - t0, t2 - t1,
+                                 terms={r: variant_terms.term_curves(res, r, rad, v.torque) for r in routes})
         made = session.runup_as_made(model, v.torque, res)      # None with runup.as_made = "none"
         if made is not None:
             from housingfe.runup.as_made import lwa_curve as as_made_curve
@@ -304,6 +311,8 @@ def analyse(result: StudyResult) -> StudyResult:
     result.rows = compare(result)
     result.rankings = rankings(result)
     result.torque_law = torque_law(result)
+    if result.runs and all(run.terms for run in result.runs.values()):
+        result.terms = variant_terms.variant_terms(result)
     if result.as_made_grade != "none":
         result.as_made = compare_as_made(result)
     return result
@@ -580,6 +589,8 @@ def markdown(result: StudyResult, wall_s: float | None = None) -> str:
                          + (f"{_num(t['measured_slope_dBA_per_doubling'], '{:+.1f}')} | " if slopes else "")
                          + f"{t['energy_means_dBA']} (at {t['torques_nm']} N m) |")
         lines.append("")
+    if result.terms:
+        lines += variant_terms.markdown(result.terms)
     if result.as_made:
         lines += markdown_as_made(result)
     per = result.timings.get("per_variant", {})
@@ -650,7 +661,7 @@ def markdown_as_made(result: StudyResult) -> list[str]:
 
 def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> None:
     """<family>.csv, <family>.md, <family>.png, <family>_runup.csv and study.json in `folder`; where the study has
-    a torque law also <family>_torque_law.csv and <family>_torque_law.png."""
+    a torque law also <family>_torque_law.csv and <family>_torque_law.png; with the runs' terms variant_terms.csv."""
     from housingfe.outputs import write_csv, write_json
 
     name = result.family.name
@@ -687,6 +698,9 @@ def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> Non
                                                 for c in list(TORQUE_LAW_AS_MADE_COLUMNS.values())[1:]]
                       if made else [])
                    for t in result.torque_law))
+    if result.terms:
+        write_csv(folder / "variant_terms.csv", list(variant_terms.COLUMNS),
+                  (variant_terms.csv_cells(r) for r in result.terms))
     (folder / f"{name}.md").write_text(markdown(result, wall_s))
     data = {
         "family": name, "scene": result.family.scene, "engagement": result.engagement,
@@ -880,6 +894,7 @@ def summary_text(result: StudyResult, wall_s: float | None = None) -> str:
                    f"{'same order' if k['matches'] else 'different order'}")
     for t in result.torque_law:
         out.append(f"torque law {_group_label(result, t)}, {t['route']}: {_torque_law_text(t)}")
+    out += variant_terms.summary_lines(result.terms)
     if result.as_made:
         label = result.as_made_label
         out.append(f"{label} (runup.as_made = {result.as_made_grade}: expected sidebands of tooth-to-tooth "
