@@ -60,10 +60,26 @@ def _run(path: Path, out: Path) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=900)
 
 
+@pytest.fixture(scope="module")
+def example_run(tmp_path_factory):
+    """example path -> (its folder, the CompletedProcess of `_run(path, folder / path.stem)`): each example runs
+    once per module, and the test of what it writes and the tests of its numbers read that one run (the same
+    command)."""
+    runs = {}
+
+    def get(path: Path):
+        if path not in runs:
+            folder = tmp_path_factory.mktemp(path.stem)
+            runs[path] = (folder, _run(path, folder / path.stem))
+        return runs[path]
+
+    return get
+
+
 @pytest.mark.parametrize("path", [_param(p) for p in EXAMPLES])
-def test_example_runs_and_writes_what_it_declares(path, tmp_path):
+def test_example_runs_and_writes_what_it_declares(path, example_run):
+    tmp_path, proc = example_run(path)
     out = tmp_path / path.stem
-    proc = _run(path, out)
     assert proc.returncode == 0, f"{path.name} exited {proc.returncode}:\n{proc.stdout[-2000:]}\n{proc.stderr[-3000:]}"
     assert proc.stdout.strip(), f"{path.name} printed nothing"
     assert out.is_dir(), f"{path.name} --out {out}: no folder written"
@@ -108,11 +124,11 @@ BEARING = ROOT / "examples" / "bearing_stiffness.py"
 
 
 @pytest.fixture(scope="module")
-def bearing_run(tmp_path_factory):
+def bearing_run(example_run):
     if not BEARING.exists():
         pytest.skip("examples/bearing_stiffness.py not present")
-    out = tmp_path_factory.mktemp("bearing") / "out"
-    proc = _run(BEARING, out)
+    folder, proc = example_run(BEARING)
+    out = folder / BEARING.stem
     assert proc.returncode == 0, proc.stderr
     with open(out / "deflection_and_stiffness.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
@@ -190,7 +206,7 @@ GEARBOX = ROOT / "examples" / "correlate_gearbox_model.py"
 
 
 @pytest.mark.slow
-def test_gearbox_example_rim_stiffens_and_brackets_the_thesis(tmp_path):
+def test_gearbox_example_rim_stiffens_and_brackets_the_thesis(example_run):
     """The rim is what the thesis found decisive: removing it lowers the first elastic mode by > 15 % and the
     thesis' 387 Hz lies between the two limits (coarse mesh; the trend holds on every mesh, docs/correlation.md);
     the mass drops by the rim's own steel: 30 x 30 mm across both ends (0.137 + 2 x 0.030 m each) and along the
@@ -198,9 +214,9 @@ def test_gearbox_example_rim_stiffens_and_brackets_the_thesis(tmp_path):
     rim's place over their 0.344 m."""
     if not GEARBOX.exists():
         pytest.skip("examples/correlate_gearbox_model.py not present")
-    proc = _run(GEARBOX, tmp_path / "g")
+    folder, proc = example_run(GEARBOX)            # the run test_example_runs_and_writes_what_it_declares checks
     assert proc.returncode == 0, proc.stderr[-2000:]
-    with open(tmp_path / "g" / "variants.csv") as fh:
+    with open(folder / GEARBOX.stem / "variants.csv") as fh:
         rows = {r["variant"]: r for r in csv.DictReader(fh)}
     rim, none = rows["reconstructed"], rows["no rim"]
     assert float(none["f1"]) < 0.85 * float(rim["f1"])
