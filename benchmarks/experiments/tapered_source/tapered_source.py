@@ -14,11 +14,12 @@ drivetrain.gear_set=B, the defaults of `housingfe study bearings`):
    misalignment.
 
     PYTHONPATH=. .venv/bin/python benchmarks/experiments/tapered_source/tapered_source.py [--out DIR] [--coarse]
-        [--no-fe]
+        [--no-fe] [--runup]
 
 Writes misalignment.csv, source_levels.csv (per configuration, source, misalignment, speed), source_means.csv,
 source_harmonics.csv (per tooth harmonic, means over 800-1500 rev/min),
-receptance.csv, receptance_peaks.csv, tapered_source.png, run.json.  Nothing in the package is changed; every
+receptance.csv, receptance_peaks.csv, tapered_source.png, run.json; with --runup also runup_layouts.csv (4. the
+run-ups with the FE bearings and the misalignment in the rig's layout: the wheel located at its back bearing).  Nothing in the package is changed; every
 variant is a named alternative (nothing tuned).
 """
 from __future__ import annotations
@@ -160,6 +161,9 @@ def main(argv=None):
     p.add_argument("--out", default="/tmp/tapered_source")
     p.add_argument("--coarse", action="store_true", help="60 mm housing mesh, lines to 1.5 kHz (a quick look)")
     p.add_argument("--no-fe", action="store_true", help="parts 1 and 2 only (no FE model)")
+    p.add_argument("--runup", action="store_true",
+                   help="also part 4: the run-ups (L_WA and its terms) with the FE bearings AND the source's "
+                        "misalignment in the rig's layout, against the model's layout")
     args = p.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -245,6 +249,10 @@ def main(argv=None):
         _write(out / "receptance.csv", rec_rows)
         _write(out / "receptance_peaks.csv", peak_rows)
     _write(out / "source_levels.csv", level_rows)
+    if args.runup and not args.no_fe:
+        t = time.perf_counter()
+        _write(out / "runup_layouts.csv", runup_layouts(session, dts, rig_gaps))
+        timings["runup_layouts_s"] = time.perf_counter() - t
     _write(out / "source_harmonics.csv", harmonic_rows)
 
     # means over 800-1500 rpm, differences to ball with the same source and misalignment
@@ -282,6 +290,44 @@ def main(argv=None):
               open(out / "run.json", "w"), indent=1)
     print(f"wall {wall:.0f} s (load {load0[0]:.1f} -> {os.getloadavg()[0]:.1f}); wrote {out}")
     return 0
+
+
+def runup_layouts(session, dts, rig_gaps) -> list:
+    """Part 4: per configuration the run-up (the study's routes, erp) in the model's layout (the scene's source, as
+    `housingfe study bearings`) and in the rig's (the FE bearings of `wheel_located_at_back` as a Rayleigh-Ritz
+    re-analysis on the same basis, the source with that layout's lead gap), and per layout the mean difference of
+    L_WA and of its terms to ball bearings over 800-1500 rev/min (housingfe.studies.variant_terms)."""
+    from runup_factors import Patched
+
+    from housingfe.runup.chain import run_source
+    from housingfe.studies.variant_terms import decompose_difference, term_curves
+
+    spec = session.spec
+    radiation = session.radiation
+    curves = {}
+    for config in CONFIGS:
+        dt = dts[config]
+        model = session.model(dt, label=config)
+        curves["model layout", config] = session.runup(model, TORQUE)
+        rig = Patched(dt, lambda s, dt=dt, c=config: wheel_located_at_back(dt, s, c))
+        model = session.model(rig, label=f"{config} (rig layout)")
+        source = dt.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
+                                 misalignment=lambda _t, g=rig_gaps[config]: g)
+        lines, _ = run_source(model, source, spec.speeds, [TORQUE], spec.f_max_hz, spec.source_receptance,
+                              spec.mesh_moment_model, spec.mesh_friction)
+        curves["rig layout", config] = session.runup(model, TORQUE, lines=lines)
+    rows = []
+    for (layout, config), res in curves.items():
+        for route in spec.routes:
+            tc = term_curves(res, route, radiation, TORQUE)
+            ref = term_curves(curves[layout, "ball"], route, radiation, TORQUE)
+            d = decompose_difference(tc[0], tc[1], ref[0], ref[1])
+            rows.append({"layout": layout, "configuration": config, "route": route,
+                         **{k: v for k, v in d.items() if k != "largest_term"}, "largest_term": d["largest_term"]})
+            print(f"  {layout:13s} {config:16s} {route:10s} dL_WA {d['mean_diff_dB']:+6.2f}: excitation "
+                  f"{d['d_excitation_dB']:+6.2f} T_path {d['d_transfer_path_dB']:+6.2f} T_housing "
+                  f"{d['d_transfer_housing_dB']:+6.2f}", flush=True)
+    return rows
 
 
 def _write(path, rows):
