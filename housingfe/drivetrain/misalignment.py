@@ -30,13 +30,15 @@ DEFAULT_MISALIGNMENT = "rigid-bores"
 COUPLED_MODEL = "coupled"
 
 
-def static_gear_tilts(drivetrain, forces=None) -> tuple[np.ndarray, np.ndarray, object]:
+def static_gear_tilts(drivetrain, forces=None, spec=None) -> tuple[np.ndarray, np.ndarray, object]:
     """(theta_pinion, theta_wheel, forces): rotation vectors [rad, housing frame] of the two gear nodes of the FE
-    interior on rigid bores under the mean tooth force (see the module docstring); forces: GearForces."""
+    interior on rigid bores under the mean tooth force (see the module docstring); forces: GearForces.  spec: the
+    interior's CouplingSpec to use instead of drivetrain.to_coupling_spec(forces) (e.g. with one bearing matrix
+    changed, for a sensitivity); the loads stay the drivetrain's."""
     from housingfe.drivetrain.interior import interior_matrices
 
     forces = forces or drivetrain.gear_forces()
-    spec = drivetrain.to_coupling_spec(forces)
+    spec = spec if spec is not None else drivetrain.to_coupling_spec(forces)
     # the drive line beyond the shaft ends is torsion only, and the spin is held here: it changes no tilt
     spec = spec.model_copy(update={"gear_meshes": [], "drive_lines": [], "aux_gearbox": None})
     centres = {}
@@ -141,10 +143,11 @@ def coupled_misalignment(housing_model, drivetrain) -> mis.Misalignment:
                           drivetrain.to_lumped()[2].total_width, drivetrain.gears.pair.base_helix_angle)
 
 
-def rigid_bore_misalignment(drivetrain) -> mis.Misalignment:
+def rigid_bore_misalignment(drivetrain, spec=None) -> mis.Misalignment:
     """The "rigid-bores" Misalignment of a drivetrain at its torque: e_w = -(pinion axis) (the FE reduction's mesh
-    normal has +sin(beta_b) along the axis, housingfe.source.misalignment), the FE contact normal."""
-    theta_p, theta_w, forces = static_gear_tilts(drivetrain)
+    normal has +sin(beta_b) along the axis, housingfe.source.misalignment), the FE contact normal.  spec: an
+    interior CouplingSpec instead of the drivetrain's (`static_gear_tilts`)."""
+    theta_p, theta_w, forces = static_gear_tilts(drivetrain, spec=spec)
     pair = drivetrain.gears.pair
     a = np.asarray(drivetrain.shaft("pinion").axis, float)
     total = drivetrain.to_lumped()[2].total_width

@@ -22,15 +22,10 @@ def _pinned(drivetrain):
     return replace(drivetrain, bearings=seats, coupling_mesh_positions=2)
 
 
-def test_gear_tilt_on_pin_supports_is_beam_theory():
-    """Shaft on two rigid pins (front at a before the gear, back at b after it, L = a + b) loaded at the gear by
-    the mean tooth force: transverse force P and moment M (the axial component at the pitch radius).  The section
-    rotation at the gear: P a b (b - a) / (3 E I L) about axis x P, plus M [(L^2 - 3 a L + 3 a^2) / (3 E I L)
-    + 1 / (kappa G A L)] (Timoshenko: the constant shear force M / L of the moment load tilts the section by
-    M / (kappa G A L); a point force's shear integrates to zero between the pins)."""
-    dt = _pinned(test_gearbox("A"))
-    theta_p, theta_w, forces = static_gear_tilts(dt)
+def _pin_theory(dt, theta_p, theta_w, forces, spans):
+    """max over the two shafts of |theta - beam theory| / |beam theory| and the smallest |beam theory| (rad)."""
     loads = dt.mesh_node_loads(float(np.linalg.norm(forces.force_on_pinion)), forces)
+    errors, sizes = [], []
     for name, theta in (("pinion", theta_p), ("wheel", theta_w)):
         line = dt.shaft(name)
         axis = np.asarray(line.axis, float) / np.linalg.norm(line.axis)
@@ -39,12 +34,42 @@ def test_gear_tilt_on_pin_supports_is_beam_theory():
         section = CircularSection(line.diameter)
         EI = STEEL.youngs_modulus * section.second_moment
         kGA = section.shear_factor(STEEL.poisson_ratio) * STEEL.shear_modulus * section.area
-        a, b = -SPANS[name][0], SPANS[name][1]
+        a, b = -spans[name][0], spans[name][1]
         L = a + b
         expected = (np.cross(axis, force) * a * b * (b - a) / (3 * EI * L)
                     + moment * ((L * L - 3 * a * L + 3 * a * a) / (3 * EI * L) + 1 / (kGA * L)))
-        assert np.linalg.norm(theta - expected) < 1e-4 * np.linalg.norm(expected)   # pins of 1e14 N/m
-        assert np.linalg.norm(expected) > 1e-5          # a real tilt (tens of urad), not a vanishing one
+        errors.append(np.linalg.norm(theta - expected) / np.linalg.norm(expected))
+        sizes.append(np.linalg.norm(expected))
+    return max(errors), min(sizes)
+
+
+def test_gear_tilt_on_pin_supports_is_beam_theory():
+    """Shaft on two rigid pins (front at a before the gear, back at b after it, L = a + b) loaded at the gear by
+    the mean tooth force: transverse force P and moment M (the axial component at the pitch radius).  The section
+    rotation at the gear: P a b (b - a) / (3 E I L) about axis x P, plus M [(L^2 - 3 a L + 3 a^2) / (3 E I L)
+    + 1 / (kappa G A L)] (Timoshenko: the constant shear force M / L of the moment load tilts the section by
+    M / (kappa G A L); a point force's shear integrates to zero between the pins)."""
+    dt = _pinned(test_gearbox("A"))
+    error, size = _pin_theory(dt, *static_gear_tilts(dt), SPANS)
+    assert error < 1e-4                  # pins of 1e14 N/m
+    assert size > 1e-5                   # a real tilt (tens of urad), not a vanishing one
+
+
+def test_gear_tilt_with_a_given_interior_spec_uses_it():
+    """static_gear_tilts(drivetrain, spec=...) solves the given interior: the ball-bearing test gearbox with the
+    interior of the same gearbox on rigid pins at its own bearing positions (+-0.1075 m) gives beam theory (the
+    moment term alone, a = b: 24 urad), not the ball bearings' tilt (the wheel's 168 urad)."""
+    spans = {"pinion": (-0.1075, 0.1075), "wheel": (-0.1075, 0.1075)}
+    dt = test_gearbox("A")
+    seats = tuple(BearingSeat(f"{shaft}_{side}", shaft, pos, f"bore_{shaft}_{side}", locating=side == "front",
+                              stiffness=(PIN, PIN, PIN, 0.0, 0.0, 0.0))
+                  for shaft, (front, back) in spans.items() for side, pos in (("front", front), ("back", back)))
+    pinned = replace(dt, bearings=seats, coupling_mesh_positions=2).to_coupling_spec()
+    error, size = _pin_theory(dt, *static_gear_tilts(dt, spec=pinned), spans)
+    assert error < 1e-4
+    assert size > 1e-6
+    theta_p, theta_w, _ = static_gear_tilts(dt)         # its own ball bearings: far larger tilts
+    assert np.linalg.norm(theta_w) > 5 * size           # 168 against 24 urad
 
 
 def test_double_helical_gears_between_equal_bearings_do_not_tilt():
