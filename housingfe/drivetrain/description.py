@@ -578,8 +578,9 @@ class Drivetrain:
 
     def configuration_matrices(self, loads: dict | None = None) -> dict | None:
         """{seat name: (K 6x6, C 6x6 or None)} of `bearing_configuration` at the statics loads (None without a
-        configuration).  The seats must be named as the configuration's positions (pinion_front, ...); both
-        front bearings locate axially (a double helical wheel is otherwise axially free)."""
+        configuration).  Each shaft's locating seat gets the configuration's locating bearing (its *_front
+        position), the other its floating one (`configuration_roles`); both locating bearings locate axially (a
+        double helical wheel is otherwise axially free)."""
         if self.bearing_configuration is None:
             return None
         from housingfe.bearings.configurations import bearing_matrices, configurations
@@ -590,11 +591,22 @@ class Drivetrain:
         loads = loads or self.bearing_loads()
         z1, z2 = self.gears.pair.teeth
         speeds = {"pinion": self.bearing_speed_rpm, "wheel": -self.bearing_speed_rpm * z1 / z2}
+        # the configuration's positions are roles: <shaft>_front its locating model (taking Fz), <shaft>_back the
+        # floating one; each seat gets the role of its `locating` flag (the identity with the front seats locating)
+        role = self.configuration_roles()
         try:
-            return bearing_matrices(self.bearing_configuration, loads, speeds, axial_location="both")
+            by_role = bearing_matrices(self.bearing_configuration, {role[n]: v for n, v in loads.items()}, speeds,
+                                       axial_location="both")
         except InputError as exc:
             raise InputError(f"drivetrain: bearings = {self.bearing_configuration!r} at {self.torque:g} N m: "
                              f"{exc}") from None
+        return {name: by_role[r] for name, r in role.items()}
+
+    def configuration_roles(self) -> dict[str, str]:
+        """{seat name: configuration position} -- the locating seat of each shaft gets "<shaft>_front" (the
+        configuration's locating bearing), the floating one "<shaft>_back", whichever side of the gearbox they
+        sit on (housingfe.bearings.configurations: "front" means "locating")."""
+        return {b.name: f"{b.shaft}_{'front' if b.locating else 'back'}" for b in self.bearings}
 
     def shaft_nodes(self, name: str) -> tuple[list[list[float]], dict]:
         """FE segments [[length, diameter], ...] (m) of a shaft from its front end, split at its bearings and the
@@ -670,6 +682,8 @@ class Drivetrain:
 # of the bearing plates (y = -/+0.140 m), bearings mid-plate (y = -/+0.1075 m).
 TEST_GEARBOX_CENTRES = {"pinion": (-0.126, 0.0, 0.200), "wheel": (0.074, 0.0, 0.200)}
 TEST_GEARBOX_BEARINGS = {"ball": {"pinion": "SKF 6316", "wheel": "SKF 6219"}}
+# which of a shaft's two bearings (at -/+0.1075 m along +y) locates it axially; "front" is the model's default layout
+LOCATING_SIDES = ("front", "back")
 GEAR_SETS = {"A": "gearset-A", "B": "gearset-B", "C": "gearset-C", "D": "gearset-D",
              "uncorrected": "gearset-uncorrected", "double_helical": "gearset-double-helical"}
 
@@ -697,14 +711,18 @@ def mesh_line_of_action(pair, pinion_centre, wheel_centre, shaft_axis) -> tuple[
     return np.cos(beta_b) * transverse + np.sin(beta_b) * a, 1.0, e_c
 
 
-def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 2000.0) -> Drivetrain:
+def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 2000.0,
+                 wheel_locating: str = "front") -> Drivetrain:
     """The Ch. 5 test gearbox (van Roosmalen 1994) as one description: gear set A-D, "uncorrected" or
     "double_helical" (the gear data of the gearset-* scenes), bearings "ball" (SKF 6316 pinion / 6219 wheel, Lim's
     model, the front bearings locating) or a configuration of housingfe.bearings.configurations (Secs. 5.8, 5.9:
     "angular_contact", "self_aligning", "tapered_roller" with the single helical sets; "cylindrical_roller",
     "fluid_film" with the double helical set, which puts no axial load on them), pinion torque (N m).  Shaft, quill-shaft and coupling dimensions are the
     ASSUMPTIONS of docs/source.md (Appendix C's parameter table did not survive); the auxiliary gearbox and motor
-    (for drive_line "back-to-back") those of `scaled_aux_gearbox` and MOTOR_*."""
+    (for drive_line "back-to-back") those of `scaled_aux_gearbox` and MOTOR_*.  wheel_locating (LOCATING_SIDES):
+    which of the wheel's bearings locates it axially, "front" (the model's default: both shafts located at the
+    front) or "back" (the rig's layout, Sec. 5.8: angular contact bearings "at the front (pinion) and at the back
+    (wheel)", the tapered ones "for the same reasons"); the pinion is located at its front bearing either way."""
     if gear_set not in GEAR_SETS:
         raise InputError(f"test_gearbox: gear_set: {gear_set!r} unknown (known: {', '.join(GEAR_SETS)})")
     from housingfe.bearings.configurations import configurations
@@ -715,7 +733,11 @@ def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 20
     axis = (0.0, 1.0, 0.0)
     shafts = (ShaftLine("pinion", 0.080, TEST_GEARBOX_CENTRES["pinion"], axis, (-0.140, 0.140)),   # SKF 6316 bore
               ShaftLine("wheel", 0.095, TEST_GEARBOX_CENTRES["wheel"], axis, (-0.140, 0.140)))      # SKF 6219 bore
-    seats = tuple(BearingSeat(f"{shaft}_{side}", shaft, s, f"bore_{shaft}_{side}", locating=side == "front",
+    if wheel_locating not in LOCATING_SIDES:
+        raise InputError(f"test_gearbox: wheel_locating: {wheel_locating!r} unknown (known: "
+                         f"{', '.join(LOCATING_SIDES)})")
+    located = {"pinion": "front", "wheel": wheel_locating}
+    seats = tuple(BearingSeat(f"{shaft}_{side}", shaft, s, f"bore_{shaft}_{side}", locating=side == located[shaft],
                               designation=TEST_GEARBOX_BEARINGS["ball"][shaft])
                   for shaft in SHAFTS for side, s in (("front", -0.1075), ("back", 0.1075)))
     quills = (QuillShaft("motor_far", 0.040, 1.5), QuillShaft("motor_pinion", 0.060, 0.25),

@@ -6,7 +6,8 @@ L_omega, L_v, L_W, L_WA over speed.  `housingfe run test-gearbox-runup`.
                    relative to this scene's file), set = [overrides], match = "name" | "position",
                    bores = {bearing = "housing bore"}, bore_tolerance (m): the drivetrain's bearings matched to
                    the housing's bores and checked against the shafts (housingfe.drivetrain.bore_matching)
-    [drivetrain]   gearbox = "test_gearbox", gear_set = "A", bearings = "ball", bearing_speed_rpm = 1500
+    [drivetrain]   gearbox = "test_gearbox", gear_set = "A", bearings = "ball", bearing_speed_rpm = 1500,
+                   wheel_locating = "front" | "back" (which wheel bearing locates it axially)
     [runup]        speeds, torques, f_max_hz (highest harmonic line), basis_factor, routes, damping_ratio, ...
     [radiation]    models = ["erp", "foller"], plates = [...]  (the housing's radiating plates)
 
@@ -79,6 +80,10 @@ class DrivetrainSpec(_Strict):
     # pinion speed at which speed-dependent bearings (fluid films) are taken with runup.bearing_speeds = "fixed"; with
     # "follow" (default) the speed of the model whose basis is re-analysed at each run-up speed
     bearing_speed_rpm: PositiveFloat = 1500.0
+    # which of the wheel's two bearings locates it axially (takes the axial mesh force; with a configuration: its
+    # locating bearing type sits there, the floating type at the other): "front" (the default, both shafts located
+    # at the front) or "back" (the thesis rig's layout, Sec. 5.8: "at the front (pinion) and at the back (wheel)")
+    wheel_locating: str = "front"
 
     @field_validator("gearbox")
     @classmethod
@@ -95,6 +100,15 @@ class DrivetrainSpec(_Strict):
         if name not in GEAR_SETS:
             raise ValueError(f"{name!r} is not a gear set (known: {', '.join(GEAR_SETS)})")
         return name
+
+    @field_validator("wheel_locating")
+    @classmethod
+    def _wheel_locating(cls, side):
+        from housingfe.drivetrain.description import LOCATING_SIDES
+
+        if side not in LOCATING_SIDES:
+            raise ValueError(f"{side!r} is not a bearing side (known: {', '.join(LOCATING_SIDES)})")
+        return side
 
     @field_validator("bearings")
     @classmethod
@@ -346,7 +360,7 @@ def drivetrain_of(spec: DrivetrainSpec, torque: float, drive_line: str = "none")
     (a run-up's RunupSpec.drive_line_model; housingfe.drivetrain.description.DRIVE_LINES)."""
     from dataclasses import replace
 
-    dt = _gearboxes()[spec.gearbox](spec.gear_set, spec.bearings, torque)
+    dt = _gearboxes()[spec.gearbox](spec.gear_set, spec.bearings, torque, wheel_locating=spec.wheel_locating)
     return replace(dt, bearing_speed_rpm=spec.bearing_speed_rpm, drive_line=drive_line)
 
 
