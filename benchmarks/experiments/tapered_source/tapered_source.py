@@ -77,30 +77,16 @@ def at_fronts(fn):
     return lambda name, K: fn(K) if name in FRONTS else K
 
 
-def wheel_located_at_back(drivetrain, spec, config: str = "tapered_roller"):
-    """A configuration with one locating bearing per shaft as the rig had it (Sec. 5.8: the angular contact
-    bearings "at the front (pinion) and at the back (wheel)"; the tapered ones "for the same reasons"): the wheel's
-    locating bearing (the configuration's, its model) at wheel_back taking the axial force, a 6219 ball bearing at
-    wheel_front carrying its radial share; the loads by the shaft's force and moment balance
-    (housingfe.studies.bearing_variants), tilt held as in the configuration."""
-    from housingfe.bearings import bearing_stiffness
-    from housingfe.bearings.configurations import evaluate
-    from housingfe.studies.bearing_variants import _node_positions, shaft_bearing_loads, to_bearing_frame
+def rig_drivetrain(session, config: str):
+    """The configuration in the rig's layout (Sec. 5.8: the angular contact bearings "at the front (pinion) and at
+    the back (wheel)"; the tapered ones "for the same reasons"): the scene's drivetrain with
+    drivetrain.wheel_locating = "back" (the library's option, housingfe.drivetrain.description.test_gearbox): the
+    configuration's locating bearing at wheel_back taking the axial force, its floating one at wheel_front, loads by
+    the shaft's force and moment balance, the FE bearings and the source's misalignment from that layout."""
+    from housingfe.runup.scene import drivetrain_of
 
-    forces = drivetrain.gear_forces()
-    by = {b.name: b for b in spec.bearings}
-    pos = _node_positions(spec)
-    axis = np.asarray(by["wheel_back"].axis, float)
-    located, floating = shaft_bearing_loads(-forces.force_on_pinion, spec.gear_meshes[0].point,
-                                            pos[by["wheel_back"].shaft_node], pos[by["wheel_front"].shaft_node], axis)
-    loads = dict(drivetrain.bearing_loads(forces))
-    loads["wheel_front"] = to_bearing_frame(located, axis)      # evaluate's locating slot, used for wheel_back
-    tapered = evaluate(config, loads, axial_location="both")["wheel_front"].K
-    ball = bearing_stiffness("SKF 6219", to_bearing_frame(floating, axis), fixed_tilt=(0.0, 0.0)).K
-    ball[5, :] = 0.0
-    ball[:, 5] = 0.0
-    mats = {"wheel_back": tapered, "wheel_front": ball}
-    return common.with_bearing_matrices(spec, lambda name, K: mats.get(name, K))
+    spec = session.scene.drivetrain.model_copy(update={"gear_set": "B", "bearings": config, "wheel_locating": "back"})
+    return drivetrain_of(spec, TORQUE, session.scene.runup.drive_line_model)
 
 
 def misalignment_rows(session) -> tuple[list, dict]:
@@ -137,10 +123,12 @@ def misalignment_rows(session) -> tuple[list, dict]:
         ("tapered_roller", "tapered at the wheel only (ball at pinion_front)",
          common.with_bearing_matrices(specs["tapered_roller"],
                                       lambda n, K: np.array(ball_k[n][0]) if n == "pinion_front" else K)),
-    ] + [(c, f"{c}, rig layout: wheel located at its back bearing", wheel_located_at_back(dts[c], specs[c], c))
-         for c in CONFIGS]
+    ] + [(c, f"{c}, rig layout: wheel located at its back bearing", "rig") for c in CONFIGS]
     for config, label, spec in variants:
-        m = rigid_bore_misalignment(dts[config], spec=spec)
+        if spec == "rig":
+            m = rigid_bore_misalignment(rig_drivetrain(session, config))
+        else:
+            m = rigid_bore_misalignment(dts[config], spec=spec)
         gaps[label] = m.lead_gap
         rows.append({"configuration": config, "variant": label, "gamma_urad": m.gamma * 1e6,
                      "lead_gap": m.lead_gap, "gap_across_face_um": m.gap_across_face * 1e6,
@@ -294,28 +282,21 @@ def main(argv=None):
 
 def runup_layouts(session, dts, rig_gaps) -> list:
     """Part 4: per configuration the run-up (the study's routes, erp) in the model's layout (the scene's source, as
-    `housingfe study bearings`) and in the rig's (the FE bearings of `wheel_located_at_back` as a Rayleigh-Ritz
-    re-analysis on the same basis, the source with that layout's lead gap), and per layout the mean difference of
-    L_WA and of its terms to ball bearings over 800-1500 rev/min (housingfe.studies.variant_terms)."""
-    from runup_factors import Patched
-
-    from housingfe.runup.chain import run_source
+    `housingfe study bearings`) and in the rig's (`rig_drivetrain`: drivetrain.wheel_locating = "back", a
+    Rayleigh-Ritz re-analysis on the same basis with that layout's FE bearings and source misalignment, as
+    `housingfe study bearings --set drivetrain.wheel_locating=back`), and per layout the mean difference of L_WA
+    and of its terms to ball bearings over 800-1500 rev/min (housingfe.studies.variant_terms).  rig_gaps: unused
+    since the library computes the rig layout's lead gap itself (kept for the call's shape)."""
     from housingfe.studies.variant_terms import decompose_difference, term_curves
 
     spec = session.spec
     radiation = session.radiation
     curves = {}
     for config in CONFIGS:
-        dt = dts[config]
-        model = session.model(dt, label=config)
+        model = session.model(dts[config], label=config)
         curves["model layout", config] = session.runup(model, TORQUE)
-        rig = Patched(dt, lambda s, dt=dt, c=config: wheel_located_at_back(dt, s, c))
-        model = session.model(rig, label=f"{config} (rig layout)")
-        source = dt.source_model(harmonics=spec.harmonics, engagement=spec.engagement,
-                                 misalignment=lambda _t, g=rig_gaps[config]: g)
-        lines, _ = run_source(model, source, spec.speeds, [TORQUE], spec.f_max_hz, spec.source_receptance,
-                              spec.mesh_moment_model, spec.mesh_friction)
-        curves["rig layout", config] = session.runup(model, TORQUE, lines=lines)
+        model = session.model(rig_drivetrain(session, config), label=f"{config} (rig layout)")
+        curves["rig layout", config] = session.runup(model, TORQUE)
     rows = []
     for (layout, config), res in curves.items():
         for route in spec.routes:
