@@ -14,6 +14,7 @@ import sys
 import pytest
 
 from housingfe.benchmarks import all as bench_all
+from tests.interrupt import interruptible
 
 PROGRESS = re.compile(r"^bench modal: (\d+)/3 runs, \d+:\d\d elapsed")
 
@@ -21,7 +22,8 @@ PROGRESS = re.compile(r"^bench modal: (\d+)/3 runs, \d+:\d\d elapsed")
 def _bench(out, *extra):
     env = {**os.environ, "HOUSINGFE_PROGRESS_SECONDS": "0", "OPENBLAS_NUM_THREADS": "1"}
     return subprocess.Popen([sys.executable, "-m", "housingfe", "bench", "modal", "--quick", "--out", str(out),
-                             *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+                             *extra], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                            preexec_fn=interruptible)
 
 
 def _interrupt_after(proc, count: int) -> tuple[list[str], str]:

@@ -12,6 +12,7 @@ import sys
 import pytest
 
 from tests.correlation.free_plate import PLATE_SCENE
+from tests.interrupt import interruptible
 
 SPEC = """
 name = "plate"
@@ -57,18 +58,10 @@ def _update(folder, out, *extra):
     return [sys.executable, "-m", "housingfe", "update", str(folder / "spec.toml"), "--out", str(out), *extra]
 
 
-def _interruptible():
-    """In the child before exec: SIGINT back to its default action.  A process started with SIGINT ignored (any
-    command run with `&` from a non-interactive shell, e.g. a CI job started in the background) passes that on,
-    and Python then keeps it ignored instead of raising KeyboardInterrupt -- as Unix intends for background jobs.
-    The user this test stands for presses Ctrl-C in a terminal, where SIGINT is not ignored."""
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
 def _start_update(folder, out, stdout=subprocess.DEVNULL):
     """`housingfe update` of folder/spec.toml into `out`, running in the background with its stderr piped."""
     return subprocess.Popen(_update(folder, out), stdout=stdout, stderr=subprocess.PIPE, text=True, env=_env(),
-                            cwd=folder, preexec_fn=_interruptible)
+                            cwd=folder, preexec_fn=interruptible)
 
 
 def _progress_reached(proc, evaluations) -> bool:
