@@ -88,37 +88,37 @@ class DrivetrainSpec(_Strict):
     @field_validator("gearbox")
     @classmethod
     def _known(cls, name):
-        if name not in _gearboxes():
-            raise ValueError(f"{name!r} is not a drivetrain description (known: {', '.join(_gearboxes())})")
-        return name
+        return _one_of(name, _gearboxes(), "a drivetrain description")
 
     @field_validator("gear_set")
     @classmethod
     def _gear_set(cls, name):
         from housingfe.drivetrain.description import GEAR_SETS
 
-        if name not in GEAR_SETS:
-            raise ValueError(f"{name!r} is not a gear set (known: {', '.join(GEAR_SETS)})")
-        return name
+        return _one_of(name, GEAR_SETS, "a gear set")
 
     @field_validator("wheel_locating")
     @classmethod
     def _wheel_locating(cls, side):
         from housingfe.drivetrain.description import LOCATING_SIDES
 
-        if side not in LOCATING_SIDES:
-            raise ValueError(f"{side!r} is not a bearing side (known: {', '.join(LOCATING_SIDES)})")
-        return side
+        return _one_of(side, LOCATING_SIDES, "a bearing side")
 
     @field_validator("bearings")
     @classmethod
     def _bearings(cls, name):
         from housingfe.bearings.configurations import configurations
 
-        known = list(configurations())          # "ball" is one of them
-        if name not in known:
-            raise ValueError(f"{name!r} is not a bearing configuration (known: {', '.join(known)})")
-        return name
+        return _one_of(name, configurations(), "a bearing configuration")     # "ball" is one of them
+
+
+def _one_of(value: str, known, what: str) -> str:
+    """value if it is one of `known` (names), else the ValueError a field validator raises: "'x' is not <what>
+    (known: ...)"."""
+    known = list(known)
+    if value not in known:
+        raise ValueError(f"{value!r} is not {what} (known: {', '.join(known)})")
+    return value
 
 
 class RunupSpec(_Strict):
