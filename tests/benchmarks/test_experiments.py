@@ -106,3 +106,29 @@ def test_frame_mount_modes_approach_the_rigid_gearbox_on_soft_springs():
     assert np.all(fe <= np.array(estimate) * (1 + 1e-3))     # Rayleigh-Ritz: the estimate bounds from above
     mass = next(r for r in rows if r["kind"] == "mass")["rigid_motion"]
     assert 160.0 < float(mass.split()[1]) < 180.0, mass       # housing 110.6 kg + interior
+
+
+def test_sa_housing_experiment_keeps_its_two_load_paths(tmp_path):
+    """benchmarks/experiments/sa_housing (why self-aligning bearings' T_housing has opposite signs on the two routes)
+    rests on: the wheel torque of route tf_omega loads the bores as the mesh force pair does (tooth-line T_housing
+    equal within 0.1 dB, ball and self-aligning), the shuttling moment makes mesh_force's bore forces (> 10 dB above
+    the pair's), the self-aligning bearings put no moment on the bores (zero moment rows, shaft node at the bore
+    master: below -200 dB re 1 N m), and self-aligning bearings raise the pair's axial share of the bore force and
+    lower the shuttling moment's.  On the coarse gearbox (60 mm mesh, lines to 1.5 kHz; ~20 s)."""
+    import csv
+
+    script = ROOT / "benchmarks" / "experiments" / "sa_housing" / "sa_housing.py"
+    proc = subprocess.run([sys.executable, str(script), "--coarse", "--no-variants", "--out", str(tmp_path)],
+                          cwd=ROOT, capture_output=True, text=True,
+                          env=dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT)), timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    rows = {(r["config"], r["part"]): {k: float(v) for k, v in r.items() if k.endswith("_dB")}
+            for r in csv.DictReader(open(tmp_path / "load_parts.csv")) if r["harmonic"] == "1"}
+    for cfg in ("ball", "self_aligning"):
+        assert abs(rows[cfg, "tf_omega"]["T_housing_dB"] - rows[cfg, "mesh pair only"]["T_housing_dB"]) < 0.1
+        assert rows[cfg, "shuttling moment only"]["L_bore_dB"] > rows[cfg, "mesh pair only"]["L_bore_dB"] + 10
+    for part in ("tf_omega", "mesh_force"):
+        assert rows["self_aligning", part]["L_bore_moment_dB"] < -200
+    share = {k: v["axial_minus_radial_dB"] for k, v in rows.items()}
+    assert share["self_aligning", "mesh pair only"] > share["ball", "mesh pair only"] + 3
+    assert share["self_aligning", "shuttling moment only"] < share["ball", "shuttling moment only"] - 10
