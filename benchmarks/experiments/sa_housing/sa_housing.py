@@ -18,7 +18,7 @@ housing is the same FE model on both routes; this script measures where the diff
    spherical rollers' translational block; the ball matrices without their radial-axial couplings k_xz, k_yz;
    the ball matrices with the spherical rollers' radial 2x2 block.
 
-    PYTHONPATH=. /work/main/.venv/bin/python benchmarks/experiments/sa_housing/sa_housing.py [--out DIR] [--coarse]
+    PYTHONPATH=. /work/main/.venv/bin/python benchmarks/experiments/sa_housing/sa_housing.py [--out DIR] [--coarse] [--no-variants]
 
 Writes harmonics.csv (part 1 per configuration, route, harmonic), load_parts.csv and tooth_line_curves.csv (per
 load part: the routes and mesh_force's two loads alone), terms.csv (the study's terms per variant and
@@ -26,8 +26,6 @@ route), bore_loads.csv and housing_split.csv (part 2), sa_housing.png, run.json.
 """
 from __future__ import annotations
 
-import argparse
-import csv
 import json
 import math
 import os
@@ -40,26 +38,13 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "bearing_ranking"))
 import common  # noqa: E402
+from runup_factors import Patched, gear_set_b_args  # noqa: E402  (Patched: a Drivetrain with its FE bearings patched)
 
 TORQUE = 2000.0
 MEAN_RANGE = (800.0, 1500.0)
 ROUTES = ("tf_omega", "mesh_force")
 COMPONENTS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
 PROBE_SPEEDS = (800.0, 1000.0, 1200.0, 1400.0, 1500.0)
-
-
-class Patched:
-    """A Drivetrain whose FE reduction (to_coupling_spec) is changed by `patch(spec) -> spec`; all else delegated
-    (bearing_ranking/runup_factors.py)."""
-
-    def __init__(self, drivetrain, patch):
-        self._dt, self._patch = drivetrain, patch
-
-    def __getattr__(self, key):
-        return getattr(self._dt, key)
-
-    def to_coupling_spec(self, forces=None):
-        return self._patch(self._dt.to_coupling_spec(forces))
 
 
 def zero_radial_axial(K):
@@ -267,16 +252,12 @@ def main(argv=None):
     from housingfe.runup.chain import with_drivetrain
     from housingfe.studies.chain_session import ChainSession
 
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--out", default="/tmp/sahousing-exp")
-    p.add_argument("--coarse", action="store_true", help="60 mm housing mesh, lines to 1.5 kHz (a quick look)")
-    p.add_argument("--no-variants", action="store_true", help="ball and self-aligning only")
-    args = p.parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    no_variants = "--no-variants" in argv                 # ball and self-aligning only
+    args, overrides = gear_set_b_args(__doc__, "/tmp/sahousing-exp", [a for a in argv if a != "--no-variants"],
+                                      extra=('radiation.models=["erp"]',))
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    overrides = ["drivetrain.gear_set=B", 'radiation.models=["erp"]']
-    if args.coarse:
-        overrides += ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500.0"]
     t0, load0 = time.perf_counter(), os.getloadavg()
     timings = {}
     session = ChainSession.from_scene("test-gearbox-runup", overrides)
@@ -284,7 +265,7 @@ def main(argv=None):
     sa = session.drivetrain("B", "self_aligning", TORQUE)
     sa_spec = sa.to_coupling_spec()
     configs = {"ball": ball, "self_aligning": sa}
-    if not args.no_variants:
+    if not no_variants:
         configs["ball_zero_moment"] = Patched(ball, lambda s: common.with_bearing_matrices(
             s, common.scale_moments(0.0)))
         configs["ball_moments_sa_translations"] = Patched(ball, lambda s: common.with_bearing_matrices(
@@ -368,13 +349,10 @@ def main(argv=None):
 
 
 def _write(path, rows):
-    if not rows:
-        return
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    from housingfe.outputs import write_csv
+
+    if rows:
+        write_csv(path, list(rows[0]), ([f"{v:.6g}" if isinstance(v, float) else v for v in r.values()] for r in rows))
 
 
 def _plot(path, load_rows):
