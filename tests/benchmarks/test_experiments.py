@@ -132,3 +132,70 @@ def test_sa_housing_experiment_keeps_its_two_load_paths(tmp_path):
     share = {k: v["axial_minus_radial_dB"] for k, v in rows.items()}
     assert share["self_aligning", "mesh pair only"] > share["ball", "mesh pair only"] + 3
     assert share["self_aligning", "shuttling moment only"] < share["ball", "shuttling moment only"] - 10
+
+
+def _floating_axial():
+    import importlib.util
+
+    path = ROOT / "benchmarks" / "experiments" / "floating_axial" / "floating_axial.py"
+    spec = importlib.util.spec_from_file_location("floating_axial", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_floating_axial_stick_criterion_by_hand():
+    """benchmarks/experiments/floating_axial: a speed with two harmonic lines of rms axial force 3+4j N and 1j N has
+    a time peak of at most sqrt(2) (5 + 1) = 8.485 N and an rms of sqrt(26) N; a rotating radial line (1, 1j, 0) N rms
+    peaks at sqrt(2) sqrt(2) = 2 N.  With F_r = 1000 N, a dynamic radial peak of 200 N and mu = 0.1 the fit holds
+    0.1 (1000 - 200) = 80 N: margin 80 / 8.485 = 9.43; a radial load the vibration lifts off holds nothing."""
+    import numpy as np
+
+    fa = _floating_axial()
+    keys, peak, rms = fa.peak_and_rms(np.array([3 + 4j, 1j, 7.0]), np.array([100.0, 100.0, 200.0]))
+    assert list(keys) == [100.0, 200.0]
+    assert np.allclose(peak, [6 * np.sqrt(2), 7 * np.sqrt(2)])
+    assert np.allclose(rms, [np.sqrt(26), 7.0])
+    _, rpeak, _ = fa.peak_and_rms(np.array([[1.0, 1j, 0.0]]), np.array([1.0]))
+    assert np.isclose(rpeak[0], 2.0)
+    assert np.isclose(fa.stick_margin(6 * np.sqrt(2), 1000.0, 200.0, 0.1), 80 / (6 * np.sqrt(2)))
+    assert fa.stick_margin(1.0, 1000.0, 1200.0, 0.2) == 0.0
+    # coherent lines: f = sqrt(2) (cos t - cos 3t) = 4 sqrt(2) c (1 - c^2), c = cos t, peaks at c = 1/sqrt(3):
+    # 8 sqrt(2) / (3 sqrt(3)) = 2.177 N, below the bound 2 sqrt(2)
+    assert np.isclose(fa.synthesised_peak(np.array([1.0, -1.0]), np.array([1, 3]), np.array([5.0, 5.0]))[0],
+                      8 * np.sqrt(2) / (3 * np.sqrt(3)), rtol=1e-3)
+
+
+def test_floating_axial_experiment_runs_coarse(tmp_path):
+    """benchmarks/experiments/floating_axial on the coarse default run-up (60 mm mesh, lines to 1.5 kHz; ~15 s): the
+    floating bearings get no axial force in the statics, the linear interior on rigid bores shares each shaft's
+    axial mesh force between its two bearings (their sum = the locating bearing's statics force, equilibrium), and the
+    margins of margins.csv are the smallest over the speeds of mu (F_r - F_r_dyn) / F_a_dyn recomputed from the
+    per-speed rows."""
+    import csv
+
+    import numpy as np
+
+    script = ROOT / "benchmarks" / "experiments" / "floating_axial" / "floating_axial.py"
+    proc = subprocess.run([sys.executable, str(script), "--coarse", "--only-default", "--out", str(tmp_path)],
+                          cwd=ROOT, capture_output=True, text=True,
+                          env=dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT)), timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    static = {r["bearing"]: r for r in csv.DictReader(open(tmp_path / "static.csv"))}
+    for shaft in ("pinion", "wheel"):
+        front, back = static[f"{shaft}_front"], static[f"{shaft}_back"]
+        assert front["role"] == "locating" and back["role"] == "floating"
+        assert float(back["F_a_statics_N"]) == 0.0
+        assert abs(float(front["F_a_statics_N"])) > 5000.0          # the helical mesh's axial force
+        total = float(front["F_a_linear_rigid_bores_N"]) + float(back["F_a_linear_rigid_bores_N"])
+        assert np.isclose(total, float(front["F_a_statics_N"]), rtol=1e-4)
+    rows = list(csv.DictReader(open(tmp_path / "floating_axial.csv")))
+    margins = list(csv.DictReader(open(tmp_path / "margins.csv")))
+    assert {(m["route"], m["bearing"]) for m in margins} == {(r, b) for r in ("tf_omega", "mesh_force")
+                                                              for b in ("pinion_back", "wheel_back")}
+    for m in margins:
+        sel = [r for r in rows if r["route"] == m["route"] and r["bearing"] == m["bearing"]]
+        for mu in (0.1, 0.2):
+            by_hand = min(mu * (float(r["F_r_static_N"]) - float(r["F_r_dyn_peak_N"])) / float(r["F_a_dyn_peak_N"])
+                          for r in sel)
+            assert np.isclose(float(m[f"min_margin_mu{mu:g}_dB"]), 20 * np.log10(by_hand), atol=0.01)
