@@ -29,7 +29,6 @@ import argparse
 import json
 import math
 import os
-import sys
 import time
 from pathlib import Path
 
@@ -83,6 +82,7 @@ def static_bearing_forces(drivetrain) -> dict:
     force (Drivetrain.mesh_node_loads at the mean normal force, the spin held, no mesh spring or drive line: as
     housingfe.drivetrain.misalignment.static_gear_tilts), axial along the shaft axis."""
     from housingfe.drivetrain.interior import interior_matrices, parts
+    from housingfe.drivetrain.misalignment import _gear_loads
 
     forces = drivetrain.gear_forces()
     spec = drivetrain.to_coupling_spec(forces).model_copy(update={"gear_meshes": [], "drive_lines": [],
@@ -90,18 +90,13 @@ def static_bearing_forces(drivetrain) -> dict:
     centres = {s.name: drivetrain.shaft(s.shaft).point(s.position) for s in drivetrain.bearings}
     K, _, _, names = interior_matrices(spec, centres)
     index = {n: 6 * i for i, n in enumerate(names)}
-    loads = drivetrain.mesh_node_loads(float(np.linalg.norm(forces.force_on_pinion)) / forces.resultant, forces)
     f = np.zeros(K.shape[0])
     scale = float(np.max(np.abs(np.diag(K))))
-    for name in ("pinion", "wheel"):
-        node = f"{name}:{drivetrain.shaft_nodes(name)[1]['gear']}"
-        a = np.asarray(drivetrain.shaft(name).axis, float)
-        a /= np.linalg.norm(a)
-        load = np.real(np.asarray(loads[node], float)).copy()
-        load[3:] -= (load[3:] @ a) * a
+    loads, axes = _gear_loads(drivetrain, forces)       # the mean tooth force without its moment about the axis
+    for node, load in loads.items():
         i = index[node]
         f[i:i + 6] += load
-        K[i + 3:i + 6, i + 3:i + 6] += scale * np.outer(a, a)
+        K[i + 3:i + 6, i + 3:i + 6] += scale * np.outer(axes[node], axes[node])     # hold the spin
     u = np.linalg.solve(K, f)
     seat = {s.name: s for s in drivetrain.bearings}
     out = {}
