@@ -380,7 +380,8 @@ def test_a_sample_with_the_wheel_located_at_the_back_is_the_run_with_that_side(t
     sides = [s["wheel_locating_ball"] for s in res.samples]
     assert sorted(sides) == ["back", "front"]
     back, front = res.metrics[sides.index("back")], res.metrics[sides.index("front")]
-    assert res.timings["processes"] == 1 and sum(m["setup_s"] > 0 for m in res.metrics) == 1     # one basis
+    # one process, at most one basis for both sides (none when an earlier test of this process built it)
+    assert res.timings["processes"] == 1 and sum(m["setup_s"] > 0 for m in res.metrics) <= 1
     run = cli_lwa_curves("test-gearbox-runup", COARSE + ("drivetrain.wheel_locating=back",), tmp_path / "run")
     for route, curve in run.items():
         np.testing.assert_allclose(back[f"{route}/lwa_curve_dBA"], curve, atol=2e-3, err_msg=route)
