@@ -704,6 +704,8 @@ def wheel_locating_side(bearings: str, wheel_locating: str = "configuration") ->
 
     config = configurations().get(bearings)
     return (config.wheel_locating if config is not None else None) or "front"
+
+
 GEAR_SETS = {"A": "gearset-A", "B": "gearset-B", "C": "gearset-C", "D": "gearset-D",
              "uncorrected": "gearset-uncorrected", "double_helical": "gearset-double-helical"}
 

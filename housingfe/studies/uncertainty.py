@@ -1036,7 +1036,9 @@ class UncertaintyResult:
                 x = np.array([s.get(name) for s in self.samples], dtype=object)[keep]
                 if any(a is None for a in x):         # an opt-in input not drawn (or an older run's samples)
                     continue
-                if name == "radiation" or name in SIDES:
+                if name in SIDES:                     # rho > 0: the wheel located at the back raises it
+                    x = np.array([a == "back" for a in x], float)
+                elif name == "radiation":
                     x = np.array([str(a) == str(x[0]) for a in x], float)
                 x = x.astype(float)
                 if np.ptp(x) == 0:
