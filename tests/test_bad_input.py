@@ -767,6 +767,12 @@ SWEEP_CASES = [
      ["--range clearance_position", "5: must be a position within the Group N clearance range"]),
     ("uncertainty-range-fails-late", ["uncertainty", "--range", "spherical_contact_angle_deg=95:100", "--out", "u"],
      ["--range spherical_contact_angle_deg", "95: must be a contact angle in [0, 90) deg"]),
+    # the wheel's locating side drawn by uncertainty (front / back): another word is refused when read
+    ("uncertainty-range-side", ["uncertainty", "--range", "wheel_locating_ball=middle", "--out", "u"],
+     ["--range wheel_locating_ball: middle: not a bearing side (give front, back or front,back)"]),
+    ("runup-wheel-locating", ["run", "test-gearbox-runup", "--set", "drivetrain.wheel_locating=configurations",
+                              "--out", "r"],
+     ["drivetrain.wheel_locating: 'configurations' is not a bearing side (known: configuration, front, back)"]),
     # `--out ""` (a shell variable that was not set) wrote into the default folder, replacing the result there
     ("out-empty", ["run", "box-free", "--out", ""], ["--out", "empty path"]),
     # a housing or source scene given to a run-up command: its keys were named as unknown run-up keys

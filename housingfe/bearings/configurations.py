@@ -11,8 +11,9 @@ Positions "pinion_front", "pinion_back", "wheel_front", "wheel_back".  Frames an
 z = shaft axis, DOF order (x, y, z, theta_x, theta_y, theta_z); `loads[position]` = (Fx, Fy, Fz, Mx, My) [N, N m]
 applied by the shaft to the bearing (inner ring / journal), as everywhere in housingfe.bearings.  The caller's
 convention: *_front is the locating bearing of its shaft and takes the axial force Fz (either sign), *_back is
-floating and must get Fz = 0.  (In the thesis' rig the wheel's locating bearing sat at the BACK of the gearbox,
-Sec. 5.8: "front" here means "locating", not the physical side.)  K [N/m, N/rad, N m/rad], C [N s/m, ...];
+floating and must get Fz = 0.  ("front" here means "locating", not the physical side: which of the wheel's two seats
+locates is `Configuration.wheel_locating`, the side the thesis states, placed by housingfe.drivetrain.description.)
+K [N/m, N/rad, N m/rad], C [N s/m, ...];
 row/column 6 (spin) is zero; K is symmetric for rolling bearings, non-symmetric for the fluid film.
 
 Assumptions (also in docs/bearings.md):
@@ -52,6 +53,10 @@ Assumptions (also in docs/bearings.md):
     K(-omega, W) = T K(+omega, P W) T with P = diag(1, -1), T = diag(1, -1, 1, -1, 1, -1).
     The thesis made K symmetric (mean of k_xy and k_yx) and dropped C for its FE model (Sec. 3.5); here both
     are returned as computed.
+  * The wheel's locating side (Configuration.wheel_locating, the physical side of its locating seat): "back" for
+    angular_contact (Sec. 5.8: "at the front (pinion) and at the back (wheel) of the gearbox") and tapered_roller
+    ("the same reasons apply"); None where the text does not say (ball, self_aligning) and for the double helical
+    configurations, whose wheel no bearing locates (Sec. 5.9).  The pinion is located at its front either way.
   * Axial stand-in (cylindrical_roller and fluid_film; axial_location): "thesis" (default) adds it at
     pinion_front only: the pinion is located, the wheel is positioned by the double helix of the mesh
     (Sec. 5.9), so the caller's model must couple the wheel axially to the pinion through the mesh (or its
@@ -103,11 +108,22 @@ class BearingChoice:
 @dataclass(frozen=True)
 class Configuration:
     """A bearing configuration of the test gearbox: name, description (with the thesis section), gear_set
-    ("single_helical" Sec. 5.8 or "double_helical" Sec. 5.9) and positions {position: BearingChoice}."""
+    ("single_helical" Sec. 5.8 or "double_helical" Sec. 5.9), positions {position: BearingChoice}, and
+    wheel_locating: the physical side of the gearbox ("front" | "back") at which the thesis puts the wheel's
+    locating bearing, None where the text does not say; wheel_locating_source: the thesis' words, or why none."""
     name: str
     description: str
     gear_set: str
     positions: dict = field(default_factory=dict)
+    wheel_locating: str | None = None
+    wheel_locating_source: str = ""
+
+    @property
+    def wheel_side_uncertain(self) -> bool:
+        """Whether the wheel's locating side is an input the text leaves open: a single helical set pushes the
+        wheel axially onto one of its bearings, and the thesis does not say which.  (The double helical sets put no
+        axial force on the wheel, Sec. 5.9: there the side only places the model's axial stand-in.)"""
+        return self.wheel_locating is None and self.gear_set == "single_helical"
 
 
 @dataclass
@@ -165,13 +181,35 @@ def _journal(position: str) -> BearingChoice:
                          note="plain journal bearing, Sec. 3.5 / 5.9 (pinion Glyco E-135-80, wheel Glacier 095 KSA 070)")
 
 
+# The wheel's locating side per configuration (Configuration.wheel_locating): taken from the thesis text where it
+# states it, never from which side makes a variant agree with the measurement; where the text is silent it stays
+# None (the drivetrain then locates the wheel at its front bearing, and `housingfe uncertainty` draws the side).
+_STATED = {
+    "angular_contact": 'Sec. 5.8: "On every shaft an angular contact ball bearing was situated at the shaft side '
+                       'where the axial force is encountered by the bearings ... The angular contact ball bearings '
+                       'were situated at the front (pinion) and at the back (wheel) of the gearbox."',
+    "tapered_roller": 'Sec. 5.8: "The same reasons apply as for the angular contact ball bearings to use only two '
+                      'of such bearings" (the angular contact ones: "at the front (pinion) and at the back (wheel)")',
+}
+_UNSTATED = {
+    "ball": "not stated: Sec. 5.8 does not say which of the reference's deep groove ball bearings takes the axial "
+            "force",
+    "self_aligning": "not stated: Sec. 5.8 puts SKF 21316 CC / 22219 CC at all four positions and does not say "
+                     "which takes the axial force",
+    "double_helical": 'no wheel bearing locates: "both wheel bearings can freely move in axial direction. The '
+                      'wheel is axially positioned by the double helix of the gear mesh" (Sec. 5.9); the double '
+                      "helical set puts no axial load on them, the side only places the model's axial stand-in",
+}
+
+
 def configurations() -> dict[str, Configuration]:
     """The six bearing configurations of the test gearbox (assumptions: module docstring)."""
     pin, whl = "SKF 6316", "SKF 6219"
     ball = {p: _rolling(p, pin if SHAFT[p] == "pinion" else whl, "lim-ball") for p in POSITIONS}
     configs = [
         Configuration("ball", "Deep groove ball bearings SKF 6316 (pinion) / 6219 (wheel) at all four positions; "
-                      "the reference configuration (thesis Sec. 5.1, 5.8)", "single_helical", ball),
+                      "the reference configuration (thesis Sec. 5.1, 5.8)", "single_helical", ball,
+                      None, _UNSTATED["ball"]),
         Configuration("angular_contact", "Single-row angular contact ball bearings SKF 7316 B (pinion) / 7219 B "
                       "(wheel) at the locating positions, deep groove 6316 / 6219 at the floating ones "
                       "(thesis Sec. 5.8)", "single_helical",
@@ -180,12 +218,15 @@ def configurations() -> dict[str, Configuration]:
                        "pinion_back": ball["pinion_back"],
                        "wheel_front": _rolling("wheel_front", "SKF 7219B", "lim-ball",
                                                "mirrored (z -> -z) when Fz < 0"),
-                       "wheel_back": ball["wheel_back"]}),
+                       "wheel_back": ball["wheel_back"]},
+                      # Sec. 5.8 (thesis text l. 2091): "The angular contact ball bearings were situated at the
+                      # front (pinion) and at the back (wheel) of the gearbox."
+                      "back", _STATED["angular_contact"]),
         Configuration("self_aligning", "Double-row self-aligning (spherical) roller bearings SKF 21316 CC "
                       "(pinion) / 22219 CC (wheel) at all four positions, zero moment stiffness (thesis Sec. 5.8)",
                       "single_helical",
                       {p: _rolling(p, "SKF 21316CC" if SHAFT[p] == "pinion" else "SKF 22219CC", "self-aligning")
-                       for p in POSITIONS}),
+                       for p in POSITIONS}, None, _UNSTATED["self_aligning"]),
         Configuration("tapered_roller", "Single-row taper roller bearings at the locating positions (estimated "
                       "SKF 30316 J2 / 30219 J2, sliced-roller model of Sec. 3.3.2), deep groove 6316 / 6219 at "
                       "the floating ones (thesis Sec. 5.8)", "single_helical",
@@ -194,16 +235,20 @@ def configurations() -> dict[str, Configuration]:
                        "pinion_back": ball["pinion_back"],
                        "wheel_front": _rolling("wheel_front", "SKF 30219 J2", "sliced-roller",
                                                "type not in the thesis: estimated; mirrored when Fz < 0"),
-                       "wheel_back": ball["wheel_back"]}),
+                       "wheel_back": ball["wheel_back"]},
+                      # Sec. 5.8 (thesis text l. 2100): "The same reasons apply as for the angular contact ball
+                      # bearings to use only two of such bearings" -- i.e. at the side where each shaft's axial
+                      # force is met, the wheel's at the back (l. 2091)
+                      "back", _STATED["tapered_roller"]),
         Configuration("cylindrical_roller", "Single-row cylindrical roller bearings SKF NJ 316 (pinion) / NU 2219 "
                       "(wheel) at all four positions, double helical gears without axial load (thesis Sec. 5.9)",
                       "double_helical",
                       {p: _rolling(p, "SKF NJ316" if SHAFT[p] == "pinion" else "SKF NU2219", "sliced-roller",
                                    "no axial load; axial stand-in at the locating position(s)")
-                       for p in POSITIONS}),
+                       for p in POSITIONS}, None, _UNSTATED["double_helical"]),
         Configuration("fluid_film", "Plain fluid-film journal bearings of thesis Sec. 3.5 at all four positions, "
                       "double helical gears (thesis Sec. 5.9)", "double_helical",
-                      {p: _journal(p) for p in POSITIONS}),
+                      {p: _journal(p) for p in POSITIONS}, None, _UNSTATED["double_helical"]),
     ]
     return {c.name: c for c in configs}
 

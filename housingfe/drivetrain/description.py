@@ -682,8 +682,30 @@ class Drivetrain:
 # of the bearing plates (y = -/+0.140 m), bearings mid-plate (y = -/+0.1075 m).
 TEST_GEARBOX_CENTRES = {"pinion": (-0.126, 0.0, 0.200), "wheel": (0.074, 0.0, 0.200)}
 TEST_GEARBOX_BEARINGS = {"ball": {"pinion": "SKF 6316", "wheel": "SKF 6219"}}
-# which of a shaft's two bearings (at -/+0.1075 m along +y) locates it axially; "front" is the model's default layout
+# which of a shaft's two bearings (at -/+0.1075 m along +y) locates it axially
 LOCATING_SIDES = ("front", "back")
+# test_gearbox(wheel_locating=...): "configuration" (the default) = the side the thesis states for the bearing
+# configuration (housingfe.bearings.configurations: Configuration.wheel_locating), "front" where it states none;
+# "front" / "back" = that side for every configuration
+WHEEL_LOCATING = ("configuration", *LOCATING_SIDES)
+
+
+def wheel_locating_side(bearings: str, wheel_locating: str = "configuration") -> str:
+    """The side ("front" | "back") of the test gearbox's wheel bearing that locates the wheel axially, for the
+    bearing configuration `bearings` and the choice `wheel_locating` (WHEEL_LOCATING): "configuration" gives the
+    side the thesis states for it (angular_contact, tapered_roller: "back", Sec. 5.8), "front" where the text states
+    none (ball, self_aligning; the double helical configurations, whose wheel no bearing locates)."""
+    if wheel_locating not in WHEEL_LOCATING:
+        raise InputError(f"test_gearbox: wheel_locating: {wheel_locating!r} unknown (known: "
+                         f"{', '.join(WHEEL_LOCATING)})")
+    if wheel_locating != "configuration":
+        return wheel_locating
+    from housingfe.bearings.configurations import configurations
+
+    config = configurations().get(bearings)
+    return (config.wheel_locating if config is not None else None) or "front"
+
+
 GEAR_SETS = {"A": "gearset-A", "B": "gearset-B", "C": "gearset-C", "D": "gearset-D",
              "uncorrected": "gearset-uncorrected", "double_helical": "gearset-double-helical"}
 
@@ -712,17 +734,18 @@ def mesh_line_of_action(pair, pinion_centre, wheel_centre, shaft_axis) -> tuple[
 
 
 def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 2000.0,
-                 wheel_locating: str = "front") -> Drivetrain:
+                 wheel_locating: str = "configuration") -> Drivetrain:
     """The Ch. 5 test gearbox (van Roosmalen 1994) as one description: gear set A-D, "uncorrected" or
     "double_helical" (the gear data of the gearset-* scenes), bearings "ball" (SKF 6316 pinion / 6219 wheel, Lim's
     model, the front bearings locating) or a configuration of housingfe.bearings.configurations (Secs. 5.8, 5.9:
     "angular_contact", "self_aligning", "tapered_roller" with the single helical sets; "cylindrical_roller",
     "fluid_film" with the double helical set, which puts no axial load on them), pinion torque (N m).  Shaft, quill-shaft and coupling dimensions are the
     ASSUMPTIONS of docs/source.md (Appendix C's parameter table did not survive); the auxiliary gearbox and motor
-    (for drive_line "back-to-back") those of `scaled_aux_gearbox` and MOTOR_*.  wheel_locating (LOCATING_SIDES):
-    which of the wheel's bearings locates it axially, "front" (the model's default: both shafts located at the
-    front) or "back" (the rig's layout, Sec. 5.8: angular contact bearings "at the front (pinion) and at the back
-    (wheel)", the tapered ones "for the same reasons"); the pinion is located at its front bearing either way."""
+    (for drive_line "back-to-back") those of `scaled_aux_gearbox` and MOTOR_*.  wheel_locating (WHEEL_LOCATING,
+    `wheel_locating_side`): which of the wheel's bearings locates it axially, "configuration" (default: the side
+    the thesis states for the configuration -- "back" for angular contact, Sec. 5.8: "at the front (pinion) and at
+    the back (wheel)", and tapered rollers, "the same reasons" -- "front" where it states none), or "front" /
+    "back" for every configuration; the pinion is located at its front bearing either way."""
     if gear_set not in GEAR_SETS:
         raise InputError(f"test_gearbox: gear_set: {gear_set!r} unknown (known: {', '.join(GEAR_SETS)})")
     from housingfe.bearings.configurations import configurations
@@ -733,10 +756,7 @@ def test_gearbox(gear_set: str = "A", bearings: str = "ball", torque: float = 20
     axis = (0.0, 1.0, 0.0)
     shafts = (ShaftLine("pinion", 0.080, TEST_GEARBOX_CENTRES["pinion"], axis, (-0.140, 0.140)),   # SKF 6316 bore
               ShaftLine("wheel", 0.095, TEST_GEARBOX_CENTRES["wheel"], axis, (-0.140, 0.140)))      # SKF 6219 bore
-    if wheel_locating not in LOCATING_SIDES:
-        raise InputError(f"test_gearbox: wheel_locating: {wheel_locating!r} unknown (known: "
-                         f"{', '.join(LOCATING_SIDES)})")
-    located = {"pinion": "front", "wheel": wheel_locating}
+    located = {"pinion": "front", "wheel": wheel_locating_side(bearings, wheel_locating)}
     seats = tuple(BearingSeat(f"{shaft}_{side}", shaft, s, f"bore_{shaft}_{side}", locating=side == located[shaft],
                               designation=TEST_GEARBOX_BEARINGS["ball"][shaft])
                   for shaft in SHAFTS for side, s in (("front", -0.1075), ("back", 0.1075)))

@@ -7,7 +7,7 @@ L_omega, L_v, L_W, L_WA over speed.  `housingfe run test-gearbox-runup`.
                    bores = {bearing = "housing bore"}, bore_tolerance (m): the drivetrain's bearings matched to
                    the housing's bores and checked against the shafts (housingfe.drivetrain.bore_matching)
     [drivetrain]   gearbox = "test_gearbox", gear_set = "A", bearings = "ball", bearing_speed_rpm = 1500,
-                   wheel_locating = "front" | "back" (which wheel bearing locates it axially)
+                   wheel_locating = "configuration" | "front" | "back" (which wheel bearing locates it axially)
     [runup]        speeds, torques, f_max_hz (highest harmonic line), basis_factor, routes, damping_ratio, ...
     [radiation]    models = ["erp", "foller"], plates = [...]  (the housing's radiating plates)
 
@@ -81,9 +81,10 @@ class DrivetrainSpec(_Strict):
     # "follow" (default) the speed of the model whose basis is re-analysed at each run-up speed
     bearing_speed_rpm: PositiveFloat = 1500.0
     # which of the wheel's two bearings locates it axially (takes the axial mesh force; with a configuration: its
-    # locating bearing type sits there, the floating type at the other): "front" (the default, both shafts located
-    # at the front) or "back" (the thesis rig's layout, Sec. 5.8: "at the front (pinion) and at the back (wheel)")
-    wheel_locating: str = "front"
+    # locating bearing type sits there, the floating type at the other): "configuration" (the default: the side the
+    # thesis states for the bearings -- "back" for angular_contact and tapered_roller, Sec. 5.8: "at the front
+    # (pinion) and at the back (wheel)" -- "front" where it states none), or "front" / "back" for any bearings
+    wheel_locating: str = "configuration"
 
     @field_validator("gearbox")
     @classmethod
@@ -100,9 +101,9 @@ class DrivetrainSpec(_Strict):
     @field_validator("wheel_locating")
     @classmethod
     def _wheel_locating(cls, side):
-        from housingfe.drivetrain.description import LOCATING_SIDES
+        from housingfe.drivetrain.description import WHEEL_LOCATING
 
-        return _one_of(side, LOCATING_SIDES, "a bearing side")
+        return _one_of(side, WHEEL_LOCATING, "a bearing side")
 
     @field_validator("bearings")
     @classmethod

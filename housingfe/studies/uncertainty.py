@@ -26,6 +26,13 @@ source's lead gap.  So each process computes ONE modal basis per layout (the sce
 with the double-helical family that gearbox's too) and every configuration of every sample is a Rayleigh-Ritz
 re-analysis on it (housingfe.runup.chain.with_drivetrain).
 
+The wheel's locating side where the thesis does not state it (`SIDES`: the ball reference and the self-aligning
+configuration, Sec. 5.8; housingfe.bearings.configurations.Configuration.wheel_side_uncertain) is a discrete input:
+front or back, 1/2 each, per sample and configuration (`wheel_locating_<configuration>`), each drawn from a stream
+of its own so that every other input of a seed stays as without it.  It moves no DOF either: a sample's other side
+is a re-analysis on the same basis (as `housingfe study bearings --set drivetrain.wheel_locating=back`).  A scene
+with an explicit drivetrain.wheel_locating ("front" / "back") fixes it.
+
 The one exception is opt-in: `mount_stiffness_N_per_m` (only with --range; `OPT_IN`, drawn from a stream of its own
 so that every seed's other inputs stay as without it) stands the housing on an elastic frame.  The fixed feet's
 Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its own on
@@ -81,8 +88,8 @@ PEAK_WINDOWS_RPM = ((450.0, 450.0), (850.0, 950.0), (1300.0, 1350.0))
 @dataclass(frozen=True)
 class Parameter:
     """An estimated input: its range [low, high] (distribution "uniform" or "loguniform"; "choice": one of the
-    scene's radiation models, equally likely), the value the chain uses (`nominal`, None: the scene's), unit,
-    what it acts on, and where the range comes from."""
+    scene's radiation models, equally likely; "side": a bearing side, front or back, equally likely), the value the
+    chain uses (`nominal`, None: the scene's), unit, what it acts on, and where the range comes from."""
 
     name: str
     distribution: str
@@ -157,6 +164,27 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
               "130-382 Hz, from 3e9 they mix with the housing's (benchmarks/experiments/frame_mount)"),
 )}
 
+
+def _side_parameters() -> dict[str, Parameter]:
+    """wheel_locating_<configuration> for every configuration whose wheel's locating side the thesis leaves open
+    (housingfe.bearings.configurations.Configuration.wheel_side_uncertain: ball, self_aligning)."""
+    from housingfe.bearings.configurations import configurations
+
+    return {f"wheel_locating_{name}": Parameter(
+        f"wheel_locating_{name}", "side", 0.0, 1.0, None, "-",
+        f"FE bearings and the source's misalignment: which of the wheel's bearings locates it axially with the "
+        f"{name} configuration (drivetrain.wheel_locating; the pinion is located at its front)",
+        f"the thesis does not say ({c.wheel_locating_source.removeprefix('not stated: ')}): front or back, equally "
+        "likely; the deterministic run takes front") for name, c in configurations().items() if c.wheel_side_uncertain}
+
+
+# The wheel's locating side where the text leaves it open: drawn in every run (a scene with an explicit
+# drivetrain.wheel_locating fixes it), each from a stream of its own (`_SIDE_STREAM`), outside the Latin hypercube
+# of the other inputs, so that adding it changed none of their draws for any seed.
+SIDES: dict[str, str] = {name: name.removeprefix("wheel_locating_") for name in _side_parameters()}
+PARAMETERS.update(_side_parameters())
+_SIDE_STREAM = 0x73696465                # "side": the seed sequence (seed, stream + k) of the k-th side input
+
 # Inputs drawn only when --range names them: the nominal of the mount is a model choice (the fixed feet), not a
 # value in the range, and each of its samples needs a housing model and basis of its own.  They are drawn from a
 # stream of their own (`_OPT_IN_STREAM`), so every other column of a seed is the same with or without them.
@@ -212,6 +240,16 @@ def parse_ranges(items) -> dict[str, tuple]:
         if name == "radiation":
             out[name] = tuple(m.strip() for m in text.split(",") if m.strip())
             continue
+        if name in SIDES:
+            from housingfe.drivetrain.description import LOCATING_SIDES
+
+            sides = tuple(dict.fromkeys(m.strip() for m in text.split(",") if m.strip()))
+            bad = [m for m in sides if m not in LOCATING_SIDES] or ([] if sides else ["nothing"])
+            if bad:
+                raise InputError(f"--range {name}: {', '.join(bad)}: not a bearing side (give front, back or "
+                                 "front,back)")
+            out[name] = sides
+            continue
         try:
             parts = [float(x) for x in text.split(":")]
         except ValueError:
@@ -238,6 +276,10 @@ def nominal_ranges(scene) -> dict[str, tuple]:
             continue
         if p.name == "radiation":
             out[p.name] = (scene.radiation.models[0],)
+        elif p.name in SIDES:              # the scene's side for the configuration ("configuration": front)
+            from housingfe.drivetrain.description import wheel_locating_side
+
+            out[p.name] = (wheel_locating_side(SIDES[p.name], scene.drivetrain.wheel_locating),)
         elif p.name == "damping_ratio":
             out[p.name] = (scene.runup.damping_ratio,) * 2
         else:
@@ -250,11 +292,13 @@ def draw_samples(scene, n_samples: int, seed: int, ranges: dict | None = None) -
     PARAMETERS' ranges with `ranges` overriding some ({name: (low, high)}; radiation: (models...)).  An OPT_IN
     input (the mount stiffness) is None (the scene's fixed feet) unless `ranges` names it; then it is drawn from a
     one-dimensional Latin hypercube of its own seeded stream, so every other input's values are those of the seed
-    without it."""
+    without it.  A side input (`SIDES`) is front or back, each with probability 1/2 (a one-dimensional Latin
+    hypercube of its own stream, u < 1/2: front; so n samples hold n/2 of each, rounded), among the sides `ranges`
+    gives; a scene with an explicit drivetrain.wheel_locating fixes it to that side."""
     from scipy.stats import qmc
 
     ranges = dict(ranges or {})
-    names = [n for n in PARAMETERS if n not in OPT_IN]
+    names = [n for n in PARAMETERS if n not in OPT_IN and n not in SIDES]
     u = qmc.LatinHypercube(d=len(names), seed=int(seed)).random(int(n_samples))
     models = list(scene.radiation.models)
     samples = [{} for _ in range(int(n_samples))]
@@ -282,7 +326,20 @@ def draw_samples(scene, n_samples: int, seed: int, ranges: dict | None = None) -
         w = qmc.LatinHypercube(d=1, seed=stream).random(int(n_samples))[:, 0]
         for i in range(len(samples)):
             samples[i][name] = _value(PARAMETERS[name], lo, hi, w[i])
+    for k, name in enumerate(SIDES):
+        pick = side_choices(scene, name, ranges)
+        stream = np.random.default_rng([int(seed), _SIDE_STREAM + k])
+        w = qmc.LatinHypercube(d=1, seed=stream).random(int(n_samples))[:, 0]
+        for i in range(len(samples)):
+            samples[i][name] = pick[min(int(w[i] * len(pick)), len(pick) - 1)]
     return samples
+
+
+def side_choices(scene, name: str, ranges: dict | None = None) -> tuple:
+    """The sides a side input (`SIDES`) is drawn from, equally likely: those `ranges` gives, else the scene's
+    explicit drivetrain.wheel_locating ("front" / "back": fixed), else ("front", "back")."""
+    explicit = scene.drivetrain.wheel_locating
+    return tuple((ranges or {}).get(name, (explicit,) if explicit != "configuration" else ("front", "back")))
 
 
 def _value(p: Parameter, lo: float, hi: float, u: float) -> float:
@@ -441,14 +498,18 @@ def _sample_base(scene_name: str, overrides: tuple, values: dict, comm) -> tuple
 
 
 def perturbed_drivetrain(base: _Base, values: dict, gear_set: str, bearings: str, torque: float):
-    """The test gearbox of the scene with gear set, bearings and torque, and the sample's drive line and
-    Appendix C parameters (the FE bearings' internals act through housingfe.bearings.catalogue.estimated_internals
-    while the matrices are computed)."""
+    """The test gearbox of the scene with gear set, bearings and torque, the sample's wheel locating side for those
+    bearings (SIDES; else the scene's), and the sample's drive line and Appendix C parameters (the FE bearings'
+    internals act through housingfe.bearings.catalogue.estimated_internals while the matrices are computed)."""
     from dataclasses import replace
 
     from housingfe.runup.scene import drivetrain_of
 
-    spec = base.session.scene.drivetrain.model_copy(update={"gear_set": gear_set, "bearings": bearings})
+    update = {"gear_set": gear_set, "bearings": bearings}
+    side = values.get(f"wheel_locating_{bearings}")
+    if side is not None:                # the sample's side where the thesis states none (SIDES)
+        update["wheel_locating"] = side
+    spec = base.session.scene.drivetrain.model_copy(update=update)
     dt = drivetrain_of(spec, float(torque), base.session.scene.runup.drive_line_model).with_bores(base.surfaces)
     changes = {}
     sd, sl = values["quill_diameter_scale"], values["quill_length_scale"]
@@ -975,7 +1036,9 @@ class UncertaintyResult:
                 x = np.array([s.get(name) for s in self.samples], dtype=object)[keep]
                 if any(a is None for a in x):         # an opt-in input not drawn (or an older run's samples)
                     continue
-                if name == "radiation":
+                if name in SIDES:                     # rho > 0: the wheel located at the back raises it
+                    x = np.array([a == "back" for a in x], float)
+                elif name == "radiation":
                     x = np.array([str(a) == str(x[0]) for a in x], float)
                 x = x.astype(float)
                 if np.ptp(x) == 0:
@@ -1234,8 +1297,9 @@ def run_uncertainty(scene: str = DEFAULT_SCENE, n_samples: int = 8, seed: int = 
         raise InputError(f"{path}: runup speeds: none inside {MEAN_RANGE_RPM[0]:g}-{MEAN_RANGE_RPM[1]:g} rev/min "
                          "(the bearings family's mean differences)")
     check_mount(scene, overrides, ranges, families)
-    full = {**{p.name: (p.low, p.high) for p in PARAMETERS.values() if p.name not in OPT_IN}, **(ranges or {})}
     samples = draw_samples(scene_obj, n_samples, seed, ranges)
+    full = {**{p.name: (p.low, p.high) for p in PARAMETERS.values() if p.name not in OPT_IN},
+            **{name: side_choices(scene_obj, name, ranges) for name in SIDES}, **(ranges or {})}
     say = progress or (lambda text: None)
     t0 = time.perf_counter()
     args = [(scene, tuple(overrides), s, families) for s in samples]
@@ -1474,7 +1538,8 @@ def register_cli(subparsers) -> None:
                         "a worker's whole share)")
     p.add_argument("--out", default=None, help="result folder (default results/uncertainty-<scene>)")
     p.add_argument("--range", action="append", metavar="NAME=LOW:HIGH",
-                   help="override a parameter's range (NAME=VALUE: fixed; radiation=erp[,foller]); names: "
+                   help="override a parameter's range (NAME=VALUE: fixed; radiation=erp[,foller]; "
+                        "wheel_locating_<configuration>=front|back|front,back); names: "
                         + ", ".join(PARAMETERS))
     p.add_argument("--family", action="append", metavar="FAMILY",
                    help="variant families per sample, repeatable: bearings (default: gear set B with the four "

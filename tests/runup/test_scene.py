@@ -18,10 +18,13 @@ def test_builtin_scenes_validate(name):
     scene, _ = load_runup_scene(name)
     assert scene.runup.speeds[0] == 50.0 and scene.runup.speeds[-1] == 1500.0 and len(scene.runup.speeds) == 30
     assert scene.drivetrain.gearbox == "test_gearbox"
+    # the wheel located where the thesis says for the scene's bearings ("front" where it says nothing)
+    assert scene.drivetrain.wheel_locating == "configuration"
 
 
 @pytest.mark.parametrize("override, key", [
     ("drivetrain.gear_set=Z", "drivetrain.gear_set"),
+    ("drivetrain.wheel_locating=middle", "drivetrain.wheel_locating"),
     ("runup.speed_max_rpm=3000.0", "runup.speed_max_rpm"),
     ("runup.speed_min_rpm=10.0", "runup.speed_min_rpm"),
     ('runup.routes=["tf_omega","shaker"]', "runup.routes"),

@@ -63,7 +63,7 @@ def test_latin_hypercube_samples():
 def test_every_range_lies_within_what_its_input_can_be():
     """Each numeric parameter has physical limits (a --range outside them is refused when read) and its own
     range and nominal value lie inside them; the edges behave as stated (open or closed)."""
-    numeric = {name for name, p in unc.PARAMETERS.items() if p.distribution != "choice"}
+    numeric = {name for name, p in unc.PARAMETERS.items() if p.distribution not in ("choice", "side")}
     assert set(unc.PHYSICAL_LIMITS) == numeric
     for name in numeric:
         p = unc.PARAMETERS[name]
@@ -116,7 +116,7 @@ def test_the_mount_is_opt_in():
         old = old_draws(models, n, seed)
         for ranges in (None, mount):
             new = unc.draw_samples(scene, n, seed, ranges)
-            assert [set(s) - {unc.MOUNT} for s in new] == [set(s) for s in old]
+            assert [set(s) - {unc.MOUNT, *unc.SIDES} for s in new] == [set(s) for s in old]
             for a, b in zip(new, old):
                 b = dict(b)
                 assert a["radiation"] == b.pop("radiation")
@@ -127,6 +127,42 @@ def test_the_mount_is_opt_in():
     assert unc.nominal_ranges(scene).keys().isdisjoint(unc.OPT_IN)        # the deterministic run: the fixed feet
     fixed = unc.draw_samples(scene, 3, 1, unc.parse_ranges(["mount_stiffness_N_per_m=3e8"]))
     assert [s[unc.MOUNT] for s in fixed] == [3e8] * 3
+
+
+def test_the_wheel_locating_side_is_a_fair_seeded_draw():
+    """The wheel's locating side where the thesis does not state it (ball, self-aligning; Sec. 5.8) is drawn per
+    sample: front or back with probability 1/2 each (over 400 seeds, one sample each, the share of "back" lies
+    within 0.5 +- 0.075, 3 s.d. of a fair coin; n = 24 samples of one seed hold 12 of each, the draw being
+    stratified), the two configurations' sides independently (they differ in some samples), reproducible from the
+    seed, and the other inputs are what the seed drew before the side existed (old_draws)."""
+    from housingfe.runup.scene import load_runup_scene
+
+    scene, _ = load_runup_scene("test-gearbox-runup")
+    assert set(unc.SIDES) == {"wheel_locating_ball", "wheel_locating_self_aligning"}
+    models = list(scene.radiation.models)
+    for name in unc.SIDES:
+        singles = [unc.draw_samples(scene, 1, seed)[0][name] for seed in range(400)]
+        assert set(singles) == {"front", "back"}
+        assert abs(singles.count("back") / 400 - 0.5) < 0.075, name
+    a = unc.draw_samples(scene, 24, seed=5)
+    assert a == unc.draw_samples(scene, 24, seed=5)
+    for name in unc.SIDES:
+        assert [s[name] for s in a].count("back") == 12, name
+    assert any(s["wheel_locating_ball"] != s["wheel_locating_self_aligning"] for s in a)
+    assert [s["wheel_locating_ball"] for s in a] != [s["wheel_locating_ball"] for s in unc.draw_samples(scene, 24, 6)]
+    for new, old in zip(a, old_draws(models, 24, 5)):
+        assert new["radiation"] == old.pop("radiation")
+        assert {k: new[k] for k in old} == pytest.approx(old, rel=1e-15, abs=1e-15)
+    # fixed: by --range, by an explicit scene side; the deterministic run's side (nominal_ranges) is front
+    pinned = unc.draw_samples(scene, 6, 5, unc.parse_ranges(["wheel_locating_ball=back"]))
+    assert {s["wheel_locating_ball"] for s in pinned} == {"back"}
+    free = unc.draw_samples(scene, 6, 5)                 # pinning one side leaves the other's draws as they were
+    assert [s["wheel_locating_self_aligning"] for s in pinned] == [s["wheel_locating_self_aligning"] for s in free]
+    back, _ = load_runup_scene("test-gearbox-runup", ["drivetrain.wheel_locating=back"])
+    assert {s[n] for s in unc.draw_samples(back, 8, 5) for n in unc.SIDES} == {"back"}
+    assert {n: unc.nominal_ranges(scene)[n] for n in unc.SIDES} == {n: ("front",) for n in unc.SIDES}
+    with pytest.raises(InputError, match="--range wheel_locating_ball: middle: not a bearing side"):
+        unc.parse_ranges(["wheel_locating_ball=middle"])
 
 
 @pytest.fixture
@@ -329,8 +365,32 @@ def test_zero_width_ranges_give_the_deterministic_run(serial, tmp_path):
         assert res.band("slope_dBA_per_doubling", route)[0] == res.band("slope_dBA_per_doubling", route)[2]
 
 
+@pytest.mark.slow
+def test_a_sample_with_the_wheel_located_at_the_back_is_the_run_with_that_side(tmp_path):
+    """Two samples, every range at zero width but the ball's side (front, back: one each, the draw being
+    stratified): the back sample, a re-analysis on the process's (front) basis, gives the L_WA curves `housingfe run
+    --set drivetrain.wheel_locating=back` writes with a basis of its own, to 2e-3 dB (measured 2026-11-28: 6e-4 dB),
+    and the side acts (the front sample differs by more than 3 dB somewhere on mesh_force; measured up to 10 dB)."""
+    from housingfe.runup.scene import load_runup_scene
+
+    scene, _ = load_runup_scene("test-gearbox-runup", list(COARSE))
+    ranges = {**unc.nominal_ranges(scene), "wheel_locating_ball": ("front", "back")}
+    res = unc.run_uncertainty("test-gearbox-runup", 2, seed=1, workers=1, overrides=COARSE, families=(),
+                              ranges=ranges)
+    sides = [s["wheel_locating_ball"] for s in res.samples]
+    assert sorted(sides) == ["back", "front"]
+    back, front = res.metrics[sides.index("back")], res.metrics[sides.index("front")]
+    # one process, at most one basis for both sides (none when an earlier test of this process built it)
+    assert res.timings["processes"] == 1 and sum(m["setup_s"] > 0 for m in res.metrics) <= 1
+    run = cli_lwa_curves("test-gearbox-runup", COARSE + ("drivetrain.wheel_locating=back",), tmp_path / "run")
+    for route, curve in run.items():
+        np.testing.assert_allclose(back[f"{route}/lwa_curve_dBA"], curve, atol=2e-3, err_msg=route)
+    assert np.max(np.abs(np.subtract(front["mesh_force/lwa_curve_dBA"], run["mesh_force"]))) > 3.0
+
+
 @pytest.mark.parametrize("args, message", [
     (["--samples", "-3"], "uncertainty: --samples: -3: must be a whole number >= 1"),
+    (["--range", "wheel_locating_ball=middle"], "--range wheel_locating_ball: middle: not a bearing side"),
     (["--range", "bearing_magic=1:2"], "--range bearing_magic: unknown parameter"),
     (["--family", "gears"], "--family gears: unknown"),
     (["--samples-per-process", "0"], "--samples-per-process: 0: must be >= 1"),

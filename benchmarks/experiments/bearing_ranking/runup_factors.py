@@ -83,7 +83,9 @@ def gear_set_b_args(doc: str, default_out: str, argv=None, extra=()) -> tuple[ar
     p.add_argument("--out", default=default_out)
     p.add_argument("--coarse", action="store_true", help="60 mm housing mesh, lines to 1.5 kHz (a quick look)")
     args = p.parse_args(argv)
-    overrides = ["drivetrain.gear_set=B", *extra]
+    # the layout these experiments were measured in: the wheel located at its front bearing for every configuration
+    # (the scene's default became the thesis' side, "configuration", on 2026-11-28: docs/design-variants.md)
+    overrides = ["drivetrain.gear_set=B", "drivetrain.wheel_locating=front", *extra]
     if args.coarse:
         overrides += ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500.0"]
     return args, overrides

@@ -155,7 +155,9 @@ def main(argv=None):
     args = p.parse_args(argv)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    overrides = ["drivetrain.gear_set=B", 'radiation.models=["erp"]']
+    # "model layout" = the wheel located at its front bearing for every configuration (the scene's default until
+    # 2026-11-28, when it became the thesis' side, "configuration"); the rig layout is `rig_drivetrain`
+    overrides = ["drivetrain.gear_set=B", "drivetrain.wheel_locating=front", 'radiation.models=["erp"]']
     if args.coarse:
         overrides += ['housing.set=["mesh.size=0.06"]', "runup.f_max_hz=1500.0"]
     t0, load0 = time.perf_counter(), os.getloadavg()
