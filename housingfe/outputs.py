@@ -389,6 +389,13 @@ def write_csv(path: Path, header: Sequence[str], rows: Iterable[Sequence]) -> No
             writer.writerow(row)
 
 
+def write_records(path: Path, records: Sequence[dict], floatfmt: str = "{:.6g}") -> None:
+    """Write dict rows as CSV, the first row's keys as the header, floats with `floatfmt`; nothing when empty."""
+    if records:
+        write_csv(path, list(records[0]), ([floatfmt.format(v) if isinstance(v, float) else v for v in r.values()]
+                                           for r in records))
+
+
 TERMINAL_WIDTH = 120   # the widest table a terminal is shown (the CSV / Markdown files keep every column whole)
 
 

@@ -34,6 +34,8 @@ from pathlib import Path
 
 import numpy as np
 
+from housingfe.outputs import write_records
+
 TORQUE = 2000.0
 MUS = (0.1, 0.2)
 ROUTES = ("tf_omega", "mesh_force")
@@ -195,9 +197,9 @@ def main(argv=None):
         static += c
         timings[f"{case}_s"] = time.perf_counter() - t
         print(f"{case}: {timings[f'{case}_s']:.1f} s ({session.log[-1].how})", flush=True)
-    _write(out / "floating_axial.csv", rows)
-    _write(out / "margins.csv", margins)
-    _write(out / "static.csv", static)
+    write_records(out / "floating_axial.csv", rows)
+    write_records(out / "margins.csv", margins)
+    write_records(out / "static.csv", static)
     for r in static:
         print("static", {k: (round(v, 1) if isinstance(v, float) else v) for k, v in r.items()})
     for r in margins:
@@ -210,11 +212,6 @@ def main(argv=None):
     return 0
 
 
-def _write(path, rows):
-    from housingfe.outputs import write_csv
-
-    if rows:
-        write_csv(path, list(rows[0]), ([f"{v:.6g}" if isinstance(v, float) else v for v in r.values()] for r in rows))
 
 
 def _plot(path, rows):

@@ -35,6 +35,8 @@ from pathlib import Path
 
 import numpy as np
 
+from housingfe.outputs import write_records
+
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "bearing_ranking"))
 import common  # noqa: E402
@@ -291,14 +293,14 @@ def main(argv=None):
 
     terms = [r for name in configs if name != "ball"
              for r in terms_rows(name, results[name], results["ball"], radiation)]
-    _write(out / "terms.csv", terms)
+    write_records(out / "terms.csv", terms)
     for r in terms:
         print("terms", {k: (round(v, 2) if isinstance(v, float) else v) for k, v in r.items()}, flush=True)
     harm = [r for name in configs for r in harmonic_rows(name, results[name])]
-    _write(out / "harmonics.csv", harm)
+    write_records(out / "harmonics.csv", harm)
     parts = [r for name in configs for r in load_part_rows(name, models[name], results[name])]
-    _write(out / "load_parts.csv", parts)
-    _write(out / "tooth_line_curves.csv", [
+    write_records(out / "load_parts.csv", parts)
+    write_records(out / "tooth_line_curves.csv", [
         {"config": cfg, "part": part, "speed_rpm": float(c[0][i]), "T_housing_dB": float(c[1][i]),
          "axial_minus_radial_dB": float(c[2][i])} for (cfg, part), c in CURVES.items() for i in range(len(c[0]))])
     for r in parts:
@@ -317,8 +319,8 @@ def main(argv=None):
         load_rows += a
         split += b
     timings["split_s"] = time.perf_counter() - t
-    _write(out / "bore_loads.csv", load_rows)
-    _write(out / "housing_split.csv", split)
+    write_records(out / "bore_loads.csv", load_rows)
+    write_records(out / "housing_split.csv", split)
     _plot(out / "sa_housing.png", load_rows)
     modes = {}
     for name, m in models.items():
@@ -333,7 +335,7 @@ def main(argv=None):
             coupling.append({"config": name, "bearing": b.name, "k_xx": K[0, 0], "k_yy": K[1, 1], "k_zz_axial": K[2, 2],
                              "k_xz": K[0, 2], "k_yz": K[1, 2],
                              "radial_axial_ratio": float(np.hypot(K[0, 2], K[1, 2]) / max(K[0, 0], K[1, 1]))})
-    _write(out / "bearing_coupling.csv", coupling)
+    write_records(out / "bearing_coupling.csv", coupling)
     for r in coupling:
         print("K", {k: (f"{v:.3g}" if isinstance(v, float) else v) for k, v in r.items()})
     wall = time.perf_counter() - t0
@@ -348,11 +350,6 @@ def main(argv=None):
     return 0
 
 
-def _write(path, rows):
-    from housingfe.outputs import write_csv
-
-    if rows:
-        write_csv(path, list(rows[0]), ([f"{v:.6g}" if isinstance(v, float) else v for v in r.values()] for r in rows))
 
 
 def _plot(path, load_rows):

@@ -25,7 +25,6 @@ variant is a named alternative (nothing tuned).
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import os
 import sys
@@ -33,6 +32,8 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from housingfe.outputs import write_records
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "bearing_ranking"))
@@ -175,7 +176,7 @@ def main(argv=None):
     print("1. misalignment under load (rigid-bores):", flush=True)
     mis_rows, gaps = misalignment_rows(session)
     timings["misalignment_s"] = time.perf_counter() - t
-    _write(out / "misalignment.csv", mis_rows)
+    write_records(out / "misalignment.csv", mis_rows)
 
     # 2. the rigid-bore lumped source per configuration and misalignment
     t = time.perf_counter()
@@ -236,14 +237,14 @@ def main(argv=None):
                                       "coupled", spec.mesh_moment_model, spec.mesh_friction)
                 record(config, "coupled", mis, lines)
             timings[f"coupled_source_{config}_s"] = time.perf_counter() - t
-        _write(out / "receptance.csv", rec_rows)
-        _write(out / "receptance_peaks.csv", peak_rows)
-    _write(out / "source_levels.csv", level_rows)
+        write_records(out / "receptance.csv", rec_rows)
+        write_records(out / "receptance_peaks.csv", peak_rows)
+    write_records(out / "source_levels.csv", level_rows)
     if args.runup and not args.no_fe:
         t = time.perf_counter()
-        _write(out / "runup_layouts.csv", runup_layouts(session, dts, rig_gaps))
+        write_records(out / "runup_layouts.csv", runup_layouts(session, dts, rig_gaps))
         timings["runup_layouts_s"] = time.perf_counter() - t
-    _write(out / "source_harmonics.csv", harmonic_rows)
+    write_records(out / "source_harmonics.csv", harmonic_rows)
 
     # means over 800-1500 rpm, differences to ball with the same source and misalignment
     means = []
@@ -265,7 +266,7 @@ def main(argv=None):
                  "dL_F_sd_dB": float(np.std((lf - ref[2])[keep]))}
         means.append({"configuration": key[0], "source": key[1], "misalignment": key[2],
                       "L_omega_mean_dB": mean_in_range(s, lw), "L_F_mean_dB": mean_in_range(s, lf), **d})
-    _write(out / "source_means.csv", means)
+    write_records(out / "source_means.csv", means)
     print("3. source over 800-1500 rpm (mean of the per-speed totals; difference to ball, mean +- s.d.):")
     for m in means:
         extra = (f"  dL_omega {m['dL_omega_to_ball_dB']:+6.2f} +- {m['dL_omega_sd_dB']:.2f}, dL_F "
@@ -313,14 +314,6 @@ def runup_layouts(session, dts, rig_gaps) -> list:
     return rows
 
 
-def _write(path, rows):
-    if not rows:
-        return
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        for r in rows:
-            w.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
 
 
 def _plot(path, curves, rec_rows, f_t, no_fe):
