@@ -134,14 +134,19 @@ def test_sa_housing_experiment_keeps_its_two_load_paths(tmp_path):
     assert share["self_aligning", "shuttling moment only"] < share["ball", "shuttling moment only"] - 10
 
 
-def _floating_axial():
+def _experiment(name):
+    """The script benchmarks/experiments/<name>/<name>.py as a module."""
     import importlib.util
 
-    path = ROOT / "benchmarks" / "experiments" / "floating_axial" / "floating_axial.py"
-    spec = importlib.util.spec_from_file_location("floating_axial", path)
+    path = ROOT / "benchmarks" / "experiments" / name / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def _floating_axial():
+    return _experiment("floating_axial")
 
 
 def test_floating_axial_stick_criterion_by_hand():
@@ -201,16 +206,6 @@ def test_floating_axial_experiment_runs_coarse(tmp_path):
             assert np.isclose(float(m[f"min_margin_mu{mu:g}_dB"]), 20 * np.log10(by_hand), atol=0.01)
 
 
-def _first_mode():
-    import importlib.util
-
-    path = ROOT / "benchmarks" / "experiments" / "first_mode" / "first_mode.py"
-    spec = importlib.util.spec_from_file_location("first_mode", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_first_mode_rayleigh_sensitivity_two_springs():
     """benchmarks/experiments/first_mode: masses m1 = 2, m2 = 1 kg, k1 (ground-m1) = 3e6, k2 (m1-m2) = 1e6 N/m.  The
     closed-form eigenfrequencies of the 2x2 problem, differentiated numerically in ln k1 (step 1e-6), give
@@ -221,7 +216,7 @@ def test_first_mode_rayleigh_sensitivity_two_springs():
     import numpy as np
     import scipy.linalg
 
-    fm = _first_mode()
+    fm = _experiment("first_mode")
     M = np.diag([2.0, 1.0])
 
     def K_parts(k1, k2):

@@ -28,10 +28,15 @@ import argparse
 import json
 import math
 import os
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "bearing_ranking"))
+# Patched: a Drivetrain whose FE coupling spec is patched (the lumped source and the lines are the base's)
+from runup_factors import Patched  # noqa: E402
 
 TORQUE = 2000.0
 ROUTE = "mesh_force"
@@ -177,20 +182,6 @@ def fd_stiffness_sensitivity(reduction, K_part, j, eps=EPS) -> float:
 
 
 # ------------------------------------------------------------------------------------------------ inputs
-class Patched:
-    """A Drivetrain whose FE coupling spec is changed by patch(spec) -> spec; all else delegated (the lumped source
-    and the lines are the base's)."""
-
-    def __init__(self, drivetrain, patch):
-        self._dt, self._patch = drivetrain, patch
-
-    def __getattr__(self, key):
-        return getattr(self._dt, key)
-
-    def to_coupling_spec(self, forces=None):
-        return self._patch(self._dt.to_coupling_spec(forces))
-
-
 def scale_shaft_diameters(shaft: str, factor: float):
     """patch: every segment diameter (outer, inner) of one FE shaft x factor (its beams' K and M; the gear body
     discs kept)."""
