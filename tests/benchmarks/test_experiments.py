@@ -134,14 +134,19 @@ def test_sa_housing_experiment_keeps_its_two_load_paths(tmp_path):
     assert share["self_aligning", "shuttling moment only"] < share["ball", "shuttling moment only"] - 10
 
 
-def _floating_axial():
+def _experiment(name):
+    """The script benchmarks/experiments/<name>/<name>.py as a module."""
     import importlib.util
 
-    path = ROOT / "benchmarks" / "experiments" / "floating_axial" / "floating_axial.py"
-    spec = importlib.util.spec_from_file_location("floating_axial", path)
+    path = ROOT / "benchmarks" / "experiments" / name / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def _floating_axial():
+    return _experiment("floating_axial")
 
 
 def test_floating_axial_stick_criterion_by_hand():
@@ -199,3 +204,82 @@ def test_floating_axial_experiment_runs_coarse(tmp_path):
             by_hand = min(mu * (float(r["F_r_static_N"]) - float(r["F_r_dyn_peak_N"])) / float(r["F_a_dyn_peak_N"])
                           for r in sel)
             assert np.isclose(float(m[f"min_margin_mu{mu:g}_dB"]), 20 * np.log10(by_hand), atol=0.01)
+
+
+def test_first_mode_rayleigh_sensitivity_two_springs():
+    """benchmarks/experiments/first_mode: masses m1 = 2, m2 = 1 kg, k1 (ground-m1) = 3e6, k2 (m1-m2) = 1e6 N/m.  The
+    closed-form eigenfrequencies of the 2x2 problem, differentiated numerically in ln k1 (step 1e-6), give
+    d f / d ln k1 for both modes; the experiment's Rayleigh sensitivity f/2 x (k1's strain energy share) must match to
+    1e-6, and a single spring-mass (k1 alone, m1) gives exactly f/2."""
+    from types import SimpleNamespace
+
+    import numpy as np
+    import scipy.linalg
+
+    fm = _experiment("first_mode")
+    M = np.diag([2.0, 1.0])
+
+    def K_parts(k1, k2):
+        return np.array([[k1, 0.0], [0.0, 0.0]]), np.array([[k2, -k2], [-k2, k2]])
+
+    def system(k1, k2):
+        K = sum(K_parts(k1, k2))
+        lam, Y = scipy.linalg.eigh(K, M)
+        return SimpleNamespace(Kr=K, Mr=M, Y=Y, frequencies_hz=np.sqrt(lam) / (2 * np.pi))
+
+    def closed_form(k1, k2):            # det(K - w^2 M) = 0: 2 w^4 - (k1 + 3 k2) w^2 + k1 k2 = 0
+        b, c = k1 + 3 * k2, k1 * k2
+        w2 = np.array([(b - np.sqrt(b * b - 8 * c)) / 4, (b + np.sqrt(b * b - 8 * c)) / 4])
+        return np.sqrt(w2) / (2 * np.pi)
+
+    k1, k2, h = 3e6, 1e6, 1e-6
+    s = system(k1, k2)
+    assert np.allclose(s.frequencies_hz, closed_form(k1, k2), rtol=1e-12)
+    dfd = (closed_form(k1 * np.exp(h), k2) - closed_form(k1 * np.exp(-h), k2)) / (2 * h)
+    for j in range(2):
+        got = fm.rayleigh_sensitivity(s, K_parts(k1, k2)[0], j)
+        assert abs(got / dfd[j] - 1) < 1e-6, (j, got, dfd[j])
+        # both parts' shares make the whole: scaling every stiffness by x scales f by sqrt(x)
+        both = got + fm.rayleigh_sensitivity(s, K_parts(k1, k2)[1], j)
+        assert abs(both - s.frequencies_hz[j] / 2) < 1e-9 * s.frequencies_hz[j]
+    one = SimpleNamespace(Kr=np.array([[k1]]), Mr=np.array([[2.0]]), Y=np.array([[1 / np.sqrt(2.0)]]),
+                          frequencies_hz=np.array([np.sqrt(k1 / 2.0) / (2 * np.pi)]))
+    assert np.isclose(fm.rayleigh_sensitivity(one, np.array([[k1]]), 0), one.frequencies_hz[0] / 2, rtol=1e-14)
+
+
+def test_first_mode_experiment_runs_coarse(tmp_path):
+    """benchmarks/experiments/first_mode on the coarse default gearbox (60 mm mesh, lines to 1.5 kHz; ~30 s, no
+    sweep): every mode's kinetic and strain energy shares of the parts (housing from its FE matrices, the interior's
+    elements projected on their nodes' rows: independent of the coupled K, M) add to 1 within 1e-6; each part's
+    Rayleigh sensitivity equals the finite difference of the re-analysed system (with_change) within 1 %; the
+    re-analysis of the drivetrain with all four bearings' K x (1 +/- 2 %) (with_drivetrain: the coupled matrices
+    re-projected) gives the sum of the four bearings' Rayleigh sensitivities within 2 %; the first mode is the wheel's
+    (its wheel_front bearing holds the largest strain energy share)."""
+    import csv
+
+    import numpy as np
+
+    script = ROOT / "benchmarks" / "experiments" / "first_mode" / "first_mode.py"
+    proc = subprocess.run([sys.executable, str(script), "--coarse", "--no-sweep", "--out", str(tmp_path)],
+                          cwd=ROOT, capture_output=True, text=True,
+                          env=dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT)), timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    energies = list(csv.DictReader(open(tmp_path / "energies.csv")))
+    modes = sorted({float(r["frequency_Hz"]) for r in energies})
+    assert 150 < modes[0] < 300, modes
+    for f in modes:
+        rows = [r for r in energies if float(r["frequency_Hz"]) == f]
+        assert abs(sum(float(r["kinetic_share"]) for r in rows) - 1) < 1e-6
+        assert abs(sum(float(r["strain_share"]) for r in rows) - 1) < 1e-6
+    first = [r for r in energies if float(r["frequency_Hz"]) == modes[0]]
+    assert max(first, key=lambda r: float(r["strain_share"]))["part"] == "bearing wheel_front"
+    sens = list(csv.DictReader(open(tmp_path / "sensitivities.csv")))
+    for r in sens:
+        if r["kind"] == "part stiffness" and abs(float(r["df_dlnp_Hz"])) > 0.1:
+            assert np.isclose(float(r["df_dlnp_Hz"]), float(r["df_dlnp_fd_Hz"]), rtol=0.01), r
+    f1 = min(float(r["mode_Hz"]) for r in sens)
+    bearings = sum(float(r["df_dlnp_Hz"]) for r in sens if float(r["mode_Hz"]) == f1
+                   and r["kind"] == "part stiffness" and r["input"].startswith("bearing "))
+    whole = next(float(r["df_dlnp_Hz"]) for r in sens if float(r["mode_Hz"]) == f1
+                 and r["input"] == "bearing stiffness (all four)")
+    assert bearings > 10 and np.isclose(whole, bearings, rtol=0.02), (whole, bearings)
