@@ -283,3 +283,58 @@ def test_first_mode_experiment_runs_coarse(tmp_path):
     whole = next(float(r["df_dlnp_Hz"]) for r in sens if float(r["mode_Hz"]) == f1
                  and r["input"] == "bearing stiffness (all four)")
     assert bearings > 10 and np.isclose(whole, bearings, rtol=0.02), (whole, bearings)
+
+
+def test_housing_reconstruction_experiment_runs_coarse(tmp_path):
+    """benchmarks/experiments/housing_reconstruction on the coarse gearbox (60 mm mesh, lines to 1.5 kHz; the default
+    and the 11.5 mm wall, ~25 s, and `housingfe run` of the same coarse scene, ~12 s):
+
+    * the default variant is the scene's own run: its mesh_force slope terms and max L_WA are those of
+      `housingfe run`'s slope_terms.csv and checks.csv;
+    * the rows add up: excitation + transfer + L_sigma + A = L_WA, T_path + T_housing = transfer, and the
+      speed-law check's fit equals the decomposition's L_WA slope;
+    * the wall thickening is what it says: walls grow inward (outer size kept), so by hand the housing gains
+      rho [(L W H - (L - 2t)(W - 2t)(H - t)) change - 2 x 0.438 x 0.242 dt (the bearing plates' proud part, 65 mm
+      in all, loses dt) - 2 L x 31.25 mm dt (the feet's outside part)] = 3.259 kg for t = 10 -> 11.5 mm;
+    * a thicker wall raises the first housing mode (interior share < 0.5) but by less than sqrt(1.15^3) = 1.233
+      (Rayleigh: the walls' bending stiffness grows at most as t^3, their mass as t, the other parts unchanged)."""
+    import csv
+
+    script = ROOT / "benchmarks" / "experiments" / "housing_reconstruction" / "housing_reconstruction.py"
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", PYTHONPATH=str(ROOT))
+    proc = subprocess.run([sys.executable, str(script), "--coarse", "--only", "default", "wall 11.5 mm", "--out",
+                           str(tmp_path)], cwd=ROOT, capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    cli = tmp_path / "cli"
+    proc = subprocess.run([sys.executable, "-m", "housingfe", "run", "test-gearbox-runup", "--set",
+                           'housing.set=["mesh.size=0.06"]', "--set", "runup.f_max_hz=1500.0", "--out", str(cli)],
+                          cwd=ROOT, capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    slopes = {(r["variant"], r["route"]): {k: (float(v) if k not in ("variant", "route", "speed_law_passes") else v)
+                                           for k, v in r.items()}
+              for r in csv.DictReader(open(tmp_path / "slopes.csv"))}
+    assert set(slopes) == {(v, r) for v in ("default", "wall 11.5 mm") for r in ("mesh_force", "tf_omega")}
+    terms = {r["term"]: float(r["slope_dB_per_doubling"]) for r in csv.DictReader(open(cli / "slope_terms.csv"))
+             if (r["route"], r["radiation"], r["basis"]) == ("mesh_force", "erp", "total")}
+    ours = slopes["default", "mesh_force"]
+    for mine, theirs in (("speed_law", "L_WA"), ("excitation", "excitation"), ("T_path", "transfer_path"),
+                         ("T_housing", "transfer_housing"), ("A_weighting", "A_weighting")):
+        assert abs(ours[mine] - terms[theirs]) < 1e-4, (mine, ours[mine], terms[theirs])
+    lwa_max = next(float(r["ours"]) for r in csv.DictReader(open(cli / "checks.csv"))
+                   if r["check"] == "LwA_max" and r["quantity"].startswith("mesh_force"))
+    assert abs(ours["max_LWA_dBA"] - lwa_max) <= 0.05 + 1e-9
+    for row in slopes.values():
+        assert abs(row["excitation"] + row["transfer"] + row["L_sigma"] + row["A_weighting"] - row["L_WA"]) < 1e-4
+        assert abs(row["T_path"] + row["T_housing"] - row["transfer"]) < 1e-4
+        assert abs(row["speed_law"] - row["L_WA"]) < 1e-4
+    var = {r["variant"]: r for r in csv.DictReader(open(tmp_path / "variants.csv"))}
+    L, W, H, t0, t1 = 0.49, 0.17, 0.3753, 0.010, 0.0115
+
+    def shell(t):
+        return L * W * H - (L - 2 * t) * (W - 2 * t) * (H - t)
+    gain = 7850.0 * (shell(t1) - shell(t0) - 2 * 0.438 * 0.242 * (t1 - t0) - 2 * L * 0.03125 * (t1 - t0))
+    assert abs(gain - 3.2595) < 1e-3
+    got = float(var["wall 11.5 mm"]["housing_mass_kg"]) - float(var["default"]["housing_mass_kg"])
+    assert abs(got - gain) < 0.01, (got, gain)
+    ratio = float(var["wall 11.5 mm"]["first_housing_mode_Hz"]) / float(var["default"]["first_housing_mode_Hz"])
+    assert 1.0 < ratio < 1.15 ** 1.5, ratio
