@@ -658,7 +658,11 @@ class Drivetrain:
             by_role = bearing_matrices(self.bearing_configuration, {role[n]: v for n, v in loads.items()}, speeds,
                                        axial_location="both", floating_axial=self.floating_axial_ratio != 0.0)
         except InputError as exc:
-            raise InputError(f"drivetrain: bearings = {self.bearing_configuration!r} at {self.torque:g} N m: "
+            held = ""
+            if self.floating_axial_ratio != 0.0:    # the held load moved axial load off (or onto) the locating one
+                held = (f" (with {FLOATING_AXIAL_KEY} = {self.floating_axial_ratio:g}: the locating bearings carry "
+                        "the mesh's axial force less the floating bearings' held load)")
+            raise InputError(f"drivetrain: bearings = {self.bearing_configuration!r} at {self.torque:g} N m{held}: "
                              f"{exc}") from None
         return {name: by_role[r] for name, r in role.items()}
 

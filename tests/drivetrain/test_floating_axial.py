@@ -131,3 +131,14 @@ def test_the_scene_key_names_itself():
                          "drivetrain.bearings=fluid_film"], r"pinion_back \(fluid film\)")):
         with pytest.raises(InputError, match=rf"drivetrain\.floating_axial_ratio: .*{what}"):
             load_runup_scene("test-gearbox-runup", sets)
+
+
+def test_a_directional_locating_bearing_relieved_of_its_axial_load_is_named():
+    """Angular contact and tapered roller bearings locate each shaft on the side its mesh force pushes it to (Sec.
+    5.8); a negative ratio takes axial load off them, and a single-row tapered bearing without enough axial load
+    has no equilibrium under its radial load: the error names the key (the boundary: measured between -0.06 and
+    -0.07 for tapered rollers, -0.12 and -0.13 for angular contact, 2026-11-28)."""
+    dt = _with_ratio(test_gearbox("B", "tapered_roller", 2000.0), -0.15)
+    with pytest.raises(InputError, match=r"with drivetrain\.floating_axial_ratio = -0\.15: .*cannot carry"):
+        dt.configuration_matrices()
+    _with_ratio(dt, 0.15).configuration_matrices()              # loaded more: carries it
