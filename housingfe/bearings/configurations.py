@@ -11,8 +11,9 @@ Positions "pinion_front", "pinion_back", "wheel_front", "wheel_back".  Frames an
 z = shaft axis, DOF order (x, y, z, theta_x, theta_y, theta_z); `loads[position]` = (Fx, Fy, Fz, Mx, My) [N, N m]
 applied by the shaft to the bearing (inner ring / journal), as everywhere in housingfe.bearings.  The caller's
 convention: *_front is the locating bearing of its shaft and takes the axial force Fz (either sign), *_back is
-floating and must get Fz = 0 (unless evaluate(..., floating_axial=True): a floating ring's friction-held axial load).  ("front" here means "locating", not the physical side: which of the wheel's two seats
-locates is `Configuration.wheel_locating`, the side the thesis states, placed by housingfe.drivetrain.description.)
+floating and must get Fz = 0 (unless evaluate(..., floating_axial=True): a floating ring's friction-held axial
+load).  ("front" here means "locating", not the physical side: which of the wheel's two seats locates is
+`Configuration.wheel_locating`, the side the thesis states, placed by housingfe.drivetrain.description.)
 K [N/m, N/rad, N m/rad], C [N s/m, ...];
 row/column 6 (spin) is zero; K is symmetric for rolling bearings, non-symmetric for the fluid film.
 

@@ -37,10 +37,10 @@ Two inputs are opt-in (only with --range; `OPT_IN`, each drawn from a stream of 
 inputs stay as without it).  `floating_axial_ratio`: the floating bearings' mean axial load as a fraction of their
 radial load (drivetrain.floating_axial_ratio; a re-analysis on the sample's basis, like the wheel's side; not applied
 to the double helical family's cylindrical roller and fluid-film bearings, which carry none).  The one exception to
-the one basis per layout is the other, `mount_stiffness_N_per_m`, which stands the housing on an elastic frame.  The fixed feet's
-Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its own on
-the elastic feet (`mount_overrides`), every family of the sample runs on them, and a process drops them when the
-next sample brings another mount (`_mount_pool`).
+the one basis per layout is the other, `mount_stiffness_N_per_m`, which stands the housing on an elastic frame.  The
+fixed feet's Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its
+own on the elastic feet (`mount_overrides`), every family of the sample runs on them, and a process drops them when
+the next sample brings another mount (`_mount_pool`).
 
 Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
 concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A worker that dies
