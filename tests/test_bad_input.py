@@ -773,6 +773,17 @@ SWEEP_CASES = [
     ("runup-wheel-locating", ["run", "test-gearbox-runup", "--set", "drivetrain.wheel_locating=configurations",
                               "--out", "r"],
      ["drivetrain.wheel_locating: 'configurations' is not a bearing side (known: configuration, front, back)"]),
+    # the floating bearings' held axial load (drivetrain.floating_axial_ratio): beyond any ring-in-bore friction, on
+    # floating bearings that carry no axial load, and a --range of uncertainty beyond the same limit
+    ("runup-floating-axial-ratio", ["run", "test-gearbox-runup", "--set", "drivetrain.floating_axial_ratio=0.5",
+                                    "--out", "r"],
+     ["drivetrain.floating_axial_ratio: 0.5: must be within +-0.3"]),
+    ("runup-floating-axial-fluid-film", ["run", "test-gearbox-runup", "--set", "drivetrain.floating_axial_ratio=0.1",
+                                         "--set", "drivetrain.gear_set=double_helical", "--set",
+                                         "drivetrain.bearings=fluid_film", "--out", "r"],
+     ["drivetrain.floating_axial_ratio: 0.1: the floating bearing(s) pinion_back (fluid film)", "carry no axial load"]),
+    ("uncertainty-range-floating-axial", ["uncertainty", "--range", "floating_axial_ratio=-0.5:0.2", "--out", "u"],
+     ["--range floating_axial_ratio: -0.5: must be within +-0.3"]),
     # `--out ""` (a shell variable that was not set) wrote into the default folder, replacing the result there
     ("out-empty", ["run", "box-free", "--out", ""], ["--out", "empty path"]),
     # a housing or source scene given to a run-up command: its keys were named as unknown run-up keys

@@ -11,8 +11,9 @@ Positions "pinion_front", "pinion_back", "wheel_front", "wheel_back".  Frames an
 z = shaft axis, DOF order (x, y, z, theta_x, theta_y, theta_z); `loads[position]` = (Fx, Fy, Fz, Mx, My) [N, N m]
 applied by the shaft to the bearing (inner ring / journal), as everywhere in housingfe.bearings.  The caller's
 convention: *_front is the locating bearing of its shaft and takes the axial force Fz (either sign), *_back is
-floating and must get Fz = 0.  ("front" here means "locating", not the physical side: which of the wheel's two seats
-locates is `Configuration.wheel_locating`, the side the thesis states, placed by housingfe.drivetrain.description.)
+floating and must get Fz = 0 (unless evaluate(..., floating_axial=True): a floating ring's friction-held axial
+load).  ("front" here means "locating", not the physical side: which of the wheel's two seats locates is
+`Configuration.wheel_locating`, the side the thesis states, placed by housingfe.drivetrain.description.)
 K [N/m, N/rad, N m/rad], C [N s/m, ...];
 row/column 6 (spin) is zero; K is symmetric for rolling bearings, non-symmetric for the fluid film.
 
@@ -276,7 +277,7 @@ def representative_loads(gear_set: str = "single_helical", pinion_torque: float 
             "wheel_front": (-ft / 2, fr / 2, -fa, 0.0, 0.0), "wheel_back": (-ft / 2, fr / 2, 0.0, 0.0, 0.0)}
 
 
-def _check_loads(name: str, loads) -> dict[str, np.ndarray]:
+def _check_loads(name: str, loads, floating_axial: bool = False) -> dict[str, np.ndarray]:
     if not isinstance(loads, dict):
         raise InputError(f"{name}: loads: need a dict {{position: (Fx, Fy, Fz, Mx, My)}}")
     unknown = sorted(set(loads) - set(POSITIONS))
@@ -292,7 +293,7 @@ def _check_loads(name: str, loads) -> dict[str, np.ndarray]:
         if f.size != 5 or not np.all(np.isfinite(f)):
             raise InputError(f"{name} {p}: load {np.asarray(loads[p]).tolist()}: need 5 finite values "
                              "(Fx, Fy, Fz, Mx, My) in N, N m")
-        if not LOCATING[p] and f[2] != 0.0:
+        if not LOCATING[p] and f[2] != 0.0 and not floating_axial:
             raise InputError(f"{name} {p}: Fz={f[2]} N: the back bearing of a shaft is the floating one and "
                              "takes no axial force (put Fz on the *_front bearing)")
         out[p] = f
@@ -302,12 +303,15 @@ def _check_loads(name: str, loads) -> dict[str, np.ndarray]:
 # ----------------------------------------------------------------------------------------- evaluation
 def evaluate(name: str, loads, speeds_rpm=None, *, hold_tilt: bool = True, axial_location: str = "thesis",
              locating_axial_stiffness: float | None = None,
-             fluid_film_model: str = "reynolds") -> dict[str, PositionResult]:
+             fluid_film_model: str = "reynolds", floating_axial: bool = False) -> dict[str, PositionResult]:
     """K (and C) of every position of configuration `name` at the mean loads (see the module docstring).
 
     loads {position: (Fx, Fy, Fz, Mx, My)} [N, N m]; speeds_rpm {"pinion": n1, "wheel": n2} [rev/min, signed]
     (fluid film only); hold_tilt, axial_location ("thesis", "both", "none"), locating_axial_stiffness [N/m]
-    and fluid_film_model ("reynolds", "ocvirk"): module docstring.  Raises InputError naming the configuration,
+    and fluid_film_model ("reynolds", "ocvirk"): module docstring.  floating_axial: accept an axial load Fz on the
+    floating (*_back) positions too (the friction-held load of a floating ring that sticks in its bore,
+    housingfe.drivetrain.description.Drivetrain.floating_axial_ratio); a position whose bearing cannot carry it
+    (cylindrical roller, fluid film) still refuses it.  Raises InputError naming the configuration,
     position and bearing for a load the bearing cannot carry or a bad argument."""
     configs = configurations()
     if name not in configs:
@@ -320,7 +324,7 @@ def evaluate(name: str, loads, speeds_rpm=None, *, hold_tilt: bool = True, axial
                                                      and math.isfinite(locating_axial_stiffness)):
         raise InputError(f"{name}: locating_axial_stiffness={locating_axial_stiffness}: must be >= 0 N/m")
     config = configs[name]
-    f_all = _check_loads(name, loads)
+    f_all = _check_loads(name, loads, floating_axial)
     out = {}
     for position, choice in config.positions.items():
         f = f_all[position]

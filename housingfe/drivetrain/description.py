@@ -96,6 +96,13 @@ DRIVE_LINE_NODE = 0
 FRICTION_LOADS = {"force": "friction_force", "pinion_torque": "friction_pinion_torque",
                   "wheel_torque": "friction_wheel_torque", "tilt_moment": "friction_tilt"}
 _GEAR_FORCES: dict = {}        # Drivetrain.gear_forces per what it depends on (repr)
+# Drivetrain.floating_axial_ratio: the mean axial load a floating bearing's outer ring keeps when it sticks in its bore,
+# as a fraction of its radial load.  Sticking bounds it by the ring's friction in the bore, |F_a| <= mu F_r; a greased
+# steel ring in a cast iron / steel bore has mu = 0.13-0.21 (benchmarks/experiments/floating_axial), dry cast iron on
+# steel 0.23 sliding / 0.4 static.  0.3 lies above every lubricated value: a larger ratio is no friction-held load of a
+# floating ring (it would be a second locating bearing), so it is refused.
+FLOATING_AXIAL_LIMIT = 0.3
+FLOATING_AXIAL_KEY = "drivetrain.floating_axial_ratio"
 
 
 # ------------------------------------------------------------------------------------------------ parts
@@ -270,7 +277,14 @@ class Drivetrain:
     designations / matrices.  drive_line (DRIVE_LINES): the FE reduction's drive line beyond the shaft ends,
     "quill-shafts" (`drive_line_parts`, the lumped model's, far ends grounded), "none", or "back-to-back" (the same
     quills, their far ends closing the loop through `aux_gearbox`, `aux_gearbox_parts`).  aux_gearbox: the rig's
-    auxiliary gearbox and motor (AuxGearbox; needed by "back-to-back" only)."""
+    auxiliary gearbox and motor (AuxGearbox; needed by "back-to-back" only).
+    floating_axial_ratio: the mean axial load of each shaft's floating bearing as a fraction of its own radial
+    load, F_a = ratio |F_r| (|ratio| <= FLOATING_AXIAL_LIMIT; 0: the floating bearings take no axial load), > 0 when
+    the shaft pushes the floating bearing away from the shaft's locating bearing (a shaft warmer than its housing,
+    grown longer while the outer ring sticks in its bore), < 0 towards it; the locating bearing takes the reaction
+    (`bearing_loads`).  It acts wherever the bearing loads do: the FE bearings' 6x6 matrices (designation and
+    configuration) and so the coupled model and the rigid-bores misalignment; the lumped source's bearings are
+    Appendix C's printed diagonal, which no load changes."""
 
     gears: GearSet
     shafts: tuple[ShaftLine, ShaftLine]
@@ -288,8 +302,13 @@ class Drivetrain:
     bearing_speed_rpm: float = 1500.0
     drive_line: str = "none"
     aux_gearbox: AuxGearbox | None = None
+    floating_axial_ratio: float = 0.0
 
     def __post_init__(self):
+        r = self.floating_axial_ratio
+        if not (isinstance(r, (int, float)) and math.isfinite(r) and abs(r) <= FLOATING_AXIAL_LIMIT):
+            raise InputError(f"{FLOATING_AXIAL_KEY}: {r!r}: must be a number within +-{FLOATING_AXIAL_LIMIT:g} (a "
+                             "floating ring held by its friction in the bore, mu <= 0.21 greased)")
         if self.drive_line not in DRIVE_LINES:
             raise InputError(f"drive_line: {self.drive_line!r} is not one of {', '.join(DRIVE_LINES)}")
         if self.drive_line == "back-to-back" and self.aux_gearbox is None:
@@ -542,9 +561,15 @@ class Drivetrain:
     def bearing_loads(self, forces: GearForces | None = None) -> dict:
         """{bearing name: (Fx, Fy, Fz, Mx, My)} (N) in each bearing's frame (housingfe.drivetrain.coupling.axis_frame
         of the shaft axis): the mean gear force shared by the two bearings of each shaft by statics, the
-        locating bearing taking all of the axial force."""
+        locating bearing taking all of the axial force -- with floating_axial_ratio != 0 less the floating
+        bearing's ratio |F_r| (along the shaft from the locating towards the floating bearing for ratio > 0), so
+        that each shaft's bearings still carry its mesh force's axial component between them.  A floating bearing
+        that cannot carry an axial load with ratio != 0: InputError naming the key (`floating_axial_problem`)."""
         from housingfe.drivetrain.coupling import axis_frame
 
+        problem = self.floating_axial_problem()
+        if problem:
+            raise InputError(problem)
         forces = forces or self.gear_forces()
         out = {}
         for shaft, sign in (("pinion", 1.0), ("wheel", -1.0)):
@@ -560,10 +585,45 @@ class Drivetrain:
             m = np.cross(forces.point - line.point(front.position), f)
             m -= (m @ a) * a
             r_back = np.cross(m, a) / (back.position - front.position)
-            for seat, load in ((front, (f - axial) - r_back + axial), (back, r_back)):
+            front_load, back_load = (f - axial) - r_back + axial, r_back
+            if self.floating_axial_ratio != 0.0:       # the floating ring's friction-held axial load
+                held = (self.floating_axial_ratio * float(np.linalg.norm(r_back))
+                        * math.copysign(1.0, back.position - front.position)) * a
+                front_load, back_load = front_load - held, back_load + held
+            for seat, load in ((front, front_load), (back, back_load)):
                 local = axis_frame(line.axis).T @ load
                 out[seat.name] = (float(local[0]), float(local[1]), float(local[2]), 0.0, 0.0)
         return out
+
+    def floating_axial_problem(self) -> str:
+        """Why floating_axial_ratio cannot act on this drivetrain ("" when it can, or when it is 0): a floating
+        bearing that carries no axial load in its model -- a fluid-film journal (no axial stiffness) or a
+        cylindrical roller bearing (the roller-raceway contacts carry none; such a floating bearing lets the shaft
+        slide inside it, so its ring keeps no friction-held axial load in the bore either)."""
+        if self.floating_axial_ratio == 0.0:
+            return ""
+        kinds = {}
+        if self.bearing_configuration is not None:
+            from housingfe.bearings.configurations import configurations
+
+            config = configurations().get(self.bearing_configuration)
+            if config is not None:
+                for b in self.bearings:
+                    if not b.locating:
+                        choice = config.positions[f"{b.shaft}_back"]
+                        kinds[b.name] = ("fluid_film" if choice.kind == "fluid_film"
+                                         else _catalogue_kind(choice.designation))
+        else:
+            for b in self.bearings:
+                if not b.locating and b.designation is not None:
+                    kinds[b.name] = _catalogue_kind(b.designation)
+        bad = {n: k for n, k in kinds.items() if k in ("fluid_film", "cylindrical_roller")}
+        if not bad:
+            return ""
+        what = ", ".join(f"{n} ({k.replace('_', ' ')})" for n, k in bad.items())
+        return (f"{FLOATING_AXIAL_KEY}: {self.floating_axial_ratio:g}: the floating bearing(s) {what} of "
+                f"bearings = {self.bearing_configuration or 'designations'!r} carry no axial load (a journal has no "
+                "axial stiffness, a cylindrical roller bearing lets the shaft slide inside it); use 0")
 
     @property
     def speed_dependent_bearings(self) -> bool:
@@ -596,9 +656,13 @@ class Drivetrain:
         role = self.configuration_roles()
         try:
             by_role = bearing_matrices(self.bearing_configuration, {role[n]: v for n, v in loads.items()}, speeds,
-                                       axial_location="both")
+                                       axial_location="both", floating_axial=self.floating_axial_ratio != 0.0)
         except InputError as exc:
-            raise InputError(f"drivetrain: bearings = {self.bearing_configuration!r} at {self.torque:g} N m: "
+            held = ""
+            if self.floating_axial_ratio != 0.0:    # the held load moved axial load off (or onto) the locating one
+                held = (f" (with {FLOATING_AXIAL_KEY} = {self.floating_axial_ratio:g}: the locating bearings carry "
+                        "the mesh's axial force less the floating bearings' held load)")
+            raise InputError(f"drivetrain: bearings = {self.bearing_configuration!r} at {self.torque:g} N m{held}: "
                              f"{exc}") from None
         return {name: by_role[r] for name, r in role.items()}
 
@@ -688,6 +752,13 @@ LOCATING_SIDES = ("front", "back")
 # configuration (housingfe.bearings.configurations: Configuration.wheel_locating), "front" where it states none;
 # "front" / "back" = that side for every configuration
 WHEEL_LOCATING = ("configuration", *LOCATING_SIDES)
+
+
+def _catalogue_kind(designation: str) -> str:
+    """The catalogue kind ("ball", "cylindrical_roller", ...) of a bearing designation."""
+    from housingfe.bearings.catalogue import lookup
+
+    return lookup(designation).kind
 
 
 def wheel_locating_side(bearings: str, wheel_locating: str = "configuration") -> str:

@@ -7,7 +7,8 @@ L_omega, L_v, L_W, L_WA over speed.  `housingfe run test-gearbox-runup`.
                    bores = {bearing = "housing bore"}, bore_tolerance (m): the drivetrain's bearings matched to
                    the housing's bores and checked against the shafts (housingfe.drivetrain.bore_matching)
     [drivetrain]   gearbox = "test_gearbox", gear_set = "A", bearings = "ball", bearing_speed_rpm = 1500,
-                   wheel_locating = "configuration" | "front" | "back" (which wheel bearing locates it axially)
+                   wheel_locating = "configuration" | "front" | "back" (which wheel bearing locates it axially),
+                   floating_axial_ratio = 0.0 (the floating bearings' mean axial load / their radial load)
     [runup]        speeds, torques, f_max_hz (highest harmonic line), basis_factor, routes, damping_ratio, ...
     [radiation]    models = ["erp", "foller"], plates = [...]  (the housing's radiating plates)
 
@@ -85,6 +86,34 @@ class DrivetrainSpec(_Strict):
     # thesis states for the bearings -- "back" for angular_contact and tapered_roller, Sec. 5.8: "at the front
     # (pinion) and at the back (wheel)" -- "front" where it states none), or "front" / "back" for any bearings
     wheel_locating: str = "configuration"
+    # the mean axial load each floating bearing keeps (its outer ring sticking in the bore: held by friction, at most
+    # mu F_r) as a fraction of its own radial load, F_a = ratio |F_r|, the same ratio on both shafts: > 0 the shaft
+    # pushes the floating bearing away from its locating bearing (a shaft warmer than its housing), < 0 towards it;
+    # the locating bearing takes the reaction.  0 (default): the floating bearings carry no axial load.  |ratio| <=
+    # 0.3 (above any lubricated ring-in-bore friction coefficient, 0.13-0.21); not with floating bearings that carry
+    # no axial load (cylindrical_roller, fluid_film).  docs/bearings.md "The floating bearings' mean axial load"
+    floating_axial_ratio: float = Field(0.0, json_schema_extra={"unit": "-"})
+
+    @field_validator("floating_axial_ratio")
+    @classmethod
+    def _floating_axial_ratio(cls, ratio):
+        from housingfe.drivetrain.description import FLOATING_AXIAL_LIMIT
+
+        if not (np.isfinite(ratio) and abs(ratio) <= FLOATING_AXIAL_LIMIT):
+            raise ValueError(f"{ratio:g}: must be within +-{FLOATING_AXIAL_LIMIT:g} (a floating ring held by its "
+                             "friction in the bore: mu = 0.13-0.21 greased)")
+        return float(ratio)
+
+    @model_validator(mode="after")
+    def _floating_bearings_carry_it(self):
+        if self.floating_axial_ratio != 0.0 and self.gearbox in _gearboxes() and self.bearings != "ball":
+            from dataclasses import replace
+
+            dt = _gearboxes()[self.gearbox](self.gear_set, self.bearings, 2000.0, wheel_locating=self.wheel_locating)
+            problem = replace(dt, floating_axial_ratio=self.floating_axial_ratio).floating_axial_problem()
+            if problem:
+                raise ValueError(problem.removeprefix("drivetrain."))
+        return self
 
     @field_validator("gearbox")
     @classmethod
@@ -362,7 +391,8 @@ def drivetrain_of(spec: DrivetrainSpec, torque: float, drive_line: str = "none")
     from dataclasses import replace
 
     dt = _gearboxes()[spec.gearbox](spec.gear_set, spec.bearings, torque, wheel_locating=spec.wheel_locating)
-    return replace(dt, bearing_speed_rpm=spec.bearing_speed_rpm, drive_line=drive_line)
+    return replace(dt, bearing_speed_rpm=spec.bearing_speed_rpm, drive_line=drive_line,
+                   floating_axial_ratio=spec.floating_axial_ratio)
 
 
 @single_thread

@@ -33,11 +33,14 @@ of its own so that every other input of a seed stays as without it.  It moves no
 is a re-analysis on the same basis (as `housingfe study bearings --set drivetrain.wheel_locating=back`).  A scene
 with an explicit drivetrain.wheel_locating ("front" / "back") fixes it.
 
-The one exception is opt-in: `mount_stiffness_N_per_m` (only with --range; `OPT_IN`, drawn from a stream of its own
-so that every seed's other inputs stay as without it) stands the housing on an elastic frame.  The fixed feet's
-Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its own on
-the elastic feet (`mount_overrides`), every family of the sample runs on them, and a process drops them when the
-next sample brings another mount (`_mount_pool`).
+Two inputs are opt-in (only with --range; `OPT_IN`, each drawn from a stream of its own so that every seed's other
+inputs stay as without it).  `floating_axial_ratio`: the floating bearings' mean axial load as a fraction of their
+radial load (drivetrain.floating_axial_ratio; a re-analysis on the sample's basis, like the wheel's side; not applied
+to the double helical family's cylindrical roller and fluid-film bearings, which carry none).  The one exception to
+the one basis per layout is the other, `mount_stiffness_N_per_m`, which stands the housing on an elastic frame.  The
+fixed feet's Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its
+own on the elastic feet (`mount_overrides`), every family of the sample runs on them, and a process drops them when
+the next sample brings another mount (`_mount_pool`).
 
 Samples are spread over processes by mpi4py.futures (MPIPoolExecutor, workers spawned; engine "processes":
 concurrent.futures.ProcessPoolExecutor with spawned processes where MPI spawn is unavailable).  A worker that dies
@@ -162,6 +165,14 @@ PARAMETERS: dict[str, Parameter] = {p.name: p for p in (
               "estimate: the thesis says only 'the gearbox stands on a frame' (Ch. 5), stiffness not given; a "
               "steel frame under the 169 kg gearbox: 1e8 N/m puts its six mount modes at 48-146 Hz, 1e9 at "
               "130-382 Hz, from 3e9 they mix with the housing's (benchmarks/experiments/frame_mount)"),
+    Parameter("floating_axial_ratio", "uniform", -0.2, 0.2, None, "-",
+              "FE bearings and the source's misalignment: the floating bearings' mean axial load / their radial "
+              "load (drivetrain.floating_axial_ratio, the locating bearings taking the reaction; > 0: the shaft "
+              "pushes them away from the locating bearing); opt-in: drawn only with --range, else the scene's "
+              "(0: no axial load); not applied to floating bearings that carry none (cylindrical roller, fluid film)",
+              "estimate: a floating ring sticks in its bore (benchmarks/experiments/floating_axial) and keeps "
+              "whatever the assembly and the shaft's thermal growth left, up to +-mu F_r; greased cast iron on steel "
+              "mu = 0.13-0.21: +-0.2"),
 )}
 
 
@@ -188,8 +199,11 @@ _SIDE_STREAM = 0x73696465                # "side": the seed sequence (seed, stre
 # Inputs drawn only when --range names them: the nominal of the mount is a model choice (the fixed feet), not a
 # value in the range, and each of its samples needs a housing model and basis of its own.  They are drawn from a
 # stream of their own (`_OPT_IN_STREAM`), so every other column of a seed is the same with or without them.
+# The floating bearings' axial load is opt-in because the deterministic chain takes 0 (the middle of the range the
+# rig allows) and the runs before it drew nothing for it; a sample of it is a re-analysis on the sample's basis.
 MOUNT = "mount_stiffness_N_per_m"
-OPT_IN = (MOUNT,)
+FLOATING_AXIAL = "floating_axial_ratio"
+OPT_IN = (MOUNT, FLOATING_AXIAL)         # the order fixes each one's stream: append, never reorder
 _OPT_IN_STREAM = 0x6D6F756E74            # "mount": the seed sequence (seed, stream + k) of the k-th opt-in input
 MOUNT_TANGENTIAL_RATIO = 1.0 / 3.0       # k_t / k_n, as the built-in scene box-supported-elastic (assumed)
 
@@ -218,6 +232,9 @@ PHYSICAL_LIMITS: dict[str, tuple] = {
     "helix_deviation_wheel": (-HELIX_QUALITY_12, True, HELIX_QUALITY_12, True,
                               f"at most ±{HELIX_QUALITY_12:.3g} f_Hbeta (quality 12, the coarsest class)"),
     "mount_stiffness_N_per_m": (0.0, False, math.inf, False, "a stiffness > 0 N/m"),
+    # housingfe.drivetrain.description.FLOATING_AXIAL_LIMIT: above any friction coefficient of a greased ring in a bore
+    "floating_axial_ratio": (-0.3, True, 0.3, True, "within +-0.3 (a floating ring held by its friction in the bore, "
+                             "mu = 0.13-0.21 greased)"),
 }
 
 
@@ -497,15 +514,31 @@ def _sample_base(scene_name: str, overrides: tuple, values: dict, comm) -> tuple
     return base, (base.setup_s if fresh else 0.0), (time.process_time() - c0 if fresh else 0.0)
 
 
+@functools.lru_cache(maxsize=None)
+def floating_bearings_carry_axial(bearings: str) -> bool:
+    """Whether the floating bearings of a bearing configuration carry an axial load (drivetrain.floating_axial_ratio
+    acts on them): not a fluid film's nor a cylindrical roller bearing's (the double helical family)."""
+    from dataclasses import replace
+
+    from housingfe.drivetrain.description import test_gearbox
+
+    return not replace(test_gearbox("A", bearings), floating_axial_ratio=0.1).floating_axial_problem()
+
+
 def perturbed_drivetrain(base: _Base, values: dict, gear_set: str, bearings: str, torque: float):
     """The test gearbox of the scene with gear set, bearings and torque, the sample's wheel locating side for those
-    bearings (SIDES; else the scene's), and the sample's drive line and Appendix C parameters (the FE bearings'
-    internals act through housingfe.bearings.catalogue.estimated_internals while the matrices are computed)."""
+    bearings (SIDES; else the scene's), the sample's floating bearings' axial load ratio where it was drawn and the
+    floating bearings carry one (else the scene's), and the sample's drive line and Appendix C parameters (the FE
+    bearings' internals act through housingfe.bearings.catalogue.estimated_internals while the matrices are
+    computed).  Neither the side nor the ratio moves a DOF: a re-analysis on the sample's basis."""
     from dataclasses import replace
 
     from housingfe.runup.scene import drivetrain_of
 
     update = {"gear_set": gear_set, "bearings": bearings}
+    ratio = values.get(FLOATING_AXIAL)
+    if ratio is not None and floating_bearings_carry_axial(bearings):      # drawn (--range) and applicable
+        update["floating_axial_ratio"] = float(ratio)
     side = values.get(f"wheel_locating_{bearings}")
     if side is not None:                # the sample's side where the thesis states none (SIDES)
         update["wheel_locating"] = side

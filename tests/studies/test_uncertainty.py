@@ -116,7 +116,7 @@ def test_the_mount_is_opt_in():
         old = old_draws(models, n, seed)
         for ranges in (None, mount):
             new = unc.draw_samples(scene, n, seed, ranges)
-            assert [set(s) - {unc.MOUNT, *unc.SIDES} for s in new] == [set(s) for s in old]
+            assert [set(s) - {*unc.OPT_IN, *unc.SIDES} for s in new] == [set(s) for s in old]
             for a, b in zip(new, old):
                 b = dict(b)
                 assert a["radiation"] == b.pop("radiation")
@@ -127,6 +127,55 @@ def test_the_mount_is_opt_in():
     assert unc.nominal_ranges(scene).keys().isdisjoint(unc.OPT_IN)        # the deterministic run: the fixed feet
     fixed = unc.draw_samples(scene, 3, 1, unc.parse_ranges(["mount_stiffness_N_per_m=3e8"]))
     assert [s[unc.MOUNT] for s in fixed] == [3e8] * 3
+
+
+def test_the_floating_axial_ratio_is_the_second_opt_in_input():
+    """floating_axial_ratio (drivetrain.floating_axial_ratio) is drawn only with --range, from the second opt-in
+    stream: every other column of a seed (the old inputs, the sides, the mount with or without its range) is what
+    the seed drew without it; drawn, it is a uniform Latin hypercube (one sample per tenth of -0.2 ... 0.2)."""
+    from housingfe.runup.scene import load_runup_scene
+
+    scene, _ = load_runup_scene("test-gearbox-runup")
+    models = list(scene.radiation.models)
+    assert unc.OPT_IN == (unc.MOUNT, unc.FLOATING_AXIAL)
+    ratio = unc.parse_ranges(["floating_axial_ratio=-0.2:0.2"])
+    mount = unc.parse_ranges(["mount_stiffness_N_per_m=1e8:1e10"])
+    for seed, n in ((1, 24), (0, 8), (7, 10)):
+        for others in ({}, mount):
+            without = unc.draw_samples(scene, n, seed, others)
+            drawn = unc.draw_samples(scene, n, seed, {**others, **ratio})
+            assert {s[unc.FLOATING_AXIAL] for s in without} == {None}
+            assert [{k: v for k, v in s.items() if k != unc.FLOATING_AXIAL} for s in drawn] == \
+                [{k: v for k, v in s.items() if k != unc.FLOATING_AXIAL} for s in without]
+            r = [s[unc.FLOATING_AXIAL] for s in drawn]
+            assert sorted(int((x + 0.2) / 0.4 * n) for x in r) == list(range(n))
+        for a, b in zip(unc.draw_samples(scene, n, seed, ratio), old_draws(models, n, seed)):
+            assert a["radiation"] == b.pop("radiation")
+            assert {k: a[k] for k in b} == pytest.approx(b, rel=1e-15, abs=1e-15)
+    assert unc.nominal_ranges(scene).keys().isdisjoint({unc.FLOATING_AXIAL})
+    assert [s[unc.FLOATING_AXIAL] for s in unc.draw_samples(scene, 3, 1, unc.parse_ranges(
+        ["floating_axial_ratio=0.1"]))] == [0.1] * 3
+    for item in ("floating_axial_ratio=-0.35:0.2", "floating_axial_ratio=0.31"):
+        with pytest.raises(InputError, match="--range floating_axial_ratio: .*must be within"):
+            unc.parse_ranges([item])
+
+
+def test_a_sample_s_floating_axial_ratio_reaches_its_drivetrain():
+    """perturbed_drivetrain puts a drawn ratio on the configurations whose floating bearings carry an axial load
+    (the bearings family), leaves it out of those that carry none (double helical: cylindrical roller, fluid film),
+    and leaves the scene's (0) where it was not drawn."""
+    from types import SimpleNamespace
+
+    from housingfe.runup.scene import load_runup_scene
+
+    scene, _ = load_runup_scene("test-gearbox-runup")
+    base = SimpleNamespace(session=SimpleNamespace(scene=scene), surfaces={})
+    values = {**{k: v[0] for k, v in unc.nominal_ranges(scene).items()}, unc.MOUNT: None}
+    for ratio, bearings, gear_set, want in ((-0.12, "ball", "A", -0.12), (0.12, "tapered_roller", "B", 0.12),
+                                            (0.12, "cylindrical_roller", "double_helical", 0.0),
+                                            (None, "self_aligning", "B", 0.0)):
+        dt = unc.perturbed_drivetrain(base, {**values, unc.FLOATING_AXIAL: ratio}, gear_set, bearings, 1000.0)
+        assert dt.floating_axial_ratio == want, bearings
 
 
 def test_the_wheel_locating_side_is_a_fair_seeded_draw():
@@ -388,6 +437,26 @@ def test_a_sample_with_the_wheel_located_at_the_back_is_the_run_with_that_side(t
     assert np.max(np.abs(np.subtract(front["mesh_force/lwa_curve_dBA"], run["mesh_force"]))) > 3.0
 
 
+@pytest.mark.slow
+def test_a_sample_s_floating_axial_ratio_is_the_run_with_that_ratio(tmp_path):
+    """One sample, every range at zero width and floating_axial_ratio = 0.15: the re-analysis on the process's
+    (ratio 0) basis gives the L_WA curves `housingfe run --set drivetrain.floating_axial_ratio=0.15` writes with a
+    basis of its own, to 2e-3 dB, and the ratio acts (tf_omega differs from the ratio-0 run by more than 3 dB
+    somewhere; measured 12.2 dB on this coarse setting, 2026-11-28)."""
+    from housingfe.runup.scene import load_runup_scene
+
+    scene, _ = load_runup_scene("test-gearbox-runup", list(COARSE))
+    ranges = {**unc.nominal_ranges(scene), unc.FLOATING_AXIAL: (0.15, 0.15)}
+    res = unc.run_uncertainty("test-gearbox-runup", 1, seed=1, workers=1, overrides=COARSE, families=(),
+                              ranges=ranges)
+    assert res.samples[0][unc.FLOATING_AXIAL] == 0.15
+    run = cli_lwa_curves("test-gearbox-runup", COARSE + ("drivetrain.floating_axial_ratio=0.15",), tmp_path / "run")
+    for route, curve in run.items():
+        np.testing.assert_allclose(res.metrics[0][f"{route}/lwa_curve_dBA"], curve, atol=2e-3, err_msg=route)
+    plain = cli_lwa_curves("test-gearbox-runup", COARSE, tmp_path / "plain")
+    assert np.max(np.abs(np.subtract(run["tf_omega"], plain["tf_omega"]))) > 3.0
+
+
 @pytest.mark.parametrize("args, message", [
     (["--samples", "-3"], "uncertainty: --samples: -3: must be a whole number >= 1"),
     (["--range", "wheel_locating_ball=middle"], "--range wheel_locating_ball: middle: not a bearing side"),
@@ -397,6 +466,7 @@ def test_a_sample_with_the_wheel_located_at_the_back_is_the_run_with_that_side(t
     (["--range", "radiation=numerical"], "--range radiation: numerical: not a radiation model of the scene"),
     (["--range", "mount_stiffness_N_per_m=0:1e9"], "--range mount_stiffness_N_per_m: 0: must be > 0"),
     (["--range", "mount_stiffness_N_per_m=-1e9"], "--range mount_stiffness_N_per_m: -1e+09: must be > 0"),
+    (["--range", "floating_axial_ratio=-0.5:0.2"], "--range floating_axial_ratio: -0.5: must be within +-0.3"),
 ])
 def test_bad_input_is_one_line_and_no_folder(tmp_path, args, message):
     out = tmp_path / "u"
