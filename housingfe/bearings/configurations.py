@@ -351,6 +351,23 @@ def evaluate(name: str, loads, speeds_rpm=None, *, hold_tilt: bool = True, axial
     return out
 
 
+def carries(name: str, position: str, load, hold_tilt: bool = True) -> bool:
+    """Whether the bearing of configuration `name` at `position` finds an equilibrium under `load` (Fx, Fy, Fz, Mx,
+    My) [N, N m] in its frame -- the bearing model of `evaluate` itself (a single-row angular contact or tapered roller
+    bearing needs enough Fz for its radial load).  A fluid-film position: True (it takes no axial load in any case)."""
+    configs = configurations()
+    if name not in configs or position not in configs[name].positions:
+        raise InputError(f"bearing configuration {name!r}: no position {position!r}")
+    choice = configs[name].positions[position]
+    if choice.kind != "rolling":
+        return True
+    try:
+        _rolling_result(choice, np.asarray(load, float).ravel()[:5], hold_tilt)
+    except InputError:
+        return False
+    return True
+
+
 def bearing_matrices(name: str, loads, speeds_rpm=None, **options) -> dict[str, tuple]:
     """{position: (K 6x6, C 6x6 or None)} of configuration `name` in each bearing's frame (see evaluate)."""
     return {p: (r.K, r.C) for p, r in evaluate(name, loads, speeds_rpm, **options).items()}

@@ -103,6 +103,10 @@ _GEAR_FORCES: dict = {}        # Drivetrain.gear_forces per what it depends on (
 # floating ring (it would be a second locating bearing), so it is refused.
 FLOATING_AXIAL_LIMIT = 0.3
 FLOATING_AXIAL_KEY = "drivetrain.floating_axial_ratio"
+# The held load's bisection tolerance (N) where a floating ring slides (Drivetrain._held_by_locating): well below the
+# held loads (0.06-0.3 of radial loads of kN) and the mesh's axial force; its results are remembered per load.
+SLIDE_TOLERANCE = 1.0
+_SLIDE: dict = {}
 
 
 # ------------------------------------------------------------------------------------------------ parts
@@ -564,14 +568,22 @@ class Drivetrain:
         locating bearing taking all of the axial force -- with floating_axial_ratio != 0 less the floating
         bearing's ratio |F_r| (along the shaft from the locating towards the floating bearing for ratio > 0), so
         that each shaft's bearings still carry its mesh force's axial component between them.  A floating bearing
-        that cannot carry an axial load with ratio != 0: InputError naming the key (`floating_axial_problem`)."""
+        that cannot carry an axial load with ratio != 0: InputError naming the key (`floating_axial_problem`).  Where
+        that held load would leave a directional locating bearing (single-row angular contact, tapered roller)
+        without an equilibrium, the ring slides and the held load is the largest the locating bearing still
+        carries (`floating_axial_held` gives the requested and the effective one)."""
+        return self._statics(forces)[0]
+
+    def _statics(self, forces: GearForces | None = None) -> tuple[dict, dict]:
+        """(bearing_loads, {shaft: (requested, effective) held axial load (N)}) -- see bearing_loads and
+        floating_axial_held."""
         from housingfe.drivetrain.coupling import axis_frame
 
         problem = self.floating_axial_problem()
         if problem:
             raise InputError(problem)
         forces = forces or self.gear_forces()
-        out = {}
+        out, held_loads = {}, {s: (0.0, 0.0) for s in SHAFTS}
         for shaft, sign in (("pinion", 1.0), ("wheel", -1.0)):
             line = self.shaft(shaft)
             seats = [b for b in self.bearings if b.shaft == shaft]
@@ -587,13 +599,61 @@ class Drivetrain:
             r_back = np.cross(m, a) / (back.position - front.position)
             front_load, back_load = (f - axial) - r_back + axial, r_back
             if self.floating_axial_ratio != 0.0:       # the floating ring's friction-held axial load
-                held = (self.floating_axial_ratio * float(np.linalg.norm(r_back))
-                        * math.copysign(1.0, back.position - front.position)) * a
+                away = math.copysign(1.0, back.position - front.position)
+                requested = self.floating_axial_ratio * float(np.linalg.norm(r_back))
+                effective = self._held_by_locating(front, axis_frame(line.axis).T, front_load, a, requested * away)
+                held = effective * a
                 front_load, back_load = front_load - held, back_load + held
+                held_loads[shaft] = (requested, effective * away)
             for seat, load in ((front, front_load), (back, back_load)):
                 local = axis_frame(line.axis).T @ load
                 out[seat.name] = (float(local[0]), float(local[1]), float(local[2]), 0.0, 0.0)
-        return out
+        return out, held_loads
+
+    def _held_by_locating(self, front: BearingSeat, to_local: np.ndarray, front_load: np.ndarray, a: np.ndarray,
+                          held: float) -> float:
+        """The held axial load (N, along the shaft axis `a`) the floating ring keeps: `held` if the locating
+        bearing of the configuration finds an equilibrium under front_load - held a, else the ring slides -- the
+        largest |held| (same sign) at which it still does, by bisection on the bearing model itself
+        (housingfe.bearings.configurations.carries) to SLIDE_TOLERANCE.  Without a configuration, or where the
+        locating bearing carries no equilibrium even at held = 0: `held` unchanged (the bearing model names the
+        load it cannot carry later, as without the ratio)."""
+        if self.bearing_configuration is None:
+            return held
+        from housingfe.bearings.configurations import carries, configurations
+
+        config = configurations().get(self.bearing_configuration)
+        position = f"{front.shaft}_front"
+        if config is None or not config.positions[position].directional:
+            return held                         # a ball / self-aligning / roller locating bearing: either direction
+
+        def ok(h: float) -> bool:
+            local = to_local @ (front_load - h * a)
+            return carries(self.bearing_configuration, position, (*local, 0.0, 0.0))
+
+        key = (self.bearing_configuration, position, tuple(np.round(front_load, 9)), tuple(np.round(a, 12)), held)
+        if key in _SLIDE:
+            return _SLIDE[key]
+        if ok(held) or not ok(0.0):
+            result = held
+        else:
+            lo, hi = 0.0, 1.0                   # fractions of the requested held load: lo carried, hi not
+            while (hi - lo) * abs(held) > SLIDE_TOLERANCE:
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if ok(mid * held) else (lo, mid)
+            result = lo * held
+        if len(_SLIDE) >= 256:
+            _SLIDE.pop(next(iter(_SLIDE)))
+        _SLIDE[key] = result
+        return result
+
+    def floating_axial_held(self, forces: GearForces | None = None) -> dict[str, tuple[float, float]]:
+        """{shaft: (requested, effective)} held axial load of each shaft's floating bearing (N, > 0 pushed away
+        from the locating bearing): requested = floating_axial_ratio |F_r|; effective = what bearing_loads applies,
+        of smaller magnitude where the locating bearing (a single-row angular contact or tapered roller bearing)
+        would lift off under the requested one -- the shaft then moves axially and the floating ring slides in its
+        bore until the locating bearing just holds (`_held_by_locating`).  Both 0.0 at ratio 0."""
+        return self._statics(forces)[1]
 
     def floating_axial_problem(self) -> str:
         """Why floating_axial_ratio cannot act on this drivetrain ("" when it can, or when it is 0): a floating
