@@ -250,3 +250,16 @@ def test_fluid_film_reversed_rotation_and_ocvirk():
 def test_bad_input_names_configuration_and_position(name, loads, speeds, kwargs, match):
     with pytest.raises(InputError, match=match):
         evaluate(name, loads, speeds, **kwargs)
+
+
+def test_carries_is_the_bearing_model_s_equilibrium():
+    """configurations.carries: a single-row tapered roller bearing needs an axial load for its radial one (no
+    equilibrium at Fz = 0, one at Fz = the thesis' 8.7 kN), a deep groove ball bearing takes Fz = 0 and either sign."""
+    from housingfe.bearings.configurations import carries
+
+    radial = (10000.0, -20000.0)
+    assert not carries("tapered_roller", "pinion_front", (*radial, 0.0, 0.0, 0.0))
+    assert carries("tapered_roller", "pinion_front", (*radial, 8663.0, 0.0, 0.0))
+    for fz in (0.0, 3000.0, -3000.0):
+        assert carries("ball", "pinion_back", (*radial, fz, 0.0, 0.0))
+    assert carries("fluid_film", "pinion_back", (*radial, 0.0, 0.0, 0.0))
