@@ -39,6 +39,7 @@ mesh stiffness from the source, never the other way round.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field, replace
 from typing import Literal
 
@@ -642,6 +643,10 @@ class Drivetrain:
                 mid = 0.5 * (lo + hi)
                 lo, hi = (mid, hi) if ok(mid * held) else (lo, mid)
             result = lo * held
+            # once per load (remembered below): the user sees that the ring slid, not only the statics' report
+            print(f"housingfe: warning: {FLOATING_AXIAL_KEY} = {self.floating_axial_ratio:g}: the {front.shaft}'s "
+                  f"floating ring slides: held load {abs(held):.0f} -> {abs(result):.0f} N, the most its locating "
+                  f"bearing ({self.bearing_configuration}) carries (Drivetrain.floating_axial_held)", file=sys.stderr)
         if len(_SLIDE) >= 256:
             _SLIDE.pop(next(iter(_SLIDE)))
         _SLIDE[key] = result

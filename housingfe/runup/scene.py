@@ -91,7 +91,9 @@ class DrivetrainSpec(_Strict):
     # pushes the floating bearing away from its locating bearing (a shaft warmer than its housing), < 0 towards it;
     # the locating bearing takes the reaction.  0 (default): the floating bearings carry no axial load.  |ratio| <=
     # 0.3 (above any lubricated ring-in-bore friction coefficient, 0.13-0.21); not with floating bearings that carry
-    # no axial load (cylindrical_roller, fluid_film).  docs/bearings.md "The floating bearings' mean axial load"
+    # no axial load (cylindrical_roller, fluid_film).  Where the held load would lift a directional locating bearing
+    # (angular_contact below about -0.12, tapered_roller -0.06) the floating ring slides: the held load is the most
+    # that bearing carries (a warning says so).  docs/bearings.md "The floating bearings' mean axial load"
     floating_axial_ratio: float = Field(0.0, json_schema_extra={"unit": "-"})
 
     @field_validator("floating_axial_ratio")
