@@ -326,7 +326,6 @@ def _delaunay_retries(size: float) -> str | None:
     return None
 
 
-
 def _glued_cells(model: BlockModel) -> tuple[dict[str, list[int]], dict[tuple[str, ...], list[int]]]:
     """The grid cells as volumes of gmsh's built-in kernel that share their faces, edges and corners by
     construction (what OCC's fragment of the cell boxes gives, without the boolean: 0.69 s of a 1 s mesh of the
