@@ -660,6 +660,15 @@ class Drivetrain:
         bore until the locating bearing just holds (`_held_by_locating`).  Both 0.0 at ratio 0."""
         return self._statics(forces)[1]
 
+    def floating_axial_report(self, forces: GearForces | None = None) -> dict[str, dict]:
+        """What each shaft's floating bearing holds, for result files: {shaft: {"requested_N", "held_N" (N, signs of
+        floating_axial_held), "slid" (the held load saturated below the requested one: `floating_axial_held`'s
+        effective != requested)}}.  Empty at ratio 0 (nothing to report)."""
+        if self.floating_axial_ratio == 0.0:
+            return {}
+        return {shaft: {"requested_N": requested, "held_N": effective, "slid": effective != requested}
+                for shaft, (requested, effective) in self.floating_axial_held(forces).items()}
+
     def floating_axial_problem(self) -> str:
         """Why floating_axial_ratio cannot act on this drivetrain ("" when it can, or when it is 0): a floating
         bearing that carries no axial load in its model -- a fluid-film journal (no axial stiffness) or a
@@ -817,6 +826,18 @@ LOCATING_SIDES = ("front", "back")
 # configuration (housingfe.bearings.configurations: Configuration.wheel_locating), "front" where it states none;
 # "front" / "back" = that side for every configuration
 WHEEL_LOCATING = ("configuration", *LOCATING_SIDES)
+
+
+def slid_rings(report: dict[str, dict]) -> list[str]:
+    """The shafts whose floating ring slid in a Drivetrain.floating_axial_report, in shaft order."""
+    return [shaft for shaft, r in report.items() if r["slid"]]
+
+
+def floating_axial_text(report: dict[str, dict]) -> str:
+    """One shaft after the other as the summaries write a Drivetrain.floating_axial_report: "pinion -3155 -> -3131 N
+    (slid), wheel -3712 N" (requested -> held where the ring slid; N, > 0 away from the locating bearing)."""
+    return ", ".join(f"{shaft} {r['requested_N']:.0f} -> {r['held_N']:.0f} N (slid)" if r["slid"]
+                     else f"{shaft} {r['held_N']:.0f} N" for shaft, r in report.items())
 
 
 def _catalogue_kind(designation: str) -> str:

@@ -124,6 +124,7 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "mesh_friction": friction_in_effect(scene, results),
         "drive_line": scene.runup.drive_line_model,       # in effect
         "bearing_speeds": bearing_speeds_json(scene, results),
+        "floating_axial": floating_axial_json(results),
         "timings_s": timings,
         "modal_basis": gm.summary(),
         "housing_resolution": _resolution(gm),
@@ -253,6 +254,34 @@ def bearing_speeds_json(scene, results: dict) -> dict:
     return out
 
 
+def floating_axial_json(results: dict) -> dict | None:
+    """runup.json "floating_axial": with drivetrain.floating_axial_ratio != 0 the ratio and per torque (text) what
+    each shaft's floating bearing held ({shaft: {"requested_N", "held_N", "slid"}}, N; a ring slides where the held
+    load would lift a directional locating bearing: Drivetrain.floating_axial_report); None at ratio 0."""
+    reports = {f"{t:g}": m.drivetrain.floating_axial_report() for t, (m, _) in results.items()}
+    if not any(reports.values()):
+        return None
+    ratio = next(iter(results.values()))[0].drivetrain.floating_axial_ratio
+    return {"ratio": ratio, "torques": reports}
+
+
+def floating_axial_lines(results: dict) -> list[str]:
+    """The summary's lines on the floating bearings' held axial load, one per torque (none at ratio 0)."""
+    from housingfe.drivetrain.description import FLOATING_AXIAL_KEY, floating_axial_text, slid_rings
+
+    data = floating_axial_json(results)
+    if data is None:
+        return []
+    lines = []
+    for t, report in data["torques"].items():
+        slid = slid_rings(report)
+        lines.append(f"floating bearings ({FLOATING_AXIAL_KEY} = {data['ratio']:g}) at {t} N m, held axial load: "
+                     f"{floating_axial_text(report)}; "
+                     + (f"the {' and '.join(slid)} floating ring{'s' if len(slid) > 1 else ''} slid (the locating "
+                        "bearing would lift off under the requested load)" if slid else "no ring slid"))
+    return lines
+
+
 def _resolution(gm) -> dict | None:
     """The housing mesh's resolution of the highest line (housingfe.fe.resolution), None if not known."""
     res = getattr(getattr(gm, "housing_model", None), "resolution", None)
@@ -311,6 +340,7 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
     friction = friction_line(scene, results)
     if friction:
         lines.append(friction)
+    lines += floating_axial_lines(results)
     if any(m.drivetrain.speed_dependent_bearings for m, _ in results.values()):
         if scene.runup.bearing_speeds == "follow":
             lines.append("bearings: the fluid films' K, C at each run-up speed (runup.bearing_speeds = \"follow\"; "

@@ -34,6 +34,12 @@ BESIDE the periodic one, labelled "as made, ISO grade g": extra columns *_as_mad
 <family>_runup.csv, sections after the periodic ones in <family>.md, "as_made" in study.json, lines in the summary.
 The periodic tables stay as with the option off ("none", the default: nothing changes).
 
+With `--set drivetrain.floating_axial_ratio=X` (X != 0) every variant's floating bearings are asked to hold
+X |F_r| axially, and where a directional locating bearing would lift off the ring slides and holds less
+(housingfe.drivetrain.description.Drivetrain.floating_axial_held): per variant the requested and the held load of
+each shaft's floating bearing and which rings slid are written as the last columns of <family>.csv
+(FLOATING_COLUMNS), a section of <family>.md and lines of the summary; at X = 0 none of them (files as before).
+
 Writes <family>.csv, <family>.md, <family>.png, <family>_runup.csv (L_WA over speed per variant and route),
 <family>_torque_law.csv and <family>_torque_law.png (where there is a torque law; plot_torque_law), variant_terms.csv
 (per route and variant the mean difference of each term of L_WA: excitation, T_path, T_housing, L_sigma,
@@ -192,7 +198,8 @@ class VariantRun:
     runup.as_made on, per route (speeds, L_WA dB(A)) with the expected sidebands of gears as made and the seconds
     they took (housingfe.runup.as_made); per route the per-speed term levels of the periodic L_WA on the total
     basis (speeds, {term: dB}; housingfe.studies.variant_terms.term_curves, None for a route without an excitation
-    level; empty when not kept)."""
+    level; empty when not kept); with drivetrain.floating_axial_ratio != 0 (floating_ratio) what each shaft's
+    floating bearing held (housingfe.drivetrain.description.Drivetrain.floating_axial_report; empty at 0)."""
 
     variant: Variant
     curves: dict
@@ -202,6 +209,8 @@ class VariantRun:
     curves_as_made: dict = field(default_factory=dict)
     as_made_s: float = 0.0
     terms: dict = field(default_factory=dict)
+    floating_ratio: float = 0.0
+    floating: dict = field(default_factory=dict)
 
     def curves_of(self, kind: str) -> dict:
         """The curves per route of the periodic model (PERIODIC) or of gears as made (AS_MADE)."""
@@ -284,7 +293,8 @@ def run_family(family: Family, session: ChainSession, progress=print) -> StudyRe
         t2 = time.perf_counter()
         how = session.log[-1].how
         runs[v.key] = VariantRun(v, {r: lwa_curve(res, r, rad, v.torque) for r in routes}, how, t1 - t0, t2 - t1,
-                                 terms={r: variant_terms.term_curves(res, r, rad, v.torque) for r in routes})
+                                 terms={r: variant_terms.term_curves(res, r, rad, v.torque) for r in routes},
+                                 **floating_of(drivetrains[v.key]))
         made = session.runup_as_made(model, v.torque, res)      # None with runup.as_made = "none"
         if made is not None:
             from housingfe.runup.as_made import lwa_curve as as_made_curve
@@ -302,6 +312,12 @@ def run_family(family: Family, session: ChainSession, progress=print) -> StudyRe
                                    | ({"as_made_s": r.as_made_s} if r.curves_as_made else {})
                                    for k, r in runs.items()}}
     return out
+
+
+def floating_of(drivetrain) -> dict:
+    """A variant's drivetrain.floating_axial_ratio and what each floating bearing held at its torque (VariantRun's
+    floating_ratio, floating: Drivetrain.floating_axial_report, the loads its model was built with)."""
+    return {"floating_ratio": drivetrain.floating_axial_ratio, "floating": drivetrain.floating_axial_report()}
 
 
 def analyse(result: StudyResult) -> StudyResult:
@@ -347,8 +363,22 @@ def compare(result: StudyResult, kind: str = "periodic") -> list[dict]:
                          "LwA_max_dBA": round(top, 1), "at_rpm": at, "measured_max_dBA": v.measured_max,
                          "thesis_calc_max_dBA": v.calc_max,
                          "LwA_energy_mean_800_1500_dBA": round(energy_mean_db(s, lwa), 1),
-                         "basis": run.basis, "model_s": round(run.model_s, 2), "runup_s": round(run.runup_s, 2)})
+                         "basis": run.basis, "model_s": round(run.model_s, 2), "runup_s": round(run.runup_s, 2)}
+                        | floating_cells(run))
     return rows
+
+
+def floating_cells(run: VariantRun) -> dict:
+    """FLOATING_COLUMNS of a variant's rows (nothing where its floating bearings hold no axial load: ratio 0)."""
+    if not run.floating:
+        return {}
+    from housingfe.drivetrain.description import slid_rings
+
+    cells = {"floating_axial_ratio": run.floating_ratio}
+    for shaft, r in run.floating.items():
+        cells[f"{shaft}_floating_requested_N"] = round(r["requested_N"], 1)
+        cells[f"{shaft}_floating_held_N"] = round(r["held_N"], 1)
+    return cells | {"floating_rings_slid": " ".join(slid_rings(run.floating)) or "none"}
 
 
 def _order(values: dict) -> list[str]:
@@ -440,6 +470,11 @@ COLUMNS = ("family", "engagement", "route", "radiation", "variant", "gear_set", 
            "mean_diff_dB", "sd_diff_dB", "speeds_in_mean", "measured_mean_dB", "measured_sd_dB", "thesis_calc_mean_dB",
            "thesis_calc_sd_dB", "LwA_max_dBA", "at_rpm", "measured_max_dBA", "thesis_calc_max_dBA",
            "LwA_energy_mean_800_1500_dBA", "basis", "model_s", "runup_s")
+# with drivetrain.floating_axial_ratio != 0: per variant (and so per torque) the held axial load of each shaft's
+# floating bearing, requested (ratio |F_r|) and held (less where the ring slid), N, and which rings slid -- after every
+# other column of <family>.csv (absent at ratio 0: the default files stay as they were)
+FLOATING_COLUMNS = ("floating_axial_ratio", "pinion_floating_requested_N", "pinion_floating_held_N",
+                    "wheel_floating_requested_N", "wheel_floating_held_N", "floating_rings_slid")
 
 
 # <family>_torque_law.csv: one row per torque-law group and route (torque_law), ours beside the measured; with
@@ -593,6 +628,7 @@ def markdown(result: StudyResult, wall_s: float | None = None) -> str:
         lines += variant_terms.markdown(result.terms)
     if result.as_made:
         lines += markdown_as_made(result)
+    lines += markdown_floating(result)
     per = result.timings.get("per_variant", {})
     lines += ["## Cost", "",
               f"{result.basis_builds} modal basis computed for {len(result.runs)} variants; per variant (s): "
@@ -602,6 +638,47 @@ def markdown(result: StudyResult, wall_s: float | None = None) -> str:
               + (f"; wall time {wall_s:.0f} s (this family; a command of one family: end to end)." if wall_s is not None else "."), "",
               "## Notes", ""] + [f"* {n}" for n in result.family.notes] + [""]
     return "\n".join(lines)
+
+
+def _floating_runs(result: StudyResult) -> dict:
+    return {k: run for k, run in result.runs.items() if run.floating}
+
+
+def floating_slid_text(result: StudyResult) -> str:
+    """The line naming the variants whose floating rings slid, and the others ("" at ratio 0)."""
+    runs = _floating_runs(result)
+    if not runs:
+        return ""
+    from housingfe.drivetrain.description import FLOATING_AXIAL_KEY, slid_rings
+
+    ratios = sorted({run.floating_ratio for run in runs.values()})
+    slid = [f"{k} ({', '.join(slid_rings(run.floating))})" for k, run in runs.items() if slid_rings(run.floating)]
+    kept = [k for k, run in runs.items() if not slid_rings(run.floating)]
+    return (f"floating rings ({FLOATING_AXIAL_KEY} = {', '.join(f'{r:g}' for r in ratios)}): slid: "
+            f"{'; '.join(slid) or 'none'}; held as requested: {', '.join(kept) or 'none'}")
+
+
+def markdown_floating(result: StudyResult) -> list[str]:
+    """The Markdown section on the floating bearings' held axial load (none at drivetrain.floating_axial_ratio 0)."""
+    runs = _floating_runs(result)
+    if not runs:
+        return []
+    from housingfe.drivetrain.description import FLOATING_AXIAL_KEY, slid_rings
+
+    lines = ["## Floating bearings' held axial load", "",
+             f"`{FLOATING_AXIAL_KEY}`: each floating bearing is asked to hold ratio·|F_r|; where a directional "
+             "locating bearing (angular contact, tapered roller) would lift off under that, the floating ring "
+             "slides and holds the most the locating bearing carries (`Drivetrain.floating_axial_held`; N, > 0 "
+             "away from the locating bearing; columns `*_floating_*` in the CSV).", "",
+             floating_slid_text(result) + ".", "",
+             "| variant | torque, N m | ratio | pinion requested → held, N | wheel requested → held, N | slid |",
+             "|---|---|---|---|---|---|"]
+    for k, run in runs.items():
+        f = run.floating
+        lines.append(f"| {k} | {run.variant.torque:g} | {run.floating_ratio:g} | "
+                     + " | ".join(f"{f[s]['requested_N']:.0f} → {f[s]['held_N']:.0f}" for s in ("pinion", "wheel"))
+                     + f" | {', '.join(slid_rings(f)) or 'no'} |")
+    return lines + [""]
 
 
 def markdown_as_made(result: StudyResult) -> list[str]:
@@ -668,13 +745,16 @@ def write(folder: Path, result: StudyResult, wall_s: float | None = None) -> Non
     made = bool(result.as_made)
     # gears as made: their columns after the periodic ones, which stay as without runup.as_made
     extra = list(AS_MADE_COLUMNS) if made else []
+    # the floating bearings' held axial loads last, only where a variant's ratio is not 0 (floating_cells)
+    floating = [c for c in FLOATING_COLUMNS if any(c in r for r in result.rows)]
 
     def as_made_cells(row):
         m = _as_made_row(result, row)
         return [result.as_made_grade] + [m[c] for c in list(AS_MADE_COLUMNS.values())[1:]]
 
-    write_csv(folder / f"{name}.csv", list(COLUMNS) + extra,
-              ([r[c] for c in COLUMNS] + (as_made_cells(r) if made else []) for r in result.rows))
+    write_csv(folder / f"{name}.csv", list(COLUMNS) + extra + floating,
+              ([r[c] for c in COLUMNS] + (as_made_cells(r) if made else []) + [r.get(c) for c in floating]
+               for r in result.rows))
     keys = list(result.runs)
     first = result.runs[keys[0]].curves[result.routes[0]][0]
     kinds = (PERIODIC, AS_MADE) if made else (PERIODIC,)
@@ -889,6 +969,12 @@ def summary_text(result: StudyResult, wall_s: float | None = None) -> str:
                               _pm(r["thesis_calc_mean_dB"], r["thesis_calc_sd_dB"]),
                               f"{r['LwA_max_dBA']:.1f} ({r['at_rpm']:g})", _num(r["measured_max_dBA"]), r["basis"]]
                              for r in result.rows]))
+    if _floating_runs(result):
+        from housingfe.drivetrain.description import floating_axial_text
+
+        out.append(floating_slid_text(result))
+        out += [f"  {k} at {run.variant.torque:g} N m, held axial load: {floating_axial_text(run.floating)}"
+                for k, run in _floating_runs(result).items()]
     for k in result.rankings:
         out.append(f"ranking {k['route']}, {k['measure']}: ours {k['ours']}; measured {k['measured']}; "
                    f"{'same order' if k['matches'] else 'different order'}")
