@@ -101,6 +101,13 @@ def estimated_internals(**values):
         _INTERNALS.reset(token)
 
 
+def internals_in_effect() -> tuple:
+    """The estimated internals `estimated_internals` sets here, as a hashable key ((name, value), ... sorted; () for
+    the rules): what a cache of results of the bearing models must hold beside the loads."""
+    values = _INTERNALS.get()
+    return () if values is None else tuple(sorted(values.items()))
+
+
 def _internal(key: str, rule: float) -> float:
     values = _INTERNALS.get()
     return rule if values is None else float(values.get(key, rule))

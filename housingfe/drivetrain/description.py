@@ -105,7 +105,8 @@ _GEAR_FORCES: dict = {}        # Drivetrain.gear_forces per what it depends on (
 FLOATING_AXIAL_LIMIT = 0.3
 FLOATING_AXIAL_KEY = "drivetrain.floating_axial_ratio"
 # The held load's bisection tolerance (N) where a floating ring slides (Drivetrain._held_by_locating): well below the
-# held loads (0.06-0.3 of radial loads of kN) and the mesh's axial force; its results are remembered per load.
+# held loads (0.06-0.3 of radial loads of kN) and the mesh's axial force; its results are remembered per load (and
+# estimated bearing internals in effect).
 SLIDE_TOLERANCE = 1.0
 _SLIDE: dict = {}
 
@@ -621,6 +622,7 @@ class Drivetrain:
         load it cannot carry later, as without the ratio)."""
         if self.bearing_configuration is None:
             return held
+        from housingfe.bearings.catalogue import internals_in_effect
         from housingfe.bearings.configurations import carries, configurations
 
         config = configurations().get(self.bearing_configuration)
@@ -632,7 +634,9 @@ class Drivetrain:
             local = to_local @ (front_load - h * a)
             return carries(self.bearing_configuration, position, (*local, 0.0, 0.0))
 
-        key = (self.bearing_configuration, position, tuple(np.round(front_load, 9)), tuple(np.round(a, 12)), held)
+        # the estimated internals (an uncertainty sample's) move where the bearing lifts off: part of the key
+        key = (self.bearing_configuration, position, tuple(np.round(front_load, 9)), tuple(np.round(a, 12)), held,
+               internals_in_effect())
         if key in _SLIDE:
             return _SLIDE[key]
         if ok(held) or not ok(0.0):

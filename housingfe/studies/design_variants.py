@@ -372,13 +372,19 @@ def floating_cells(run: VariantRun) -> dict:
     """FLOATING_COLUMNS of a variant's rows (nothing where its floating bearings hold no axial load: ratio 0)."""
     if not run.floating:
         return {}
+    return {"floating_axial_ratio": run.floating_ratio} | floating_report_cells(run.floating)
+
+
+def floating_report_cells(report: dict) -> dict:
+    """A Drivetrain.floating_axial_report as result-file cells: per shaft <shaft>_floating_requested_N and
+    <shaft>_floating_held_N (N, 0.1 N), and floating_rings_slid (the shafts whose ring slid, or "none")."""
     from housingfe.drivetrain.description import slid_rings
 
-    cells = {"floating_axial_ratio": run.floating_ratio}
-    for shaft, r in run.floating.items():
+    cells = {}
+    for shaft, r in report.items():
         cells[f"{shaft}_floating_requested_N"] = round(r["requested_N"], 1)
         cells[f"{shaft}_floating_held_N"] = round(r["held_N"], 1)
-    return cells | {"floating_rings_slid": " ".join(slid_rings(run.floating)) or "none"}
+    return cells | {"floating_rings_slid": " ".join(slid_rings(report)) or "none"}
 
 
 def _order(values: dict) -> list[str]:

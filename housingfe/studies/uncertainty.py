@@ -36,9 +36,11 @@ with an explicit drivetrain.wheel_locating ("front" / "back") fixes it.
 Two inputs are opt-in (only with --range; `OPT_IN`, each drawn from a stream of its own so that every seed's other
 inputs stay as without it).  `floating_axial_ratio`: the floating bearings' mean axial load as a fraction of their
 radial load (drivetrain.floating_axial_ratio; a re-analysis on the sample's basis, like the wheel's side; not applied
-to the double helical family's cylindrical roller and fluid-film bearings, which carry none).  The one exception to
-the one basis per layout is the other, `mount_stiffness_N_per_m`, which stands the housing on an elastic frame.  The
-fixed feet's Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its
+to the double helical family's cylindrical roller and fluid-film bearings, which carry none); with a ratio != 0 each
+sample says per configuration what its floating bearings held and which rings slid (`floating_cells`, samples.csv
+columns; the summary counts the samples in which each configuration's rings slid: `floating_slid_line`).  The one
+exception to the one basis per layout is the other, `mount_stiffness_N_per_m`, which stands the housing on an elastic
+frame.  The fixed feet's Ritz vectors hold no rigid-body motion, so a sample with a mount builds a housing model and bases of its
 own on the elastic feet (`mount_overrides`), every family of the sample runs on them, and a process drops them when
 the next sample brings another mount (`_mount_pool`).
 
@@ -606,6 +608,39 @@ def _misalignment(base: _Base, drivetrain, values: dict):
     return lambda torque: law(torque) + extra
 
 
+def _internals(values: dict) -> dict:
+    """A sample's estimated bearing internals (housingfe.bearings.catalogue.estimated_internals' keywords)."""
+    return {k: values[k] for k in ("clearance_position", "groove_inner", "groove_outer", "spherical_contact_angle_deg",
+                                   "tapered_e_scale")}
+
+
+def floating_label(gear_set: str, bearings: str, torque: float, top: float) -> str:
+    """How a sample's result files name a configuration's floating bearings: "<gear set>_<bearings>", with
+    "_<torque>Nm" at a torque other than the scene's highest `top` (N m)."""
+    return f"{gear_set}_{bearings}" + ("" if float(torque) == float(top) else f"_{float(torque):g}Nm")
+
+
+def floating_cells(base: _Base, values: dict, gear_set: str, bearings: str, torque: float, top: float) -> dict:
+    """What one configuration's floating bearings hold in one sample, as samples.csv cells named
+    "<floating_label>_<column>" (housingfe.studies.design_variants.floating_report_cells: requested and held axial
+    load per shaft, N, and which rings slid): the statics of the sample's drivetrain (its ratio, wheel side) with its
+    estimated internals in effect, which move where a directional locating bearing lifts off
+    (Drivetrain.floating_axial_report).  {} where the floating bearings hold no axial load (ratio 0, or none carried)."""
+    from housingfe.bearings.catalogue import estimated_internals
+    from housingfe.studies.design_variants import floating_report_cells
+
+    with estimated_internals(**_internals(values)):
+        report = perturbed_drivetrain(base, values, gear_set, bearings, torque).floating_axial_report()
+    if not report:
+        return {}
+    label = floating_label(gear_set, bearings, torque, top)
+    return {f"{label}_{k}": v for k, v in floating_report_cells(report).items()}
+
+
+# the samples.csv column (floating_cells) naming the shafts whose floating ring slid, after the configuration's label
+SLID_SUFFIX = "_floating_rings_slid"
+
+
 def _runs(base: _Base, values: dict, gear_set: str, bearings: str, torque: float | None = None,
           engagements: tuple = (None,)) -> tuple:
     """(coupled model, {engagement: RunupResult}) of one configuration in one sample: one Rayleigh-Ritz
@@ -619,9 +654,7 @@ def _runs(base: _Base, values: dict, gear_set: str, bearings: str, torque: float
 
     spec = base.session.spec
     torque = max(spec.torques_nm) if torque is None else float(torque)
-    internals = {k: values[k] for k in ("clearance_position", "groove_inner", "groove_outer",
-                                        "spherical_contact_angle_deg", "tapered_e_scale")}
-    with estimated_internals(**internals):
+    with estimated_internals(**_internals(values)):
         dt = perturbed_drivetrain(base, values, gear_set, bearings, torque)
         start = base.model
         if values["damping_ratio"] != spec.damping_ratio:
@@ -761,6 +794,12 @@ class _SampleRuns:
         self.values = values
         self.curves: dict = {}
         self.failed: dict = {}
+        self.floating: dict = {}        # samples.csv cells of the configurations' floating bearings (floating_cells)
+
+    def note_floating(self, base: _Base, gear_set: str, bearings: str, torque: float) -> None:
+        """Keep what a configuration that ran holds in its floating bearings (floating_cells; nothing at ratio 0)."""
+        self.floating.update(floating_cells(base, self.values, gear_set, bearings, torque,
+                                            max(base.session.spec.torques_nm)))
 
     def get(self, base: _Base, gear_set: str, bearings: str, torque: float | None = None,
             engagements: tuple = (None,)) -> dict | None:
@@ -778,6 +817,7 @@ class _SampleRuns:
             except InputError as exc:
                 self.failed[key] = str(exc)
                 return None
+            self.note_floating(base, gear_set, bearings, torque)
             rad = self.values["radiation"]
             if rad not in base.session.scene.radiation.models:      # another scene's radiation models
                 rad = base.session.scene.radiation.models[0]
@@ -811,7 +851,9 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
     without the process's bases), "setup_s" and "setup_cpu_s" (the bases, wall and CPU, when this sample built
     them: with a mount value (`MOUNT`) every new mount's housing model and bases), "mount" (whether the sample
     stands on a frame) and "rss_mb" (the process's resident memory after the sample).  A sample with a mount value
-    runs every configuration of every family on the housing on that frame (`mount_overrides`).  worker: the call runs in a pool process (its FE on MPI.COMM_SELF)."""
+    runs every configuration of every family on the housing on that frame (`mount_overrides`).  With
+    drivetrain.floating_axial_ratio != 0 also each configuration's floating bearings' held loads (floating_cells).
+    worker: the call runs in a pool process (its FE on MPI.COMM_SELF)."""
     from mpi4py import MPI
 
     comm = MPI.COMM_SELF if worker else MPI.COMM_WORLD
@@ -824,6 +866,7 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
     engagements = (None, REPLICA_ENGAGEMENT) if "profile-corrections" in families else (None,)
     model_a, results_a = _runs(base, values, scene.drivetrain.gear_set, scene.drivetrain.bearings, None, engagements)
     torque = max(base.session.spec.torques_nm)
+    runs.note_floating(base, scene.drivetrain.gear_set, scene.drivetrain.bearings, torque)
     for e, res in results_a.items():       # set A, ball, top torque: the default chain and the families' set A
         runs.curves[(scene.scene.name, scene.drivetrain.gear_set, scene.drivetrain.bearings, torque, e)] = {
             route: res.series(route, rad, torque, "LwA_dB") for route in base.session.spec.routes}
@@ -894,6 +937,7 @@ def evaluate_sample(scene_name: str, overrides: tuple, values: dict, families: t
         out["seconds_double-helical"] = time.perf_counter() - t2
     if runs.failed and not out.get("failed"):
         out["failed"] = "; ".join(f"{k[1]}/{k[2]}@{k[3]:g}: {why}" for k, why in runs.failed.items())
+    out.update(runs.floating)              # with drivetrain.floating_axial_ratio != 0 only (floating_cells)
     out["checks"] = checks
     out["seconds"] = time.perf_counter() - t0
     out["cpu_s"] = time.process_time() - c0          # the machine is shared: CPU time is the steadier measure
@@ -1422,10 +1466,35 @@ def summary_text(result: UncertaintyResult) -> str:
     failed = [m["failed"] for m in result.metrics if m.get("failed")]
     notes = [f"{len(failed)} sample(s) with a configuration that could not run (NaN, left out of the bands): "
              + " | ".join(failed[:3])] if failed else []
+    floating = floating_slid_line(result)
     table = format_table(["route", "quantity", "p5", "median", "p95", "fraction", "driver (Spearman rho)"], rows)
     return "\n".join([head, table, cost, f"driver: the input of largest |rank correlation|; with "
                       f"{len(result.samples)} samples |rho| < {2 / math.sqrt(max(len(result.samples), 1)):.2f} is noise",
-                      *notes])
+                      *([floating] if floating else []), *notes])
+
+
+def floating_slid_line(result: UncertaintyResult) -> str:
+    """The summary's line counting, per configuration (floating_label), in how many of the samples that held an
+    axial load in its floating bearings (drivetrain.floating_axial_ratio != 0) a ring slid, and which shafts':
+    "floating rings slid: A_ball 0/12, B_angular_contact 7/12 (pinion 7, wheel 5), ..." ("" when none held one)."""
+    counts: dict = {}
+    for m in result.metrics:
+        for key, slid in m.items():
+            if key.endswith(SLID_SUFFIX):
+                c = counts.setdefault(key.removesuffix(SLID_SUFFIX), {"slid": 0, "samples": 0})
+                c["samples"] += 1
+                c["slid"] += slid != "none"
+                for shaft in ("" if slid == "none" else slid).split():
+                    c[shaft] = c.get(shaft, 0) + 1
+    if not counts:
+        return ""
+    parts = []
+    for label, c in counts.items():
+        shafts = {k: c[k] for k in sorted(c) if k not in ("slid", "samples")}
+        parts.append(f"{label} {c['slid']}/{c['samples']}"
+                     + (f" ({', '.join(f'{k} {v}' for k, v in shafts.items())})" if shafts else ""))
+    return ("floating rings slid (drivetrain.floating_axial_ratio != 0; held loads per sample in samples.csv "
+            "*_floating_*): " + ", ".join(parts))
 
 
 def _driver(row) -> str:
