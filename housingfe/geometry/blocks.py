@@ -29,6 +29,8 @@ import numpy as np
 # 0.35 x size (worst 0.034 -> 0.089), box-free as tets at 30 and 45 mm at 0.85 and 0.9 x size (0.084, 0.082); all
 # mesh identically twice (docs/stability.md).  HXT stays the last resort, and the mesher string says which ran;
 # meshes with slivers everywhere (MAX_RETRY_SLIVERS) go to it at once.  Meshes that passed before are unchanged.
+# Where the retries fail, points are embedded inside the slivers one refinement leaves (_embed_points_at_slivers):
+# box-free as tets at 56.6 mm, worst 0.031 on HXT (not reproducible), 0.105 so, the same mesh twice.
 # Netgen's optimiser (Mesh.OptimizeNetgen) is not compiled into this gmsh 4.8; Relocate3D does not move the
 # slivers, whose four corners lie on the boundary.
 TET_ALGORITHM = 1
@@ -43,6 +45,11 @@ SLIVER_RETRY_SIZE_FACTORS = (0.95, 0.9, 0.85)
 # no retries where more elements than this are slivers after the refinement (the cases the retries rescue had
 # 2-16; NAFEMS FV12 at t/L = 1/1000 has 7360 of 7362, docs/stability.md)
 MAX_RETRY_SLIVERS = 100
+# where the retries fail, a point is embedded inside each sliver left by one refinement (_embed_points_at_slivers);
+# not where more elements than this are slivers in the plain mesh (FV12 at t/L = 1/1000: 7360)
+MAX_EMBED_SLIVERS = 1000
+# and at most this many rounds of embedding
+EMBED_ROUNDS = 3
 
 FaceClassifier = Callable[[np.ndarray, np.ndarray], Sequence[str]]
 
@@ -273,7 +280,8 @@ def distribute_gmsh_model(comm):
 
 def mesh_tetrahedra(size: float, hxt_fallback: bool = True) -> str:
     """Mesh the current gmsh model with linear tetrahedra of `size` (m) the project's way: every option set,
-    Delaunay on one thread (reproducible), slivers refined away, HXT only where that fails (hxt_fallback;
+    Delaunay on one thread (reproducible), slivers refined away (Delaunay retries, then points embedded in the
+    slivers left), HXT only where that fails (hxt_fallback;
     False keeps Delaunay's best mesh, slivers and all, for the caller's quality rule).  Returns the mesher's
     description for the reports.  Any OCC solid can be meshed so (block models, imported CAD)."""
     import gmsh
@@ -292,6 +300,9 @@ def mesh_tetrahedra(size: float, hxt_fallback: bool = True) -> str:
     retried = _delaunay_retries(size)
     if retried is not None:
         return retried
+    embedded = _embed_points_at_slivers(size)
+    if embedded is not None:
+        return embedded
     _set_tet_size(size)
     _hxt_fallback(size)
     return "gmsh HXT (Delaunay left slivers; HXT is not reproducible run to run)"
@@ -323,6 +334,60 @@ def _delaunay_retries(size: float) -> str | None:
         _remesh_finer_at(np.zeros((0, 3)), factor * size)
         if _refine_slivers(factor * size) >= DELAUNAY_MIN_QUALITY:
             return f"gmsh Delaunay (reproducible; at {factor:g} x size)"
+    return None
+
+
+def _embed_points_at_slivers(size: float) -> str | None:
+    """Last deterministic route before HXT, for slivers the refinement moves rather than removes (box-free as
+    tets at 56.6 mm, 2026-11-28: the plain mesh's 244 slivers sit in the 8 x 8 mm corner columns, one element
+    long; halving the size around them leaves 2-4 flat tets across the 8 mm plates, whose two faces got nearly
+    the same triangulation, four corners in one plane, shape ratio 1e-4).  Re-mesh at `size` (m) with the size
+    halved around the plain mesh's slivers, then put a point inside each sliver still left (its centroid,
+    embedded in its volume: the tetrahedra around it are rebuilt with an interior vertex) and re-mesh, up to
+    EMBED_ROUNDS times.  Returns the mesher's description once the worst shape ratio reaches
+    DELAUNAY_MIN_QUALITY, None if it does not or where more than MAX_EMBED_SLIVERS elements (plain mesh) or
+    MAX_RETRY_SLIVERS (after the refinement) are slivers; the embedded points are then removed again."""
+    import gmsh
+
+    if int((_tet_qualities()[0] < 0.08).sum()) > MAX_EMBED_SLIVERS:
+        return None
+    _set_tet_size(size)
+    _remesh_finer_at(np.zeros((0, 3)), size)
+    q, mid = _tet_qualities()
+    if int((q < 0.08).sum()) > MAX_EMBED_SLIVERS:
+        return None
+    spots = mid[q < 0.08]
+    _remesh_finer_at(spots, size)
+    embedded, slivers = [], len(spots)
+    for _ in range(EMBED_ROUNDS):
+        q, mid = _tet_qualities()
+        if q.min() >= DELAUNAY_MIN_QUALITY:
+            return "gmsh Delaunay (reproducible; slivers refined, points embedded in the rest)"
+        bad = np.flatnonzero(q < 0.08)
+        if len(bad) > min(MAX_RETRY_SLIVERS, slivers):
+            break       # no fewer slivers than before the last points (box-free at 40 mm: 22, 30, 113)
+        slivers = len(bad)
+        # the volume of each sliver, in _tet_qualities' order (all tetrahedra, gmsh's order)
+        volume_of = {}
+        for _, volume in gmsh.model.getEntities(3):
+            for tags in gmsh.model.mesh.getElements(3, volume)[1]:
+                volume_of.update(dict.fromkeys(tags.tolist(), volume))
+        tet_tags = gmsh.model.mesh.getElements(3)[1][0]
+        volumes = [volume_of[int(tet_tags[i])] for i in bad]
+        points = [gmsh.model.occ.addPoint(*mid[i]) for i in bad]
+        embedded += points
+        gmsh.model.occ.synchronize()
+        for point, volume in zip(points, volumes):
+            gmsh.model.mesh.embed(0, [point], 3, volume)
+        _set_tet_size(size)
+        _remesh_finer_at(spots, size)
+    if _tet_qualities()[0].min() >= DELAUNAY_MIN_QUALITY:
+        return "gmsh Delaunay (reproducible; slivers refined, points embedded in the rest)"
+    # the points go again, so that HXT meshes the model as before (left in, box-free at 40 mm got worst 0.004;
+    # removed without removeEmbedded, the volumes kept dangling points: nodes at the origin)
+    gmsh.model.mesh.removeEmbedded(gmsh.model.getEntities(3), 0)
+    gmsh.model.occ.remove([(0, point) for point in embedded])
+    gmsh.model.occ.synchronize()
     return None
 
 
