@@ -139,16 +139,17 @@ def plot(rows: list[dict], path: Path, f: tuple[float, float]):
         for bearings, marker in (("cylindrical_roller", "o"), ("fluid_film", "s")):
             sel = [r for r in rows if r["bearings"] == bearings]
             for w in sorted({r["wheel_um"] for r in sel}):
+                colour = {-1: "C0", 0: "C1", 1: "C2"}[int(np.sign(round(w - NOMINAL_UM[1], 6)))]
                 pts = sorted((r["pinion_um"], r[f"torque_law_{route}_dB"]) for r in sel if r["wheel_um"] == w)
                 ax.plot(*zip(*pts), marker=marker, ls="-" if bearings == "cylindrical_roller" else ":",
-                        label=f"{bearings}, wheel {w:g} um")
+                        color=colour, label=f"{bearings}, wheel {w:g} um")
             if sel:
                 ax.axhline(MEASURED_DB[bearings], color="k", ls="-" if bearings == "cylindrical_roller" else ":",
                            lw=0.8, label=f"measured ({bearings})")
         ax.set_title(f"{route}")
         ax.set_xlabel(f"pinion tip relief (um), +-f_Halpha = {f[0]:g} um")
         ax.grid(alpha=0.3)
-    axes[0].set_ylabel("L_WA(2000) - L_WA(1000 N m), mean 800-1500 rpm (dB(A))")
+    axes[0].set_ylabel("L_WA(2000) - L_WA(1000 N m) (dB(A))\nmean 800-1500 rpm")
     axes[1].legend(fontsize=7)
     fig.suptitle(f"Double helical torque law vs tip-relief amounts (wheel +-f_Halpha = {f[1]:g} um)")
     fig.tight_layout()
