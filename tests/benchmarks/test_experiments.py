@@ -338,3 +338,34 @@ def test_housing_reconstruction_experiment_runs_coarse(tmp_path):
     assert abs(got - gain) < 0.01, (got, gain)
     ratio = float(var["wall 11.5 mm"]["first_housing_mode_Hz"]) / float(var["default"]["first_housing_mode_Hz"])
     assert 1.0 < ratio < 1.15 ** 1.5, ratio
+
+
+def test_relief_tolerance_grid_by_hand_and_coupled_stiffness_follows():
+    """benchmarks/experiments/relief_tolerance: ISO 1328-1:1995 grade 5 f_Halpha = 2 sqrt(m) + 0.14 sqrt(d) + 0.5 um
+    with the geometric means of the ranges m 2-3.5 mm (sqrt 7) and d 50-125 / 280-560 mm: 4.998 -> 5.0 um (pinion),
+    6.539 -> 6.5 um (wheel), so the corner p+w- is (25, 35.5) um.  The amounts are patched where the gear set is
+    built: the coupled model's mean mesh stiffness at 1000 N m drops with more relief (less flank in contact) and the
+    lengths stay Appendix F's 2.2 / 3.3 mm (~3 s)."""
+    import math
+
+    rt = _experiment("relief_tolerance")
+    m, d1, d2 = math.sqrt(2 * 3.5), math.sqrt(50 * 125), math.sqrt(280 * 560)
+    assert abs(2 * math.sqrt(m) + 0.14 * math.sqrt(d1) + 0.5 - 4.998) < 1e-3
+    assert abs(2 * math.sqrt(m) + 0.14 * math.sqrt(d2) + 0.5 - 6.539) < 1e-3
+    assert rt.profile_slope_tolerances() == (5.0, 6.5)
+    assert rt.amounts("p+w-") == (25.0, 35.5) and rt.amounts("p0w0") == (20.0, 42.0)
+    from housingfe.drivetrain.description import test_gearbox
+
+    nominal = test_gearbox("double_helical", "cylindrical_roller", 1000.0)
+    rt.patch_amounts(25.0, 48.5)
+    try:
+        more = test_gearbox("double_helical", "cylindrical_roller", 1000.0)
+    finally:
+        from housingfe.source.roosmalen import run as roosmalen
+        roosmalen.build = roosmalen.build.__wrapped__
+    assert math.isclose(nominal.gears.corrections.tip_relief[0], 20e-6)
+    assert math.isclose(nominal.gears.corrections.tip_relief[1], 42e-6)
+    assert math.isclose(more.gears.corrections.tip_relief[0], 25e-6)
+    assert math.isclose(more.gears.corrections.tip_relief[1], 48.5e-6)
+    assert more.gears.corrections.tip_relief_length == nominal.gears.corrections.tip_relief_length
+    assert more.gear_forces().stiffness < 0.995 * nominal.gear_forces().stiffness
