@@ -3,6 +3,10 @@ VENV ?= .venv
 export OMPI_ALLOW_RUN_AS_ROOT = 1
 export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM = 1
 export OPENBLAS_NUM_THREADS = 1
+# pytest-xdist workers for `make test` ("auto": one per core); mpirun tests then share the cores with the other
+# worker, so idle MPI ranks yield the core instead of spinning (same answers, docs/CONTRIBUTING.md).
+TEST_WORKERS ?= auto
+export OMPI_MCA_mpi_yield_when_idle = 1
 
 .PHONY: bootstrap demo test bench container clean
 
@@ -14,7 +18,7 @@ demo: bootstrap
 	$(VENV)/bin/housingfe run test-gearbox-runup --out results/test-gearbox-runup
 
 test: bootstrap
-	$(VENV)/bin/python -m pytest -q --durations=25 tests
+	$(VENV)/bin/python -m pytest -q --durations=25 -n $(TEST_WORKERS) --dist loadfile tests
 
 bench: bootstrap
 	$(VENV)/bin/housingfe bench modal --out results/bench-modal

@@ -6,6 +6,8 @@ import pytest
 os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT", "1")
 os.environ.setdefault("OMPI_ALLOW_RUN_AS_ROOT_CONFIRM", "1")
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+# under pytest-xdist an mpirun test shares the cores with the other workers: idle ranks yield instead of spinning
+os.environ.setdefault("OMPI_MCA_mpi_yield_when_idle", "1")
 
 
 @pytest.fixture(scope="session")
