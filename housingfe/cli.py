@@ -53,7 +53,7 @@ def _cmd_validate(args: argparse.Namespace) -> int:
 
     validate.main(out_dir=args.out, json_path=args.json, scenes=args.scenes, quick=args.quick,
                   results_dir=args.results, only=args.only,
-                  bands=args.bands)
+                  bands=args.bands, workers=args.workers)
     return 0
 
 
@@ -163,6 +163,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="runup-checks: the check rows of issue 28 alone (checks.md; docs/runup.md)")
     p.add_argument("--bands", default=None, metavar="FILE",
                    help="JSON {check_id: [low, high]}: the model's uncertainty band of each check (checks.md)")
+    p.add_argument("--workers", type=int, default=1, metavar="N",
+                   help="stale FE computations run N at a time, each its own process (default 1)")
     p.set_defaults(func=_cmd_validate, mpi="refuse")
 
     p = sub.add_parser("bench", help="speed-against-error benchmarks (tables, CSV, PNG)")

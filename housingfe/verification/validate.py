@@ -84,14 +84,15 @@ ONLY = {"runup-checks": "housingfe.verification.runup_checks_rows"}
 
 def main(out_dir: str | Path = "results/validate", json_path: str | Path | None = None,
          scenes: list[str] | None = None, quick: bool = False, results_dir: str | Path | None = None,
-         only: str | None = None, bands: str | Path | None = None) -> list[dict]:
+         only: str | None = None, bands: str | Path | None = None, workers: int = 1) -> list[dict]:
     """Collect the rows, print them, write validate.csv and validate.md to out_dir, and the check rows of issue 28
     (housingfe.verification.checks) to checks.csv and checks.md (and the JSON list of rows to json_path if
     given).  scenes: names or paths (only their rows); default every built-in housing scene with a reference and a
     modal analysis plus the other modules' rows; quick: the CI subset; only="runup-checks": the check rows of
     issue 28 alone (runup_checks_rows.only_rows).  results_dir: where FE results are cached (default results/).  bands: a JSON
     file {check_id: [low, high]} of the model's uncertainty bands, attached to the check rows (checks.attach_bands;
-    without it every band is "—").  Raises SolverError (one line) after writing the table when a computation
+    without it every band is "—").  workers: how many of the stale FE computations run at once (each is its own
+    subprocess; prefetch), default 1.  Raises SolverError (one line) after writing the table when a computation
     failed."""
     from housingfe.progress import Progress
 
@@ -99,9 +100,12 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
         raise InputError(f"validate: --only: {only!r} is not one of {', '.join(ONLY)}")
     if only is not None and scenes:
         raise InputError("validate: --only and scene names: give one or the other")
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise InputError(f"validate: --workers: {workers!r} is not a whole number >= 1")
     from housingfe.verification.checks import attach_bands, read_bands
 
     band_table = read_bands(bands) if bands is not None else {}
+    _FAILED.clear()         # a computation that failed in an earlier call is tried again
 
     t0 = time.perf_counter()
     results = Path(results_dir) if results_dir is not None else RESULTS
@@ -117,6 +121,8 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     reserve_output(out_dir, own_files=OWN_FILES)
     if only is not None:
         failures: list[str] = []
+        if workers > 1:
+            prefetch(fe_results(None, results, quick, only=True), workers)
         rows = importlib.import_module(ONLY[only]).only_rows(results, quick, failures)
         attach_bands(rows, band_table)
         write_outputs(rows, Path(out_dir), json_path)
@@ -141,6 +147,8 @@ def main(out_dir: str | Path = "results/validate", json_path: str | Path | None 
     # steps: every scene (computed or taken from its up-to-date cache), the bearing-variant study and the run-up
     # scenes (full run), every row provider
     steps = len(names) + (0 if scenes else (0 if quick else 1 + len(RUNUP_SCENES)) + len(ROW_PROVIDERS))
+    if workers > 1:
+        prefetch(fe_results(names, results, quick, scenes_only=bool(scenes)), workers)
     progress = Progress("validate", steps, "steps")
     for name in names:
         try:
@@ -297,7 +305,10 @@ def write_stamp(folder: Path, scene, files, extra=None) -> None:
 
 def compute(job: dict, scene, folder: Path, results: Path, label: str, extra=None, reason: str = "") -> None:
     """Run `job` in a subprocess (the worker), then stamp the folder with the key of what it imported.
-    Any failure -> ComputationFailed with one line; the full output is kept in <results>/.validate-logs/."""
+    Any failure -> ComputationFailed with one line; the full output is kept in <results>/.validate-logs/.  A
+    computation that already failed in this process (in prefetch) is not run again: its failure is raised."""
+    if folder.resolve() in _FAILED:
+        raise _FAILED[folder.resolve()]
     logs = results / ".validate-logs"
     logs.mkdir(parents=True, exist_ok=True)
     log = logs / f"{folder.name}.log"
@@ -313,10 +324,57 @@ def compute(job: dict, scene, folder: Path, results: Path, label: str, extra=Non
     if proc.returncode != 0 or not deps.is_file():
         lines = [line.strip() for line in proc.stderr.splitlines() if line.strip()]
         last = lines[-1] if lines else "no error message"
-        raise ComputationFailed(f"{label}: exit {proc.returncode}: {last} (log: {log})")
+        _FAILED[folder.resolve()] = ComputationFailed(f"{label}: exit {proc.returncode}: {last} (log: {log})")
+        raise _FAILED[folder.resolve()]
     files = dependency_files(json.loads(deps.read_text()))
     write_stamp(folder, scene, files, extra)
     print(f"validate: {label} done in {time.perf_counter() - t0:.0f} s", flush=True)
+
+
+# result folder -> the ComputationFailed of its computation in this process (compute does not run it twice)
+_FAILED: dict[Path, ComputationFailed] = {}
+
+
+def fe_results(names: list[str] | None, results: Path, quick: bool = False, scenes_only: bool = False,
+               only: bool = False) -> list:
+    """The FE results a validate reads, as callables that compute each when stale (else cost nothing), the longest
+    first: the design-variant study (a few minutes), the run-ups (about a minute each: the three of RUNUP_SCENES
+    and the default as made), the bearing-variant study, then the housing scenes `names`.  scenes_only: the named
+    scenes alone; quick: the housing scenes alone (nothing heavier is computed with --quick); only: the FE results
+    of `--only runup-checks` (the study and the default run-up as periodic and as made)."""
+    from functools import partial
+
+    from housingfe.verification import study_rows
+    from housingfe.verification.checks import AS_MADE_PITCHES
+    from housingfe.verification.runup_checks_rows import as_made_overrides
+
+    jobs = []
+    if not (quick or scenes_only):
+        jobs.append(partial(study_rows.study_folder, results, quick))
+        runups = [(DEFAULT_RUNUP, ())] if only else list(RUNUP_SCENES)
+        runups += [(DEFAULT_RUNUP, as_made_overrides(p)) for p in AS_MADE_PITCHES]
+        jobs += [partial(runup_folder, name, overrides, results, quick) for name, overrides in runups]
+        if not only:
+            jobs.append(partial(bearing_variant_folder, results))
+    jobs += [partial(modal_results, name, results) for name in (names or [])]
+    return jobs
+
+
+def prefetch(jobs: list, workers: int) -> None:
+    """Run `jobs` (fe_results) `workers` at a time.  Each computation is its own subprocess (compute), so threads
+    of concurrent.futures only start and wait on them; a failure is remembered (compute raises it again when the
+    rows are collected, without re-running) and printed there, so here it is passed over."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    t0 = time.perf_counter()
+    with ThreadPoolExecutor(max_workers=workers) as pool:
+        for future in [pool.submit(job) for job in jobs]:
+            try:
+                future.result()
+            except (ComputationFailed, InputError, SolverError):
+                pass
+    print(f"validate: {len(jobs)} FE results up to date ({workers} at a time) in {time.perf_counter() - t0:.0f} s",
+          flush=True)
 
 
 def modal_results(name: str, results: Path | None = None) -> dict | None:
@@ -383,14 +441,7 @@ def bearing_variant_rows(results: Path | None = None) -> list[dict]:
     """Sec. 5.8 / Fig. 5.18: TF_omega of ball minus self-aligning bearings in the test gearbox (thesis FEM 7.3 dB
     mean, s.d. 4.5 dB).  Reuses <results>/bearing-variants-<scene>/variants.json when its key matches, else runs
     the study for VARIANT_CONFIGS first (a few minutes)."""
-    results = RESULTS if results is None else results
-    scene, path = load_housing_scene(VARIANT_SCENE)
-    folder = results / f"bearing-variants-{scene.scene.name}"
-    extra = {"configs": list(VARIANT_CONFIGS)}
-    reason = stale_reason(folder, scene, "variants.json", extra)
-    if reason:
-        compute({"kind": "bearing-variants", "scene": str(path), "configs": list(VARIANT_CONFIGS), "overrides": []},
-                scene, folder, results, f"housingfe bearing-variants --scene {scene.scene.name}", extra, reason)
+    scene, folder = bearing_variant_folder(results)
     with open(folder / "variants.json") as fh:
         data = json.load(fh)
     ref = thesis()["test_gearbox"]["bearings"]
@@ -407,6 +458,20 @@ def bearing_variant_rows(results: Path | None = None) -> list[dict]:
         out.append(row(scene.scene.name, f"TF_omega {label}: s.d. over 320-600 Hz",
                        r["sd_dB_320_600Hz"], ref["fem_TF_ball_minus_self_aligning_sd_dB"], "dB", src))
     return out
+
+
+def bearing_variant_folder(results: Path | None = None) -> tuple:
+    """(scene, folder) of the bearing-variant study's cached result <results>/bearing-variants-<scene>/
+    (variants.json), computed first when its key does not match (a few minutes)."""
+    results = RESULTS if results is None else results
+    scene, path = load_housing_scene(VARIANT_SCENE)
+    folder = results / f"bearing-variants-{scene.scene.name}"
+    extra = {"configs": list(VARIANT_CONFIGS)}
+    reason = stale_reason(folder, scene, "variants.json", extra)
+    if reason:
+        compute({"kind": "bearing-variants", "scene": str(path), "configs": list(VARIANT_CONFIGS), "overrides": []},
+                scene, folder, results, f"housingfe bearing-variants --scene {scene.scene.name}", extra, reason)
+    return scene, folder
 
 
 def runup_folder(name: str, overrides=(), results: Path | None = None, quick: bool = False) -> tuple[str, Path] | None:

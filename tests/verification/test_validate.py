@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from housingfe.errors import SolverError
+from housingfe.errors import InputError, SolverError
 from housingfe.scene import load_housing_scene
 from housingfe.verification import validate
 from housingfe.verification.published import thesis
@@ -264,3 +264,52 @@ def test_main_writes_csv_markdown_and_json(tmp_path, monkeypatch):
     assert top["published"] == 0.0544
     assert (out / "validate.csv").read_text().count("\n") == len(rows) + 1
     assert (out / "validate.md").read_text().startswith("| scene |")
+
+
+def _tiny_plates(tmp_path, names):
+    """Copies of NAFEMS FV12 on a 4 x 4 mesh under other names: scenes that compute in a few seconds."""
+    text = (Path(validate.PACKAGE) / "scenes" / "nafems-fv12.toml").read_text()
+    paths = []
+    for name in names:
+        scene = tmp_path / f"{name}.toml"
+        scene.write_text(text.replace('name = "nafems-fv12"', f'name = "{name}"').replace("size = 0.625", "size = 2.5"))
+        paths.append(str(scene))
+    return paths
+
+
+@pytest.mark.slow
+def test_workers_compute_at_once_and_give_the_rows_of_one_worker(tmp_path, capsys):
+    """`--workers 2`: the two stale scenes are computed by the prefetch, two subprocesses at a time (their logs'
+    start lines both precede either's end), and the rows are those of a one-worker validate from its own empty
+    cache."""
+    scenes = _tiny_plates(tmp_path, ["plate-a", "plate-b"])
+    two = validate.main(out_dir=tmp_path / "v2", scenes=scenes, results_dir=tmp_path / "r2", workers=2)
+    out = capsys.readouterr().out.splitlines()
+    started = [i for i, line in enumerate(out) if line.startswith("validate: computing housingfe run plate-")]
+    done = [i for i, line in enumerate(out) if line.startswith("validate: housingfe run plate-")]
+    assert len(started) == 2 and len(done) == 2 and max(started) < min(done)
+    assert any(line.startswith("validate: 2 FE results up to date (2 at a time)") for line in out)
+    one = validate.main(out_dir=tmp_path / "v1", scenes=scenes, results_dir=tmp_path / "r1")
+    assert [(r["quantity"], r["ours"]) for r in two] == [(r["quantity"], r["ours"]) for r in one]
+    assert len(two) >= 12
+
+
+def test_a_computation_that_failed_in_the_prefetch_is_not_run_again(tmp_path, monkeypatch):
+    """With workers > 1 the prefetch computes first; the failure it met is reported once when the rows are
+    collected, from one subprocess run per scene (the worker counts its runs in a file)."""
+    runs = tmp_path / "runs"
+    monkeypatch.setattr(validate, "_WORKER", f"import sys\nopen({str(runs)!r}, 'a').write('x')\n"
+                                             "print('solver error: boom', file=sys.stderr)\nsys.exit(3)")
+    with pytest.raises(SolverError, match="1 computation.*housingfe run box-free: exit 3: solver error: boom"):
+        validate.main(out_dir=tmp_path / "v", scenes=["box-free"], results_dir=tmp_path / "r", workers=2)
+    assert runs.read_text() == "x"
+    with pytest.raises(SolverError, match="boom"):        # a new call tries again
+        validate.main(out_dir=tmp_path / "v", scenes=["box-free"], results_dir=tmp_path / "r", workers=2)
+    assert runs.read_text() == "xx"
+
+
+@pytest.mark.parametrize("workers", [0, -1, 1.5, True])
+def test_workers_must_be_a_whole_number_of_at_least_one(tmp_path, workers):
+    with pytest.raises(InputError, match="--workers"):
+        validate.main(out_dir=tmp_path / "v", scenes=["box-free"], results_dir=tmp_path / "r", workers=workers)
+    assert not (tmp_path / "v").exists()
