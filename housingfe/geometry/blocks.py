@@ -30,7 +30,9 @@ import numpy as np
 # mesh identically twice (docs/stability.md).  HXT stays the last resort, and the mesher string says which ran;
 # meshes with slivers everywhere (MAX_RETRY_SLIVERS) go to it at once.  Meshes that passed before are unchanged.
 # Where the retries fail, points are embedded inside the slivers one refinement leaves (_embed_points_at_slivers):
-# box-free as tets at 56.6 mm, worst 0.031 on HXT (not reproducible), 0.105 so, the same mesh twice.
+# box-free as tets at 56.6 mm, worst 0.031 on HXT (not reproducible), 0.105 so, the same mesh twice; where that
+# fails, the same after two refinements (box-free as tets at its 40 mm: 22 slivers after one refinement, 30 after
+# the points; 3 after two, 1 after the first points, none after the second: worst 0.090, docs/stability.md).
 # Netgen's optimiser (Mesh.OptimizeNetgen) is not compiled into this gmsh 4.8; Relocate3D does not move the
 # slivers, whose four corners lie on the boundary.
 TET_ALGORITHM = 1
@@ -45,11 +47,14 @@ SLIVER_RETRY_SIZE_FACTORS = (0.95, 0.9, 0.85)
 # no retries where more elements than this are slivers after the refinement (the cases the retries rescue had
 # 2-16; NAFEMS FV12 at t/L = 1/1000 has 7360 of 7362, docs/stability.md)
 MAX_RETRY_SLIVERS = 100
-# where the retries fail, a point is embedded inside each sliver left by one refinement (_embed_points_at_slivers);
+# where the retries fail, a point is embedded inside each sliver left by the refinement (_embed_points_at_slivers);
 # not where more elements than this are slivers in the plain mesh (FV12 at t/L = 1/1000: 7360)
 MAX_EMBED_SLIVERS = 1000
 # and at most this many rounds of embedding
 EMBED_ROUNDS = 3
+# the numbers of refinements (halvings around the slivers, accumulated) tried in turn before the points are embedded
+# (box-free as tets at 40 mm: 22 slivers after one, points fail; 3 after two, points pass)
+EMBED_REFINEMENTS = (1, 2)
 
 FaceClassifier = Callable[[np.ndarray, np.ndarray], Sequence[str]]
 
@@ -300,9 +305,10 @@ def mesh_tetrahedra(size: float, hxt_fallback: bool = True) -> str:
     retried = _delaunay_retries(size)
     if retried is not None:
         return retried
-    embedded = _embed_points_at_slivers(size)
-    if embedded is not None:
-        return embedded
+    for refinements in EMBED_REFINEMENTS:
+        embedded = _embed_points_at_slivers(size, refinements)
+        if embedded is not None:
+            return embedded
     _set_tet_size(size)
     _hxt_fallback(size)
     return "gmsh HXT (Delaunay left slivers; HXT is not reproducible run to run)"
@@ -337,16 +343,17 @@ def _delaunay_retries(size: float) -> str | None:
     return None
 
 
-def _embed_points_at_slivers(size: float) -> str | None:
+def _embed_points_at_slivers(size: float, refinements: int = 1) -> str | None:
     """Last deterministic route before HXT, for slivers the refinement moves rather than removes (box-free as
     tets at 56.6 mm, 2026-11-28: the plain mesh's 244 slivers sit in the 8 x 8 mm corner columns, one element
     long; halving the size around them leaves 2-4 flat tets across the 8 mm plates, whose two faces got nearly
     the same triangulation, four corners in one plane, shape ratio 1e-4).  Re-mesh at `size` (m) with the size
-    halved around the plain mesh's slivers, then put a point inside each sliver still left (its centroid,
-    embedded in its volume: the tetrahedra around it are rebuilt with an interior vertex) and re-mesh, up to
-    EMBED_ROUNDS times.  Returns the mesher's description once the worst shape ratio reaches
-    DELAUNAY_MIN_QUALITY, None if it does not or where more than MAX_EMBED_SLIVERS elements (plain mesh) or
-    MAX_RETRY_SLIVERS (after the refinement) are slivers; the embedded points are then removed again."""
+    halved around the plain mesh's slivers (`refinements` times, each adding the slivers it left to the balls),
+    then put a point inside each sliver still left (its centroid, embedded in its volume: the tetrahedra around
+    it are rebuilt with an interior vertex) and re-mesh, up to EMBED_ROUNDS times.  Returns the mesher's
+    description once the worst shape ratio reaches DELAUNAY_MIN_QUALITY, None if it does not or where more than
+    MAX_EMBED_SLIVERS elements (plain mesh) or MAX_RETRY_SLIVERS (after the refinement) are slivers; the embedded
+    points are then removed again."""
     import gmsh
 
     if int((_tet_qualities()[0] < 0.08).sum()) > MAX_EMBED_SLIVERS:
@@ -359,10 +366,16 @@ def _embed_points_at_slivers(size: float) -> str | None:
     spots = mid[q < 0.08]
     _remesh_finer_at(spots, size)
     embedded, slivers = [], len(spots)
+    for _ in range(refinements - 1):
+        q, mid = _tet_qualities()
+        spots = np.vstack([spots, mid[q < 0.08]])
+        _remesh_finer_at(spots, size)
+    done = "gmsh Delaunay (reproducible; slivers refined{}, points embedded in the rest)".format(
+        "" if refinements == 1 else f" {refinements} times")
     for _ in range(EMBED_ROUNDS):
         q, mid = _tet_qualities()
         if q.min() >= DELAUNAY_MIN_QUALITY:
-            return "gmsh Delaunay (reproducible; slivers refined, points embedded in the rest)"
+            return done
         bad = np.flatnonzero(q < 0.08)
         if len(bad) > min(MAX_RETRY_SLIVERS, slivers):
             break       # no fewer slivers than before the last points (box-free at 40 mm: 22, 30, 113)
@@ -382,7 +395,7 @@ def _embed_points_at_slivers(size: float) -> str | None:
         _set_tet_size(size)
         _remesh_finer_at(spots, size)
     if _tet_qualities()[0].min() >= DELAUNAY_MIN_QUALITY:
-        return "gmsh Delaunay (reproducible; slivers refined, points embedded in the rest)"
+        return done
     # the points go again, so that HXT meshes the model as before (left in, box-free at 40 mm got worst 0.004;
     # removed without removeEmbedded, the volumes kept dangling points: nodes at the origin)
     gmsh.model.mesh.removeEmbedded(gmsh.model.getEntities(3), 0)
