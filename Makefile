@@ -18,7 +18,7 @@ demo: bootstrap
 	$(VENV)/bin/housingfe run test-gearbox-runup --out results/test-gearbox-runup
 
 test: bootstrap
-	$(VENV)/bin/python -m pytest -q --durations=25 -n $(TEST_WORKERS) --dist loadfile tests
+	$(VENV)/bin/python -m pytest -q --durations=25 -n $(TEST_WORKERS) --dist load tests
 
 bench: bootstrap
 	$(VENV)/bin/housingfe bench modal --out results/bench-modal

@@ -129,6 +129,18 @@ def published_rows(results: Path | None = None, quick: bool = False, failures: l
     return out
 
 
+def fe_results(results: Path | None = None, quick: bool = False) -> list:
+    """The FE results these rows read besides the default run-up and the study (validate and study_rows declare
+    those), for `housingfe validate --workers` (validate.fe_results): the default run-up as made, per pitch model,
+    as [(rough seconds, callable computing it when stale)]."""
+    from functools import partial
+
+    from housingfe.verification import validate
+
+    return [(60.0, partial(validate.runup_folder, validate.DEFAULT_RUNUP, as_made_overrides(pitch), results, quick))
+            for pitch in ck.AS_MADE_PITCHES]
+
+
 def only_rows(results: Path, quick: bool = False, failures: list[str] | None = None) -> list[dict]:
     """The check rows of issue 28 alone (`housingfe validate --only runup-checks`): the default run-up's tagged rows,
     the design-variant study's (study_rows), the quasi-static excitation's (source_rows.excitation_rows) and the

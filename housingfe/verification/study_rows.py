@@ -133,6 +133,14 @@ def bound_rows(data: dict) -> list[dict]:
                                       in routes else len(routes), ".mean." not in r["check_id"]))
 
 
+def fe_results(results: Path | None = None, quick: bool = False) -> list:
+    """The FE result these rows read, for `housingfe validate --workers` (validate.fe_results): [(rough seconds,
+    callable computing it when stale)]."""
+    from functools import partial
+
+    return [(240.0, partial(study_folder, results, quick))]
+
+
 def study_folder(results: Path | None = None, quick: bool = False) -> Path | None:
     """<results>/study-validate/ with every job's study.json, computed first when its key does not match (a few
     minutes); with quick a stale result is not computed: None, and a note on the console."""

@@ -338,26 +338,26 @@ _FAILED: dict[Path, ComputationFailed] = {}
 def fe_results(names: list[str] | None, results: Path, quick: bool = False, scenes_only: bool = False,
                only: bool = False) -> list:
     """The FE results a validate reads, as callables that compute each when stale (else cost nothing), the longest
-    first: the design-variant study (a few minutes), the run-ups (about a minute each: the three of RUNUP_SCENES
-    and the default as made), the bearing-variant study, then the housing scenes `names`.  scenes_only: the named
-    scenes alone; quick: the housing scenes alone (nothing heavier is computed with --quick); only: the FE results
-    of `--only runup-checks` (the study and the default run-up as periodic and as made)."""
+    first.  Nothing heavier than the housing scenes `names` with quick or scenes_only; else also the run-ups
+    (RUNUP_SCENES; with only, the default's alone), the bearing-variant study (not with only), and what each row
+    provider declares in its optional `fe_results(results, quick)` -> [(seconds, callable)] (the design-variant
+    study, the default run-up as made; `only`: the providers `--only runup-checks` reads).  The seconds are a rough
+    cost, used for the order alone."""
     from functools import partial
-
-    from housingfe.verification import study_rows
-    from housingfe.verification.checks import AS_MADE_PITCHES
-    from housingfe.verification.runup_checks_rows import as_made_overrides
 
     jobs = []
     if not (quick or scenes_only):
-        jobs.append(partial(study_rows.study_folder, results, quick))
         runups = [(DEFAULT_RUNUP, ())] if only else list(RUNUP_SCENES)
-        runups += [(DEFAULT_RUNUP, as_made_overrides(p)) for p in AS_MADE_PITCHES]
-        jobs += [partial(runup_folder, name, overrides, results, quick) for name, overrides in runups]
+        jobs += [(60.0, partial(runup_folder, name, overrides, results, quick)) for name, overrides in runups]
         if not only:
-            jobs.append(partial(bearing_variant_folder, results))
-    jobs += [partial(modal_results, name, results) for name in (names or [])]
-    return jobs
+            jobs.append((60.0, partial(bearing_variant_folder, results)))
+        providers = ("housingfe.verification.runup_checks_rows", "housingfe.verification.study_rows") if only \
+            else ROW_PROVIDERS
+        for module_name in providers:
+            declared = getattr(importlib.import_module(module_name), "fe_results", None)
+            jobs += declared(results, quick) if declared is not None else []
+    jobs = [job for _, job in sorted(jobs, key=lambda j: -j[0])]       # stable: equal costs keep their order
+    return jobs + [partial(modal_results, name, results) for name in (names or [])]
 
 
 def prefetch(jobs: list, workers: int) -> None:
