@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Literal, Optional, Union
 
 import numpy as np
-from pydantic import Field, PositiveFloat, PositiveInt, field_validator, model_validator
+from pydantic import Field, PositiveFloat, PositiveInt, ValidationInfo, field_validator, model_validator
 
 from housingfe.errors import InputError
 from housingfe.scene import RadiationPlate
@@ -176,6 +176,12 @@ class RunupSpec(_Strict):
     # Eq. 2.62 over the face-width slices; "thesis-2d" is the thesis' two-dimensional shock (the replica);
     # "envelope-bound" the face-width excitation's envelope bound near an integer overlap ratio (a bound, not a model)
     engagement: Literal[ENGAGEMENT_MODELS] = DEFAULT_ENGAGEMENT
+    # a transmission error the user brings instead of the engagement model (housingfe.source.transmission_error;
+    # docs/source.md "A transmission error from a file"): a CSV file (relative to the scene file, else to the current
+    # folder) with columns torque_Nm, harmonic, amplitude_um (or _mm, _m), phase_deg (optional): the quasi-static TE
+    # per tooth harmonic, measured or from another code, at torques that span runup.torques_nm; the mesh stiffness
+    # S(t) stays the model's.  "" (default) = the engagement model
+    transmission_error: str = Field("", json_schema_extra={"unit": "file"})
     # the receptance around the mesh in the source's harmonic balance (housingfe.runup.chain.SOURCE_RECEPTANCES):
     # "coupled" = the coupled gearbox (housing, bearings, shafts, gear bodies) from the Ritz reduction;
     # "rigid-bores" = the lumped interior on rigid bores (the thesis' Ch. 2 source)
@@ -234,6 +240,40 @@ class RunupSpec(_Strict):
     # at which a film carries its load the nearest speed that carries it (flagged in runup.json).  Rolling-element
     # bearings do not depend on speed: the same either way.  Default "follow" (since 2026-11-27; the physical one)
     bearing_speeds: Literal["fixed", "follow"] = "follow"
+
+    @field_validator("transmission_error")
+    @classmethod
+    def _transmission_error(cls, value: str, info: ValidationInfo) -> str:
+        if not value:
+            return ""
+        from housingfe.source.transmission_error import read
+
+        path = Path(value).expanduser()
+        scene = (info.context or {}).get("scene_path") if info is not None else None
+        if not path.is_absolute() and scene is not None and (Path(scene).resolve().parent / path).is_file():
+            path = Path(scene).resolve().parent / path
+        path = path.resolve()
+        try:
+            read(path)
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+        return str(path)
+
+    @model_validator(mode="after")
+    def _transmission_error_torques(self):
+        if not self.transmission_error:
+            return self
+        if "engagement" in self.model_fields_set:
+            raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
+                             f"{self.engagement!r} is set as well: give one of the two")
+        from housingfe.source.transmission_error import read
+
+        te = read(self.transmission_error)
+        for torque in self.torques_nm:
+            problem = te.torque_problem(torque)
+            if problem is not None:
+                raise ValueError(f"transmission_error: {problem} (runup.torques_nm)")
+        return self
 
     @field_validator("as_made", mode="before")
     @classmethod
@@ -505,6 +545,12 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     note = source.overlap_note(reference_torque)      # cached operating point: milliseconds
     notes = [note] if note else []
     notes += [n for t, (m, _) in results.items() if (n := held_speed_note(m, t))]
+    te = source.transmission_error
+    if te is not None:
+        notes.append(f"  excitation: the transmission error of {te.source} (sha256 {te.sha256[:12]}, harmonics "
+                     f"{int(te.harmonics[0])}..{int(te.harmonics[-1])}, torques "
+                     f"{', '.join(f'{t:g}' for t in te.torques)} N m) instead of the engagement model, on the model's "
+                     "mesh stiffness S(t) (runup.transmission_error; docs/source.md)")
     bound = bound_checks = None
     if note:      # the face-width default at the helix's cancellation: the envelope bound on the same models
         from housingfe.runup.chain import engagement_rerun
@@ -541,10 +587,25 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
         if comm.rank == 0:
             report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes,
                          bound, bound_checks, as_made)
+            write_transmission_error(tmp / "transmission_error.csv", source, spec)
     if comm.rank == 0:
         print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
+
+
+def write_transmission_error(path: Path, source, spec: RunupSpec) -> None:
+    """The quasi-static transmission error the run's source had at each torque, harmonics 1..spec.harmonics, in the
+    format runup.transmission_error reads (housingfe.source.transmission_error): the model's, or the file's."""
+    from housingfe.source.transmission_error import write
+
+    what = (f"the file {spec.transmission_error}" if spec.transmission_error else
+            f"the engagement model {spec.engagement!r} on the model's mesh stiffness")
+    count = spec.harmonics
+    write(path, spec.torques_nm, range(1, count + 1),
+          [source.quasi_static_transmission_error(t, count) for t in spec.torques_nm],
+          comment=f"quasi-static transmission error of the run-up's source: {what}\n"
+                  "e = d_qs - mean d_qs, d_qs = (F - F_e) / S(t); t = 0 at the mesh position T1 (docs/source.md)")
 
 
 def _source(drivetrain, spec: RunupSpec, misalignment):
@@ -554,7 +615,13 @@ def _source(drivetrain, spec: RunupSpec, misalignment):
         from housingfe.drivetrain.misalignment import lead_gap_law
 
         misalignment = lead_gap_law(drivetrain, "rigid-bores")
-    return drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement, misalignment=misalignment)
+    te = None
+    if spec.transmission_error:
+        from housingfe.source.transmission_error import read
+
+        te = read(spec.transmission_error)
+    return drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement, misalignment=misalignment,
+                                   transmission_error=te)
 
 
 def matched_drivetrains(ref: HousingRef, model, drivetrains: dict, path) -> tuple[dict, list[dict]]:

@@ -1,6 +1,7 @@
 """Run-up scenes: bad input is one line naming the key, exit 2, no result folder (issue 14's list: an unknown
 gear set, a speed range outside what the source supports, a bearing that cannot carry the load at a torque, a
 missing drivetrain; plus an unknown route or radiator); the built-in scenes validate."""
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -133,4 +134,42 @@ def test_cli_bad_input_one_line_exit_2_no_folder(tmp_path, args, words):
     assert proc.returncode == 2, proc.stderr
     lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
     assert len(lines) == 1 and words in lines[0] and "Traceback" not in proc.stderr, proc.stderr
+    assert not out.exists() and not list(tmp_path.glob(".out*"))
+
+
+def test_transmission_error_file_is_found_beside_the_scene_then_in_the_current_folder(tmp_path, monkeypatch):
+    """runup.transmission_error: relative to the scene file, else to the current folder (a --set on a built-in
+    scene); its torques must span runup.torques_nm; it replaces the engagement model, so both cannot be set."""
+    text = (Path(__file__).parents[2] / "housingfe/scenes/test-gearbox-runup.toml").read_text()
+    (tmp_path / "scene").mkdir()
+    (tmp_path / "scene/te.csv").write_text("torque_Nm,harmonic,amplitude_um\n1000,1,1.0\n2500,1,2.0\n")
+    (tmp_path / "scene/gearbox.toml").write_text(text)
+    scene, _ = load_runup_scene(str(tmp_path / "scene/gearbox.toml"), ['runup.transmission_error="te.csv"'])
+    assert scene.runup.transmission_error == str((tmp_path / "scene/te.csv").resolve())
+    monkeypatch.chdir(tmp_path / "scene")
+    scene, _ = load_runup_scene("test-gearbox-runup", ['runup.transmission_error="te.csv"'])
+    assert scene.runup.transmission_error == str((tmp_path / "scene/te.csv").resolve())
+    assert load_runup_scene("test-gearbox-runup")[0].runup.transmission_error == ""
+    with pytest.raises(InputError, match=r"runup.transmission_error: .*te.csv: has no transmission error at 3000 N m "
+                                         r"\(it gives 1000..2500 N m.*\(runup.torques_nm\)"):
+        load_runup_scene("test-gearbox-runup", ['runup.transmission_error="te.csv"', "runup.torques_nm=[2000.0, 3000.0]"])
+    with pytest.raises(InputError, match=r"runup.transmission_error: the file replaces the engagement model; "
+                                         r"engagement = 'thesis-2d' is set as well"):
+        load_runup_scene("test-gearbox-runup", ['runup.transmission_error="te.csv"', 'runup.engagement="thesis-2d"'])
+    with pytest.raises(InputError, match=r"runup.transmission_error: .*missing.csv: cannot read the transmission "
+                                         r"error file"):
+        load_runup_scene("test-gearbox-runup", ['runup.transmission_error="missing.csv"'])
+
+
+def test_cli_bad_transmission_error_file_one_line_exit_2_no_folder(tmp_path):
+    (tmp_path / "te.csv").write_text("torque_Nm,harmonic,amplitude_um\n2000,1,-3\n")
+    out = tmp_path / "out"
+    proc = subprocess.run(HOUSINGFE + ["run", "test-gearbox-runup", "--out", str(out), "--set",
+                                       "runup.transmission_error=te.csv"], capture_output=True, text=True,
+                          timeout=300, cwd=tmp_path,      # the file is found in the current folder
+                          env={**os.environ, "PYTHONPATH": str(Path(__file__).parents[2])})
+    assert proc.returncode == 2, proc.stderr
+    lines = [ln for ln in proc.stderr.splitlines() if ln.strip()]
+    assert len(lines) == 1 and "runup.transmission_error:" in lines[0] and "te.csv: line 2: amplitude_um: -3 is " \
+        "negative" in lines[0] and "Traceback" not in proc.stderr, proc.stderr
     assert not out.exists() and not list(tmp_path.glob(".out*"))

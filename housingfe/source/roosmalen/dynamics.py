@@ -387,6 +387,18 @@ def engagement_force_envelope_bound(pair: GearPair, corrections: Corrections, st
     return normal_force - S * (d.mean() + np.fft.irfft(coefficients, S.size))
 
 
+def engagement_force_from_transmission_error(stiffness: np.ndarray, normal_force: float,
+                                            transmission_error: np.ndarray) -> np.ndarray:
+    """F_e [N] over one mesh period (samples of `stiffness` S(t) [N/m]) whose quasi-static mesh compression
+    (F - F_e) / S is mean(F / S) + e(t), e = `transmission_error` [m] (samples of the same instants): a TE the user
+    brings (housingfe.source.transmission_error) instead of an engagement model, on the model's own S(t).  The
+    quasi-static excitation k_m (d - mean d) is then k_m e(t) exactly; the constant mean(F / S) (the stiffness-only
+    compression) only sets the static state, which no harmonic sees."""
+    S = np.asarray(stiffness, dtype=float)
+    e = np.asarray(transmission_error, dtype=float)
+    return normal_force - S * (np.mean(normal_force / S) + e)
+
+
 def engagement_shock(model: str, pair: GearPair, corrections: Corrections, stiffness: np.ndarray,
                      normal_force: float, load_share: np.ndarray | None = None) -> np.ndarray:
     """F_e [N] of the engagement model `model` (ENGAGEMENT_MODELS): "thesis-2d" = `engagement_force` (Eq. 2.62,

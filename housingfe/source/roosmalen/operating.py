@@ -80,14 +80,18 @@ class SourceModel:
     balance; speed_range_rpm: the supported pinion speeds (rev/min).  misalignment: the mesh misalignment under
     load (housingfe.source.misalignment) in the stiffness curve and the face-width load share: "none" (aligned
     gears), "lumped" (the static tilt of this model's own 14-DOF interior) or a function torque [N m] ->
-    MeshModel.lead_gap [m/m] (e.g. housingfe.drivetrain.misalignment.lead_gap_law)."""
+    MeshModel.lead_gap [m/m] (e.g. housingfe.drivetrain.misalignment.lead_gap_law).  transmission_error: a TE the
+    user brings (housingfe.source.transmission_error.TransmissionError, e.g. `transmission_error.read("te.csv")`)
+    instead of the engagement model, at every torque within its torques; None (default) = the engagement model."""
 
     def __init__(self, pair: GearPair, corrections: Corrections, interior: dyn.LumpedInterior,
                  geometry: dyn.ShaftGeometry, *, mesh_model: MeshModel | None = None, n_slices: int = 24,
                  torque_configuration: int = 2, stiffness_positions: int = dyn.DEFAULT_STIFFNESS_POSITIONS, harmonics: int = 30,
                  speed_range_rpm: tuple[float, float] = SPEED_RANGE_RPM, engagement: str = dyn.DEFAULT_ENGAGEMENT,
-                 misalignment="none"):
+                 misalignment="none", transmission_error=None):
         self.pair, self.corrections, self.interior, self.geometry = pair, corrections, interior, geometry
+        # a TE the user brings (housingfe.source.transmission_error.TransmissionError) replaces the engagement model
+        self.transmission_error = transmission_error
         self.mesh_model = mesh_model or MeshModel(
             pair, shafts=(ShaftBending(*geometry.pinion_spans, geometry.pinion_shaft_diameter),
                           ShaftBending(*geometry.wheel_spans, geometry.wheel_shaft_diameter)),
@@ -124,7 +128,8 @@ class SourceModel:
         if torque not in self._points:
             self._points[torque] = OperatingPoint(self.pair, self.corrections, self.interior, self.mesh_model,
                                                   torque, self.stiffness_positions, engagement=self.engagement,
-                                                  lead_gap=self.lead_gap(torque))
+                                                  lead_gap=self.lead_gap(torque),
+                                                  transmission_error=self.transmission_error)
         return self._points[torque]
 
     def prepared(self, torques_nm) -> dict:
@@ -195,6 +200,7 @@ class SourceModel:
             raise InputError(f"engagement: {engagement!r} is not one of {', '.join(dyn.ENGAGEMENT_MODELS)}")
         other = copy.copy(self)
         other.engagement = engagement
+        other.transmission_error = None
         other._points = {t: op.with_engagement(self.pair, self.corrections, engagement) for t, op in self._points.items()}
         return other
 
@@ -204,6 +210,8 @@ class SourceModel:
         integer) and how far the envelope bound lies above it at n = 1; None otherwise."""
         from housingfe.source.roosmalen.overlap import cancellation_note
 
+        if self.transmission_error is not None:     # the file's TE, not the face-width model, is the excitation
+            return None
         return cancellation_note(self.pair, self.corrections, self._point(float(torque_nm)))
 
     def centre_of_pressure(self, torque_nm: float):
@@ -221,6 +229,16 @@ class SourceModel:
         from housingfe.source.mesh_friction import FrictionCurve
 
         return FrictionCurve.of_curve(self._point(float(torque_nm)).curve, mu)
+
+    def quasi_static_transmission_error(self, torque_nm: float, count: int) -> np.ndarray:
+        """One-sided complex amplitudes [m] of harmonics 1..count of the quasi-static transmission error
+        e = d_qs - mean d_qs, d_qs = (F - F_e) / S(t), at a pinion torque [N m]: what the source's excitation is
+        (k_m e below the mesh mode), in the phase convention of housingfe.source.transmission_error (the file
+        format it reads and writes)."""
+        from housingfe.source.transmission_error import harmonics_of
+
+        op = self._point(float(torque_nm))
+        return harmonics_of(dyn.quasi_static_compression(op.S, op.shock, op.normal_force), count)
 
     def mesh_stiffness(self, torque_nm: float) -> tuple[np.ndarray, np.ndarray]:
         """(S samples over one mesh period [N/m], F_e samples [N]) at a torque, uniformly spaced (the inputs of

@@ -173,12 +173,16 @@ class OperatingPoint:
     face-width slices with the load share of `face_load_share`, "thesis-2d" is the thesis' Eq. 2.62, "envelope-bound"
     the envelope bound of the face-width excitation (same load share; dynamics.engagement_force_envelope_bound).
     lead_gap [m/m]: the misalignment under load (MeshModel.lead_gap, housingfe.source.misalignment), in the
-    stiffness curve and the load share (0: aligned gears, exactly as before)."""
+    stiffness curve and the load share (0: aligned gears, exactly as before).  transmission_error: a
+    housingfe.source.transmission_error.TransmissionError the user brings, which replaces the engagement model: F_e
+    is then the shock whose quasi-static compression is the file's TE at this torque on the model's S(t)
+    (dyn.engagement_force_from_transmission_error); None (default) = the engagement model."""
 
     def __init__(self, pair, corr, interior, model, torque: float, n_positions: int, n_samples: int = 256,
-                 engagement: str = dyn.DEFAULT_ENGAGEMENT, lead_gap: float = 0.0):
+                 engagement: str = dyn.DEFAULT_ENGAGEMENT, lead_gap: float = 0.0, transmission_error=None):
         self.torque = torque
         self.engagement = engagement
+        self.transmission_error = transmission_error
         self.n_positions = n_positions
         self.lead_gap = float(lead_gap)
         if self.lead_gap != 0.0:
@@ -188,9 +192,14 @@ class OperatingPoint:
         self.curve = stiffness_curve(model, self.normal_force, n_positions)
         t = np.arange(n_samples) / n_samples
         self.S = np.interp(t, self.curve.position, self.curve.stiffness, period=1.0)
-        self.load_share = (face_load_share(model, self.normal_force, n_positions=n_positions)
-                           if engagement in ("face-width", "envelope-bound") else None)
-        self.shock = dyn.engagement_shock(engagement, pair, corr, self.S, self.normal_force, self.load_share)
+        if transmission_error is not None:
+            self.load_share = None
+            self.shock = dyn.engagement_force_from_transmission_error(
+                self.S, self.normal_force, transmission_error.samples(torque, n_samples))
+        else:
+            self.load_share = (face_load_share(model, self.normal_force, n_positions=n_positions)
+                               if engagement in ("face-width", "envelope-bound") else None)
+            self.shock = dyn.engagement_shock(engagement, pair, corr, self.S, self.normal_force, self.load_share)
         self.mats = dyn.assemble(pair, interior, self.curve.mean)
         self.f0 = dyn.preload_force(self.mats, torque)
 
@@ -202,6 +211,7 @@ class OperatingPoint:
             raise InputError(f"engagement: {engagement!r} is not one of {', '.join(dyn.ENGAGEMENT_MODELS)}")
         other = copy.copy(self)
         other.engagement = engagement
+        other.transmission_error = None
         if other.load_share is None and engagement != "thesis-2d":
             other.load_share = face_load_share(self.mesh_model, self.normal_force, n_positions=self.n_positions)
         other.shock = dyn.engagement_shock(engagement, pair, corr, self.S, self.normal_force, other.load_share)

@@ -1,0 +1,38 @@
+"""A run-up driven by a transmission error from a file (runup.transmission_error): the run writes the TE its source
+had, in the format it reads; fed back, it gives the same run-up; twice that TE gives +6.02 dB on tf_omega (the chain
+is linear in the excitation); the summary says which excitation was used."""
+import csv
+import json
+import math
+
+import numpy as np
+
+from housingfe.source import transmission_error as tem
+from tests.runup.test_imported_runup import SETTINGS
+
+
+def _lwa(folder):
+    with open(folder / "runup.csv") as fh:
+        return {(r["route"], float(r["speed_rpm"])): float(r["LwA_dB"]) for r in csv.DictReader(fh)}
+
+
+def test_the_runs_own_te_fed_back_gives_the_same_run_up_and_twice_it_six_decibels(tmp_path, scene_run):
+    default = scene_run("test-gearbox-runup", SETTINGS)           # shared with test_as_made, test_imported_runup
+    own = tem.read(default / "transmission_error.csv")
+    assert own.torques.tolist() == [2000.0] and own.harmonics.tolist() == list(range(1, 31))
+    assert 0.3e-6 < abs(own.amplitudes[0, 0]) < 1.0e-6            # set A's face-width TE, ~0.56 um (docs/source.md)
+
+    fed_back = scene_run("test-gearbox-runup", SETTINGS + [f'runup.transmission_error="{default}/transmission_error.csv"'])
+    ref, back = _lwa(default), _lwa(fed_back)
+    assert ref.keys() == back.keys() and len(ref) == 6
+    assert max(abs(ref[k] - back[k]) for k in ref) < 0.01
+    summary = (fed_back / "summary.txt").read_text()
+    assert "excitation: the transmission error of" in summary and "instead of the engagement model" in summary
+    settings = json.loads((fed_back / "runup.json").read_text())["scene_settings"]["runup"]
+    assert settings["transmission_error"].endswith("transmission_error.csv")
+    assert "instead of the engagement model" not in (default / "summary.txt").read_text()
+
+    tem.write(tmp_path / "twice.csv", own.torques, own.harmonics, 2 * own.amplitudes)
+    twice = _lwa(scene_run("test-gearbox-runup", SETTINGS + [f'runup.transmission_error="{tmp_path}/twice.csv"']))
+    steps = [twice[k] - ref[k] for k in ref if k[0] == "tf_omega"]
+    assert len(steps) == 3 and np.allclose(steps, 20 * math.log10(2), atol=0.01), steps
