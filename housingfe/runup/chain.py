@@ -737,6 +737,30 @@ def engagement_rerun(models: dict, source, engagement: str, speeds_rpm, f_lines_
     return out, time.perf_counter() - t0
 
 
+def te_sensitivity(models: dict, source, harmonics, speeds_rpm, f_lines_max: float,
+                   receptance: str = DEFAULT_SOURCE_RECEPTANCE, routes=("tf_omega", "mesh_force")) -> tuple[dict, float]:
+    """The run-up per micrometre of transmission error: on the SAME coupled models {torque N m: GearboxModel}, the
+    source driven by 1 um of quasi-static TE at one tooth harmonic n alone (a one-line
+    housingfe.source.transmission_error.TransmissionError on the model's S(t)), for each n of `harmonics`, without
+    the mesh moment and the friction (they do not scale with the TE).  The chain is linear in the TE, so a TE of
+    a um at harmonic n gives the line's levels + 20 lg(a); what the gearbox makes of a TE (source dynamics, path,
+    housing, radiation), apart from the TE itself: the designer's TE target, and the source/transfer split of a
+    measured level.  Returns ({torque: {n: RunupResult}}, seconds)."""
+    from housingfe.source.transmission_error import TransmissionError
+
+    t0 = time.perf_counter()
+    out = {}
+    for torque, model in models.items():
+        out[torque] = {}
+        for n in harmonics:
+            unit = TransmissionError(np.array([float(torque)]), np.array([int(n)]), np.array([[1e-6 + 0j]]),
+                                     source=f"1 um at harmonic {int(n)}")
+            lines, _ = run_source(model, source.with_transmission_error(unit), speeds_rpm, [float(torque)],
+                                  f_lines_max, receptance, "none", "none")
+            out[torque][int(n)] = runup(model, None, speeds_rpm, [float(torque)], routes=tuple(routes), lines=lines)
+    return out, time.perf_counter() - t0
+
+
 # ------------------------------------------------------------------------------------------------ routes
 @dataclass
 class RouteResult:

@@ -29,6 +29,11 @@ HARMONIC_COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "harmonic", 
 CHECK_COLUMNS = ("check", "quantity", "ours", "measured", "thesis_calculated", "goal", "passed", "note")
 
 
+# the run-up per micrometre of TE (runup.te_sensitivity): per torque, harmonic n, route, radiation and speed the
+# levels of line n when 1 um of TE at harmonic n alone drives the chain, and the run's total L_WA of that drive
+SENSITIVITY_CSV = "te_sensitivity.csv"
+SENSITIVITY_COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "harmonic", "frequency_hz", "L_omega_dB",
+                       "L_omega_coupled_dB", "Lv_dB", "Lw_dB", "LwA_dB", "LwA_total_dB")
 BOUND_CSV = "runup_envelope_bound.csv"
 BOUND_HARMONICS_CSV = "runup_envelope_bound_harmonics.csv"
 
@@ -70,14 +75,16 @@ def _fmt(v):
 
 def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict,
           decompositions: list = (), notes: list = (), bound: dict | None = None,
-          bound_checks: tuple | None = None, as_made=None) -> None:
+          bound_checks: tuple | None = None, as_made=None, sensitivity: dict | None = None) -> None:
     """Every output file of a run-up into `folder` (rank 0); decompositions: housingfe.runup.slopes
     SlopeDecomposition of every curve; notes: lines for the summary about the model's validity (e.g. the source's
     housingfe.source.roosmalen.overlap.cancellation_note); bound: {torque: RunupResult} of the envelope bound
     (engagement "envelope-bound" on the same models) -> runup_envelope_bound.csv and
     runup_envelope_bound_harmonics.csv; bound_checks: (check rows, peak contributions) of the bound's curves
     (housingfe.runup.checks.evaluate) -> runup.json "envelope_bound"; as_made: housingfe.runup.as_made.AsMadeRun
-    (runup.as_made on) -> runup_as_made.csv and runup.json "as_made"."""
+    (runup.as_made on) -> runup_as_made.csv and runup.json "as_made"; sensitivity: {torque: {n: RunupResult}} of
+    1 um of TE at harmonic n (housingfe.runup.chain.te_sensitivity) -> te_sensitivity.csv and runup.json
+    "te_sensitivity"."""
     totals = [r for _, res in results.values() for r in res.totals]
     outputs.write_csv(folder / "runup.csv", TOTAL_COLUMNS, ([_fmt(r[k]) for k in TOTAL_COLUMNS] for r in totals))
     if bound:
@@ -89,6 +96,9 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         from housingfe.runup import as_made as am
 
         outputs.write_csv(folder / am.CSV, am.COLUMNS, ([_fmt(r[k]) for k in am.COLUMNS] for r in as_made.rows))
+    if sensitivity:
+        outputs.write_csv(folder / SENSITIVITY_CSV, SENSITIVITY_COLUMNS,
+                          ([_fmt(r[k]) for k in SENSITIVITY_COLUMNS] for r in sensitivity_rows(sensitivity)))
     harm = [r for _, res in results.values() for r in res.harmonic_rows()]
     # gears as made in the totals (runup.as_made_totals): a last column says which lines are the sidebands
     columns = HARMONIC_COLUMNS + (("line",) if any(res.lines.incoherent is not None for _, res in results.values())
@@ -113,8 +123,8 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
                                                                             decompositions)))
     _import_pyplot()                    # once, before the pictures are shared out (0.25 s)
     outputs.run_split(pictures, parallel=gm.structure.V.mesh.comm.size == 1)
-    (folder / "summary.txt").write_text(summary_text(scene, results, gm, check_rows, timings, decompositions, notes)
-                                        + "\n")
+    (folder / "summary.txt").write_text(summary_text(scene, results, gm, check_rows, timings, decompositions, notes,
+                                                     sensitivity) + "\n")
     import dolfinx
 
     outputs.write_json(folder / "runup.json", {
@@ -130,6 +140,12 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         "housing_resolution": _resolution(gm),
         "ritz_reanalysis": {f"{t:g}": m.reduction.frequencies_hz[:12].tolist() for t, (m, _) in results.items()},
         "checks": check_rows, "peak_contributions": contributions,
+        "te_sensitivity": ({"harmonics": sorted({n for per in sensitivity.values() for n in per}),
+                            "csv": SENSITIVITY_CSV,
+                            "what": "the run-up driven by 1 um of quasi-static TE at one tooth harmonic alone, on the "
+                                    "same models, without mesh moment and friction (housingfe.runup.chain."
+                                    "te_sensitivity): a TE of a um gives the line's levels + 20 lg(a)"}
+                           if sensitivity else None),
         "slope_terms": [d.to_json() for d in decompositions],
         "envelope_bound": None if not bound_checks else {
             "engagement": "envelope-bound", "what": "a bound, not the model (docs/source.md)", "totals": BOUND_CSV,
@@ -318,8 +334,41 @@ def friction_line(scene, results: dict) -> str | None:
             "on mesh_force (docs/source.md, 'Sliding friction'); tf_omega does not contain it")
 
 
+def sensitivity_rows(sensitivity: dict) -> list[dict]:
+    """Rows of te_sensitivity.csv (SENSITIVITY_COLUMNS) from {torque: {n: RunupResult}} of
+    housingfe.runup.chain.te_sensitivity: the levels of line n (the driven harmonic; the others hold only what the
+    stiffness ripple couples into them) and the total L_WA of each drive."""
+    rows = []
+    for torque, per in sensitivity.items():
+        for n, res in per.items():
+            totals = {(r["route"], r["radiation"], r["speed_rpm"]): r["LwA_dB"] for r in res.totals}
+            for r in res.harmonic_rows():
+                if r["harmonic"] == n:
+                    rows.append({**r, "LwA_total_dB": totals[r["route"], r["radiation"], r["speed_rpm"]]})
+    return rows
+
+
+def sensitivity_lines(scene, sensitivity: dict) -> list[str]:
+    """Summary lines: L_WA per um of TE at each driven harmonic, the scene's first radiation model, at the spectrum
+    speeds the run has."""
+    rad = scene.radiation.models[0]
+    rows = sensitivity_rows(sensitivity)
+    lines = []
+    for torque, per in sensitivity.items():
+        for n in per:
+            for route in scene.runup.routes:
+                got = {r["speed_rpm"]: r["LwA_dB"] for r in rows if r["torque_nm"] == torque and r["harmonic"] == n
+                       and r["route"] == route and r["radiation"] == rad}
+                speeds = [s for s in scene.runup.spectrum_speeds_rpm if s in got]
+                if speeds:
+                    lines.append(f"  {torque:g} N m  {route:10s} harmonic {n}: L_WA per 1 um of TE "
+                                 + " / ".join(f"{got[s]:.1f}" for s in speeds) + " dB(A) at "
+                                 + " / ".join(f"{s:g}" for s in speeds) + " rpm")
+    return ["TE sensitivity (runup.te_sensitivity, te_sensitivity.csv; a TE of a um adds 20 lg(a)):"] + lines
+
+
 def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, decompositions: list = (),
-                 notes: list = ()) -> str:
+                 notes: list = (), sensitivity: dict | None = None) -> str:
     """The console summary: the model, the run-up maxima per route, the notes (one line each), the checks, which
     term makes the speed law (one line per curve, and the table of slopes), the time split."""
     b = gm.basis
@@ -355,6 +404,8 @@ def summary_text(scene, results: dict, gm, check_rows: list, timings: dict, deco
         lines.append(f"drive line: {what} (runup.drive_line) are in the coupled model; its lowest elastic mode "
                      + (f"{b.frequencies_hz[b.rigid_count]:.1f} Hz" if len(b.frequencies_hz) > b.rigid_count else "-"))
     lines += list(notes)
+    if sensitivity:
+        lines += sensitivity_lines(scene, sensitivity)
     lines.append("checks (ours | measured | thesis calc. | pass):")
     for r in check_rows:
         lines.append(f"  {r['quantity']}: {r['ours']} | {_fmt(r['measured'])} | {_fmt(r['thesis_calculated'])} | "

@@ -182,6 +182,11 @@ class RunupSpec(_Strict):
     # per tooth harmonic, measured or from another code, at torques that span runup.torques_nm; the mesh stiffness
     # S(t) stays the model's.  "" (default) = the engagement model
     transmission_error: str = Field("", json_schema_extra={"unit": "file"})
+    # the run-up per micrometre of transmission error (housingfe.runup.chain.te_sensitivity; te_sensitivity.csv): the
+    # tooth harmonics n at which 1 um of TE alone drives the same chain (no mesh moment, no friction): the L_WA a TE
+    # target gives, and how a measured level splits into source and transfer; [] = none (each costs one source and
+    # response pass, ~1 s)
+    te_sensitivity: list[PositiveInt] = Field(default=[1], json_schema_extra={"unit": "tooth harmonic"})
     # the receptance around the mesh in the source's harmonic balance (housingfe.runup.chain.SOURCE_RECEPTANCES):
     # "coupled" = the coupled gearbox (housing, bearings, shafts, gear bodies) from the Ritz reduction;
     # "rigid-bores" = the lumped interior on rigid bores (the thesis' Ch. 2 source)
@@ -258,6 +263,16 @@ class RunupSpec(_Strict):
         except InputError as exc:
             raise ValueError(str(exc)) from None
         return str(path)
+
+    @model_validator(mode="after")
+    def _te_sensitivity(self):
+        if len(set(self.te_sensitivity)) != len(self.te_sensitivity):
+            raise ValueError(f"te_sensitivity: {self.te_sensitivity}: a harmonic is named twice")
+        too_high = [n for n in self.te_sensitivity if n > self.harmonics]
+        if too_high:
+            raise ValueError(f"te_sensitivity: harmonic {too_high[0]} is above the source's runup.harmonics = "
+                             f"{self.harmonics}")
+        return self
 
     @model_validator(mode="after")
     def _transmission_error_torques(self):
@@ -545,6 +560,13 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     note = source.overlap_note(reference_torque)      # cached operating point: milliseconds
     notes = [note] if note else []
     notes += [n for t, (m, _) in results.items() if (n := held_speed_note(m, t))]
+    sensitivity = None
+    if spec.te_sensitivity:         # the chain per um of TE on the same models (~1 s per harmonic)
+        from housingfe.runup.chain import te_sensitivity
+
+        sensitivity, timings["te_sensitivity_s"] = te_sensitivity(
+            {t: m for t, (m, _) in results.items()}, source, spec.te_sensitivity, spec.speeds, spec.f_max_hz,
+            spec.source_receptance, routes=tuple(spec.routes))
     te = source.transmission_error
     if te is not None:
         notes.append(f"  excitation: the transmission error of {te.source} (sha256 {te.sha256[:12]}, harmonics "
@@ -586,10 +608,10 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
             report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes,
-                         bound, bound_checks, as_made)
+                         bound, bound_checks, as_made, sensitivity)
             write_transmission_error(tmp / "transmission_error.csv", source, spec)
     if comm.rank == 0:
-        print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes))
+        print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes, sensitivity))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
 

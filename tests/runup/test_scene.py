@@ -39,6 +39,10 @@ def test_builtin_scenes_validate(name):
     ('runup.drive_line="back-to-front"', "runup.drive_line"),
     ("runup.as_made=13", "runup.as_made"),
     ('runup.as_made="5"', "runup.as_made"),
+    ("runup.te_sensitivity=[1, 1]", "runup.te_sensitivity"),
+    ("runup.te_sensitivity=[31]", "runup.te_sensitivity"),
+    ("runup.te_sensitivity=[0]", "runup.te_sensitivity"),
+    ('runup.transmission_error="no-such-te.csv"', "runup.transmission_error"),
 ])
 def test_bad_values_name_the_key(override, key):
     with pytest.raises(InputError) as err:

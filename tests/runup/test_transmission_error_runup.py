@@ -36,3 +36,23 @@ def test_the_runs_own_te_fed_back_gives_the_same_run_up_and_twice_it_six_decibel
     twice = _lwa(scene_run("test-gearbox-runup", SETTINGS + [f'runup.transmission_error="{tmp_path}/twice.csv"']))
     steps = [twice[k] - ref[k] for k in ref if k[0] == "tf_omega"]
     assert len(steps) == 3 and np.allclose(steps, 20 * math.log10(2), atol=0.01), steps
+
+
+def test_te_sensitivity_is_the_run_up_driven_by_one_micrometre_at_that_harmonic(tmp_path, scene_run):
+    """te_sensitivity.csv (runup.te_sensitivity, default [1]) equals, line by line, the run-up driven by a TE file of
+    1 um at the tooth frequency alone without the mesh moment: two code paths, one answer."""
+    default = scene_run("test-gearbox-runup", SETTINGS)
+    with open(default / "te_sensitivity.csv") as fh:
+        sens = {(r["route"], float(r["speed_rpm"])): float(r["LwA_dB"]) for r in csv.DictReader(fh)
+                if r["harmonic"] == "1"}
+    (tmp_path / "unit.csv").write_text("torque_Nm,harmonic,amplitude_um\n2000,1,1.0\n")
+    unit = scene_run("test-gearbox-runup", SETTINGS + [f'runup.transmission_error="{tmp_path}/unit.csv"',
+                                                       'runup.mesh_moment="none"', "runup.te_sensitivity=[]"])
+    assert not (unit / "te_sensitivity.csv").exists()
+    with open(unit / "runup_harmonics.csv") as fh:
+        line1 = {(r["route"], float(r["speed_rpm"])): float(r["LwA_dB"]) for r in csv.DictReader(fh)
+                 if r["harmonic"] == "1"}
+    assert sens.keys() == line1.keys() and len(sens) == 6
+    assert max(abs(sens[k] - line1[k]) for k in sens) < 1e-6
+    summary = (default / "summary.txt").read_text()
+    assert "TE sensitivity" in summary and "harmonic 1: L_WA per 1 um of TE" in summary

@@ -204,6 +204,15 @@ class SourceModel:
         other._points = {t: op.with_engagement(self.pair, self.corrections, engagement) for t, op in self._points.items()}
         return other
 
+    def with_transmission_error(self, transmission_error) -> "SourceModel":
+        """The same source driven by a TE the user brings (housingfe.source.transmission_error.TransmissionError)
+        instead of its engagement model; the operating points computed so far keep their stiffness curves and
+        matrices and only recompute F_e (OperatingPoint.with_transmission_error)."""
+        other = copy.copy(self)
+        other.transmission_error = transmission_error
+        other._points = {t: op.with_transmission_error(transmission_error) for t, op in self._points.items()}
+        return other
+
     def overlap_note(self, torque_nm: float) -> str | None:
         """The summary line of housingfe.source.roosmalen.overlap.cancellation_note at a pinion torque [N m]: the
         face-width engagement's excitation at the helix's cancellation (overlap ratio within 0.1 of a non-zero

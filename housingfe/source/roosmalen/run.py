@@ -217,6 +217,16 @@ class OperatingPoint:
         other.shock = dyn.engagement_shock(engagement, pair, corr, self.S, self.normal_force, other.load_share)
         return other
 
+    def with_transmission_error(self, transmission_error) -> "OperatingPoint":
+        """This operating point driven by a TE the user brings (housingfe.source.transmission_error
+        .TransmissionError, covering this torque) instead of its engagement model: the stiffness curve, matrices and
+        preload reused, only F_e recomputed (dyn.engagement_force_from_transmission_error)."""
+        other = copy.copy(self)
+        other.transmission_error = transmission_error
+        other.shock = dyn.engagement_force_from_transmission_error(
+            self.S, self.normal_force, transmission_error.samples(self.torque, self.S.size))
+        return other
+
     def steady_state(self, pair: GearPair, speed_rpm: float, harmonics: int) -> dyn.SteadyState:
         return dyn.harmonic_balance(self.mats, self.S, self.shock, self.f0, pair.tooth_frequency(speed_rpm),
                                     H=harmonics)
