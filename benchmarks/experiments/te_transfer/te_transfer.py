@@ -32,9 +32,16 @@ MEASURED_L_OMEGA = {500.0: 109.9, 1000.0: 111.2, 1500.0: 120.8}     # Fig. 5.4, 
 # the thesis' 6 dB(A)-per-doubling overlay through it, around which the measurement scatters by 5-10 dB(A)
 MEASURED_L_WA = {250.0: 74.0, 500.0: 80.0, 1000.0: 86.0, 1500.0: 89.0}
 MEASURED_MAX_L_WA = 100.5
-MOUNT = ['housing.set=["supports.0.kind=elastic","supports.0.total_normal_stiffness=1e9",'
-         '"supports.0.total_tangential_stiffness=3.33333e8"]']
-CASES = {"fixed feet": [], "frame mount K_v 1e9 N/m": MOUNT}
+
+
+def mount(kv: float) -> list[str]:
+    """The frame mount of docs/runup.md: the feet on springs of total normal stiffness kv [N/m], tangential kv / 3."""
+    return [f'housing.set=["supports.0.kind=elastic","supports.0.total_normal_stiffness={kv:g}",'
+            f'"supports.0.total_tangential_stiffness={kv / 3:g}"]']
+
+
+# the fixed feet (the built-in scene) and three frame stiffnesses of the range docs/runup.md measured (not published)
+CASES = {"fixed feet": [], "mount K_v 3e8": mount(3e8), "mount K_v 1e9": mount(1e9), "mount K_v 1e10": mount(1e10)}
 
 
 def run(out: Path, extra: list[str]) -> list[dict]:
@@ -54,7 +61,7 @@ def main(out_dir: Path) -> None:
     with tempfile.TemporaryDirectory(prefix="te-transfer-") as tmp:
         all_rows, maxima = {}, []
         for case, extra in CASES.items():
-            both = run(Path(tmp) / case.split()[0], extra)
+            both = run(Path(tmp) / case.replace(" ", "_"), extra)
             all_rows[case] = [r for r in both if r["harmonic"] == "1"]
             second = {(r["route"], float(r["speed_rpm"])): float(r["LwA_dB"]) for r in both if r["harmonic"] == "2"}
             for r in all_rows[case]:
