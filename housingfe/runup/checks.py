@@ -88,6 +88,37 @@ def _row(check, quantity, ours, measured=None, calculated=None, goal="", passed=
             "passed": "" if passed is None else ("yes" if passed else "no"), "note": note}
 
 
+def te_transfer_rows(scene, sensitivity: dict | None) -> list[dict]:
+    """Set A, ball bearings, 2000 N m: per route, the tooth line's L_WA - L_omega per um of TE at 500 rev/min
+    (te_sensitivity.csv, housingfe.runup.chain.te_sensitivity) beside the measured L_WA there (80 dB(A), the thesis'
+    reference point of the speed law, Sec. 5.5) minus the measured tooth-band L_omega (109.9 dB, Fig. 5.4): what the
+    gearbox makes of a wheel angular velocity at the tooth frequency, whatever the TE (report; the measured L_WA is a
+    total, so "ours - measured" bounds the tooth line's own deficit from above).  L_omega: the rigid-bore source's on
+    tf_omega, the wheel's on the flexible housing on mesh_force.  [] without the sensitivity at n = 1."""
+    dt = scene.drivetrain
+    if not sensitivity or 2000.0 not in sensitivity or 1 not in sensitivity[2000.0]:
+        return []
+    if not (dt.gear_set == "A" and dt.bearings == "ball"):
+        return []
+    tg = thesis()["test_gearbox"]
+    speed, l_wa = 500.0, tg["meas_Lw_500rpm_dBA"]
+    measured = round(l_wa - tg["meas_L_omega_tooth_band_dB"]["500"], 1)
+    res, rad, rows = sensitivity[2000.0][1], scene.radiation.models[0], []
+    for r in res.harmonic_rows():
+        if r["harmonic"] != 1 or r["speed_rpm"] != speed or r["radiation"] != rad:
+            continue
+        route = r["route"]
+        l_omega = r["L_omega_coupled_dB"] if route == "mesh_force" else r["L_omega_dB"]
+        ours = round(float(r["LwA_dB"] - l_omega), 1)
+        rows.append(_row("te_transfer", f"{route}: tooth-line L_WA - L_omega at 500 rpm, dB(A) re dB (per um of TE, "
+                         f"sigma {rad}; measured: L_WA {l_wa:g} dB(A) - tooth-band L_omega)", ours, measured, None,
+                         "report", None,
+                         f"ours - measured {ours - measured:+.1f} dB: with the measured L_omega the tooth line gives "
+                         f"that much L_WA {'less' if ours < measured else 'more'} than the measured total (an upper "
+                         "bound on the tooth line's own deficit; benchmarks/experiments/te_transfer)"))
+    return rows
+
+
 def l_omega_rows(res, measured: dict) -> list[dict]:
     """L_omega of the wheel in the tooth band at the measured speeds (measured {"500": dB, ...}): the rigid-bore
     source's (report) and on the flexible housing (within L_OMEGA_TOLERANCE_DB of the measured: the source's

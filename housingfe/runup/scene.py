@@ -605,6 +605,7 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
                          "added")
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
+    check_rows = check_rows + checks.te_transfer_rows(scene, sensitivity)
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
             report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes,
