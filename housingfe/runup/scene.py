@@ -249,20 +249,12 @@ class RunupSpec(_Strict):
     @field_validator("transmission_error")
     @classmethod
     def _transmission_error(cls, value: str, info: ValidationInfo) -> str:
-        if not value:
-            return ""
-        from housingfe.source.transmission_error import read
+        from housingfe.source.transmission_error import scene_file
 
-        path = Path(value).expanduser()
-        scene = (info.context or {}).get("scene_path") if info is not None else None
-        if not path.is_absolute() and scene is not None and (Path(scene).resolve().parent / path).is_file():
-            path = Path(scene).resolve().parent / path
-        path = path.resolve()
         try:
-            read(path)
+            return scene_file(value, (info.context or {}).get("scene_path") if info is not None else None)
         except InputError as exc:
             raise ValueError(str(exc)) from None
-        return str(path)
 
     @model_validator(mode="after")
     def _te_sensitivity(self):

@@ -93,6 +93,20 @@ class TransmissionError:
         return np.fft.irfft(spectrum, n_samples)
 
 
+def scene_file(value: str, scene_path) -> str:
+    """The absolute path of a scene's `transmission_error` file, validated (`read`): relative to the scene file
+    when it is there, else to the current folder (a --set on a built-in scene); "" stays "".  InputError naming the
+    file for anything `read` cannot take."""
+    if not value:
+        return ""
+    path = Path(value).expanduser()
+    if not path.is_absolute() and scene_path is not None and (Path(scene_path).resolve().parent / path).is_file():
+        path = Path(scene_path).resolve().parent / path
+    path = path.resolve()
+    read(path)
+    return str(path)
+
+
 def harmonics_of(samples: np.ndarray, count: int) -> np.ndarray:
     """One-sided complex amplitudes of harmonics 1..count of samples of one period (the inverse of
     TransmissionError.samples for a band-limited signal)."""

@@ -133,3 +133,32 @@ def test_a_one_micrometre_te_gives_the_mean_stiffness_receptances_l_omega(gearse
         expected = level(abs(w * q[dyn.WHEEL_THETA_Z]) ** 2 / 2, OMEGA0)
         ours = src.operating_point(rpm, 2000.0).L_omega[0]
         assert abs(ours - expected) < 0.05, (rpm, ours, expected)
+
+
+def test_a_source_scene_takes_the_file_beside_it_and_refuses_torques_outside_it(tmp_path):
+    """[source] transmission_error: relative to the scene file; source.torque_Nm and torque_run_Nm must lie within
+    the file's torques; SourceModel.from_scene drives the source with it (the model's own TE fed back: the same
+    tooth-band L_omega)."""
+    from pathlib import Path
+
+    import housingfe
+
+    text = (Path(housingfe.__file__).parent / "scenes" / "gearset-A.toml").read_text()
+    own = SourceModel.from_scene("gearset-A")
+    tem.write(tmp_path / "te.csv", [2000.0], range(1, 61), [own.quasi_static_transmission_error(2000.0, 60)])
+    scene = tmp_path / "a.toml"
+    scene.write_text(text.replace("[source]\n", '[source]\ntransmission_error = "te.csv"\n', 1))
+    with pytest.raises(InputError, match=r"a.toml: source.transmission_error: .*te.csv: has no transmission error at "
+                                         r"400 N m .*\(torque_run_Nm; set it within the file's torques\)"):
+        SourceModel.from_scene(str(scene))
+    scene.write_text(text.replace("[source]\n", '[source]\ntransmission_error = "te.csv"\n', 1)
+                     .replace("torque_run_Nm = [400.0, 800.0, 1200.0, 1600.0, 2000.0]", "torque_run_Nm = [2000.0]"))
+    from_file = SourceModel.from_scene(str(scene))
+    assert from_file.transmission_error is not None and from_file.transmission_error.source.endswith("te.csv")
+    for rpm in (500.0, 1500.0):
+        assert abs(from_file.operating_point(rpm, 2000.0).L_omega_tooth_band
+                   - own.operating_point(rpm, 2000.0).L_omega_tooth_band) < 1e-4
+    scene.write_text(text.replace("[source]\n", '[source]\ntransmission_error = "te.csv"\nengagement = "thesis-2d"\n', 1)
+                     .replace("torque_run_Nm = [400.0, 800.0, 1200.0, 1600.0, 2000.0]", "torque_run_Nm = [2000.0]"))
+    with pytest.raises(InputError, match="the file replaces the engagement model"):
+        SourceModel.from_scene(str(scene))

@@ -117,9 +117,14 @@ class SourceModel:
         data, path = read_scene_dict(str(scene))
         table = roosmalen.parse(data, str(path))
         pair, corr, geometry, interior, model = roosmalen.build(table, str(path))
+        te = None
+        if table.transmission_error:
+            from housingfe.source.transmission_error import read
+
+            te = read(table.transmission_error)
         return cls(pair, corr, interior, geometry, mesh_model=model, stiffness_positions=table.stiffness_positions,
                    harmonics=table.harmonics, speed_range_rpm=(table.speed_min_rpm, table.speed_max_rpm),
-                   engagement=table.engagement)
+                   engagement=table.engagement, transmission_error=te)
 
     def _point(self, torque: float):
         """Stiffness curve, matrices, shock and preload at a torque (cached: they do not depend on speed)."""
@@ -219,8 +224,6 @@ class SourceModel:
         integer) and how far the envelope bound lies above it at n = 1; None otherwise."""
         from housingfe.source.roosmalen.overlap import cancellation_note
 
-        if self.transmission_error is not None:     # the file's TE, not the face-width model, is the excitation
-            return None
         return cancellation_note(self.pair, self.corrections, self._point(float(torque_nm)))
 
     def centre_of_pressure(self, torque_nm: float):

@@ -106,6 +106,8 @@ def cancellation_note(pair: GearPair, corrections: Corrections, point) -> str | 
     eps_b = pair.overlap_ratio
     if point.engagement != "face-width" or not near_integer(eps_b):
         return None
+    if getattr(point, "transmission_error", None) is not None:     # a TE from a file, not the face-width model
+        return None
     b = envelope_bound(pair, corrections, point.S, point.normal_force, point.shock, point.load_share,
                        point.curve.mean, harmonics=1)
     return (f"NOTE: overlap ratio {eps_b:.3f} is near an integer: the face-width engagement's tooth-harmonic "

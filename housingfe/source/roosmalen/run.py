@@ -23,7 +23,16 @@ from pathlib import Path
 from typing import Annotated, Literal, Optional, Union
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PositiveFloat,
+    PositiveInt,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from housingfe.errors import InputError
 from housingfe.outputs import format_table, write_csv, write_json
@@ -120,12 +129,44 @@ class SourceTable(_Strict):
     slices: int = Field(16, ge=2, le=200)
     torque_configuration: Literal[1, 2] = 2
     engagement: Literal[dyn.ENGAGEMENT_MODELS] = dyn.DEFAULT_ENGAGEMENT
+    # a transmission error the user brings instead of the engagement model (housingfe.source.transmission_error;
+    # docs/source.md "A transmission error from a file"): a CSV file relative to the scene file (else to the current
+    # folder) whose torques span torque_Nm and torque_run_Nm; "" (default) = the engagement model
+    transmission_error: str = Field("", json_schema_extra={"unit": "file"})
     measured_L_omega_dB: Optional[dict[str, float]] = None
     gears: GearsTable
     corrections: CorrectionsTable = CorrectionsTable()
     shafts: ShaftsTable = ShaftsTable()
     interior: InteriorTable = InteriorTable()
     bearings: BearingsTable = BearingsTable()
+
+
+    @field_validator("transmission_error")
+    @classmethod
+    def _transmission_error(cls, value: str, info: ValidationInfo) -> str:
+        from housingfe.source.transmission_error import scene_file
+
+        try:
+            return scene_file(value, (info.context or {}).get("scene_path") if info is not None else None)
+        except InputError as exc:
+            raise ValueError(str(exc)) from None
+
+    @model_validator(mode="after")
+    def _transmission_error_torques(self):
+        if not self.transmission_error:
+            return self
+        if "engagement" in self.model_fields_set:
+            raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
+                             f"{self.engagement!r} is set as well: give one of the two")
+        from housingfe.source.transmission_error import read
+
+        te = read(self.transmission_error)
+        for key, torques in (("torque_Nm", [self.torque_Nm]), ("torque_run_Nm", self.torque_run_Nm)):
+            for torque in torques:
+                problem = te.torque_problem(torque)
+                if problem is not None:
+                    raise ValueError(f"transmission_error: {problem} ({key}; set it within the file's torques)")
+        return self
 
 
 def parse(scene: dict, scene_path: str) -> SourceTable:
@@ -298,8 +339,13 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     plt.close(fig)
 
     # ---- stiffness at the scene torque
+    te = None
+    if table.transmission_error:
+        from housingfe.source.transmission_error import read
+
+        te = read(table.transmission_error)
     op = OperatingPoint(pair, corr, interior, model, table.torque_Nm, table.stiffness_positions,
-                        engagement=table.engagement)
+                        engagement=table.engagement, transmission_error=te)
     c = op.curve
     iso = iso6336_stiffness(pair)
     write_csv(out_dir / "stiffness.csv", ["position_fraction_of_pitch", "mesh_stiffness_N_per_m",
@@ -377,7 +423,7 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     torque_rows = []
     for T in table.torque_run_Nm:
         opT = op if T == table.torque_Nm else OperatingPoint(pair, corr, interior, model, T, table.stiffness_positions,
-                                                             engagement=table.engagement)
+                                                             engagement=table.engagement, transmission_error=te)
         st = opT.steady_state(pair, table.torque_run_speed_rpm, H)
         contact.append(dyn.contact_check(st, T, table.torque_run_speed_rpm))
         torque_rows.append([table.torque_run_speed_rpm, T, pair.tooth_frequency(table.torque_run_speed_rpm),
@@ -440,6 +486,17 @@ def run_scene(scene: dict, scene_path: str, out_dir: Path) -> dict:
     note = overlap.cancellation_note(pair, corr, op)     # face-width engagement at a near-integer eps_beta
     if note:
         summary += ["", note]
+    if te is not None:
+        summary += ["", f"excitation: the transmission error of {te.source} (sha256 {te.sha256[:12]}) instead of the "
+                        "engagement model, on the model's mesh stiffness S(t) (source.transmission_error)"]
+    # the quasi-static TE the source had, in the format source.transmission_error / runup.transmission_error read
+    from housingfe.source.transmission_error import harmonics_of, write
+
+    write(out_dir / "transmission_error.csv", [table.torque_Nm], range(1, H + 1),
+          [harmonics_of(dyn.quasi_static_compression(op.S, op.shock, op.normal_force), H)],
+          comment="quasi-static transmission error of the source at source.torque_Nm: "
+                  + (f"the file {te.source}" if te is not None else f"the engagement model {table.engagement!r}")
+                  + "\ne = d_qs - mean d_qs, d_qs = (F - F_e) / S(t); t = 0 at the mesh position T1 (docs/source.md)")
     lost = [x.message for x in contact if x.lost]
     write_json(out_dir / "contact_check.json", {"contact_loss": lost, "min_over_mean_mesh_force": min(
         x.min_force_N / x.mean_force_N for x in contact)})
