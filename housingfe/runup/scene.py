@@ -249,12 +249,9 @@ class RunupSpec(_Strict):
     @field_validator("transmission_error")
     @classmethod
     def _transmission_error(cls, value: str, info: ValidationInfo) -> str:
-        from housingfe.source.transmission_error import scene_file
+        from housingfe.source.transmission_error import validated_scene_file
 
-        try:
-            return scene_file(value, (info.context or {}).get("scene_path") if info is not None else None)
-        except InputError as exc:
-            raise ValueError(str(exc)) from None
+        return validated_scene_file(value, info)
 
     @model_validator(mode="after")
     def _te_sensitivity(self):
@@ -268,8 +265,13 @@ class RunupSpec(_Strict):
 
     @model_validator(mode="after")
     def _transmission_error_torques(self):
-        if not self.transmission_error:
-            return self
+        from housingfe.source.transmission_error import scene_problem
+
+        problem = self.transmission_error and scene_problem(self.transmission_error, "engagement" in self.model_fields_set,
+                                                            self.engagement, {"runup.torques_nm": self.torques_nm})
+        if problem:
+            raise ValueError(problem)
+        return self
         if "engagement" in self.model_fields_set:
             raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
                              f"{self.engagement!r} is set as well: give one of the two")

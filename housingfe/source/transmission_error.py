@@ -107,6 +107,30 @@ def scene_file(value: str, scene_path) -> str:
     return str(path)
 
 
+def validated_scene_file(value: str, info) -> str:
+    """`scene_file` for a pydantic field validator (info: its ValidationInfo, whose context holds the scene's path):
+    InputError becomes the ValueError the validator raises."""
+    try:
+        return scene_file(value, (info.context or {}).get("scene_path") if info is not None else None)
+    except InputError as exc:
+        raise ValueError(str(exc)) from None
+
+
+def scene_problem(file: str, engagement_given: bool, engagement: str, torques: dict) -> str | None:
+    """Why a scene's TE file cannot serve it, or None: `engagement` set beside it (engagement_given), or a torque
+    [N m] of {key: [torques]} outside the file's torques (a message naming the key)."""
+    if engagement_given:
+        return (f"transmission_error: the file replaces the engagement model; engagement = {engagement!r} is set as "
+                "well: give one of the two")
+    te = read(file)
+    for key, values in torques.items():
+        for torque in values:
+            problem = te.torque_problem(torque)
+            if problem is not None:
+                return f"transmission_error: {problem} ({key}; set it within the file's torques)"
+    return None
+
+
 def harmonics_of(samples: np.ndarray, count: int) -> np.ndarray:
     """One-sided complex amplitudes of harmonics 1..count of samples of one period (the inverse of
     TransmissionError.samples for a band-limited signal)."""

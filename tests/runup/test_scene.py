@@ -155,7 +155,7 @@ def test_transmission_error_file_is_found_beside_the_scene_then_in_the_current_f
     assert scene.runup.transmission_error == str((tmp_path / "scene/te.csv").resolve())
     assert load_runup_scene("test-gearbox-runup")[0].runup.transmission_error == ""
     with pytest.raises(InputError, match=r"runup.transmission_error: .*te.csv: has no transmission error at 3000 N m "
-                                         r"\(it gives 1000..2500 N m.*\(runup.torques_nm\)"):
+                                         r"\(it gives 1000..2500 N m.*\(runup.torques_nm; set it within"):
         load_runup_scene("test-gearbox-runup", ['runup.transmission_error="te.csv"', "runup.torques_nm=[2000.0, 3000.0]"])
     with pytest.raises(InputError, match=r"runup.transmission_error: the file replaces the engagement model; "
                                          r"engagement = 'thesis-2d' is set as well"):

@@ -144,17 +144,20 @@ class SourceTable(_Strict):
     @field_validator("transmission_error")
     @classmethod
     def _transmission_error(cls, value: str, info: ValidationInfo) -> str:
-        from housingfe.source.transmission_error import scene_file
+        from housingfe.source.transmission_error import validated_scene_file
 
-        try:
-            return scene_file(value, (info.context or {}).get("scene_path") if info is not None else None)
-        except InputError as exc:
-            raise ValueError(str(exc)) from None
+        return validated_scene_file(value, info)
 
     @model_validator(mode="after")
     def _transmission_error_torques(self):
-        if not self.transmission_error:
-            return self
+        from housingfe.source.transmission_error import scene_problem
+
+        problem = self.transmission_error and scene_problem(
+            self.transmission_error, "engagement" in self.model_fields_set, self.engagement,
+            {"torque_Nm": [self.torque_Nm], "torque_run_Nm": self.torque_run_Nm})
+        if problem:
+            raise ValueError(problem)
+        return self
         if "engagement" in self.model_fields_set:
             raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
                              f"{self.engagement!r} is set as well: give one of the two")
