@@ -182,6 +182,13 @@ def test_one_and_two_ranks_agree(tmp_path, coarse_cli_shuttling):
         for key in ("Lv_dB", "LwA_dB", "L_omega_dB", "L_omega_coupled_dB"):
             assert (ra[key] == rb[key] == "") or float(ra[key]) == pytest.approx(float(rb[key]), abs=1e-6)
     assert two.stdout.count("with the envelope bound: max L_WA") == 1
+    # the run-up per um of TE (runup.te_sensitivity, default n = 1) on the same models: the same on both
+    a, b = _rows(one_dir / "te_sensitivity.csv"), _rows(tmp_path / "two/te_sensitivity.csv")
+    assert len(a) == len(b) == 2 * 2 * 3
+    for ra, rb in zip(a, b):
+        for key in ("Lv_dB", "LwA_dB", "L_omega_dB", "LwA_total_dB"):
+            assert float(ra[key]) == pytest.approx(float(rb[key]), abs=1e-6)
+    assert two.stdout.count("TE sensitivity (runup.te_sensitivity") == 1
 
 
 # the housing of COARSE_CLI on an elastic frame: supports.0 (the feet) with 1e9 N/m vertical, a third of it in plane
