@@ -89,7 +89,8 @@ def _row(check, quantity, ours, measured=None, calculated=None, goal="", passed=
 
 
 def te_transfer_rows(scene, sensitivity: dict | None) -> list[dict]:
-    """Set A, ball bearings, 2000 N m: per route, the tooth line's L_WA - L_omega per um of TE at 500 rev/min
+    """At 2000 N m: `te_target_rows` where the configuration's maximum was measured, and for set A on ball bearings
+    per route the tooth line's L_WA - L_omega per um of TE at 500 rev/min
     (te_sensitivity.csv, housingfe.runup.chain.te_sensitivity) beside the measured L_WA there (80 dB(A), the thesis'
     reference point of the speed law, Sec. 5.5) minus the measured tooth-band L_omega (109.9 dB, Fig. 5.4): what the
     gearbox makes of a wheel angular velocity at the tooth frequency, whatever the TE (report; the measured L_WA is a
@@ -98,12 +99,13 @@ def te_transfer_rows(scene, sensitivity: dict | None) -> list[dict]:
     dt = scene.drivetrain
     if not sensitivity or 2000.0 not in sensitivity or 1 not in sensitivity[2000.0]:
         return []
+    rows = te_target_rows(scene, sensitivity[2000.0][1], measured_lwa_max(dt.gear_set, dt.bearings))
     if not (dt.gear_set == "A" and dt.bearings == "ball"):
-        return []
+        return rows
     tg = thesis()["test_gearbox"]
     speed, l_wa = 500.0, tg["meas_Lw_500rpm_dBA"]
     measured = round(l_wa - tg["meas_L_omega_tooth_band_dB"]["500"], 1)
-    res, rad, rows = sensitivity[2000.0][1], scene.radiation.models[0], []
+    res, rad = sensitivity[2000.0][1], scene.radiation.models[0]
     for r in res.harmonic_rows():
         if r["harmonic"] != 1 or r["speed_rpm"] != speed or r["radiation"] != rad:
             continue
@@ -116,6 +118,25 @@ def te_transfer_rows(scene, sensitivity: dict | None) -> list[dict]:
                          f"ours - measured {ours - measured:+.1f} dB: with the measured L_omega the tooth line gives "
                          f"that much L_WA {'less' if ours < measured else 'more'} than the measured total (an upper "
                          "bound on the tooth line's own deficit; benchmarks/experiments/te_transfer)"))
+    return rows
+
+
+def te_target_rows(scene, unit, measured_max: float | None) -> list[dict]:
+    """Per route, the tooth-frequency TE [um] that would make the measured maximum L_WA (dB(A)) through this chain:
+    10^((measured - max over speed of L_WA per um) / 20), from `unit` (the RunupResult of 1 um at n = 1,
+    housingfe.runup.chain.te_sensitivity), the scene's first radiation model; report.  [] without a measured
+    maximum."""
+    if measured_max is None:
+        return []
+    rad, rows = scene.radiation.models[0], []
+    for route in unit.routes:
+        line = [r for r in unit.harmonic_rows() if r["harmonic"] == 1 and r["route"] == route and r["radiation"] == rad]
+        best = max(line, key=lambda r: r["LwA_dB"])
+        te = 10.0 ** ((measured_max - best["LwA_dB"]) / 20.0)
+        rows.append(_row("te_target", f"{route}: tooth-frequency TE that makes the measured max L_WA {measured_max:g} "
+                         f"dB(A) through this chain, um (sigma {rad})", round(float(te), 2), None, None, "report", None,
+                         f"max L_WA per um of TE at n = 1: {best['LwA_dB']:.1f} dB(A) at {best['speed_rpm']:g} rpm "
+                         "(te_sensitivity.csv; the run's own TE: transmission_error.csv)"))
     return rows
 
 

@@ -550,6 +550,11 @@ def tag_default_runup(r: dict, c: dict, run_checks: list[dict] = ()) -> dict:
         which = "rigid-bore source" if kind == "L_omega" else "flexible housing"
         why = (f"the route's excitation, L_omega in the tooth band ({which}), is {np.mean(gaps):+.1f} dB from the "
                f"measured (mean over the measured speeds 500/1000/1500 rpm the run has: {len(gaps)})") if gaps else ""
+        target = next((x for x in run_checks if x["check"] == "te_target" and x["quantity"].startswith(f"{route}:")),
+                      None)
+        if target is not None:
+            why += ("; " if why else "") + (f"a tooth-frequency TE of {target['ours']} um would make the measured "
+                                            f"maximum through this chain ({target['note'].split(' (')[0]})")
         tag(r, f"28.default.max_lwa.{route}", tolerance="3 dB", why=why, **common)
     elif c["check"] == "speed_law":
         tag(r, f"28.speed_law.{route}", tolerance="2 dB", why=c["note"].split("; total")[0], **common)

@@ -6,6 +6,7 @@ import json
 import math
 
 import numpy as np
+import pytest
 
 from housingfe.source import transmission_error as tem
 from tests.runup.test_imported_runup import SETTINGS
@@ -73,3 +74,24 @@ def test_the_tooth_lines_transfer_at_500_rpm_is_reported_beside_the_measured_rat
         l_omega = float(r["L_omega_coupled_dB"] if c["quantity"].startswith("mesh_force") else r["L_omega_dB"])
         assert c["measured"] == -29.9 and abs(c["ours"] - (float(r["LwA_dB"]) - l_omega)) < 0.051
         assert c["passed"] == "" and "upper bound" in c["note"]
+
+
+def test_the_te_for_the_measured_maximum_is_reported_and_named_in_the_max_lwa_check(scene_run):
+    """checks "te_target": per route 10^((100.5 - max over speed of L_WA per um at n = 1) / 20) um; validate's
+    28.default.max_lwa.<route> row says it in its why."""
+    from housingfe.verification.validate import run_check_rows
+
+    default = scene_run("test-gearbox-runup", SETTINGS)
+    with open(default / "te_sensitivity.csv") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["harmonic"] == "1" and r["radiation"] == "erp"]
+    checks = json.loads((default / "runup.json").read_text())["checks"]
+    targets = {c["quantity"].split(":")[0]: c for c in checks if c["check"] == "te_target"}
+    assert sorted(targets) == ["mesh_force", "tf_omega"]
+    for route, c in targets.items():
+        best = max(float(r["LwA_dB"]) for r in rows if r["route"] == route)
+        assert c["ours"] == pytest.approx(10 ** ((100.5 - best) / 20), rel=0.01)
+        assert c["measured"] is None and c["passed"] == ""
+    tagged = {r["check_id"]: r for r in run_check_rows("test-gearbox-runup", checks) if r.get("check_id")}
+    for route, c in targets.items():
+        assert f"a tooth-frequency TE of {c['ours']} um would make the measured maximum" in \
+            tagged[f"28.default.max_lwa.{route}"]["why"]
