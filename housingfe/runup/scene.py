@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Literal, Optional, Union
 
 import numpy as np
-from pydantic import Field, PositiveFloat, PositiveInt, ValidationInfo, field_validator, model_validator
+from pydantic import Field, PositiveFloat, PositiveInt, field_validator, model_validator
 
 from housingfe.errors import InputError
 from housingfe.scene import RadiationPlate
@@ -36,6 +36,7 @@ from housingfe.scenefile import (
 from housingfe.solvers.blas import single_thread
 from housingfe.source.roosmalen.dynamics import DEFAULT_ENGAGEMENT, ENGAGEMENT_MODELS
 from housingfe.source.roosmalen.operating import SPEED_RANGE_RPM
+from housingfe.source.transmission_error import checked_scene, validated_scene_file
 
 # the engagement the run-up also runs (source + routes on the same models) when the default meets an overlap ratio
 # near an integer (housingfe.source.roosmalen.overlap.cancellation_note): its range, not a model adopted
@@ -246,12 +247,7 @@ class RunupSpec(_Strict):
     # bearings do not depend on speed: the same either way.  Default "follow" (since 2026-11-27; the physical one)
     bearing_speeds: Literal["fixed", "follow"] = "follow"
 
-    @field_validator("transmission_error")
-    @classmethod
-    def _transmission_error(cls, value: str, info: ValidationInfo) -> str:
-        from housingfe.source.transmission_error import validated_scene_file
-
-        return validated_scene_file(value, info)
+    _transmission_error = field_validator("transmission_error")(validated_scene_file)
 
     @model_validator(mode="after")
     def _te_sensitivity(self):
@@ -265,13 +261,7 @@ class RunupSpec(_Strict):
 
     @model_validator(mode="after")
     def _transmission_error_torques(self):
-        from housingfe.source.transmission_error import scene_problem
-
-        problem = self.transmission_error and scene_problem(self.transmission_error, "engagement" in self.model_fields_set,
-                                                            self.engagement, {"runup.torques_nm": self.torques_nm})
-        if problem:
-            raise ValueError(problem)
-        return self
+        return checked_scene(self, {"runup.torques_nm": self.torques_nm})
         if "engagement" in self.model_fields_set:
             raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
                              f"{self.engagement!r} is set as well: give one of the two")

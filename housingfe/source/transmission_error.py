@@ -116,19 +116,22 @@ def validated_scene_file(value: str, info) -> str:
         raise ValueError(str(exc)) from None
 
 
-def scene_problem(file: str, engagement_given: bool, engagement: str, torques: dict) -> str | None:
-    """Why a scene's TE file cannot serve it, or None: `engagement` set beside it (engagement_given), or a torque
-    [N m] of {key: [torques]} outside the file's torques (a message naming the key)."""
-    if engagement_given:
-        return (f"transmission_error: the file replaces the engagement model; engagement = {engagement!r} is set as "
-                "well: give one of the two")
-    te = read(file)
+def checked_scene(table, torques: dict):
+    """A scene table (a pydantic model with `transmission_error` and `engagement`) for its model validator: the table,
+    or the ValueError naming why its TE file cannot serve it -- `engagement` set beside the file, or a torque [N m]
+    of {key: [torques]} outside the file's torques."""
+    if not table.transmission_error:
+        return table
+    if "engagement" in table.model_fields_set:
+        raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
+                         f"{table.engagement!r} is set as well: give one of the two")
+    te = read(table.transmission_error)
     for key, values in torques.items():
         for torque in values:
             problem = te.torque_problem(torque)
             if problem is not None:
-                return f"transmission_error: {problem} ({key}; set it within the file's torques)"
-    return None
+                raise ValueError(f"transmission_error: {problem} ({key}; set it within the file's torques)")
+    return table
 
 
 def harmonics_of(samples: np.ndarray, count: int) -> np.ndarray:

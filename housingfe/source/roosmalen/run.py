@@ -23,16 +23,7 @@ from pathlib import Path
 from typing import Annotated, Literal, Optional, Union
 
 import numpy as np
-from pydantic import (
-    BaseModel,
-    ConfigDict,
-    Field,
-    PositiveFloat,
-    PositiveInt,
-    ValidationInfo,
-    field_validator,
-    model_validator,
-)
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, field_validator, model_validator
 
 from housingfe.errors import InputError
 from housingfe.outputs import format_table, write_csv, write_json
@@ -48,6 +39,7 @@ from housingfe.source.stiffness import (
     normal_force_from_torque,
     stiffness_curve,
 )
+from housingfe.source.transmission_error import checked_scene, validated_scene_file
 
 
 class _Strict(BaseModel):
@@ -141,23 +133,11 @@ class SourceTable(_Strict):
     bearings: BearingsTable = BearingsTable()
 
 
-    @field_validator("transmission_error")
-    @classmethod
-    def _transmission_error(cls, value: str, info: ValidationInfo) -> str:
-        from housingfe.source.transmission_error import validated_scene_file
-
-        return validated_scene_file(value, info)
+    _transmission_error = field_validator("transmission_error")(validated_scene_file)
 
     @model_validator(mode="after")
     def _transmission_error_torques(self):
-        from housingfe.source.transmission_error import scene_problem
-
-        problem = self.transmission_error and scene_problem(
-            self.transmission_error, "engagement" in self.model_fields_set, self.engagement,
-            {"torque_Nm": [self.torque_Nm], "torque_run_Nm": self.torque_run_Nm})
-        if problem:
-            raise ValueError(problem)
-        return self
+        return checked_scene(self, {"torque_Nm": [self.torque_Nm], "torque_run_Nm": self.torque_run_Nm})
         if "engagement" in self.model_fields_set:
             raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
                              f"{self.engagement!r} is set as well: give one of the two")
