@@ -57,3 +57,15 @@ def test_rerun_equals_a_fresh_source_with_the_engagement(coarse, receptance):
     tooth = lines.harmonic == 1
     rise = 20 * np.log10(np.abs(b.mesh_excitation[tooth]) / np.abs(lines.mesh_excitation[tooth]))
     assert np.all(rise > 10.0)           # 17.1 dB on the coarse model
+
+
+def test_te_sensitivity_on_a_source_with_points_at_other_torques(coarse):
+    """runup.te_sensitivity of a run-up at several torques: the unit TE of one torque must not be asked at the
+    source's other torques (found by housingfe validate on the double helical run-ups at 1000 and 2000 N m)."""
+    from housingfe.runup.chain import te_sensitivity
+
+    gm, src, _, _ = coarse
+    src.prepared([1000.0, 2000.0])
+    out, _ = te_sensitivity({2000.0: gm}, src, [1], SPEEDS, F_LINES)
+    assert list(out) == [2000.0] and list(out[2000.0]) == [1]
+    assert all(np.isfinite(r["LwA_dB"]) for r in out[2000.0][1].totals)

@@ -162,3 +162,14 @@ def test_a_source_scene_takes_the_file_beside_it_and_refuses_torques_outside_it(
                      .replace("torque_run_Nm = [400.0, 800.0, 1200.0, 1600.0, 2000.0]", "torque_run_Nm = [2000.0]"))
     with pytest.raises(InputError, match="the file replaces the engagement model"):
         SourceModel.from_scene(str(scene))
+
+
+def test_with_a_te_at_one_torque_the_other_torques_points_are_dropped_not_an_error(gearset_a):
+    """A source whose operating points were computed at 1000 and 2000 N m, driven by a TE given at 2000 N m only (as
+    runup.te_sensitivity does per torque of a multi-torque run-up): 2000 N m works, 1000 N m is the TE's error."""
+    gearset_a.prepared([1000.0, 2000.0])
+    unit = tem.TransmissionError(np.array([2000.0]), np.array([1]), np.array([[1e-6 + 0j]]), source="unit")
+    driven = gearset_a.with_transmission_error(unit)
+    assert np.isfinite(driven.operating_point(500.0, 2000.0).L_omega_tooth_band)
+    with pytest.raises(InputError, match="unit: has no transmission error at 1000 N m"):
+        driven.operating_point(500.0, 1000.0)

@@ -211,11 +211,13 @@ class SourceModel:
 
     def with_transmission_error(self, transmission_error) -> "SourceModel":
         """The same source driven by a TE the user brings (housingfe.source.transmission_error.TransmissionError)
-        instead of its engagement model; the operating points computed so far keep their stiffness curves and
-        matrices and only recompute F_e (OperatingPoint.with_transmission_error)."""
+        instead of its engagement model; the operating points computed so far at torques the TE covers keep their
+        stiffness curves and matrices and only recompute F_e (OperatingPoint.with_transmission_error); the others
+        are dropped (asking for them is then the TE's InputError, as for a torque never computed)."""
         other = copy.copy(self)
         other.transmission_error = transmission_error
-        other._points = {t: op.with_transmission_error(transmission_error) for t, op in self._points.items()}
+        other._points = {t: op.with_transmission_error(transmission_error) for t, op in self._points.items()
+                         if transmission_error.torque_problem(t) is None}
         return other
 
     def overlap_note(self, torque_nm: float) -> str | None:
