@@ -158,6 +158,25 @@ def naming_the_override(exc: InputError, overrides: list[str] | None, source: st
     return exc
 
 
+def scene_file_key(value: str, info, read) -> str:
+    """A file-valued scene key for a pydantic field validator: "" stays ""; else the absolute path -- relative to the
+    scene file when the file is there, else to the current folder (a --set on a built-in scene) -- checked by
+    `read(path)` (which raises InputError naming the file for what it cannot take: that becomes the validator's
+    ValueError).  info: the validator's ValidationInfo, whose context holds the scene's path (parse_table)."""
+    if not value:
+        return ""
+    scene_path = (info.context or {}).get("scene_path") if info is not None else None
+    path = Path(value).expanduser()
+    if not path.is_absolute() and scene_path is not None and (Path(scene_path).resolve().parent / path).is_file():
+        path = Path(scene_path).resolve().parent / path
+    path = path.resolve()
+    try:
+        read(path)
+    except InputError as exc:
+        raise ValueError(str(exc)) from None
+    return str(path)
+
+
 def parse_table(model_cls, data, path, prefix: str = ""):
     """model_cls.model_validate(data), or InputError "<path>: <prefix><key>: <problem>" naming the first bad
     key (an unknown key before the missing one it causes).  Shared by every kind of scene."""

@@ -32,6 +32,8 @@ CHECK_COLUMNS = ("check", "quantity", "ours", "measured", "thesis_calculated", "
 # the run-up per micrometre of TE (runup.te_sensitivity): per torque, harmonic n, route, radiation and speed the
 # levels of line n when 1 um of TE at harmonic n alone drives the chain, and the run's total L_WA of that drive
 SENSITIVITY_CSV = "te_sensitivity.csv"
+# the user's measured run-up beside ours (runup.measured; housingfe.runup.measured.COMPARISON_COLUMNS)
+MEASURED_CSV = "measured_comparison.csv"
 SENSITIVITY_COLUMNS = ("route", "radiation", "torque_nm", "speed_rpm", "harmonic", "frequency_hz", "L_omega_dB",
                        "L_omega_coupled_dB", "Lv_dB", "Lw_dB", "LwA_dB", "LwA_total_dB")
 BOUND_CSV = "runup_envelope_bound.csv"
@@ -75,7 +77,8 @@ def _fmt(v):
 
 def write(folder: Path, scene, results: dict, gm, check_rows: list, contributions: list, timings: dict,
           decompositions: list = (), notes: list = (), bound: dict | None = None,
-          bound_checks: tuple | None = None, as_made=None, sensitivity: dict | None = None) -> None:
+          bound_checks: tuple | None = None, as_made=None, sensitivity: dict | None = None,
+          comparison: dict | None = None) -> None:
     """Every output file of a run-up into `folder` (rank 0); decompositions: housingfe.runup.slopes
     SlopeDecomposition of every curve; notes: lines for the summary about the model's validity (e.g. the source's
     housingfe.source.roosmalen.overlap.cancellation_note); bound: {torque: RunupResult} of the envelope bound
@@ -84,7 +87,8 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
     (housingfe.runup.checks.evaluate) -> runup.json "envelope_bound"; as_made: housingfe.runup.as_made.AsMadeRun
     (runup.as_made on) -> runup_as_made.csv and runup.json "as_made"; sensitivity: {torque: {n: RunupResult}} of
     1 um of TE at harmonic n (housingfe.runup.chain.te_sensitivity) -> te_sensitivity.csv and runup.json
-    "te_sensitivity"."""
+    "te_sensitivity"; comparison: the measured run-up beside ours (housingfe.runup.scene.measured_comparison,
+    runup.measured) -> measured_comparison.csv, runup.json "measured" and its points on runup.png."""
     totals = [r for _, res in results.values() for r in res.totals]
     outputs.write_csv(folder / "runup.csv", TOTAL_COLUMNS, ([_fmt(r[k]) for k in TOTAL_COLUMNS] for r in totals))
     if bound:
@@ -96,6 +100,11 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
         from housingfe.runup import as_made as am
 
         outputs.write_csv(folder / am.CSV, am.COLUMNS, ([_fmt(r[k]) for k in am.COLUMNS] for r in as_made.rows))
+    if comparison is not None:
+        from housingfe.runup import measured
+
+        outputs.write_csv(folder / MEASURED_CSV, measured.COMPARISON_COLUMNS,
+                          ([_fmt(r[k]) for k in measured.COMPARISON_COLUMNS] for r in comparison["rows"]))
     if sensitivity:
         outputs.write_csv(folder / SENSITIVITY_CSV, SENSITIVITY_COLUMNS,
                           ([_fmt(r[k]) for k in SENSITIVITY_COLUMNS] for r in sensitivity_rows(sensitivity)))
@@ -114,7 +123,8 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
                               ([_fmt(r[k]) for k in columns] for r in rows))
             pictures.append((PICTURE_COST_S["spectrum"], lambda rows=rows, speed=speed: spectrum_plot(
                 folder / f"spectra_{speed:g}rpm.png", rows, speed, scene.radiation.models[0])))
-    pictures.append((PICTURE_COST_S["runup"], lambda: runup_plot(folder / "runup.png", scene, totals)))
+    pictures.append((PICTURE_COST_S["runup"], lambda: runup_plot(folder / "runup.png", scene, totals,
+                                                                         comparison)))
     if decompositions:
         outputs.write_csv(folder / "slope_terms.csv", slope_terms.SLOPE_COLUMNS,
                           ([_fmt(r[k]) for k in slope_terms.SLOPE_COLUMNS]
@@ -147,6 +157,10 @@ def write(folder: Path, scene, results: dict, gm, check_rows: list, contribution
                                     "te_sensitivity): a TE of a um gives the line's levels + 20 lg(a)"}
                            if sensitivity else None),
         "slope_terms": [d.to_json() for d in decompositions],
+        "measured": None if comparison is None else {
+            "file": comparison["measured"].source, "sha256": comparison["measured"].sha256, "csv": MEASURED_CSV,
+            "outside_speeds": comparison["outside"], "statistics": comparison["statistics"],
+            "what": "ours - measured at the measured speeds (ours linear in speed; housingfe.runup.measured)"},
         "envelope_bound": None if not bound_checks else {
             "engagement": "envelope-bound", "what": "a bound, not the model (docs/source.md)", "totals": BOUND_CSV,
             "harmonics": BOUND_HARMONICS_CSV, "checks": bound_checks[0], "peak_contributions": bound_checks[1]},
@@ -205,8 +219,9 @@ def spectrum_plot(path: Path, rows: list, speed: float, radiation: str) -> None:
     plt.close(fig)
 
 
-def runup_plot(path: Path, scene, totals: list) -> None:
-    """L_omega, L_v and L_WA over speed (like Figs. 5.4/5.7/5.10) with the measured points of set A."""
+def runup_plot(path: Path, scene, totals: list, comparison: dict | None = None) -> None:
+    """L_omega, L_v and L_WA over speed (like Figs. 5.4/5.7/5.10) with the measured points of set A, and those of
+    a measured run-up the user brought (comparison: housingfe.runup.scene.measured_comparison; L_W is not drawn)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -244,6 +259,12 @@ def runup_plot(path: Path, scene, totals: list) -> None:
         axes[2].plot([250, 500, 1000, 1500], [74, 80, 86, 89], "rs", ms=7, label="measured, speed law (Fig. 5.10)")
         axes[2].axhline(tg["meas_Lw_max_dBA"], color="r", ls="--", alpha=0.6, label="measured max 100.5")
         axes[2].axhline(tg["calc_Lw_max_dBA"], color="gray", ls="--", alpha=0.6, label="thesis calc. max 89.4")
+    if comparison is not None:
+        axis = {"L_omega_dB": 0, "L_v_dB": 1, "L_WA_dBA": 2}
+        for (quantity, torque), (speeds, values) in comparison["measured"].series.items():
+            if quantity in axis:
+                axes[axis[quantity]].plot(speeds, values, "D", mfc="none", color="m", ms=7,
+                                          label="measured (runup.measured)" + (f", {torque:g} N m" if torque else ""))
     for ax, label in zip(axes, ("L_omega, tooth band (dB re 5e-8 rad/s)", "L_v, all harmonics (dB re 5e-8 m/s)",
                                 f"L_WA (dB(A) re 1 pW), sigma: {rad}")):
         ax.set_xlabel("pinion speed (rev/min)")

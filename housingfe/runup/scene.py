@@ -188,6 +188,12 @@ class RunupSpec(_Strict):
     # target gives, and how a measured level splits into source and transfer; [] = none (each costs one source and
     # response pass, ~1 s)
     te_sensitivity: list[PositiveInt] = Field(default=[1], json_schema_extra={"unit": "tooth harmonic"})
+    # a measured run-up laid over the chain's (housingfe.runup.measured; docs/runup.md "Your measured run-up beside
+    # the chain's"): a CSV file (relative to the scene file, else to the current folder) with columns speed_rpm,
+    # torque_Nm (optional with one torque) and one or more of L_WA_dBA, L_W_dB, L_v_dB, L_omega_dB (the chain's dB
+    # references); its torques must be the run's.  Writes measured_comparison.csv, the summary's ours - measured
+    # (mean +- s.d., maxima, slopes), runup.json "measured" and the points on runup.png.  "" (default) = none
+    measured: str = Field("", json_schema_extra={"unit": "file"})
     # the receptance around the mesh in the source's harmonic balance (housingfe.runup.chain.SOURCE_RECEPTANCES):
     # "coupled" = the coupled gearbox (housing, bearings, shafts, gear bodies) from the Ritz reduction;
     # "rigid-bores" = the lumped interior on rigid bores (the thesis' Ch. 2 source)
@@ -249,6 +255,20 @@ class RunupSpec(_Strict):
 
     _transmission_error = field_validator("transmission_error")(validated_scene_file)
 
+    @field_validator("measured")
+    @classmethod
+    def _measured_file(cls, value, info):
+        from housingfe.runup import measured
+        from housingfe.scenefile import scene_file_key
+
+        return scene_file_key(value, info, measured.read)
+
+    @model_validator(mode="after")
+    def _measured_torques(self):
+        from housingfe.runup.measured import checked_scene as measured_checked
+
+        return measured_checked(self)
+
     @model_validator(mode="after")
     def _te_sensitivity(self):
         if len(set(self.te_sensitivity)) != len(self.te_sensitivity):
@@ -262,17 +282,6 @@ class RunupSpec(_Strict):
     @model_validator(mode="after")
     def _transmission_error_torques(self):
         return checked_scene(self, {"runup.torques_nm": self.torques_nm})
-        if "engagement" in self.model_fields_set:
-            raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
-                             f"{self.engagement!r} is set as well: give one of the two")
-        from housingfe.source.transmission_error import read
-
-        te = read(self.transmission_error)
-        for torque in self.torques_nm:
-            problem = te.torque_problem(torque)
-            if problem is not None:
-                raise ValueError(f"transmission_error: {problem} (runup.torques_nm)")
-        return self
 
     @field_validator("as_made", mode="before")
     @classmethod
@@ -590,15 +599,33 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     decompositions = [d for _, res in results.values() for d in slopes.decompose_all(res)]
     timings["total_s"] = time.perf_counter() - t_start
     check_rows = check_rows + checks.te_transfer_rows(scene, sensitivity)
+    comparison = None
+    if spec.measured:       # the user's measured run-up beside ours (housingfe.runup.measured)
+        comparison = measured_comparison(spec, [r for _, res in results.values() for r in res.totals])
+        notes += comparison["summary"]
     with outputs.atomic_output_dir(out, comm) as tmp:
         if comm.rank == 0:
             report.write(tmp, scene, results, gm, check_rows, contributions, timings, decompositions, notes,
-                         bound, bound_checks, as_made, sensitivity)
+                         bound, bound_checks, as_made, sensitivity, comparison)
             write_transmission_error(tmp / "transmission_error.csv", source, spec)
     if comm.rank == 0:
         print(report.summary_text(scene, results, gm, check_rows, timings, decompositions, notes, sensitivity))
         print(f"total wall time {time.perf_counter() - t_start:.1f} s; results: {out}/")
     return out
+
+
+def measured_comparison(spec: RunupSpec, totals: list[dict]) -> dict:
+    """The run's totals (runup.csv rows) beside the measured run-up of spec.measured (housingfe.runup.measured):
+    {"measured": MeasuredRunup, "rows": compare's rows, "statistics": per series, "outside": measured points outside
+    the run's speeds, "summary": the summary's lines (first radiation model)}."""
+    from housingfe.runup import measured
+
+    data = measured.read(spec.measured)
+    rows, outside = measured.compare(data, totals, spec.torques_nm)
+    stats = measured.statistics(rows)
+    radiation = totals[0]["radiation"] if totals else ""
+    return {"measured": data, "rows": rows, "statistics": stats, "outside": outside,
+            "summary": measured.summary_lines(data, stats, outside, radiation)}
 
 
 def write_transmission_error(path: Path, source, spec: RunupSpec) -> None:

@@ -93,27 +93,12 @@ class TransmissionError:
         return np.fft.irfft(spectrum, n_samples)
 
 
-def scene_file(value: str, scene_path) -> str:
-    """The absolute path of a scene's `transmission_error` file, validated (`read`): relative to the scene file
-    when it is there, else to the current folder (a --set on a built-in scene); "" stays "".  InputError naming the
-    file for anything `read` cannot take."""
-    if not value:
-        return ""
-    path = Path(value).expanduser()
-    if not path.is_absolute() and scene_path is not None and (Path(scene_path).resolve().parent / path).is_file():
-        path = Path(scene_path).resolve().parent / path
-    path = path.resolve()
-    read(path)
-    return str(path)
-
-
 def validated_scene_file(value: str, info) -> str:
-    """`scene_file` for a pydantic field validator (info: its ValidationInfo, whose context holds the scene's path):
-    InputError becomes the ValueError the validator raises."""
-    try:
-        return scene_file(value, (info.context or {}).get("scene_path") if info is not None else None)
-    except InputError as exc:
-        raise ValueError(str(exc)) from None
+    """The `transmission_error` key of a scene for a pydantic field validator (housingfe.scenefile.scene_file_key):
+    the absolute path of a file `read` takes, relative to the scene file when it is there; "" stays ""."""
+    from housingfe.scenefile import scene_file_key
+
+    return scene_file_key(value, info, read)
 
 
 def checked_scene(table, torques: dict):
