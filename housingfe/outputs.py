@@ -400,33 +400,38 @@ TERMINAL_WIDTH = 120   # the widest table a terminal is shown (the CSV / Markdow
 
 
 def format_table(header: Sequence[str], rows: Sequence[Sequence], floatfmt: str = "{:.4g}",
-                 width: int | None = TERMINAL_WIDTH) -> str:
+                 width: int | None = TERMINAL_WIDTH, keys: int = 1) -> str:
     """A plain-text table with aligned columns (for terminals and summary.txt), at most `width` characters wide
-    (None: any width).  A wider table is split into blocks of columns, each repeating the first column; a text
-    column still too wide for one block is shortened with "…" (the full text belongs in the CSV beside it)."""
+    (None: any width).  A wider table is split into blocks of columns, each repeating the first `keys` columns
+    (those that tell the rows apart); a text column still too wide for one block is shortened with "…" (the full
+    text belongs in the CSV beside it)."""
     cells = [[str(h) for h in header]]
     for row in rows:
         cells.append([floatfmt.format(v) if isinstance(v, float) else str(v) for v in row])
     widths = [max(len(r[i]) for r in cells) for i in range(len(header))]
+    keys = max(1, min(keys, len(widths) - 1))
     if width is None or sum(widths) + 2 * (len(widths) - 1) <= width or len(widths) < 2:
         return _aligned(cells, widths)
-    # every column must fit beside the first one: shorten the first, then each other, to half the width
+    # every column must fit beside the key columns: the keys together, then each other column, to half the width
+    # (the first key column gives up what the keys exceed)
     limit = width // 2 - 1
+    cut = [max(4, widths[0] - (sum(widths[:keys]) + 2 * (keys - 1) - limit))] + [limit] * (len(widths) - 1)
     for i in range(len(widths)):
-        if widths[i] > limit:
+        if widths[i] > cut[i]:
             for r in cells:
-                if len(r[i]) > limit:
-                    r[i] = r[i][:limit - 1] + "…"
-            widths[i] = limit
+                if len(r[i]) > cut[i]:
+                    r[i] = r[i][:cut[i] - 1] + "…"
+            widths[i] = cut[i]
+    key_width = sum(widths[:keys]) + 2 * (keys - 1)
     blocks, current = [], []
-    for i in range(1, len(widths)):
-        if current and widths[0] + sum(widths[j] + 2 for j in current + [i]) > width:
+    for i in range(keys, len(widths)):
+        if current and key_width + sum(widths[j] + 2 for j in current + [i]) > width:
             blocks.append(current)
             current = []
         current.append(i)
     blocks.append(current)
-    return "\n\n".join(_aligned([[r[0]] + [r[j] for j in block] for r in cells],
-                                 [widths[0]] + [widths[j] for j in block]) for block in blocks)
+    return "\n\n".join(_aligned([r[:keys] + [r[j] for j in block] for r in cells],
+                                 widths[:keys] + [widths[j] for j in block]) for block in blocks)
 
 
 def _aligned(cells: list[list[str]], widths: list[int]) -> str:

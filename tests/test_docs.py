@@ -4,6 +4,7 @@ quoted in README.md and the docs a new user meets first parses with today's comm
 built-in scene and benchmark names, example scripts.  The examples themselves run in tests/test_examples.py."""
 from __future__ import annotations
 
+import functools
 import os
 import re
 import shlex
@@ -142,3 +143,85 @@ def test_readme_builtin_scene_names_exist():
     assert len(names) >= 20, names
     missing = [n for n in names if not (SCENE_DIR / f"{n}.toml").is_file()]
     assert not missing, f"README lists built-in scenes that do not exist: {missing}"
+
+
+# ------------------------------------------------------------------------------------ links between the docs
+def _markdown_files() -> list[Path]:
+    """Every markdown file a reader follows links through: README, docs/, examples/, benchmarks/, tests' READMEs."""
+    return [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")),
+            *sorted(p for d in ("examples", "benchmarks", "tests") for p in (ROOT / d).rglob("*.md"))]
+
+
+def _slug(heading: str) -> str:
+    """GitHub's anchor of a heading: lower case, punctuation dropped (hyphens kept), spaces to hyphens."""
+    return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+
+
+@functools.lru_cache(maxsize=None)
+def _headings(path: Path) -> tuple[str, ...]:
+    """The markdown headings of a file, outside fenced blocks."""
+    found, fenced = [], False
+    for line in path.read_text().splitlines():
+        if line.lstrip().startswith("```"):
+            fenced = not fenced
+        elif not fenced and (m := re.match(r"#{1,6}\s+(.*)", line)):
+            found.append(m.group(1).strip())
+    return tuple(found)
+
+
+@functools.lru_cache(maxsize=None)
+def _flat_lower(path: Path) -> str:
+    """A file's text on one line, lower case (for bold lead-ins that wrap)."""
+    return " ".join(path.read_text().split()).lower()
+
+
+def _broken_links(path: Path) -> list[str]:
+    """What in one markdown file points at nothing: a relative link [..](target#anchor) to a missing file or
+    heading, a mention of docs/<name>.md that does not exist, and a quoted section (docs/<name>.md, "Title")
+    that is neither a heading nor a bold lead-in of that file."""
+    text, bad = path.read_text(), []
+    here = path.relative_to(ROOT)
+    for target in re.findall(r"\]\(([^)\s]+)\)", text):
+        if re.match(r"[a-z]+:", target):            # http:, https:, mailto: are not ours to check
+            continue
+        file, _, anchor = target.partition("#")
+        dest = (path.parent / file) if file else path
+        if not dest.exists():
+            bad.append(f"{here}: link ({target}): no file {file}")
+        elif anchor and dest.suffix == ".md" and anchor not in {_slug(h) for h in _headings(dest)}:
+            bad.append(f"{here}: link ({target}): no heading #{anchor} in {dest.relative_to(ROOT)}")
+    for mention in re.findall(r"(?<![\w/.])(docs/[\w./-]+\.md)", text):
+        if not (ROOT / mention).exists():
+            bad.append(f"{here}: mentions {mention}, which does not exist")
+    flat = " ".join(text.split())
+    for mention, title in re.findall(r"(docs/[\w./-]+\.md),? (?:section )?[\"“]([^\"”]{3,80})[\"”]", flat):
+        dest = ROOT / mention
+        if not dest.exists():
+            continue
+        title = title.rstrip(".,").lower()
+        if not any(title in h.lower() for h in _headings(dest)) and f"**{title}" not in _flat_lower(dest):
+            bad.append(f'{here}: {mention}, "{title}": no such section')
+    return bad
+
+
+def test_links_between_the_docs_resolve():
+    """Every relative link, docs/<name>.md mention and quoted section title of the markdown files points at a
+    file and heading that exist (a renamed doc or section breaks the test, naming where it was referred to)."""
+    files = _markdown_files()
+    assert len(files) >= 40, files
+    bad = [b for path in files for b in _broken_links(path)]
+    assert not bad, "\n".join(bad)
+
+
+def test_link_check_finds_a_broken_link(tmp_path, monkeypatch):
+    """The checker itself: a missing file, a missing heading, a missing doc and a missing section are reported."""
+    (tmp_path / "docs").mkdir()
+    (tmp_path / "docs" / "a.md").write_text("# Title A\n\n**Bold lead.** text\n")
+    page = tmp_path / "docs" / "b.md"
+    page.write_text('[ok](a.md#title-a) [gone](c.md) [no](a.md#nothing) docs/missing.md; docs/a.md, "Bold lead"; '
+                    'docs/a.md, "No such part"\n')
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    bad = _broken_links(page)
+    assert len(bad) == 4, bad
+    assert any("c.md" in b for b in bad) and any("#nothing" in b for b in bad)
+    assert any("missing.md" in b for b in bad) and any("no such part" in b for b in bad)

@@ -177,6 +177,30 @@ def test_wide_table_fits_120_columns_and_keeps_every_cell():
             assert f"{r * 100 + i:g}" in text
 
 
+def test_wide_table_repeats_every_key_column_in_each_block():
+    """Rows told apart by three columns (variant, route, radiation, as `housingfe runup-causes` prints them) stay
+    told apart in every block of a split table: each block's line of a row carries its route and radiation, and
+    the long variant names are shortened so that the keys fit."""
+    from housingfe.outputs import format_table
+
+    header = ["variant", "route", "radiation"] + [f"quantity_number_{i}" for i in range(6)]
+    rows = [["reference: xi 0.04, modes to 6000 Hz + static vectors, harmonics to 4000 Hz", route, rad]
+            + [float(100 * k + i) for i in range(6)]
+            for k, (route, rad) in enumerate([(r, s) for r in ("tf_omega", "mesh_force") for s in ("erp", "foller")])]
+    text = format_table(header, rows, keys=3)
+    assert max(len(line) for line in text.splitlines()) <= 120, text
+    blocks = text.split("\n\n")
+    assert len(blocks) >= 2, text
+    for block in blocks:
+        lines = block.splitlines()[2:]
+        assert len(lines) == 4, block
+        for k, (row, line) in enumerate(zip(rows, lines)):
+            assert f" {row[1]} " in line and f" {row[2]} " in line, (k, line)
+    for k in range(4):
+        for i in range(6):
+            assert f"{100 * k + i:g}" in text
+
+
 def test_validate_terminal_table_fits_and_points_to_the_files():
     from housingfe.verification.validate import format_rows
 

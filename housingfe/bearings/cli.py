@@ -47,7 +47,7 @@ def register(subparsers) -> None:
                     "contact_angle_deg, ...; SI, angle in degrees) or the flags below; flags override.")
     p.add_argument("designation", nargs="?", default=None, help="catalogue designation, e.g. 'SKF 6312' or 6312")
     p.add_argument("--geometry", metavar="FILE.toml", default=None,
-                   help="internal geometry as a TOML [bearing] table (keys as the flags, SI units)")
+                   help="internal geometry as a TOML [bearing] table (keys: elements, element_diameter, pitch_diameter, ... as listed above, not the flag names; SI units)")
     for flag, (_, typ, metavar, text) in _FLAGS.items():
         p.add_argument(flag, type=typ, metavar=metavar, default=None, help=text)
     p.add_argument("--load", nargs=5, type=float, required=True, metavar=("FX", "FY", "FZ", "MX", "MY"),

@@ -271,8 +271,8 @@ def register_cli(subparsers) -> None:
                               "and what it does to the load share and the quasi-static excitation")
     p.add_argument("--gear-sets", nargs="+", default=["A"], help="gear sets of the test gearbox (default A)")
     p.add_argument("--bearings", default="ball", help="bearing configuration (default ball)")
-    p.add_argument("--torques", nargs="+", type=float, default=[1000.0, 2000.0], help="pinion torques, N m")
+    p.add_argument("--torques", nargs="+", type=float, default=[1000.0, 2000.0], help="pinion torques, N m (default 1000 2000)")
     p.add_argument("--models", nargs="+", default=["none", "lumped", "rigid-bores"],
-                   help=f"misalignment models ({', '.join(MISALIGNMENT_MODELS)})")
-    p.add_argument("--out", default="results/misalignment", help="result folder")
+                   help=f"misalignment models ({', '.join(MISALIGNMENT_MODELS)}; default all)")
+    p.add_argument("--out", default="results/misalignment", help="result folder (default results/misalignment)")
     p.set_defaults(func=_cmd_misalignment, mpi="serial")

@@ -350,14 +350,14 @@ def plot(path: Path, results: dict) -> None:
 def register_cli(subparsers) -> None:
     p = subparsers.add_parser("bearing-variants",
                               help="TF_omega of the test gearbox with each bearing configuration (Sec. 5.8/5.9)")
-    p.add_argument("--scene", default="test-gearbox-interior", help="housing scene with an interior")
+    p.add_argument("--scene", default="test-gearbox-interior", help="housing scene with an interior (default test-gearbox-interior)")
     p.add_argument("--configs", nargs="+", default=None,
                    help="configurations (default: all of housingfe.bearings.configurations, ball_zero_moment (the "
                         "thesis' FEM stand-in for self-aligning bearings: moment rows and columns zeroed), "
                         "ball_zero_tilt_stiffness (only the tilt block zeroed) and ball_appendix_c_moments; 'ball' is "
                         "the reference)")
-    p.add_argument("--torque", type=float, default=TORQUE_NM, help="pinion torque [N m]")
-    p.add_argument("--out", default=None, help="result folder")
+    p.add_argument("--torque", type=float, default=TORQUE_NM, help=f"pinion torque [N m] (default {TORQUE_NM:g})")
+    p.add_argument("--out", default=None, help="result folder (default results/bearing-variants-<scene>)")
     p.add_argument("--set", action="append", metavar="KEY=VALUE", help="override a scene value")
     p.set_defaults(func=_cmd)
 

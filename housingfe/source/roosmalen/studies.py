@@ -273,7 +273,7 @@ def register_cli(subparsers) -> None:
                    "double helical)")
     p.add_argument("--harmonics", type=int, default=15, help="tooth harmonics n = 1..N (default 15)")
     p.add_argument("--torque", type=float, default=None, help="pinion torque, N m (default: each scene's)")
-    p.add_argument("--out", default="results/source-spectrum", help="result folder")
+    p.add_argument("--out", default="results/source-spectrum", help="result folder (default results/source-spectrum)")
     p.set_defaults(func=_cmd_spectrum, mpi="serial")
 
 
