@@ -134,6 +134,7 @@ def main(out_dir: Path, quick: bool) -> None:
     from mpi4py import MPI
 
     from housingfe.benchmarks.runup import _setup
+    from housingfe.progress import Progress
     from housingfe.runup.chain import (
         build_gearbox_model,
         coupled_source_lines,
@@ -147,12 +148,15 @@ def main(out_dir: Path, quick: bool) -> None:
     load_before = os.getloadavg()
     scene, housing_scene, drivetrain, torque = _setup(quick)
     spec = scene.runup
+    # the model, then the five sections of the table (docs/progress.md)
+    progress = Progress("bench flexsource", 6, "steps", comm=comm)
     t0 = time.perf_counter()
     hm = housing_model_for(housing_scene, spec.f_max_hz, comm)
     gm = build_gearbox_model(hm, drivetrain, spec.f_max_hz, damping_ratio=spec.damping_ratio,
                              basis_factor=spec.basis_factor, radiators=radiators_of(scene.radiation, hm),
                              surface=spec.surface)
     basis_s = time.perf_counter() - t0
+    progress.update(note=f"coupled model and basis, {basis_s:.1f} s")
     source = drivetrain.source_model(harmonics=spec.harmonics, engagement=spec.engagement)
     source.mesh_stiffness(torque)             # the stiffness curve once (cached), as in a run-up
     speeds = list(spec.speeds)
@@ -176,6 +180,8 @@ def main(out_dir: Path, quick: bool) -> None:
             f"min/median/max {w.min():.2f}/{np.median(w):.2f}/{w.max():.2f} s; source {src_s:.3f} s; "
             f"target <= {TARGET_RUNUP_S:g} s: {'met' if w.max() <= TARGET_RUNUP_S else 'NOT met'}")
 
+    progress.update(note="1 run-up after the basis")
+
     def ritz(f):
         return mesh_receptance(gm, f)
 
@@ -188,6 +194,7 @@ def main(out_dir: Path, quick: bool) -> None:
             _error_db(st, reference, spec.f_max_hz), "dB", f"vs H = {H_REFERENCE}")
     H = spec.harmonics
     base, _ = _solve_speeds(gm, source, speeds, torque, H, ritz)
+    progress.update(note="2 harmonics")
     # 3. modes
     for f_cut in (0.25 * spec.f_max_hz, 0.5 * spec.f_max_hz, spec.f_max_hz, spec.basis_factor * spec.f_max_hz,
                   np.inf):
@@ -203,6 +210,7 @@ def main(out_dir: Path, quick: bool) -> None:
             row("3 modes", f"{label} ({info['modes']}){' + static correction' if corr else ''}, H = {H}",
                 1e3 * sec / len(speeds), sec, _error_db(st, base, spec.f_max_hz), "dB",
                 "vs the Ritz receptance (solve of the reduced system)")
+    progress.update(note="3 modes")
     # 4. first order
     st, sec = _solve_speeds(gm, source, speeds, torque, H, ritz, first_order=True)
     S, _ = source.mesh_stiffness(torque)
@@ -211,6 +219,7 @@ def main(out_dir: Path, quick: bool) -> None:
         row("4 first order", f"mean-stiffness solve (quasi-static TE on the mean system), lines n = {lo}..{hi}",
             1e3 * sec / len(speeds), sec, _error_db(st, base, spec.f_max_hz, hi, lo), "dB",
             f"vs the full solve; ripple |S_n|max / S_0 = {ripple:.2%} ({20 * math.log10(1 + ripple):.2f} dB)")
+    progress.update(note="4 first order")
     # 5. full Hill system on the Ritz coordinates
     for speed in (500.0, 1500.0):
         d_full, sec = full_hill_on_ritz(gm, source, speed, torque, 10)
@@ -220,6 +229,8 @@ def main(out_dir: Path, quick: bool) -> None:
         row("5 full Hill system", f"{speed:g} rpm, H = 10, {21 * n_vec} unknowns vs 21", 1e3 * sec1, sec, err,
             "rel.", f"full system {sec:.2f} s; rank-one {1e3 * sec1:.2f} ms; mean compression "
                     f"{abs(d[10] - d_full[10]) / abs(d_full[10]):.1e} rel.")
+    progress.update(note="5 full Hill system")
+    progress.close()
     load_after = os.getloadavg()
     if comm.rank != 0:
         return

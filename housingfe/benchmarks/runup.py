@@ -291,13 +291,21 @@ def main(out_dir: Path, quick: bool) -> None:
     repetitions = 1 if quick else 3
     direct_speeds = [1500.0] if quick else [500.0, 1000.0, 1500.0]
 
+    from housingfe.progress import Progress
+
+    # the sections of the table (docs/progress.md: every long command says how far it is)
+    progress = Progress("bench runup", 6, "sections", comm=comm)
     e2e = end_to_end(scene, housing_scene, drivetrain, torque, comm)
     gm = e2e["model"]
+    progress.update(note=f"end to end, {e2e['total_s']:.1f} s")
     alone = runup_alone(gm, e2e["source"], scene, torque, repetitions)
+    progress.update(note="run-up alone")
     num = numerical_sigma(gm, scene, torque, e2e["lines"])
+    progress.update(note="numerical sigma")
     other_torque = 1000.0
     reuses = [reuse(gm, scene, f"{other_torque:g} N m", drivetrain_of(scene.drivetrain, other_torque, spec.drive_line_model),
                     e2e["source"], other_torque)]
+    progress.update(note=f"re-analysis at {other_torque:g} N m")
     spec_b = scene.drivetrain.model_copy(update={"gear_set": "B"})
     dt_b = drivetrain_of(spec_b, torque, spec.drive_line_model)
     t0 = time.perf_counter()
@@ -305,7 +313,10 @@ def main(out_dir: Path, quick: bool) -> None:
     source_b_s = time.perf_counter() - t0
     reuses.append(reuse(gm, scene, "gear set B", dt_b, source_b, torque))
     reuses[-1]["source_s"] += source_b_s
+    progress.update(note="re-analysis for gear set B")
     rvd = ritz_vs_direct(gm, e2e["source"], scene, torque, direct_speeds)
+    progress.update(note=f"Ritz vs direct at {len(direct_speeds)} speed(s)")
+    progress.close()
     load_after = os.getloadavg()
     bench_s = time.perf_counter() - t_bench
     if comm.rank != 0:
