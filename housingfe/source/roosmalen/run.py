@@ -47,7 +47,7 @@ from housingfe.source.stiffness import (
     normal_force_from_torque,
     stiffness_curve,
 )
-from housingfe.source.transmission_error import checked_scene, validated_scene_file
+from housingfe.source.transmission_error import SAMPLES_PER_MESH_PERIOD, checked_scene, validated_scene_file
 
 
 class _Strict(BaseModel):
@@ -146,18 +146,6 @@ class SourceTable(_Strict):
     @model_validator(mode="after")
     def _transmission_error_torques(self):
         return checked_scene(self, {"torque_Nm": [self.torque_Nm], "torque_run_Nm": self.torque_run_Nm})
-        if "engagement" in self.model_fields_set:
-            raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
-                             f"{self.engagement!r} is set as well: give one of the two")
-        from housingfe.source.transmission_error import read
-
-        te = read(self.transmission_error)
-        for key, torques in (("torque_Nm", [self.torque_Nm]), ("torque_run_Nm", self.torque_run_Nm)):
-            for torque in torques:
-                problem = te.torque_problem(torque)
-                if problem is not None:
-                    raise ValueError(f"transmission_error: {problem} ({key}; set it within the file's torques)")
-        return self
 
 
 def parse(scene: dict, scene_path: str) -> SourceTable:
@@ -210,7 +198,7 @@ class OperatingPoint:
     is then the shock whose quasi-static compression is the file's TE at this torque on the model's S(t)
     (dyn.engagement_force_from_transmission_error); None (default) = the engagement model."""
 
-    def __init__(self, pair, corr, interior, model, torque: float, n_positions: int, n_samples: int = 256,
+    def __init__(self, pair, corr, interior, model, torque: float, n_positions: int, n_samples: int = SAMPLES_PER_MESH_PERIOD,
                  engagement: str = dyn.DEFAULT_ENGAGEMENT, lead_gap: float = 0.0, transmission_error=None):
         self.torque = torque
         self.engagement = engagement
