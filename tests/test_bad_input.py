@@ -498,6 +498,10 @@ SOURCE_CASES = [
     ("source-speed-bursts", _set("source.speed_max_rpm", 1e9), ["source.speed_max_rpm", "1000 m/s", "bursts"]),
     ("source-spectrum-speed-bursts", _set("source.spectrum_speeds_rpm", [500.0, 1e9]),
      ["source.spectrum_speeds_rpm.1", "1000 m/s"]),
+    # no torque run: an IndexError traceback after the run (torque_run.png); a torque twice: run and written twice
+    ("source-torque-run-empty", _set("source.torque_run_Nm", []), ["source.torque_run_Nm", "at least 1 item"]),
+    ("source-torque-run-twice", _set("source.torque_run_Nm", [2000.0, 2000.0]),
+     ["source.torque_run_Nm: 2000 N m is given twice"]),
 ]
 
 

@@ -122,7 +122,8 @@ class SourceTable(_Strict):
     speed_max_rpm: PositiveFloat = 1500.0
     speed_steps: int = Field(30, ge=2, le=2000)
     spectrum_speeds_rpm: list[PositiveFloat] = [500.0, 1000.0, 1500.0]
-    torque_run_Nm: list[PositiveFloat] = [400.0, 800.0, 1200.0, 1600.0, 2000.0]
+    # pinion torques of the torque run at torque_run_speed_rpm, each once (at least one)
+    torque_run_Nm: list[PositiveFloat] = Field([400.0, 800.0, 1200.0, 1600.0, 2000.0], min_length=1)
     torque_run_speed_rpm: PositiveFloat = 1500.0
     harmonics: int = Field(30, ge=2, le=400)
     stiffness_positions: int = Field(dyn.DEFAULT_STIFFNESS_POSITIONS, ge=4, le=512)
@@ -142,6 +143,14 @@ class SourceTable(_Strict):
 
 
     _transmission_error = field_validator("transmission_error")(validated_scene_file)
+
+    @field_validator("torque_run_Nm")
+    @classmethod
+    def _torque_run_once_each(cls, torques):
+        twice = [t for i, t in enumerate(torques) if t in torques[:i]]
+        if twice:
+            raise ValueError(f"{twice[0]:g} N m is given twice")
+        return torques
 
     @model_validator(mode="after")
     def _transmission_error_torques(self):
