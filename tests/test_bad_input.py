@@ -862,6 +862,13 @@ SWEEP_CASES = [
     # analysis.harmonic.surface (a housing-scene key) without the file; now right after meshing (~10 s)
     ("runup-surface-unknown", ["run", "test-gearbox-runup", "--set", "runup.surface=outr", "--out", "r"],
      ["test-gearbox-runup.toml: runup.surface: no surface 'outr' on the housing test-gearbox (known: "]),
+    # a radiation model twice was computed and reported twice; a plate on a surface the housing lacks did not name
+    # the run-up scene
+    ("runup-radiation-model-twice", ["run", "test-gearbox-runup", "--set", 'radiation.models=["erp", "erp"]', "--out",
+                                     "r"], ["test-gearbox-runup.toml: radiation.models: 'erp' is given twice"]),
+    ("runup-radiation-plate-unknown", ["run", "test-gearbox-runup", "--set",
+                                       'radiation.plates=[{surface = "nowhere", thickness = 0.01}]', "--out", "r"],
+     ["test-gearbox-runup.toml: radiation.plates[0].surface: no surface 'nowhere'"]),
     # a parameter's second --range replaced its first without a word
     ("uncertainty-range-twice", ["uncertainty", "--range", "clearance_position=0.1:0.2", "--range",
                                  "clearance_position=0.3:0.4", "--out", "u"], ["--range clearance_position: given twice"]),

@@ -366,6 +366,9 @@ class RunupRadiation(_Strict):
     def _registered(cls, names):
         from housingfe.radiation.radiators import check_radiator
 
+        twice = [n for i, n in enumerate(names) if n in names[:i]]
+        if twice:        # computed and reported twice
+            raise ValueError(f"{twice[0]!r} is given twice")
         return [check_radiator(n) for n in names]
 
     @model_validator(mode="after")
@@ -483,7 +486,10 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     if spec.surface not in model.housing.facet_groups:     # else found after the basis, named as a housing-scene key
         raise InputError(f"{path}: runup.surface: no surface {spec.surface!r} on the housing {scene.housing.scene} "
                          f"(known: {', '.join(sorted(model.housing.facet_groups))})")
-    radiators = radiators_of(scene.radiation, model)
+    try:
+        radiators = radiators_of(scene.radiation, model)
+    except InputError as exc:       # a plate's surface the housing lacks: name the run-up scene too
+        raise InputError(f"{path}: {exc}") from None
     timings["mesh_s"] = time.perf_counter() - t0
     progress.update(note=f"housing model, {model.dofs} DOFs")
     reference_torque = max(spec.torques_nm)
