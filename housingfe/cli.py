@@ -243,6 +243,9 @@ def main(argv: list[str] | None = None) -> int:
         if out is not None and not str(out).strip():
             # `--out "$UNSET"` fell back to the default folder (replacing the result there)
             raise InputError(f"--out: {out!r} is an empty path; give a folder, or leave --out out for the default")
+        from housingfe.progress import check_environment
+
+        check_environment()        # a typo in HOUSINGFE_PROGRESS(_SECONDS) was ignored without a word
         if comm is not None and mode == "refuse":
             raise InputError(f"{args.command}: runs its cases in processes of its own (its MPI cases start their "
                              "own mpirun): start it without mpirun / srun")

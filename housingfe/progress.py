@@ -9,6 +9,7 @@ too (or nothing, when disabled off a tty); the plain, rate-limited lines are wha
 """
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -31,6 +32,27 @@ def _rank() -> int:
         if os.environ.get(var, "").isdigit():
             return int(os.environ[var])
     return 0
+
+
+def check_environment(environ=None) -> None:
+    """InputError naming the variable when HOUSINGFE_PROGRESS_SECONDS is not a number of seconds >= 0 or
+    HOUSINGFE_PROGRESS not 0 or 1 (Progress itself falls back to its defaults: a typo was ignored without a word).
+    The CLI calls it before any work."""
+    from housingfe.errors import InputError
+
+    environ = os.environ if environ is None else environ
+    seconds = environ.get("HOUSINGFE_PROGRESS_SECONDS")
+    if seconds is not None:
+        try:
+            value = float(seconds)
+        except ValueError:
+            value = float("nan")
+        if not (math.isfinite(value) and value >= 0.0):
+            raise InputError(f"HOUSINGFE_PROGRESS_SECONDS: {seconds!r} is not a number of seconds >= 0 (the longest "
+                             f"time between progress lines; default {DEFAULT_LOG_SECONDS:g}, 0: a line per item)")
+    enabled = environ.get("HOUSINGFE_PROGRESS")
+    if enabled is not None and enabled.strip() not in ("0", "1"):
+        raise InputError(f"HOUSINGFE_PROGRESS: {enabled!r}: give 0 (no progress lines) or 1 (the default)")
 
 
 class Progress:

@@ -498,6 +498,10 @@ SOURCE_CASES = [
     ("source-speed-bursts", _set("source.speed_max_rpm", 1e9), ["source.speed_max_rpm", "1000 m/s", "bursts"]),
     ("source-spectrum-speed-bursts", _set("source.spectrum_speeds_rpm", [500.0, 1e9]),
      ["source.spectrum_speeds_rpm.1", "1000 m/s"]),
+    # no torque run: an IndexError traceback after the run (torque_run.png); a torque twice: run and written twice
+    ("source-torque-run-empty", _set("source.torque_run_Nm", []), ["source.torque_run_Nm", "at least 1 item"]),
+    ("source-torque-run-twice", _set("source.torque_run_Nm", [2000.0, 2000.0]),
+     ["source.torque_run_Nm: 2000 N m is given twice"]),
 ]
 
 
@@ -667,7 +671,10 @@ SWEEP_FILES = {"afile": "precious", "userdir/keep.txt": "precious", "binary.toml
                "override-key-typo.toml": UPDATE_SPEC + '[search_overrides]\n"box-free" = ["mesh.sise=0.06"]\n',
                "plates-row.toml": 'plates = [["side", 1, "big", 1.3, 0.005, 2000.0]]\n',
                "duplicate-target.toml": UPDATE_SPEC + '[[targets]]\nname = "m"\nscene = "box-free"\nkind = "mass"\n'
-                                                      'value = 20.0\n'}
+                                                      'value = 20.0\n',
+               # transmission errors (runup.transmission_error): harmonics the source cannot take
+               "te-harmonic-40.csv": "torque_Nm,harmonic,amplitude_um\n2000,40,0.5\n",
+               "te-harmonic-huge.csv": "torque_Nm,harmonic,amplitude_um\n2000,1e300,0.5\n"}
 
 
 def _sweep_folder(tmp_path: Path) -> Path:
@@ -827,6 +834,44 @@ SWEEP_CASES = [
      ["runup.speed_max_rpm", "outside the range the source supports"]),
     ("runup-spectrum-speed-huge", ["run", "test-gearbox-runup", "--set", "runup.spectrum_speeds_rpm=[1e9]", "--out",
                                    "r"], ["runup.spectrum_speeds_rpm: 1e+09 rev/min", "outside the range"]),
+    # the run-up audit of 2026-11-28: each was accepted (or refused only after meshing) before
+    # a step beyond the range ran speed_min alone (one speed, no speed law, spectra skipped) and reported it as usual
+    ("runup-speed-step-above-range", ["run", "test-gearbox-runup", "--set", "runup.speed_step_rpm=5000", "--out", "r"],
+     ["runup.speed_step_rpm: 5000 rev/min is larger than the run-up 50..1500 rev/min"]),
+    # f_max below every tooth line: the housing meshed at elements metres wide (gmsh did not finish in minutes)
+    ("runup-f-max-below-the-tooth-frequency", ["run", "test-gearbox-runup", "--set", "runup.f_max_hz=1e-3", "--out",
+                                               "r"], ["test-gearbox-runup.toml: runup.f_max_hz: 0.001 Hz is below the "
+                                                      "tooth frequency 20 Hz at runup.speed_min_rpm = 50 rev/min"]),
+    # a torque or a route given twice was run (and written) twice
+    ("runup-torque-twice", ["run", "test-gearbox-runup", "--set", "runup.torques_nm=[2000.0, 2000.0]", "--out", "r"],
+     ["runup.torques_nm: 2000.0 is given twice"]),
+    ("runup-route-twice", ["run", "test-gearbox-runup", "--set", 'runup.routes=["tf_omega", "tf_omega"]', "--out",
+                           "r"], ["runup.routes: 'tf_omega' is given twice"]),
+    # 100000 harmonics: a MemoryError traceback (298 GiB) after the housing and its basis were built
+    ("runup-harmonics-huge", ["run", "test-gearbox-runup", "--set", "runup.harmonics=100000", "--out", "r"],
+     ["runup.harmonics", "less than or equal to 400"]),
+    # a TE file whose harmonics all lie above runup.harmonics excited nothing (its harmonics dropped without a word);
+    # a harmonic of 1e300 was an OverflowError traceback, one of 500 refused after meshing
+    ("runup-te-above-the-harmonics", ["run", "test-gearbox-runup", "--set", "runup.transmission_error=te-harmonic-40.csv",
+                                      "--out", "r"],
+     ["runup.transmission_error", "te-harmonic-40.csv: its lowest harmonic 40 is above harmonics = 30"]),
+    ("runup-te-harmonic-huge", ["run", "test-gearbox-runup", "--set", "runup.transmission_error=te-harmonic-huge.csv",
+                                "--out", "r"],
+     ["te-harmonic-huge.csv: line 2: harmonic: 1e+300 is above the highest harmonic the source resolves (127"]),
+    # a misspelt runup.surface was found after the coupled model and its basis (25 s), named
+    # analysis.harmonic.surface (a housing-scene key) without the file; now right after meshing (~10 s)
+    ("runup-surface-unknown", ["run", "test-gearbox-runup", "--set", "runup.surface=outr", "--out", "r"],
+     ["test-gearbox-runup.toml: runup.surface: no surface 'outr' on the housing test-gearbox (known: "]),
+    # a radiation model twice was computed and reported twice; a plate on a surface the housing lacks did not name
+    # the run-up scene
+    ("runup-radiation-model-twice", ["run", "test-gearbox-runup", "--set", 'radiation.models=["erp", "erp"]', "--out",
+                                     "r"], ["test-gearbox-runup.toml: radiation.models: 'erp' is given twice"]),
+    ("runup-radiation-plate-unknown", ["run", "test-gearbox-runup", "--set",
+                                       'radiation.plates=[{surface = "nowhere", thickness = 0.01}]', "--out", "r"],
+     ["test-gearbox-runup.toml: radiation.plates[0].surface: no surface 'nowhere'"]),
+    # a parameter's second --range replaced its first without a word
+    ("uncertainty-range-twice", ["uncertainty", "--range", "clearance_position=0.1:0.2", "--range",
+                                 "clearance_position=0.3:0.4", "--out", "u"], ["--range clearance_position: given twice"]),
 ]
 
 

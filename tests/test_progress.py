@@ -151,3 +151,25 @@ def test_checkpoint_survives_a_cut_line(tmp_path):
     assert len(path.read_text().splitlines()) == 2
     fresh.remove()
     assert not path.parent.exists()
+
+
+@pytest.mark.parametrize("name, value, message", [
+    ("HOUSINGFE_PROGRESS_SECONDS", "abc", "HOUSINGFE_PROGRESS_SECONDS: 'abc' is not a number of seconds >= 0"),
+    ("HOUSINGFE_PROGRESS_SECONDS", "-1", "HOUSINGFE_PROGRESS_SECONDS: '-1' is not a number of seconds >= 0"),
+    ("HOUSINGFE_PROGRESS_SECONDS", "nan", "HOUSINGFE_PROGRESS_SECONDS: 'nan'"),
+    ("HOUSINGFE_PROGRESS", "false", "HOUSINGFE_PROGRESS: 'false': give 0 (no progress lines) or 1"),
+])
+def test_a_bad_progress_variable_stops_the_command_with_one_line(name, value, message, tmp_path):
+    """A typo in the variables was ignored without a word (the default taken): now one line, exit 2, before any
+    work; 0 and 2.5 are taken."""
+    from housingfe.progress import check_environment
+
+    with pytest.raises(InputError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        check_environment({name: value})
+    check_environment({"HOUSINGFE_PROGRESS_SECONDS": "2.5", "HOUSINGFE_PROGRESS": "0"})
+    env = {**os.environ, name: value}
+    proc = subprocess.run([sys.executable, "-m", "housingfe", "run", "box-free", "--out", str(tmp_path / "r")],
+                          capture_output=True, text=True, env=env, timeout=120, cwd=tmp_path)
+    lines = proc.stderr.strip().splitlines()
+    assert proc.returncode == 2 and len(lines) == 1 and lines[0].startswith("housingfe: error: " + message), lines
+    assert not list(tmp_path.iterdir())

@@ -111,6 +111,11 @@ def _sets(path: Path) -> list[dict]:
     sets = [sets] if isinstance(sets, dict) else list(sets)
     if not sets:
         raise InputError(f"{path}: no UFF datasets in the file")
+    with open(path, "rb") as fh:      # pyuff drops a last dataset cut short without a word (fewer modes)
+        fh.seek(max(0, path.stat().st_size - 256))
+        tail = fh.read().rstrip().splitlines()
+    if not tail or tail[-1].strip() != b"-1":
+        raise InputError(f"{path}: truncated: the file ends inside a dataset (no closing '    -1' line)")
     return sets
 
 
@@ -202,7 +207,7 @@ def read_mode_csv(path: str | Path, units: str | None = None, key: str = "--unit
     if not path.is_file():
         raise InputError(f"{path}: file not found")
     try:
-        with open(path, newline="") as fh:
+        with open(path, newline="", encoding="utf-8-sig") as fh:      # a spreadsheet's "CSV UTF-8" has a BOM
             rows = list(csv.DictReader(fh))
     except (UnicodeDecodeError, csv.Error) as exc:
         raise InputError(f"{path}: not a CSV text file ({exc})") from None
@@ -227,6 +232,9 @@ def read_mode_csv(path: str | Path, units: str | None = None, key: str = "--unit
         key = (row["point"].strip(), *np.round(d / np.linalg.norm(d), 9))
         channels.setdefault(key, (pt, d / np.linalg.norm(d)))
         entry = table.setdefault(mode, {"f": f, "values": {}})
+        if key in entry["values"]:        # the later value replaced the earlier without a word
+            direction = ", ".join(row[c].strip() for c in ("dx", "dy", "dz"))
+            raise InputError(f"{path}: row {r}: mode {mode}, point {key[0]}, direction ({direction}) is given twice")
         entry["values"][key] = value
     keys = list(channels)
     for mode, entry in table.items():

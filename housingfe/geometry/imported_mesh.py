@@ -148,11 +148,17 @@ def read_mesh_file(path, units: str, key: str = "geometry") -> MeshFile:
         return _CACHE[stamp]
     try:
         # meshio 5.0 prints the error of every format it tried first to stdout (a .msh is tried as ANSYS first:
-        # a blank line before our output); a format that fails for good still raises
-        with contextlib.redirect_stdout(io.StringIO()):
+        # a blank line before our output); a format that fails for good still raises -- except a ReadError of every
+        # format tried (a gmsh 1.0 file), after which it prints "Error: ..." on stderr and calls sys.exit(1)
+        printed = io.StringIO()
+        with contextlib.redirect_stdout(printed), contextlib.redirect_stderr(printed):
             raw = meshio.read(str(path))
-    except Exception as exc:    # meshio raises anything from ReadError to KeyError and IndexError
-        what = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+    except (Exception, SystemExit) as exc:    # meshio raises anything from ReadError to KeyError and IndexError
+        if isinstance(exc, SystemExit):      # its "Error: ..." line, wrapped by rich at 80 columns
+            text = printed.getvalue().rpartition("Error:")[2]
+            what = " ".join(text.split()) or "meshio exited"
+        else:
+            what = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise InputError(f"{path}: {key}.file: cannot read as a mesh ({what}); meshio reads Abaqus .inp, "
                          "Nastran .bdf/.nas, gmsh .msh, ...") from None
     nastran = path.suffix.lower() in (".bdf", ".nas", ".dat", ".fem")

@@ -170,7 +170,7 @@ class RunupSpec(_Strict):
     basis_factor: float = Field(1.5, ge=1.0, le=4.0)
     routes: list[str] = Field(default=["tf_omega", "mesh_force"], min_length=1)
     damping_ratio: float = Field(0.04, gt=0.0, lt=1.0)
-    harmonics: PositiveInt = 30
+    harmonics: int = Field(30, ge=1, le=400)     # of the source's harmonic balance (at most 400, as [source] harmonics)
     spectrum_speeds_rpm: list[PositiveFloat] = [500.0, 1000.0, 1500.0]
     surface: str = "outer"
     # the source's engagement shock (housingfe.source.roosmalen.dynamics.ENGAGEMENT_MODELS): "face-width" distributes
@@ -349,6 +349,16 @@ class RunupSpec(_Strict):
         lo, hi = SPEED_RANGE_RPM
         if self.speed_min_rpm > self.speed_max_rpm:
             raise ValueError(f"speed_min_rpm: {self.speed_min_rpm:g} is above speed_max_rpm {self.speed_max_rpm:g}")
+        span = self.speed_max_rpm - self.speed_min_rpm
+        if span > 0.0 and self.speed_step_rpm > span * (1.0 + 1e-9):     # else one speed, speed_max never reached
+            raise ValueError(f"speed_step_rpm: {self.speed_step_rpm:g} rev/min is larger than the run-up "
+                             f"{self.speed_min_rpm:g}..{self.speed_max_rpm:g} rev/min: it would run speed_min_rpm "
+                             "alone (for one speed give speed_max_rpm = speed_min_rpm)")
+        for key in ("torques_nm", "routes"):     # a repeat ran (and reported) the same run-up twice
+            values = getattr(self, key)
+            twice = [v for i, v in enumerate(values) if v in values[:i]]
+            if twice:
+                raise ValueError(f"{key}: {twice[0]!r} is given twice")
         keys = [("speed_min_rpm", self.speed_min_rpm), ("speed_max_rpm", self.speed_max_rpm)]
         # a spectrum speed outside the run-up was skipped without a word (no spectra_<speed>rpm.csv)
         keys += [("spectrum_speeds_rpm", s) for s in self.spectrum_speeds_rpm]
@@ -376,6 +386,9 @@ class RunupRadiation(_Strict):
     def _registered(cls, names):
         from housingfe.radiation.radiators import check_radiator
 
+        twice = [n for i, n in enumerate(names) if n in names[:i]]
+        if twice:        # computed and reported twice
+            raise ValueError(f"{twice[0]!r} is given twice")
         return [check_radiator(n) for n in names]
 
     @model_validator(mode="after")
@@ -432,6 +445,13 @@ def load_runup_scene(name_or_path: str, overrides: list[str] | None = None) -> t
         problem = pair.torque_problem(torque)
         if problem is not None:
             raise InputError(f"{path}: runup.torques_nm.{i}: {problem}")
+    # below the lowest tooth frequency no line is computed at any speed, and the housing is meshed for f_max_hz (a
+    # mesh of elements metres wide: gmsh did not finish in minutes)
+    f_tooth = pair.tooth_frequency(scene.runup.speed_min_rpm)
+    if scene.runup.f_max_hz < f_tooth:
+        raise InputError(f"{path}: runup.f_max_hz: {scene.runup.f_max_hz:g} Hz is below the tooth frequency "
+                         f"{f_tooth:.4g} Hz at runup.speed_min_rpm = {scene.runup.speed_min_rpm:g} rev/min: no line "
+                         "of the run-up would lie below it")
     return scene, path
 
 
@@ -483,7 +503,13 @@ def run_scene(name_or_path: str, out_dir: str | None = None, overrides: list[str
     progress = Progress(f"run-up {scene.scene.name}", 2 + len(spec.torques_nm), "steps", comm=comm)
     t0 = time.perf_counter()
     model = housing_model_for(housing_scene, spec.f_max_hz, comm)
-    radiators = radiators_of(scene.radiation, model)
+    if spec.surface not in model.housing.facet_groups:     # else found after the basis, named as a housing-scene key
+        raise InputError(f"{path}: runup.surface: no surface {spec.surface!r} on the housing {scene.housing.scene} "
+                         f"(known: {', '.join(sorted(model.housing.facet_groups))})")
+    try:
+        radiators = radiators_of(scene.radiation, model)
+    except InputError as exc:       # a plate's surface the housing lacks: name the run-up scene too
+        raise InputError(f"{path}: {exc}") from None
     timings["mesh_s"] = time.perf_counter() - t0
     progress.update(note=f"housing model, {model.dofs} DOFs")
     reference_torque = max(spec.torques_nm)

@@ -45,6 +45,9 @@ PHASE_UNITS = {"phase_deg": math.pi / 180.0, "phase_rad": 1.0}
 COLUMNS = ("torque_Nm", "harmonic", *AMPLITUDE_UNITS, *PHASE_UNITS)
 # torques closer than this (relative) are the same torque: a file's 2000 serves a run-up's 2000.0000001
 SAME_TORQUE = 1e-9
+# samples of one mesh period on which the source holds S(t) and the TE (housingfe.source.roosmalen.run
+# .OperatingPoint): a harmonic n of the file must lie below its Nyquist limit, n < SAMPLES_PER_MESH_PERIOD / 2
+SAMPLES_PER_MESH_PERIOD = 256
 
 
 @dataclass(frozen=True)
@@ -102,15 +105,20 @@ def validated_scene_file(value: str, info) -> str:
 
 
 def checked_scene(table, torques: dict):
-    """A scene table (a pydantic model with `transmission_error` and `engagement`) for its model validator: the table,
-    or the ValueError naming why its TE file cannot serve it -- `engagement` set beside the file, or a torque [N m]
-    of {key: [torques]} outside the file's torques."""
+    """A scene table (a pydantic model with `transmission_error`, `engagement` and `harmonics`) for its model
+    validator: the table, or the ValueError naming why its TE file cannot serve it -- `engagement` set beside the file,
+    every harmonic of the file above the source's `harmonics`, or a torque [N m] of {key: [torques]} outside the
+    file's torques."""
     if not table.transmission_error:
         return table
     if "engagement" in table.model_fields_set:
         raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
                          f"{table.engagement!r} is set as well: give one of the two")
     te = read(table.transmission_error)
+    if te.harmonics[0] > table.harmonics:       # the harmonic balance keeps 1..harmonics: nothing of the file would act
+        raise ValueError(f"transmission_error: {te.source}: its lowest harmonic {int(te.harmonics[0])} is above "
+                         f"harmonics = {table.harmonics}, the highest the source's harmonic balance keeps: the file "
+                         "would excite nothing (raise harmonics)")
     for key, values in torques.items():
         for torque in values:
             problem = te.torque_problem(torque)
@@ -176,6 +184,9 @@ def read(path: str | Path) -> TransmissionError:
             raise InputError(f"{where}: torque_Nm: {torque:g} is not a positive torque")
         if n != int(n) or n < 1:
             raise InputError(f"{where}: harmonic: {n:g} is not a harmonic number 1, 2, ...")
+        if n >= SAMPLES_PER_MESH_PERIOD // 2:      # else refused after the housing was meshed (or an overflow)
+            raise InputError(f"{where}: harmonic: {n:g} is above the highest harmonic the source resolves "
+                             f"({SAMPLES_PER_MESH_PERIOD // 2 - 1}: {SAMPLES_PER_MESH_PERIOD} samples per mesh period)")
         a = values[amplitude[0]]
         if a < 0.0:
             raise InputError(f"{where}: {amplitude[0]}: {a:g} is negative (an amplitude; put the sign in the phase)")

@@ -256,6 +256,8 @@ def parse_ranges(items) -> dict[str, tuple]:
             raise InputError(f"--range {item}: give NAME=LOW:HIGH or NAME=VALUE")
         if name not in PARAMETERS:
             raise InputError(f"--range {name}: unknown parameter (known: {', '.join(PARAMETERS)})")
+        if name in out:       # the later one replaced the earlier without a word
+            raise InputError(f"--range {name}: given twice ({name}={text.strip()} after an earlier --range {name})")
         if name == "radiation":
             out[name] = tuple(m.strip() for m in text.split(",") if m.strip())
             continue

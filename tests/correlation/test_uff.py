@@ -94,3 +94,24 @@ def test_missing_file_and_bad_csv(tmp_path):
     (tmp_path / "c.csv").write_text("mode,frequency_hz,point\n1,2,3\n")
     with pytest.raises(InputError, match="column 'x' missing"):
         read_mode_csv(tmp_path / "c.csv")
+
+
+def test_truncated_uff_bom_csv_and_repeated_channel(tmp_path):
+    """A universal file cut inside its last dataset gave the modes before the cut without a word (pyuff drops the
+    open dataset: 1 of 4 modes at half the file); a CSV saved with a byte-order mark (a spreadsheet's "CSV UTF-8")
+    was "column 'mode' missing"; a channel given twice for one mode kept the later value silently."""
+    nodes, modes = _modes(np.random.default_rng(5))
+    write_uff(tmp_path / "ema.uff", nodes, modes, [])
+    raw = (tmp_path / "ema.uff").read_bytes()
+    assert len(read_measured_modes(tmp_path / "ema.uff").frequencies_hz) == 4
+    for cut in (len(raw) // 2, len(raw) - 8):
+        (tmp_path / "cut.uff").write_bytes(raw[:cut])
+        with pytest.raises(InputError, match=r"cut.uff: truncated: the file ends inside a dataset"):
+            read_measured_modes(tmp_path / "cut.uff")
+    header = "mode,frequency_hz,point,x,y,z,dx,dy,dz,value\n"
+    (tmp_path / "bom.csv").write_bytes(("\ufeff" + header + "1,641,1,0,0,0,0,0,1,0.5\n").encode())
+    bom = read_measured_modes(tmp_path / "bom.csv")
+    assert bom.frequencies_hz.tolist() == [641.0] and bom.shapes.tolist() == [[0.5]]
+    (tmp_path / "twice.csv").write_text(header + "1,641,1,0,0,0,0,0,1,0.5\n1,641,1,0,0,0,0,0,1,0.7\n")
+    with pytest.raises(InputError, match=r"twice.csv: row 3: mode 1, point 1, direction \(0, 0, 1\) is given twice"):
+        read_measured_modes(tmp_path / "twice.csv")

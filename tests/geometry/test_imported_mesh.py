@@ -270,6 +270,14 @@ def test_bad_mesh_files(tmp_path, capsys, comm):
          'set geometry.units = "mm"')
 
 
+def test_a_gmsh_1_file_is_one_line_not_meshios_exit(tmp_path, capsys):
+    """meshio reads a .msh as ANSYS, then gmsh; when both raise its ReadError it prints "Error: ..." and calls
+    sys.exit(1): `housingfe run` ended with exit 1 and meshio's line instead of naming geometry.file."""
+    (tmp_path / "old.msh").write_text("$NOD\n1\n1 0 0 0\n$ENDNOD\n$ELM\n0\n$ENDELM\n")     # gmsh 1.0: no $MeshFormat
+    _bad(tmp_path, capsys, mesh_scene(tmp_path, "old.msh", "m"), "old.msh: geometry.file: cannot read as a mesh",
+         "as either of ansys, gmsh")
+
+
 def test_memory_guard_names_the_mesh_file(tmp_path, comm, monkeypatch):
     """The model-size guard counts the DOFs from the file's vertices, edges, faces and cells (the box: 10 557 at
     Q2 from the linear and the quadratic file, 44 256 at Q3) and stops before building anything when that needs

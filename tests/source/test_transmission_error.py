@@ -70,6 +70,10 @@ def test_torques_between_the_files_are_interpolated_and_outside_refused(tmp_path
     ("torque_Nm,harmonic,amplitude_m\n2000,1,2.5\n", r"implausible .* check the unit in the column name"),
     ("# only a comment\n", "no rows"),
     ("torque_Nm,harmonic,amplitude_um\n", "no rows after the header"),
+    # above the source's 256 samples per mesh period: refused by the source after meshing; 1e300 an OverflowError
+    ("torque_Nm,harmonic,amplitude_um\n2000,128,1\n", r"line 2: harmonic: 128 is above the highest harmonic the "
+                                                      r"source resolves \(127"),
+    ("torque_Nm,harmonic,amplitude_um\n2000,1e300,1\n", r"line 2: harmonic: 1e\+300 is above"),
 ])
 def test_a_bad_file_is_one_message_naming_the_file_and_line(tmp_path, text, message):
     path = _file(tmp_path, text)
@@ -162,6 +166,26 @@ def test_a_source_scene_takes_the_file_beside_it_and_refuses_torques_outside_it(
                      .replace("torque_run_Nm = [400.0, 800.0, 1200.0, 1600.0, 2000.0]", "torque_run_Nm = [2000.0]"))
     with pytest.raises(InputError, match="the file replaces the engagement model"):
         SourceModel.from_scene(str(scene))
+
+
+def test_a_source_scene_refuses_a_file_whose_harmonics_all_lie_above_its_harmonic_balance(tmp_path):
+    """source.harmonics = 30 keeps the shock's harmonics 1..30: a file of harmonic 31 alone excited nothing (it ran to
+    a result, L_omega of the stiffness ripple alone); 30 is the last one that acts, and 127 the last one read."""
+    from pathlib import Path
+
+    import housingfe
+
+    text = (Path(housingfe.__file__).parent / "scenes" / "gearset-A.toml").read_text()
+    scene = tmp_path / "a.toml"
+    scene.write_text(text.replace("[source]\n", '[source]\ntransmission_error = "te.csv"\n', 1)
+                     .replace("torque_run_Nm = [400.0, 800.0, 1200.0, 1600.0, 2000.0]", "torque_run_Nm = [2000.0]"))
+    assert "harmonics = 30\n" in text
+    _file(tmp_path, "torque_Nm,harmonic,amplitude_um\n2000,31,0.5\n")
+    with pytest.raises(InputError, match=r"a.toml: source.transmission_error: .*te.csv: its lowest harmonic 31 is "
+                                         r"above harmonics = 30"):
+        SourceModel.from_scene(str(scene))
+    _file(tmp_path, "torque_Nm,harmonic,amplitude_um\n2000,30,0.5\n2000,127,0.1\n")
+    assert SourceModel.from_scene(str(scene)).transmission_error.harmonics.tolist() == [30, 127]
 
 
 def test_with_a_te_at_one_torque_the_other_torques_points_are_dropped_not_an_error(gearset_a):

@@ -47,7 +47,7 @@ from housingfe.source.stiffness import (
     normal_force_from_torque,
     stiffness_curve,
 )
-from housingfe.source.transmission_error import checked_scene, validated_scene_file
+from housingfe.source.transmission_error import SAMPLES_PER_MESH_PERIOD, checked_scene, validated_scene_file
 
 
 class _Strict(BaseModel):
@@ -122,7 +122,8 @@ class SourceTable(_Strict):
     speed_max_rpm: PositiveFloat = 1500.0
     speed_steps: int = Field(30, ge=2, le=2000)
     spectrum_speeds_rpm: list[PositiveFloat] = [500.0, 1000.0, 1500.0]
-    torque_run_Nm: list[PositiveFloat] = [400.0, 800.0, 1200.0, 1600.0, 2000.0]
+    # pinion torques of the torque run at torque_run_speed_rpm, each once (at least one)
+    torque_run_Nm: list[PositiveFloat] = Field([400.0, 800.0, 1200.0, 1600.0, 2000.0], min_length=1)
     torque_run_speed_rpm: PositiveFloat = 1500.0
     harmonics: int = Field(30, ge=2, le=400)
     stiffness_positions: int = Field(dyn.DEFAULT_STIFFNESS_POSITIONS, ge=4, le=512)
@@ -143,21 +144,17 @@ class SourceTable(_Strict):
 
     _transmission_error = field_validator("transmission_error")(validated_scene_file)
 
+    @field_validator("torque_run_Nm")
+    @classmethod
+    def _torque_run_once_each(cls, torques):
+        twice = [t for i, t in enumerate(torques) if t in torques[:i]]
+        if twice:
+            raise ValueError(f"{twice[0]:g} N m is given twice")
+        return torques
+
     @model_validator(mode="after")
     def _transmission_error_torques(self):
         return checked_scene(self, {"torque_Nm": [self.torque_Nm], "torque_run_Nm": self.torque_run_Nm})
-        if "engagement" in self.model_fields_set:
-            raise ValueError(f"transmission_error: the file replaces the engagement model; engagement = "
-                             f"{self.engagement!r} is set as well: give one of the two")
-        from housingfe.source.transmission_error import read
-
-        te = read(self.transmission_error)
-        for key, torques in (("torque_Nm", [self.torque_Nm]), ("torque_run_Nm", self.torque_run_Nm)):
-            for torque in torques:
-                problem = te.torque_problem(torque)
-                if problem is not None:
-                    raise ValueError(f"transmission_error: {problem} ({key}; set it within the file's torques)")
-        return self
 
 
 def parse(scene: dict, scene_path: str) -> SourceTable:
@@ -210,7 +207,7 @@ class OperatingPoint:
     is then the shock whose quasi-static compression is the file's TE at this torque on the model's S(t)
     (dyn.engagement_force_from_transmission_error); None (default) = the engagement model."""
 
-    def __init__(self, pair, corr, interior, model, torque: float, n_positions: int, n_samples: int = 256,
+    def __init__(self, pair, corr, interior, model, torque: float, n_positions: int, n_samples: int = SAMPLES_PER_MESH_PERIOD,
                  engagement: str = dyn.DEFAULT_ENGAGEMENT, lead_gap: float = 0.0, transmission_error=None):
         self.torque = torque
         self.engagement = engagement
