@@ -158,6 +158,54 @@ def naming_the_override(exc: InputError, overrides: list[str] | None, source: st
     return exc
 
 
+def read_csv_rows(path, what: str, columns, columns_hint: str, example: str):
+    """A CSV file the user brings (a transmission error, a measured run-up) for its reader: (sha256 of its bytes, the
+    header's column names, the header's line number, [(line number, row of cells)] after it).  Blank lines and lines
+    starting with '#' are skipped and a UTF-8 byte-order mark is taken.  InputError naming the file -- and the line
+    -- when it cannot be read (`what`: "the transmission error file"), has no rows (`example`: the header to
+    suggest), a column outside `columns` (`columns_hint` says which are known) or named twice, or a row whose count
+    of values is not the header's."""
+    import csv
+    import hashlib
+    import io
+
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+        text = raw.decode("utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else type(exc).__name__
+        raise InputError(f"{path}: cannot read {what} ({reason})") from None
+    lines = [(number, line) for number, line in enumerate(text.splitlines(), 1)
+             if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
+        raise InputError(f"{path}: no rows ({example})")
+    rows = list(csv.reader(io.StringIO("\n".join(line for _, line in lines))))
+    header = [h.strip() for h in rows[0]]
+    unknown = [h for h in header if h not in columns]
+    if unknown:
+        raise InputError(f"{path}: line {lines[0][0]}: unknown column {unknown[0]!r} ({columns_hint})")
+    if len(set(header)) != len(header):
+        raise InputError(f"{path}: line {lines[0][0]}: a column is named twice")
+    body = []
+    for (number, _), row in zip(lines[1:], rows[1:]):
+        if len(row) != len(header):
+            raise InputError(f"{path}: line {number}: {len(row)} values for {len(header)} columns")
+        body.append((number, row))
+    return hashlib.sha256(raw).hexdigest(), header, lines[0][0], body
+
+
+def csv_number(where: str, column: str, cell: str) -> float:
+    """A finite number from a CSV cell, or InputError "<where>: <column>: '<cell>' is not a (finite) number"."""
+    try:
+        value = float(cell)
+    except ValueError:
+        raise InputError(f"{where}: {column}: {cell.strip()!r} is not a number") from None
+    if not math.isfinite(value):
+        raise InputError(f"{where}: {column}: {value} is not a finite number")
+    return value
+
+
 def scene_file_key(value: str, info, read) -> str:
     """A file-valued scene key for a pydantic field validator: "" stays ""; else the absolute path -- relative to the
     scene file when the file is there, else to the current folder (a --set on a built-in scene) -- checked by

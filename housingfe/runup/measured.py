@@ -25,9 +25,6 @@ doubling of speed of both over the compared speeds.
 """
 from __future__ import annotations
 
-import csv
-import hashlib
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -94,48 +91,25 @@ class MeasuredRunup:
 def read(path: str | Path) -> MeasuredRunup:
     """The MeasuredRunup of a CSV file (module docstring); InputError naming the file, and the line where one is at
     fault, for anything it cannot take."""
+    from housingfe.scenefile import csv_number, read_csv_rows
+
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-        text = raw.decode("utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else type(exc).__name__
-        raise InputError(f"{path}: cannot read the measured run-up file ({reason})") from None
-    lines = [(number, line) for number, line in enumerate(text.splitlines(), 1)
-             if line.strip() and not line.lstrip().startswith("#")]
-    if not lines:
-        raise InputError(f"{path}: no rows (a header such as `torque_Nm,speed_rpm,L_WA_dBA` and one row per speed)")
-    rows = list(csv.reader(io.StringIO("\n".join(line for _, line in lines))))
-    header = [h.strip() for h in rows[0]]
-    head = f"{path}: line {lines[0][0]}"
-    unknown = [h for h in header if h not in COLUMNS]
-    if unknown:
-        raise InputError(f"{head}: unknown column {unknown[0]!r} (columns: speed_rpm, optionally torque_Nm, and one "
-                         f"or more of {', '.join(QUANTITIES)})")
-    if len(set(header)) != len(header):
-        raise InputError(f"{head}: a column is named twice")
+    sha256, header, head, body = read_csv_rows(
+        path, "the measured run-up file", COLUMNS,
+        f"columns: speed_rpm, optionally torque_Nm, and one or more of {', '.join(QUANTITIES)}",
+        "a header such as `torque_Nm,speed_rpm,L_WA_dBA` and one row per speed")
     if "speed_rpm" not in header:
-        raise InputError(f"{head}: no column 'speed_rpm'")
+        raise InputError(f"{path}: line {head}: no column 'speed_rpm'")
     levels = [h for h in header if h in QUANTITIES]
     if not levels:
-        raise InputError(f"{head}: no level column (one or more of {', '.join(QUANTITIES)})")
+        raise InputError(f"{path}: line {head}: no level column (one or more of {', '.join(QUANTITIES)})")
     col = {h: i for i, h in enumerate(header)}
     points: dict[tuple, dict[float, float]] = {}
-    for (number, _), row in zip(lines[1:], rows[1:]):
+    for number, row in body:
         where = f"{path}: line {number}"
-        if len(row) != len(header):
-            raise InputError(f"{where}: {len(row)} values for {len(header)} columns")
-        values = {}
-        for h in header:
-            cell = row[col[h]].strip()
-            if not cell and h in QUANTITIES:
-                continue                     # not measured at this speed
-            try:
-                values[h] = float(cell)
-            except ValueError:
-                raise InputError(f"{where}: {h}: {cell!r} is not a number") from None
-            if not math.isfinite(values[h]):
-                raise InputError(f"{where}: {h}: {values[h]} is not a finite number")
+        # an empty level cell is a level not measured at that speed
+        values = {h: csv_number(where, h, row[col[h]]) for h in header
+                  if row[col[h]].strip() or h not in QUANTITIES}
         speed = values["speed_rpm"]
         if speed <= 0.0:
             raise InputError(f"{where}: speed_rpm: {speed:g} is not a positive speed")
@@ -156,7 +130,7 @@ def read(path: str | Path) -> MeasuredRunup:
         raise InputError(f"{path}: no measured level after the header")
     series = {key: (np.array(sorted(s), float), np.array([s[v] for v in sorted(s)], float))
               for key, s in sorted(points.items(), key=lambda kv: (kv[0][0], kv[0][1] or 0.0))}
-    return MeasuredRunup(series, str(path), hashlib.sha256(raw).hexdigest())
+    return MeasuredRunup(series, str(path), sha256)
 
 
 def checked_scene(spec):

@@ -29,9 +29,6 @@ so the quasi-static excitation k_m (d - mean d) is k_m e(t) exactly (dynamics.en
 """
 from __future__ import annotations
 
-import csv
-import hashlib
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -137,48 +134,26 @@ def harmonics_of(samples: np.ndarray, count: int) -> np.ndarray:
 def read(path: str | Path) -> TransmissionError:
     """The TransmissionError of a CSV file (module docstring); InputError naming the file, and the line where one is
     at fault, for anything it cannot take."""
+    from housingfe.scenefile import csv_number, read_csv_rows
+
     path = Path(path)
-    try:
-        raw = path.read_bytes()
-        text = raw.decode("utf-8-sig")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else type(exc).__name__
-        raise InputError(f"{path}: cannot read the transmission error file ({reason})") from None
-    lines = [(number, line) for number, line in enumerate(text.splitlines(), 1)
-             if line.strip() and not line.lstrip().startswith("#")]
-    if not lines:
-        raise InputError(f"{path}: no rows (a header `torque_Nm,harmonic,amplitude_um,phase_deg` and one row per "
-                         "torque and harmonic)")
-    rows = list(csv.reader(io.StringIO("\n".join(line for _, line in lines))))
-    header = [h.strip() for h in rows[0]]
-    unknown = [h for h in header if h not in COLUMNS]
-    if unknown:
-        raise InputError(f"{path}: line {lines[0][0]}: unknown column {unknown[0]!r} (columns: torque_Nm, harmonic, "
-                         f"one of {', '.join(AMPLITUDE_UNITS)}, optionally one of {', '.join(PHASE_UNITS)})")
-    if len(set(header)) != len(header):
-        raise InputError(f"{path}: line {lines[0][0]}: a column is named twice")
+    sha256, header, head, body = read_csv_rows(
+        path, "the transmission error file", COLUMNS,
+        f"columns: torque_Nm, harmonic, one of {', '.join(AMPLITUDE_UNITS)}, optionally one of {', '.join(PHASE_UNITS)}",
+        "a header `torque_Nm,harmonic,amplitude_um,phase_deg` and one row per torque and harmonic")
     amplitude = [h for h in header if h in AMPLITUDE_UNITS]
     phase = [h for h in header if h in PHASE_UNITS]
     for need in ("torque_Nm", "harmonic"):
         if need not in header:
-            raise InputError(f"{path}: line {lines[0][0]}: no column {need!r}")
+            raise InputError(f"{path}: line {head}: no column {need!r}")
     if len(amplitude) != 1 or len(phase) > 1:
-        raise InputError(f"{path}: line {lines[0][0]}: give exactly one amplitude column ({', '.join(AMPLITUDE_UNITS)})"
+        raise InputError(f"{path}: line {head}: give exactly one amplitude column ({', '.join(AMPLITUDE_UNITS)})"
                          f" and at most one phase column ({', '.join(PHASE_UNITS)})")
     col = {h: i for i, h in enumerate(header)}
     table: dict[float, dict[int, complex]] = {}
-    for (number, _), row in zip(lines[1:], rows[1:]):
+    for number, row in body:
         where = f"{path}: line {number}"
-        if len(row) != len(header):
-            raise InputError(f"{where}: {len(row)} values for {len(header)} columns")
-        values = {}
-        for h in header:
-            try:
-                values[h] = float(row[col[h]])
-            except ValueError:
-                raise InputError(f"{where}: {h}: {row[col[h]].strip()!r} is not a number") from None
-            if not math.isfinite(values[h]):
-                raise InputError(f"{where}: {h}: {values[h]} is not a finite number")
+        values = {h: csv_number(where, h, row[col[h]]) for h in header}
         torque, n = values["torque_Nm"], values["harmonic"]
         if torque <= 0.0:
             raise InputError(f"{where}: torque_Nm: {torque:g} is not a positive torque")
@@ -209,7 +184,7 @@ def read(path: str | Path) -> TransmissionError:
                              f"{harmonics}: every torque must list the same harmonics")
     amplitudes = np.array([[table[t][n] for n in harmonics] for t in torques], complex)
     return TransmissionError(np.array(torques, float), np.array(harmonics, int), amplitudes, source=str(path),
-                             sha256=hashlib.sha256(raw).hexdigest())
+                             sha256=sha256)
 
 
 def write(path: str | Path, torques, harmonics, amplitudes, comment: str = "") -> None:
