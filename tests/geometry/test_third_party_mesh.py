@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tests.geometry.test_imported_mesh import mesh_scene
+
 BEAMS = Path(__file__).parent / "data" / "skfem_beams.msh"
 # scikit-fem 12.0.2, ex21 on skfem_beams.msh: the lowest eigenvalues omega^2, (rad/s)^2, and its DOF count
 SKFEM_EIGENVALUES = np.array([50194.94437033, 251542.76238882, 301210.39794464, 598305.23144171])
@@ -26,15 +28,8 @@ F_MAX_HZ = 130.0            # the four modes above (35.7, 79.8, 87.3, 123.1 Hz) 
 
 def beams_scene(folder: Path, units: str = "m") -> Path:
     """A housing scene of the scikit-fem mesh with ex21's steel, clamped at `fixed`."""
-    path = folder / "beams.toml"
-    path.write_text(f"""[scene]
-name = "skfem-beams"
-kind = "housing"
-[geometry]
-kind = "mesh"
-file = "{BEAMS}"
-units = "{units}"
-[[geometry.surfaces]]
+    # the imported-mesh tests' scene (their kind "mesh" header, degree 2, no pictures) with ex21's steel and clamp
+    return mesh_scene(folder, str(BEAMS), units, f_max=F_MAX_HZ, extra="""[[geometry.surfaces]]
 name = "fixed"
 set = "fixed"
 [material]
@@ -42,19 +37,10 @@ name = "steel"
 youngs_modulus = 200e9
 poisson_ratio = 0.3
 density = 8050.0
-[mesh]
-degree = 2
 [[supports]]
 surface = "fixed"
 kind = "fixed"
-[analysis.modal]
-f_max = {F_MAX_HZ}
-[output]
-mode_pictures = 0
-paraview = false
-pictures = false
 """)
-    return path
 
 
 def run_cli(*args, cwd: Path, ranks: int = 1) -> subprocess.CompletedProcess:
